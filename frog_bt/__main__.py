@@ -1,0 +1,3 @@
+from frog_bt.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,68 @@
+"""The one exception hierarchy of frog-bt.
+
+::
+
+    FrogError
+    ├── DefinitionError          a file the user wrote is wrong; raised before anything connects
+    │   ├── ConfigError          config/*.yaml, scenario files
+    │   └── TreeError            trees/*.yaml
+    ├── DecodeError              one inbound message or datagram is malformed; counted, never fatal
+    └── RuntimeFault             the tour cannot go on (link down for good, docking failed, ...)
+
+Definition errors name the file, the path inside it and what was expected, so a
+content designer can fix a YAML file without reading Python.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+
+class FrogError(Exception):
+    """Base class of every error frog-bt raises on purpose."""
+
+
+def format_path(path: Sequence[str | int]) -> str:
+    """``("root", "children", 2, "params")`` -> ``root.children[2].params``."""
+    out = ""
+    for part in path:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += f".{part}" if out else str(part)
+    return out or "<top>"
+
+
+class DefinitionError(FrogError):
+    """A definition file is invalid: ``file: path: what was expected``."""
+
+    def __init__(self, file: str, path: Sequence[str | int], message: str) -> None:
+        self.file = str(file)
+        self.path = tuple(path)
+        self.detail = message
+        super().__init__(f"{self.file}: {format_path(self.path)}: {message}")
+
+
+class ConfigError(DefinitionError):
+    """A site configuration or scenario file is invalid."""
+
+
+class TreeError(DefinitionError):
+    """A tree file is invalid."""
+
+
+class DecodeError(FrogError):
+    """An inbound frame, message or datagram is malformed.
+
+    ``path`` says where in the message the problem is (``msg.pose.position.x``).
+    """
+
+    def __init__(self, message: str, path: Sequence[str | int] = ()) -> None:
+        self.path = tuple(path)
+        self.detail = message
+        where = format_path(self.path) if self.path else ""
+        super().__init__(f"{where}: {message}" if where else message)
+
+
+class RuntimeFault(FrogError):
+    """The executive cannot go on; the message is the one-line reason printed on exit."""

@@ -1,0 +1,1 @@
+"""The UDP link to the content front end (CONTRACT §2)."""

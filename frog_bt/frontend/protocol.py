@@ -1,0 +1,181 @@
+"""The front-end datagram protocol, sans-I/O (CONTRACT §2).
+
+:class:`Endpoint` is one side of the link; the executive and the simulated
+front end each hold one. It numbers what it originates (``seq``), acks what it
+receives, resends what is not acked every ``resend_after`` seconds up to
+``max_sends`` sends in all, and suppresses events whose ``seq`` it already
+received within ``dedup_window`` seconds (acked again, not acted on). Datagrams
+from any host but the peer's are dropped and counted.
+
+Time is passed in (``now``) and bytes are returned: no socket, no clock.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from collections import OrderedDict
+from dataclasses import dataclass, field
+from typing import Any
+
+from frog_bt.errors import DecodeError
+from frog_bt.frontend.messages import FrontendMessage, decode_message, message_fields
+
+MAX_DATAGRAM = 8192
+log = logging.getLogger(__name__)
+
+
+def encode_datagram(type_: str, seq: int, fields: dict[str, Any] | None = None) -> bytes:
+    obj = {"type": type_, "seq": seq, **(fields or {})}
+    data = json.dumps(obj, separators=(",", ":"), allow_nan=False).encode()
+    if len(data) > MAX_DATAGRAM:
+        raise ValueError(f"datagram of {len(data)} bytes exceeds {MAX_DATAGRAM}")
+    return data
+
+
+def decode_datagram(data: bytes) -> dict[str, Any]:
+    """The JSON object of a datagram, with a valid ``type`` and ``seq``; or DecodeError."""
+    if len(data) > MAX_DATAGRAM:
+        raise DecodeError(f"datagram of {len(data)} bytes exceeds {MAX_DATAGRAM}")
+    try:
+        obj = json.loads(data.decode("utf-8"), parse_constant=_reject_constant)
+    except (ValueError, UnicodeDecodeError, RecursionError) as exc:
+        raise DecodeError(f"not UTF-8 JSON: {exc}"[:200]) from None
+    if not isinstance(obj, dict):
+        raise DecodeError(f"expected a JSON object, got {type(obj).__name__}")
+    if not isinstance(obj.get("type"), str):
+        raise DecodeError("expected a string", ("type",))
+    seq = obj.get("seq")
+    if isinstance(seq, bool) or not isinstance(seq, int) or seq < 0:
+        raise DecodeError(f"expected an integer >= 0, got {seq!r}"[:200], ("seq",))
+    return obj
+
+
+def _reject_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not valid JSON")
+
+
+@dataclass(slots=True)
+class LinkStats:
+    sent: int = 0
+    resent: int = 0
+    acked: int = 0
+    unacked: int = 0  # commands given up on after max_sends
+    received: int = 0
+    duplicates: int = 0
+    malformed: int = 0
+    foreign: int = 0
+
+
+@dataclass(slots=True)
+class _Pending:
+    data: bytes
+    message: FrontendMessage
+    sends: int
+    next_send: float
+
+
+@dataclass(frozen=True, slots=True)
+class Received:
+    """What one inbound datagram produced: a message to act on and/or an ack to send."""
+
+    message: FrontendMessage | None = None
+    reply: bytes | None = None
+    error: DecodeError | None = None
+    acked: FrontendMessage | None = None
+
+
+@dataclass(slots=True)
+class Endpoint:
+    """One side of the front-end link.
+
+    ``inbound`` is the table of message types this side acts on (events for the
+    executive, commands for the front end).
+    """
+
+    peer_host: str
+    inbound: dict[str, type[FrontendMessage]]
+    resend_after: float = 0.25
+    max_sends: int = 8
+    dedup_window: float = 10.0
+    stats: LinkStats = field(default_factory=LinkStats)
+    next_seq: int = 1
+    _pending: OrderedDict[int, _Pending] = field(default_factory=OrderedDict)
+    _seen: OrderedDict[int, float] = field(default_factory=OrderedDict)
+
+    def send(self, message: FrontendMessage, now: float) -> bytes:
+        """Datagram for a new message; it is resent by :meth:`poll` until acked."""
+        seq = self.next_seq
+        self.next_seq += 1
+        data = encode_datagram(message.type, seq, message_fields(message))
+        self._pending[seq] = _Pending(data, message, 1, now + self.resend_after)
+        self.stats.sent += 1
+        return data
+
+    def receive(self, data: bytes, host: str, now: float) -> Received:
+        if host != self.peer_host:
+            self.stats.foreign += 1
+            return Received()
+        try:
+            obj = decode_datagram(data)
+        except DecodeError as exc:
+            self.stats.malformed += 1
+            return Received(error=exc)
+        seq: int = obj["seq"]
+        if obj["type"] == "ack":
+            pending = self._pending.pop(seq, None)
+            if pending is None:
+                return Received()
+            self.stats.acked += 1
+            return Received(acked=pending.message)
+        reply = encode_datagram("ack", seq)
+        self._prune(now)
+        if seq in self._seen:
+            self.stats.duplicates += 1
+            return Received(reply=reply)
+        self._seen[seq] = now
+        try:
+            message = decode_message(obj, self.inbound)
+        except DecodeError as exc:
+            self.stats.malformed += 1
+            return Received(reply=reply, error=exc)
+        self.stats.received += 1
+        return Received(message=message, reply=reply)
+
+    def _prune(self, now: float) -> None:
+        while self._seen:
+            seq, t = next(iter(self._seen.items()))
+            if now - t <= self.dedup_window:
+                break
+            del self._seen[seq]
+
+    def forget_seen(self) -> None:
+        """Forget received seqs (the peer restarted and numbers from 1 again)."""
+        self._seen.clear()
+
+    def poll(self, now: float) -> list[bytes]:
+        """Datagrams to resend now; commands past ``max_sends`` are given up on."""
+        out: list[bytes] = []
+        for seq in list(self._pending):
+            p = self._pending[seq]
+            if p.next_send > now:
+                continue
+            if p.sends >= self.max_sends:
+                del self._pending[seq]
+                self.stats.unacked += 1
+                log.warning("front end never acked %s (seq %d) after %d sends",
+                            p.message.type, seq, p.sends)
+                continue
+            p.sends += 1
+            p.next_send = now + self.resend_after
+            self.stats.resent += 1
+            out.append(p.data)
+        return out
+
+    @property
+    def next_deadline(self) -> float | None:
+        return min((p.next_send for p in self._pending.values()), default=None)
+
+    @property
+    def pending(self) -> int:
+        return len(self._pending)
