@@ -216,14 +216,18 @@ def decode_diagnostics(msg: Any) -> Diagnostics:
             kv_obj = _obj(kv, kv_path)
             key, text = _str(kv_obj, "key", kv_path), _str(kv_obj, "value", kv_path)
             if name == "battery" and key == "percentage":
-                try:
-                    pct = float(text)
-                except ValueError:
-                    raise DecodeError(f"expected a number, got {text!r}", (*kv_path, "value")) from None
-                if not math.isfinite(pct):
-                    raise DecodeError(f"expected a finite number, got {text!r}", (*kv_path, "value"))
-                battery = pct
+                battery = _percentage(text, (*kv_path, "value"))
     return Diagnostics(stamp, battery, tuple(faults))
+
+
+def _percentage(text: str, path: Path) -> float:
+    try:
+        pct = float(text)
+    except ValueError:
+        raise DecodeError(f"expected a number, got {text[:40]!r}", path) from None
+    if not math.isfinite(pct):
+        raise DecodeError(f"expected a finite number, got {text!r}", path)
+    return pct
 
 
 def _level(status: Mapping[str, Any], path: Path) -> int:
