@@ -1,0 +1,95 @@
+"""Commands to the robot over rosbridge, and the one request awaiting ``/FROG_response``.
+
+``/GotoWayPoint`` and ``/ApproachPeopleFar`` share ``/FROG_response`` and carry
+no goal id, so at most one of them is pending at a time: a new goal replaces
+the active one (CONTRACT §1), and a response that arrives while nothing is
+pending is stale and ignored. Responses are applied to the pending
+:class:`Request` in the pre-tick snapshot, so every tick sees one consistent
+state.
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from frog_bt.clock import Clock
+from frog_bt.config import Poi
+from frog_bt.messages import encode_int32, encode_pose, encode_string
+from frog_bt.topics import ABORTED, ACTIVE, FAILED, SUCCEEDED
+
+log = logging.getLogger(__name__)
+TERMINAL = (SUCCEEDED, FAILED, ABORTED)
+CODE_NAMES = {ACTIVE: "active", SUCCEEDED: "succeeded", FAILED: "failed", ABORTED: "aborted"}
+
+
+@dataclass(slots=True)
+class Request:
+    """A goal or approach sent to the robot; ``code`` is the latest response (0: none yet)."""
+
+    id: int
+    kind: str  # "goto" | "approach"
+    target: str
+    sent_at: float
+    code: int = 0
+    answered_at: float | None = None
+
+    @property
+    def done(self) -> bool:
+        return self.code in TERMINAL
+
+
+Publish = Callable[[str, dict[str, Any]], None]  # (role, msg)
+
+
+class Actions:
+    """Publishes robot commands by role (``goto``, ``approach``, ``icl``, ``dock``)."""
+
+    def __init__(self, publish: Publish, clock: Clock) -> None:
+        self._publish = publish
+        self._clock = clock
+        self._ids = itertools.count(1)
+        self.pending: Request | None = None
+        self.stale_responses = 0
+        self.face_stream = False
+
+    def goto(self, waypoint: str, poi: Poi) -> Request:
+        now = self._clock.now()
+        self._publish("goto", encode_pose(poi.x, poi.y, poi.z, poi.w, now))
+        return self._replace(Request(next(self._ids), "goto", waypoint, now))
+
+    def approach(self, person_id: int) -> Request:
+        self._publish("approach", encode_int32(person_id))
+        return self._replace(Request(next(self._ids), "approach", str(person_id),
+                                     self._clock.now()))
+
+    def _replace(self, request: Request) -> Request:
+        self.pending = request
+        return request
+
+    def cancel(self, request: Request | None) -> None:
+        """Stop waiting for ``request``; a later response to it is stale."""
+        if request is not None and self.pending is request:
+            self.pending = None
+
+    def on_response(self, code: int, at: float) -> Request | None:
+        """Apply one ``/FROG_response`` code; returns the request it answered, if any."""
+        request = self.pending
+        if request is None:
+            self.stale_responses += 1
+            log.debug("ignored /FROG_response %d: nothing pending", code)
+            return None
+        request.code, request.answered_at = code, at
+        if code in TERMINAL:
+            self.pending = None
+        return request
+
+    def dock(self, action: str) -> None:
+        self._publish("dock", encode_string(action))
+
+    def icl(self, on: bool) -> None:
+        self.face_stream = on
+        self._publish("icl", encode_string("start" if on else "stop"))

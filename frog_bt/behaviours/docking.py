@@ -1,0 +1,58 @@
+"""Docking at and undocking from the charger (``/docking/dock``, ``/docking/state``)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field
+
+from frog_bt.blackboard import Reading
+from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
+
+TARGET = {"dock": "docked", "undock": "undocked"}
+
+
+@register
+class Docking(Leaf):
+    """Dock or undock and wait for the robot to report it done.
+
+    Reads ``/docking`` and ``/now``. Sends ``/docking/dock`` ``action`` in
+    initialise (not when the robot already reports the target state). SUCCESS
+    on ``docked`` / ``undocked`` received after the command; FAILURE on
+    ``failed`` received after the command, or after ``timeout`` seconds
+    (default: site ``timeouts.dock`` / ``timeouts.undock``).
+    """
+
+    class Params(Params):
+        action: Literal["dock", "undock"]
+        timeout: float | None = Field(None, gt=0, allow_inf_nan=False)
+
+    reads = ("/docking", "/now")
+
+    def initialise(self) -> None:
+        action = self.params.action
+        state: Reading[str] | None = self.get("/docking")
+        self.sent_at = self.ctx.clock.now()
+        self.already = state is not None and state.value == TARGET[action]
+        if not self.already:
+            self.ctx.actions.dock(action)
+            self.ctx.note(f"{action}")
+        timeouts = self.ctx.site.timeouts
+        self.timeout = self.params.timeout or getattr(timeouts, action)
+
+    def update(self) -> Status:
+        if self.already:
+            return SUCCESS
+        state: Reading[str] | None = self.get("/docking")
+        if state is not None and state.at >= self.sent_at:
+            if state.value == TARGET[self.params.action]:
+                return SUCCESS
+            if state.value == "failed":
+                self.ctx.note(f"{self.params.action} failed")
+                return FAILURE
+        if self.get("/now") - self.sent_at >= self.timeout:
+            self.ctx.note(f"{self.params.action}: no {TARGET[self.params.action]} "
+                          f"within {self.timeout:g} s")
+            return FAILURE
+        self.feedback_message = f"{state.value if state else 'no state'}"
+        return RUNNING

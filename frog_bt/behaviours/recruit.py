@@ -1,0 +1,169 @@
+"""Finding, approaching and introducing a visitor at POI0 (seed: "POI0")."""
+
+from __future__ import annotations
+
+import math
+
+from pydantic import Field
+
+from frog_bt.actions import CODE_NAMES, Request
+from frog_bt.blackboard import EventLog, Reading
+from frog_bt.frontend.messages import AskTour as AskTourCommand
+from frog_bt.frontend.messages import StartIntroduction as StartIntroductionCommand
+from frog_bt.frontend.messages import UserNegative, UserPositive
+from frog_bt.messages import PersonDetection, PersonDetections, Pose
+from frog_bt.topics import SUCCEEDED
+from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
+
+Timeout = Field(None, gt=0, allow_inf_nan=False)
+
+
+def facing_visitor(persons: tuple[PersonDetection, ...], pose: Pose, lo: float, hi: float,
+                   exclude: frozenset[int] = frozenset()) -> PersonDetection | None:
+    """The nearest person facing the robot (``lo < orientation < hi``), not in ``exclude``."""
+    candidates = [p for p in persons if lo < p.orientation < hi and p.id not in exclude]
+    if not candidates:
+        return None
+    return min(candidates,
+               key=lambda p: (math.hypot(p.position.x - pose.x, p.position.y - pose.y), p.id))
+
+
+@register
+class SeekVisitor(Leaf):
+    """Look for a visitor: a person facing the robot, the nearest when several.
+
+    Reads ``/persons`` (ignored when older than site ``recruit.detection_max_age``),
+    ``/pose``, ``/now`` and ``/declined`` (people who said no this tour).
+    Writes ``/visitor`` (the person id). RUNNING until someone qualifies, then SUCCESS.
+    """
+
+    reads = ("/persons", "/pose", "/now", "/declined")
+    writes = ("/visitor",)
+
+    def update(self) -> Status:
+        cfg = self.ctx.site.recruit
+        persons: Reading[PersonDetections] | None = self.get("/persons")
+        pose: Reading[Pose] | None = self.get("/pose")
+        now = self.get("/now")
+        if pose is None:
+            self.feedback_message = "no pose yet"
+            return RUNNING
+        if persons is None or persons.age(now) > cfg.detection_max_age:
+            self.feedback_message = "no recent person detections"
+            return RUNNING
+        declined = self.get("/declined") or frozenset()
+        person = facing_visitor(persons.value.persons, pose.value, cfg.facing_min,
+                                cfg.facing_max, declined)
+        if person is None:
+            self.feedback_message = f"{len(persons.value.persons)} seen, none facing"
+            return RUNNING
+        self.set("/visitor", person.id)
+        self.ctx.note(f"visitor {person.id} faces the robot "
+                      f"({person.orientation:.0f} deg), nearest of {len(persons.value.persons)}")
+        return SUCCESS
+
+
+@register
+class ApproachVisitor(Leaf):
+    """Approach ``/visitor`` with ``/ApproachPeopleFar``.
+
+    Reads ``/visitor``, ``/now``. SUCCESS on ``/FROG_response`` 2; FAILURE on 3
+    or 4, or after ``timeout`` (default: site ``timeouts.approach``).
+    """
+
+    class Params(Params):
+        timeout: float | None = Timeout
+
+    reads = ("/visitor", "/now")
+
+    def initialise(self) -> None:
+        self.visitor = self.get("/visitor")
+        self.request: Request = self.ctx.actions.approach(self.visitor)
+        self.timeout = self.params.timeout or self.ctx.site.timeouts.approach
+        self.ctx.note(f"approach visitor {self.visitor}")
+
+    def update(self) -> Status:
+        request = self.request
+        if request.code == SUCCEEDED:
+            self.ctx.note(f"approached visitor {self.visitor}")
+            return SUCCESS
+        if request.done or self.ctx.actions.pending is not request:
+            self.ctx.note(f"approach of visitor {self.visitor} "
+                          f"{CODE_NAMES.get(request.code, 'replaced')}: seek again")
+            return FAILURE
+        if self.get("/now") - request.sent_at >= self.timeout:
+            self.ctx.note(f"approach of visitor {self.visitor} timed out: seek again")
+            return FAILURE
+        return RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status in (INVALID, FAILURE):
+            self.ctx.actions.cancel(getattr(self, "request", None))
+
+
+@register
+class StartIntroduction(Leaf):
+    """Send ``start_introduction``; ``icl`` is true while the face stream runs.
+
+    Reads ``/icl``. SUCCESS.
+    """
+
+    reads = ("/icl",)
+
+    def update(self) -> Status:
+        self.ctx.send(StartIntroductionCommand(bool(self.get("/icl"))))
+        return SUCCESS
+
+
+@register
+class AskTour(Leaf):
+    """Ask the visitor to join (``ask_tour``).
+
+    ``engaged`` is null for now: the engagement measure comes with the
+    engagement issue. SUCCESS.
+    """
+
+    def update(self) -> Status:
+        self.ctx.send(AskTourCommand(None))
+        return SUCCESS
+
+
+@register
+class WaitAnswer(Leaf):
+    """Wait for the visitor's answer to ``ask_tour``.
+
+    Reads ``/events``, ``/visitor``, ``/now``; writes ``/declined``. SUCCESS on
+    ``user_positive``; FAILURE on ``user_negative`` or after ``timeout``
+    (default: site ``timeouts.answer``), adding the visitor to ``/declined`` so
+    that the next search looks for someone else.
+    """
+
+    class Params(Params):
+        timeout: float | None = Timeout
+
+    reads = ("/events", "/visitor", "/now")
+    writes = ("/declined",)
+
+    def initialise(self) -> None:
+        events: EventLog = self.get("/events")
+        self.since = events.last_index
+        self.started = self.ctx.clock.now()
+        self.timeout = self.params.timeout or self.ctx.site.timeouts.answer
+
+    def update(self) -> Status:
+        events: EventLog = self.get("/events")
+        visitor = self.get("/visitor")
+        for event in events.since(self.since):
+            if isinstance(event.message, UserPositive):
+                self.ctx.note(f"visitor {visitor} wants the tour")
+                return SUCCESS
+            if isinstance(event.message, UserNegative):
+                return self._decline(visitor, "does not want the tour")
+        if self.get("/now") - self.started >= self.timeout:
+            return self._decline(visitor, f"gave no answer within {self.timeout:g} s")
+        return RUNNING
+
+    def _decline(self, visitor: int, why: str) -> Status:
+        self.set("/declined", (self.get("/declined") or frozenset()) | {visitor})
+        self.ctx.note(f"visitor {visitor} {why}: seek again")
+        return FAILURE

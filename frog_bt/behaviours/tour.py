@@ -1,0 +1,85 @@
+"""Tour bookkeeping leaves: front-end readiness, tour status, waiting for events."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field
+
+from frog_bt.blackboard import EventLog
+from frog_bt.frontend.messages import EVENTS, Tour
+from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
+
+
+@register
+class WaitFrontendIdle(Leaf):
+    """Wait until the front end says it is ready (``frontend_idle``).
+
+    Reads ``/frontend_ready``. RUNNING until it is true, then SUCCESS.
+    """
+
+    reads = ("/frontend_ready",)
+
+    def update(self) -> Status:
+        if self.get("/frontend_ready"):
+            return SUCCESS
+        self.feedback_message = "waiting for frontend_idle"
+        return RUNNING
+
+
+@register
+class TourStatus(Leaf):
+    """Send ``tour`` with ``state`` and ``reason`` to the front end.
+
+    Writes ``/frontend_ready`` (False: the next tour needs a fresh
+    ``frontend_idle``), ``/declined`` (cleared when a tour starts) and
+    ``/tour_state``. SUCCESS.
+    """
+
+    class Params(Params):
+        state: Literal["started", "ended", "aborted"]
+        reason: str = ""
+
+    writes = ("/frontend_ready", "/declined", "/tour_state")
+
+    def update(self) -> Status:
+        p = self.params
+        self.ctx.send(Tour(p.state, p.reason))
+        self.ctx.note(f"tour {p.state}" + (f": {p.reason}" if p.reason else ""))
+        self.set("/frontend_ready", False)
+        self.set("/tour_state", p.state)
+        if p.state == "started":
+            self.set("/declined", frozenset())
+        return SUCCESS
+
+
+@register
+class WaitEvent(Leaf):
+    """Wait for a front-end event that arrives after this leaf starts.
+
+    Reads ``/events`` and ``/now``. SUCCESS when an ``event`` arrives (matching
+    ``poi``/``part`` when given); FAILURE after ``timeout`` seconds (project
+    clock; none: wait for ever).
+    """
+
+    class Params(Params):
+        event: Literal[tuple(EVENTS)]  # type: ignore[valid-type]
+        timeout: float | None = Field(None, gt=0, allow_inf_nan=False)
+
+    reads = ("/events", "/now")
+
+    def initialise(self) -> None:
+        events: EventLog = self.get("/events")
+        self.since = events.last_index
+        self.started = self.ctx.clock.now()
+
+    def update(self) -> Status:
+        events: EventLog = self.get("/events")
+        if events.first_since(self.since, EVENTS[self.params.event]) is not None:
+            return SUCCESS
+        timeout = self.params.timeout
+        if timeout is not None and self.get("/now") - self.started >= timeout:
+            self.ctx.note(f"{self.name}: no {self.params.event} within {timeout:g} s")
+            return FAILURE
+        self.feedback_message = f"waiting for {self.params.event}"
+        return RUNNING

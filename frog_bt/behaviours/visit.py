@@ -1,0 +1,105 @@
+"""At a stop: is the visitor still with us, and the stop's content."""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+from pydantic import Field
+
+from frog_bt.behaviours.navigation import PoiParams
+from frog_bt.blackboard import EventLog, Reading
+from frog_bt.frontend.messages import ContentDone, StartPoi
+from frog_bt.frontend.messages import FinishPoi as FinishPoiCommand
+from frog_bt.messages import Pose, TrackedPeople
+from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
+
+
+def someone_within(people: TrackedPeople, pose: Pose, radius: float) -> bool:
+    return any(math.hypot(p.position.x - pose.x, p.position.y - pose.y) <= radius
+               for p in people.people)
+
+
+@register
+class VisitorFollows(Leaf):
+    """Is the visitor still following? Someone tracked by the laser near the robot.
+
+    Reads ``/people``, ``/pose``, ``/now``. SUCCESS as soon as a tracked person is
+    within ``radius`` metres (default: site ``follow.radius``); RUNNING for up to
+    ``grace`` seconds while nobody is (default: site ``follow.grace``), then FAILURE.
+    """
+
+    class Params(Params):
+        radius: float | None = Field(None, gt=0, allow_inf_nan=False)
+        grace: float | None = Field(None, ge=0, allow_inf_nan=False)
+
+    reads = ("/people", "/pose", "/now")
+
+    def initialise(self) -> None:
+        cfg = self.ctx.site.follow
+        self.radius = self.params.radius or cfg.radius
+        self.grace = cfg.grace if self.params.grace is None else self.params.grace
+        self.started = self.ctx.clock.now()
+
+    def update(self) -> Status:
+        people: Reading[TrackedPeople] | None = self.get("/people")
+        pose: Reading[Pose] | None = self.get("/pose")
+        now = self.get("/now")
+        fresh = people is not None and people.age(now) <= max(1.0, self.grace)
+        if fresh and pose is not None and someone_within(people.value, pose.value, self.radius):
+            return SUCCESS
+        if now - self.started >= self.grace:
+            self.ctx.note(f"nobody within {self.radius:g} m for {self.grace:g} s: "
+                          "visitor lost, back to recruit")
+            return FAILURE
+        self.feedback_message = "waiting for the visitor to catch up"
+        return RUNNING
+
+
+@register
+class PlayContent(Leaf):
+    """Play part ``part`` of ``poi``'s content and wait until it is done.
+
+    Sends ``start_poi`` (with the waypoint chosen on the way, ``/waypoint``) in
+    initialise. Reads ``/waypoint``, ``/events``, ``/now``. SUCCESS on the
+    matching ``content_done``, or after ``timeout`` seconds (default: site
+    ``timeouts.content``) with a note: a silent front end must not stop the tour.
+    """
+
+    class Params(PoiParams):
+        part: Literal["a", "b"] = "a"
+        timeout: float | None = Field(None, gt=0, allow_inf_nan=False)
+
+    reads = ("/waypoint", "/events", "/now")
+
+    def initialise(self) -> None:
+        p = self.params
+        events: EventLog = self.get("/events")
+        self.since = events.last_index
+        self.started = self.ctx.clock.now()
+        self.timeout = p.timeout or self.ctx.site.timeouts.content
+        waypoint = self.get("/waypoint") or p.poi
+        self.ctx.send(StartPoi(p.poi, waypoint, p.part))
+
+    def update(self) -> Status:
+        p = self.params
+        events: EventLog = self.get("/events")
+        if events.first_since(self.since, ContentDone, poi=p.poi, part=p.part) is not None:
+            return SUCCESS
+        if self.get("/now") - self.started >= self.timeout:
+            self.ctx.note(f"{p.poi} part {p.part}: no content_done within "
+                          f"{self.timeout:g} s, going on")
+            return SUCCESS
+        self.feedback_message = f"playing {p.poi} part {p.part}"
+        return RUNNING
+
+
+@register
+class FinishPoi(Leaf):
+    """Send ``finish_poi`` for ``poi``. SUCCESS."""
+
+    Params = PoiParams
+
+    def update(self) -> Status:
+        self.ctx.send(FinishPoiCommand(self.params.poi))
+        return SUCCESS

@@ -1,0 +1,189 @@
+"""Site configuration: POIs, time-of-day variants, tour order, timeouts, thresholds, links.
+
+Loaded from ``config/site.yaml`` (or ``--config FILE``) and validated up front;
+an error names the file, the path inside it and what was expected::
+
+    config/site.yaml: tour.stops[2].poi: unknown POI 'POI9' (known: END, POI0, ...)
+"""
+
+from __future__ import annotations
+
+import math
+from datetime import time as dtime
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from frog_bt.errors import ConfigError
+from frog_bt.topics import DEFAULT_FRONTEND, DEFAULT_LISTEN, DEFAULT_ROSBRIDGE_URL, INPUTS, OUTPUTS
+from frog_bt.yamlfile import PathError, load_yaml, validate
+
+DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config" / "site.yaml"
+
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Poi(_Model):
+    x: Finite
+    y: Finite
+    z: Finite
+    w: Finite
+    name: str = ""
+    note: str = ""
+
+    @model_validator(mode="after")
+    def _unit_quaternion(self) -> Poi:
+        if not math.isclose(math.hypot(self.z, self.w), 1.0, abs_tol=0.02):
+            raise ValueError(f"orientation z={self.z}, w={self.w} is not a unit quaternion")
+        return self
+
+
+class Variant(_Model):
+    """``waypoint`` is used while local time <= ``until`` (the last variant has no ``until``)."""
+
+    waypoint: str
+    until: dtime | None = None
+
+    @field_validator("until", mode="before")
+    @classmethod
+    def _parse_time(cls, value: Any) -> Any:
+        if isinstance(value, int) and not isinstance(value, bool):
+            # YAML 1.1 reads 13:00 as the sexagesimal integer 780.
+            return dtime(value // 60, value % 60)
+        return value
+
+
+class Stop(_Model):
+    """One stop of the tour, in order."""
+
+    poi: str
+    content: bool = True
+    face_stream: bool = False
+    projector: bool = False
+    check_follower: bool = True
+    content_timeout: Positive | None = None
+
+
+class Tour(_Model):
+    dock: str = "SHOP"
+    recruit_at: str = "POI0"
+    stops: list[Stop]
+
+
+class Timeouts(_Model):
+    navigation: Positive = 600.0
+    approach: Positive = 120.0
+    undock: Positive = 60.0
+    dock: Positive = 120.0
+    introduction: Positive = 300.0
+    answer: Positive = 120.0
+    content: Positive = 600.0
+
+
+class Navigation(_Model):
+    attempts: int = Field(3, ge=1)
+
+
+class Recruit(_Model):
+    facing_min: Finite = 135.0
+    facing_max: Finite = 225.0
+    detection_max_age: Positive = 1.0
+
+
+class Follow(_Model):
+    radius: Positive = 4.0
+    grace: NonNegative = 10.0
+
+
+class Links(_Model):
+    rosbridge: str = DEFAULT_ROSBRIDGE_URL
+    frontend: str = "{}:{}".format(*DEFAULT_FRONTEND)
+    listen: str = "{}:{}".format(*DEFAULT_LISTEN)
+    secret_env: str = "FROG_ROSBRIDGE_SECRET"
+    secret_file: str | None = None
+
+
+class Executive(_Model):
+    tick_hz: Positive = 10.0
+
+
+class Site(_Model):
+    pois: dict[str, Poi]
+    variants: dict[str, list[Variant]] = {}
+    tour: Tour
+    timeouts: Timeouts = Timeouts()
+    navigation: Navigation = Navigation()
+    recruit: Recruit = Recruit()
+    follow: Follow = Follow()
+    links: Links = Links()
+    executive: Executive = Executive()
+    topics: dict[Literal[tuple(INPUTS) + tuple(OUTPUTS)], str] = {}  # type: ignore[valid-type]
+
+    @model_validator(mode="after")
+    def _cross_check(self) -> Site:
+        known = sorted(self.pois)
+        for name, variants in self.variants.items():
+            if not variants:
+                raise _at(("variants", name), "expected at least one variant")
+            for i, v in enumerate(variants):
+                if v.waypoint not in self.pois:
+                    raise _at(("variants", name, i, "waypoint"), _unknown(v.waypoint, known))
+                last = i == len(variants) - 1
+                if (v.until is None) != last:
+                    raise _at(("variants", name, i, "until"),
+                              "every variant but the last needs 'until'; the last has none")
+        for key in ("dock", "recruit_at"):
+            if getattr(self.tour, key) not in self.pois:
+                raise _at(("tour", key), _unknown(getattr(self.tour, key), known))
+        for i, stop in enumerate(self.tour.stops):
+            if stop.poi not in self.pois and stop.poi not in self.variants:
+                raise _at(("tour", "stops", i, "poi"),
+                          _unknown(stop.poi, sorted({*self.pois, *self.variants})))
+        return self
+
+    # ------------------------------------------------------------ queries
+
+    def waypoint_for(self, poi: str, local: dtime) -> str:
+        """The waypoint (POI table id) for logical ``poi`` at local time of day ``local``."""
+        for variant in self.variants.get(poi, ()):
+            if variant.until is None or local <= variant.until:
+                return variant.waypoint
+        return poi
+
+    def topic(self, role: str) -> str:
+        default = INPUTS.get(role) or OUTPUTS[role]
+        return self.topics.get(role, default.name)
+
+    def stop_timeout(self, stop: Stop) -> float:
+        return stop.content_timeout or self.timeouts.content
+
+
+def _at(path: tuple[str | int, ...], message: str) -> PathError:
+    return PathError(path, message)
+
+
+def _unknown(name: str, known: list[str]) -> str:
+    return f"unknown POI {name!r} (known: {', '.join(known)})"
+
+
+def load_site(path: str | Path | None = None) -> Site:
+    """The validated site configuration; raises ConfigError naming file and path."""
+    path = Path(path) if path is not None else DEFAULT_CONFIG
+    data = load_yaml(path, ConfigError)
+    if not isinstance(data, dict):
+        raise ConfigError(str(path), (), "expected a mapping at the top level")
+    return validate(Site, data, path, ConfigError)
+
+
+def parse_hostport(text: str, what: str = "address") -> tuple[str, int]:
+    host, sep, port = text.rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
+        raise ValueError(f"{what} {text!r}: expected HOST:PORT")
+    return host, int(port)

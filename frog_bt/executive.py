@@ -1,0 +1,185 @@
+"""The online executive: rosbridge and UDP links around a :class:`~frog_bt.core.Core`.
+
+Ticks are event-driven — a tick follows any relevant input (a navigation
+response, a docking state, a front-end event, detections, diagnostics, a link
+change) — plus a periodic tick (``executive.tick_hz``, default 10 Hz) on the
+project clock. Bursts of inputs coalesce into one tick. All I/O happens in the
+links' own tasks; a tick only reads the snapshot and hands frames to
+non-blocking sends.
+
+With ``--sim-time`` nothing is timed before the first ``/clock``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import py_trees
+
+from frog_bt.clock import Clock, ManualClock
+from frog_bt.config import Site
+from frog_bt.core import Core
+from frog_bt.frontend.link import FrontendLink
+from frog_bt.frontend.messages import EVENTS, FrontendMessage
+from frog_bt.rosbridge.client import RosbridgeClient
+from frog_bt.rosbridge.link import LinkState
+from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
+from frog_bt.tree.loader import LoadedTree
+
+log = logging.getLogger(__name__)
+Status = py_trees.common.Status
+Tap = Callable[[float, str, Any], None]
+
+
+@dataclass(slots=True)
+class Outcome:
+    """Why :meth:`Executive.run` returned: exit code, one-line reason, tours completed."""
+
+    code: int = 0
+    reason: str = ""
+    tours: int = 0
+
+
+@dataclass(slots=True)
+class Taps:
+    """Observers of traffic and ticks (recording, telemetry, status line)."""
+
+    ros_in: list[Tap] = field(default_factory=list)
+    ros_out: list[Tap] = field(default_factory=list)
+    frontend_in: list[Tap] = field(default_factory=list)
+    frontend_out: list[Tap] = field(default_factory=list)
+    tick: list[Callable[[Executive], None]] = field(default_factory=list)
+
+
+class Executive:
+    def __init__(self, site: Site, tree: LoadedTree, clock: Clock, *,
+                 rosbridge_url: str, frontend: tuple[str, int], listen: tuple[str, int],
+                 sim_time: bool = False, secret: str | None = None, once: bool = False,
+                 taps: Taps | None = None) -> None:
+        if sim_time and not isinstance(clock, ManualClock):
+            raise ValueError("sim time needs a ManualClock (SimClock)")
+        self.site = site
+        self.clock = clock
+        self.sim_time = sim_time
+        self.once = once
+        self.taps = taps or Taps()
+        self.outcome = Outcome()
+        self.client = RosbridgeClient(rosbridge_url, secret=secret, on_message=self._on_ros,
+                                      on_link=self._on_link)
+        self.link = FrontendLink(listen, frontend, clock, inbound=EVENTS,
+                                 on_message=self._on_event)
+        self.core = Core(site, tree, clock, self._publish, self._send)
+        self._wake = asyncio.Event()
+        self._stopping = asyncio.Event()
+
+    # ------------------------------------------------------------ I/O callbacks (cache only)
+
+    def _on_ros(self, topic: str, value: Any) -> None:
+        if topic == CLOCK.name and self.sim_time:
+            self.clock.set(value)  # type: ignore[attr-defined]
+            return
+        for tap in self.taps.ros_in:
+            tap(self.clock.now(), topic, value)
+        if self.core.on_ros(topic, value):
+            self._wake.set()
+
+    def _on_link(self, state: LinkState) -> None:
+        self.core.inputs.link = state
+        self._wake.set()
+
+    def _on_event(self, message: FrontendMessage) -> None:
+        for tap in self.taps.frontend_in:
+            tap(self.clock.now(), message.type, message)
+        self.core.on_event(message)
+        self._wake.set()
+
+    # ------------------------------------------------------------ outputs (non-blocking)
+
+    def _publish(self, topic: str, msg: dict[str, Any]) -> None:
+        self.client.publish(topic, msg)
+        for tap in self.taps.ros_out:
+            tap(self.clock.now(), topic, msg)
+
+    def _send(self, message: FrontendMessage) -> None:
+        self.link.send(message)
+        for tap in self.taps.frontend_out:
+            tap(self.clock.now(), message.type, message)
+
+    # ------------------------------------------------------------ lifecycle
+
+    async def run(self) -> Outcome:
+        """Connect, tick until stopped (or one tour done with ``once``), then halt cleanly."""
+        for role, topic in OUTPUTS.items():
+            self.client.advertise(self.site.topic(role), topic.type)
+        for role, topic in INPUTS.items():
+            self.client.subscribe(self.site.topic(role), topic.type)
+        if self.sim_time:
+            self.client.subscribe(CLOCK.name, CLOCK.type)
+        await self.link.start()
+        self.client.start()
+        try:
+            if await self._until_stopped(self.clock.wait_ready()):
+                self.core.setup()
+                await self._loop()
+        finally:
+            await self._shutdown()
+        return self.outcome
+
+    async def _until_stopped(self, awaitable: Any) -> bool:
+        """Await ``awaitable`` unless stop() comes first; True when it completed."""
+        task = asyncio.ensure_future(awaitable)
+        stop = asyncio.ensure_future(self._stopping.wait())
+        await asyncio.wait({task, stop}, return_when=asyncio.FIRST_COMPLETED)
+        task.cancel()
+        stop.cancel()
+        return not self._stopping.is_set()
+
+    def stop(self, reason: str = "", code: int = 0) -> None:
+        if not self._stopping.is_set():
+            self.outcome.code, self.outcome.reason = code, reason
+        self._stopping.set()
+        self._wake.set()
+
+    async def _loop(self) -> None:
+        periodic = asyncio.create_task(self._periodic())
+        try:
+            while not self._stopping.is_set():
+                await self._wake.wait()
+                self._wake.clear()
+                if not self._stopping.is_set():
+                    self.tick()
+        finally:
+            periodic.cancel()
+
+    async def _periodic(self) -> None:
+        period = 1.0 / self.site.executive.tick_hz
+        next_at = self.clock.now()
+        while True:
+            next_at = max(next_at + period, self.clock.now())
+            await self.clock.sleep_until(next_at)
+            self._wake.set()
+
+    def tick(self) -> None:
+        status = self.core.tick()
+        for tap in self.taps.tick:
+            tap(self)
+        if status == Status.SUCCESS:
+            self.outcome.tours += 1
+            if self.once:
+                self.stop("tour ended docked", 0)
+        elif status == Status.FAILURE:
+            reason = self.core.last_note or "the tour tree failed"
+            log.error("tour failed: %s", reason)
+            if self.once:
+                self.stop(reason, 1)
+
+    async def _shutdown(self) -> None:
+        """Halt the tree (scopes switch the face stream off, ...) and flush the links."""
+        self.core.halt()
+        await self.client.close()
+        self.link.close()
+        await self.link.wait_closed()

@@ -1,0 +1,1 @@
+"""Tour trees: the leaf registry, project-clock decorators and the YAML loader."""

@@ -1,0 +1,312 @@
+"""Build a py_trees tree from YAML files, checking everything before anything connects.
+
+A tree file has a ``root`` node (and an optional ``description``). A node is a
+mapping with a ``type``:
+
+* composites ``Sequence`` / ``Selector`` (``memory`` is required: it changes
+  behaviour, so it is always explicit) and ``Parallel`` (``policy: all | one``),
+  with ``children``;
+* decorators (:mod:`frog_bt.tree.decorators`: ``Retry``, ``Timeout``,
+  ``FaceStream``), with ``child``;
+* leaves (:mod:`frog_bt.behaviours`), their parameters given inline.
+
+Any node may have a ``name``, and ``when: VAR`` / ``when: not VAR`` to keep it
+only where a variable is true. Two constructs are expanded at load time:
+``{include: FILE, with: {VAR: VALUE}}`` inserts another file's root, and
+``{foreach: stops, include: FILE}`` (in a ``children`` list) inserts FILE once
+per tour stop of the site configuration, with that stop's variables.
+
+Strings may use ``{VAR}``; a string that is exactly ``"{VAR}"`` takes the
+variable's value and type. Variables: ``dock``, ``recruit_at``,
+``nav_attempts`` from the site, and per stop ``poi``, ``content``,
+``face_stream``, ``projector``, ``check_follower``, ``content_timeout``.
+
+Every error is a :class:`~frog_bt.errors.TreeError` naming the file, the path
+inside it and what was expected; blackboard keys read by a leaf that nothing
+writes are errors too.
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import py_trees
+from pydantic import BaseModel
+
+import frog_bt.behaviours  # noqa: F401 - registers the leaf types
+from frog_bt.blackboard import INPUT_KEYS
+from frog_bt.config import Site
+from frog_bt.errors import TreeError
+from frog_bt.tree.decorators import DECORATORS
+from frog_bt.tree.leaf import LEAVES
+from frog_bt.yamlfile import load_yaml, validate
+
+DEFAULT_TREE_DIR = Path(__file__).resolve().parent.parent.parent / "trees"
+DEFAULT_TREE = DEFAULT_TREE_DIR / "tour.yaml"
+COMPOSITES = ("Sequence", "Selector", "Parallel")
+STRUCTURE = {"type", "name", "when"}
+_VAR = re.compile(r"\{(\w+)\}")
+
+Path_ = tuple[str | int, ...]
+Behaviour = py_trees.behaviour.Behaviour
+
+
+@dataclass(frozen=True, slots=True)
+class Where:
+    file: str
+    path: Path_
+
+
+@dataclass
+class LoadedTree:
+    """A built tree and where each node came from (for errors, render and telemetry)."""
+
+    root: Behaviour
+    file: str
+    description: str = ""
+    where: dict[int, Where] = field(default_factory=dict)  # id(node) -> file and path
+
+    def nodes(self) -> Iterator[Behaviour]:
+        yield from self.root.iterate()
+
+
+def site_variables(site: Site | None) -> dict[str, Any]:
+    if site is None:
+        return {"dock": "SHOP", "recruit_at": "POI0", "nav_attempts": 3}
+    return {"dock": site.tour.dock, "recruit_at": site.tour.recruit_at,
+            "nav_attempts": site.navigation.attempts}
+
+
+class _Builder:
+    def __init__(self, site: Site | None, tree_dir: Path) -> None:
+        self.site = site
+        self.tree_dir = tree_dir
+        self.where: dict[int, Where] = {}
+        self.stack: list[Path] = []
+
+    # ------------------------------------------------------------ files
+
+    def file(self, path: Path, variables: dict[str, Any]) -> tuple[Behaviour | None, str]:
+        path = path if path.is_absolute() else self.tree_dir / path
+        if path.resolve() in (p.resolve() for p in self.stack):
+            raise TreeError(str(path), (), "includes itself (directly or through others)")
+        data = load_yaml(path, TreeError)
+        if not isinstance(data, dict):
+            raise TreeError(str(path), (), "expected a mapping with a 'root' node")
+        unknown = set(data) - {"root", "description"}
+        if unknown:
+            raise TreeError(str(path), (sorted(unknown)[0],),
+                            "unknown key (a tree file has 'root' and 'description')")
+        if "root" not in data:
+            raise TreeError(str(path), ("root",), "missing required key")
+        self.stack.append(path)
+        try:
+            nodes = self.node(data["root"], str(path), ("root",), variables)
+        finally:
+            self.stack.pop()
+        if len(nodes) > 1:
+            raise TreeError(str(path), ("root",), "expected one node, got a foreach")
+        return (nodes[0] if nodes else None), str(data.get("description", ""))
+
+    # ------------------------------------------------------------ nodes
+
+    def node(self, data: Any, file: str, path: Path_, variables: dict[str, Any]
+             ) -> list[Behaviour]:
+        """The behaviours for one node entry (none when ``when`` is false, several for foreach)."""
+        if not isinstance(data, dict):
+            raise TreeError(file, path, f"expected a node (a mapping), got {_short(data)}")
+        if "when" in data and not self._when(data["when"], file, (*path, "when"), variables):
+            return []
+        if "foreach" in data:
+            return self._foreach(data, file, path, variables)
+        if "include" in data:
+            return self._include(data, file, path, variables)
+        if "type" not in data:
+            raise TreeError(file, path, "missing required key 'type' (or 'include', 'foreach')")
+        type_ = data["type"]
+        if not isinstance(type_, str):
+            raise TreeError(file, (*path, "type"), f"expected a type name, got {_short(type_)}")
+        name = self._subst(data.get("name", ""), file, (*path, "name"), variables)
+        if type_ in COMPOSITES:
+            behaviour = self._composite(type_, data, file, path, variables, name)
+        elif type_ in DECORATORS:
+            behaviour = self._decorator(type_, data, file, path, variables, name)
+        elif type_ in LEAVES:
+            behaviour = self._leaf(type_, data, file, path, variables, name)
+        else:
+            known = [*COMPOSITES, *DECORATORS, *LEAVES]
+            close = difflib.get_close_matches(type_, known, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else f" (known: {', '.join(known)})"
+            raise TreeError(file, (*path, "type"), f"unknown type {type_!r}{hint}")
+        if behaviour is not None:
+            self.where[id(behaviour)] = Where(file, path)
+            return [behaviour]
+        return []
+
+    def _composite(self, type_: str, data: dict[str, Any], file: str, path: Path_,
+                   variables: dict[str, Any], name: str) -> Behaviour:
+        allowed = STRUCTURE | {"children"} | ({"memory"} if type_ != "Parallel" else
+                                              {"policy", "synchronise"})
+        self._no_unknown(data, allowed, file, path, type_)
+        children_data = data.get("children")
+        if not isinstance(children_data, list) or not children_data:
+            raise TreeError(file, (*path, "children"), "expected a non-empty list of nodes")
+        # (after `when`, a composite may keep no children: it then succeeds at once)
+        children: list[Behaviour] = []
+        for i, child in enumerate(children_data):
+            children += self.node(child, file, (*path, "children", i), variables)
+        name = name or type_
+        if type_ == "Parallel":
+            policy = data.get("policy", "all")
+            sync = data.get("synchronise", True)
+            if policy not in ("all", "one"):
+                raise TreeError(file, (*path, "policy"), f"expected 'all' or 'one', got {policy!r}")
+            if not isinstance(sync, bool):
+                raise TreeError(file, (*path, "synchronise"), "expected true or false")
+            pol = (py_trees.common.ParallelPolicy.SuccessOnAll(synchronise=sync)
+                   if policy == "all" else
+                   py_trees.common.ParallelPolicy.SuccessOnOne())
+            return py_trees.composites.Parallel(name, policy=pol, children=children)
+        if "memory" not in data:
+            raise TreeError(file, (*path, "memory"),
+                            f"missing required key: a {type_} must say memory: true or false")
+        memory = data["memory"]
+        if not isinstance(memory, bool):
+            raise TreeError(file, (*path, "memory"),
+                            f"expected true or false, got {_short(memory)}")
+        cls = py_trees.composites.Sequence if type_ == "Sequence" else py_trees.composites.Selector
+        return cls(name, memory=memory, children=children)
+
+    def _decorator(self, type_: str, data: dict[str, Any], file: str, path: Path_,
+                   variables: dict[str, Any], name: str) -> Behaviour | None:
+        cls = DECORATORS[type_]
+        raw = {k: v for k, v in data.items() if k not in STRUCTURE | {"child"}}
+        params = self._params(cls.Params, raw, file, path, variables)
+        if "child" not in data:
+            raise TreeError(file, (*path, "child"), f"missing required key: a {type_} has a child")
+        child = self.node(data["child"], file, (*path, "child"), variables)
+        if len(child) != 1:
+            if not child:
+                return None  # its child was left out by `when`
+            raise TreeError(file, (*path, "child"), "expected one node, got a foreach")
+        return cls(name or f"{type_}{_summary(params)}", child[0], params)
+
+    def _leaf(self, type_: str, data: dict[str, Any], file: str, path: Path_,
+              variables: dict[str, Any], name: str) -> Behaviour:
+        cls = LEAVES[type_]
+        raw = {k: v for k, v in data.items() if k not in STRUCTURE}
+        params = self._params(cls.Params, raw, file, path, variables)
+        return cls(name or f"{type_}{_summary(params)}", params)
+
+    def _params(self, model: type[BaseModel], raw: dict[str, Any], file: str, path: Path_,
+                variables: dict[str, Any]) -> BaseModel:
+        values = {k: self._subst(v, file, (*path, k), variables) for k, v in raw.items()}
+        return validate(model, values, file, TreeError, context={"site": self.site},
+                        base=path)
+
+    def _include(self, data: dict[str, Any], file: str, path: Path_,
+                 variables: dict[str, Any]) -> list[Behaviour]:
+        self._no_unknown(data, {"include", "with", "when", "foreach"}, file, path, "include")
+        target = data["include"]
+        if not isinstance(target, str):
+            raise TreeError(file, (*path, "include"), "expected a file name")
+        extra = data.get("with", {})
+        if not isinstance(extra, dict):
+            raise TreeError(file, (*path, "with"), "expected a mapping of variables")
+        scope = dict(variables)
+        for k, v in extra.items():
+            scope[str(k)] = self._subst(v, file, (*path, "with", k), variables)
+        base = Path(file).parent
+        node, _ = self.file(base / target if not Path(target).is_absolute() else Path(target),
+                            scope)
+        return [node] if node is not None else []
+
+    def _foreach(self, data: dict[str, Any], file: str, path: Path_,
+                 variables: dict[str, Any]) -> list[Behaviour]:
+        if data["foreach"] != "stops":
+            raise TreeError(file, (*path, "foreach"), "expected 'stops' (the site's tour stops)")
+        if "include" not in data:
+            raise TreeError(file, (*path, "include"), "missing required key: foreach needs include")
+        stops = [] if self.site is None else [s.model_dump() for s in self.site.tour.stops]
+        out: list[Behaviour] = []
+        for stop in stops:
+            out += self._include({k: v for k, v in data.items() if k != "foreach"}, file, path,
+                                 {**variables, **stop})
+        return out
+
+    # ------------------------------------------------------------ helpers
+
+    def _when(self, expr: Any, file: str, path: Path_, variables: dict[str, Any]) -> bool:
+        if not isinstance(expr, str):
+            raise TreeError(file, path, "expected a variable name or 'not NAME'")
+        negate = expr.startswith("not ")
+        name = expr[4:].strip() if negate else expr.strip()
+        if name not in variables:
+            raise TreeError(file, path, f"unknown variable {name!r} (known: "
+                            f"{', '.join(sorted(variables))})")
+        return bool(variables[name]) != negate
+
+    def _subst(self, value: Any, file: str, path: Path_, variables: dict[str, Any]) -> Any:
+        if isinstance(value, str):
+            whole = _VAR.fullmatch(value)
+            for match in _VAR.finditer(value):
+                if match.group(1) not in variables:
+                    raise TreeError(file, path, f"unknown variable {match.group(1)!r} (known: "
+                                    f"{', '.join(sorted(variables))})")
+            if whole:
+                return variables[whole.group(1)]
+            return _VAR.sub(lambda m: str(variables[m.group(1)]), value)
+        if isinstance(value, list):
+            return [self._subst(v, file, (*path, i), variables) for i, v in enumerate(value)]
+        if isinstance(value, dict):
+            return {k: self._subst(v, file, (*path, k), variables) for k, v in value.items()}
+        return value
+
+    @staticmethod
+    def _no_unknown(data: dict[str, Any], allowed: set[str], file: str, path: Path_,
+                    what: str) -> None:
+        for key in data:
+            if key not in allowed:
+                raise TreeError(file, (*path, key),
+                                f"unknown key for {what} (expected: {', '.join(sorted(allowed))})")
+
+
+def _summary(params: BaseModel) -> str:
+    values = [str(v) for v in params.model_dump(exclude_none=True).values()
+              if isinstance(v, str | int | float) and not isinstance(v, bool) and v != ""]
+    return f" {' '.join(values)}" if values else ""
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def check_keys(tree: LoadedTree) -> None:
+    """Every key a node reads must be written by some node or by the input snapshot."""
+    written = set(INPUT_KEYS)
+    for node in tree.nodes():
+        written.update(getattr(node, "writes", ()))
+    for node in tree.nodes():
+        for key in getattr(node, "reads", ()):
+            if key not in written:
+                where = tree.where.get(id(node), Where(tree.file, ()))
+                raise TreeError(where.file, where.path,
+                                f"{type(node).__name__} reads {key}, which nothing writes")
+
+
+def load_tree(path: str | Path | None = None, site: Site | None = None) -> LoadedTree:
+    """Load, expand, build and check a tree file (default ``trees/tour.yaml``)."""
+    path = Path(path) if path is not None else DEFAULT_TREE
+    builder = _Builder(site, path.parent)
+    root, description = builder.file(path, site_variables(site))
+    if root is None:
+        raise TreeError(str(path), ("root",), "the whole tree was left out by 'when'")
+    tree = LoadedTree(root, str(path), description, builder.where)
+    check_keys(tree)
+    return tree
