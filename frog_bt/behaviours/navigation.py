@@ -92,10 +92,10 @@ class SkipStop(Leaf):
 
 @register
 class Skipped(Leaf):
-    """Is ``poi`` being skipped? Reads ``/skipped``. SUCCESS if so, else FAILURE."""
+    """Is ``poi`` being skipped? Reads ``/skipped`` (optional). SUCCESS if so, else FAILURE."""
 
     Params = PoiParams
-    reads = ("/skipped",)
+    optional_reads = ("/skipped",)
 
     def update(self) -> Status:
         return SUCCESS if self.get("/skipped") == self.params.poi else FAILURE

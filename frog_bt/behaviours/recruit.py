@@ -37,7 +37,8 @@ class SeekVisitor(Leaf):
     Writes ``/visitor`` (the person id). RUNNING until someone qualifies, then SUCCESS.
     """
 
-    reads = ("/persons", "/pose", "/now", "/declined")
+    reads = ("/persons", "/pose", "/now")
+    optional_reads = ("/declined",)
     writes = ("/visitor",)
 
     def update(self) -> Status:
@@ -105,10 +106,10 @@ class ApproachVisitor(Leaf):
 class StartIntroduction(Leaf):
     """Send ``start_introduction``; ``icl`` is true while the face stream runs.
 
-    Reads ``/icl``. SUCCESS.
+    Reads ``/icl`` (optional: False without a FaceStream scope). SUCCESS.
     """
 
-    reads = ("/icl",)
+    optional_reads = ("/icl",)
 
     def update(self) -> Status:
         self.ctx.send(StartIntroductionCommand(bool(self.get("/icl"))))
@@ -142,6 +143,7 @@ class WaitAnswer(Leaf):
         timeout: float | None = Timeout
 
     reads = ("/events", "/visitor", "/now")
+    optional_reads = ("/declined",)
     writes = ("/declined",)
 
     def initialise(self) -> None:

@@ -61,7 +61,7 @@ class PlayContent(Leaf):
     """Play part ``part`` of ``poi``'s content and wait until it is done.
 
     Sends ``start_poi`` (with the waypoint chosen on the way, ``/waypoint``) in
-    initialise. Reads ``/waypoint``, ``/events``, ``/now``. SUCCESS on the
+    initialise. Reads ``/events``, ``/now`` and, optionally, ``/waypoint``. SUCCESS on the
     matching ``content_done``, or after ``timeout`` seconds (default: site
     ``timeouts.content``) with a note: a silent front end must not stop the tour.
     """
@@ -70,7 +70,8 @@ class PlayContent(Leaf):
         part: Literal["a", "b"] = "a"
         timeout: float | None = Field(None, gt=0, allow_inf_nan=False)
 
-    reads = ("/waypoint", "/events", "/now")
+    reads = ("/events", "/now")
+    optional_reads = ("/waypoint",)
 
     def initialise(self) -> None:
         p = self.params

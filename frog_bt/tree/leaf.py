@@ -1,7 +1,8 @@
 """The base class and registry of every leaf a tree file can name.
 
 A leaf type declares its parameters (a pydantic model), the blackboard keys it
-reads and the keys it writes; :func:`register` adds it to :data:`LEAVES` under
+reads (``reads``: something must write them; ``optional_reads``: a default
+applies while nothing has) and the keys it writes; :func:`register` adds it to :data:`LEAVES` under
 its class name. The loader checks a whole tree file against these declarations
 before anything connects, and ``render`` draws a tree with no robot.
 
@@ -32,14 +33,15 @@ class Params(BaseModel):
 
 class Leaf(py_trees.behaviour.Behaviour):
     Params: ClassVar[type[BaseModel]] = Params
-    reads: ClassVar[tuple[str, ...]] = ()
+    reads: ClassVar[tuple[str, ...]] = ()  # must be written by some node or the snapshot
+    optional_reads: ClassVar[tuple[str, ...]] = ()  # read when present, with a default
     writes: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, name: str, params: BaseModel | None = None) -> None:
         super().__init__(name)
         self.params: Any = params if params is not None else type(self).Params()
         self.bb = self.attach_blackboard_client(name=name)
-        for key in self.reads:
+        for key in (*self.reads, *self.optional_reads):
             self.bb.register_key(key, access=py_trees.common.Access.READ)
         for key in self.writes:
             self.bb.register_key(key, access=py_trees.common.Access.WRITE)
