@@ -169,6 +169,9 @@ def _check(kind: str, value: Any, name: str) -> Any:
             return None
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise bad("a number in [-1, 1] or null")
+        # An int too large for a float (JSON allows 10**400) is out of range, not a crash.
+        if isinstance(value, int) and not -1 <= value <= 1:
+            raise bad("a number in [-1, 1] or null")
         value = float(value)
         if not (math.isfinite(value) and -1.0 <= value <= 1.0):
             raise bad("a number in [-1, 1] or null")

@@ -106,8 +106,9 @@ class Endpoint:
     def send(self, message: FrontendMessage, now: float) -> bytes:
         """Datagram for a new message; it is resent by :meth:`poll` until acked."""
         seq = self.next_seq
-        self.next_seq += 1
+        # Encode first: a message that cannot be encoded must not use up a seq.
         data = encode_datagram(message.type, seq, message_fields(message))
+        self.next_seq += 1
         self._pending[seq] = _Pending(data, message, 1, now + self.resend_after)
         self.stats.sent += 1
         return data

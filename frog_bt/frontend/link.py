@@ -1,0 +1,292 @@
+"""The front-end UDP link: a thin asyncio shell around :class:`Endpoint` (CONTRACT §2).
+
+:class:`FrontendLink` owns one UDP socket, bound to ``listen``. It sends what it
+originates to ``peer`` from that socket and answers every datagram with an ack
+sent back to the datagram's source address. All protocol decisions (numbering,
+acks, resends, duplicates, foreign hosts, malformed datagrams) are the
+:class:`~frog_bt.frontend.protocol.Endpoint`'s; this module only moves bytes and
+turns the injected :class:`~frog_bt.clock.Clock` into resend wake-ups.
+
+The same class serves both sides:
+
+* the executive: ``FrontendLink(("127.0.0.1", 5006), ("127.0.0.1", 5005), clock)``
+  acts on events and sends commands;
+* the simulated front end: ``FrontendLink(("127.0.0.1", 5005), ("127.0.0.1", 5006),
+  clock, inbound=COMMANDS)`` acts on commands and sends events.
+
+Resends run on the project clock (sim time in sim, the recording's time in
+replay), never on the event loop's own clock.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import ipaddress
+import logging
+import socket
+import time
+from collections.abc import Callable
+
+from frog_bt.clock import Clock
+from frog_bt.frontend.messages import EVENTS, FrontendMessage
+from frog_bt.frontend.protocol import MAX_DATAGRAM, Endpoint, LinkStats
+
+log = logging.getLogger(__name__)
+
+Address = tuple[str, int]
+# (direction "in" | "out", datagram, clock time): a tap for recordings (CONTRACT §6).
+DatagramTap = Callable[[str, bytes, float], None]
+
+WARN_INTERVAL = 5.0  # wall seconds between two warnings of one kind
+
+
+class WarningLimiter:
+    """At most one warning per kind per ``interval`` wall seconds.
+
+    Warnings suppressed in between are counted and reported with the next one
+    that gets through, so a flood of bad datagrams costs one log line per
+    interval, not one per datagram.
+    """
+
+    def __init__(self, interval: float = WARN_INTERVAL,
+                 wall: Callable[[], float] = time.monotonic) -> None:
+        self.interval = interval
+        self._wall = wall
+        self._last: dict[str, float] = {}
+        self._suppressed: dict[str, int] = {}
+
+    def warn(self, kind: str, message: str) -> bool:
+        """Log ``message`` unless ``kind`` was logged within the interval; True if logged."""
+        now = self._wall()
+        last = self._last.get(kind)
+        if last is not None and now - last < self.interval:
+            self._suppressed[kind] = self._suppressed.get(kind, 0) + 1
+            return False
+        suppressed = self._suppressed.pop(kind, 0)
+        if suppressed:
+            message = f"{message} ({suppressed} more {kind} suppressed)"
+        log.warning("%s", message)
+        self._last[kind] = now
+        return True
+
+
+class _DatagramProtocol(asyncio.DatagramProtocol):
+    def __init__(self, link: FrontendLink) -> None:
+        self._link = link
+
+    def datagram_received(self, data: bytes, addr: tuple) -> None:  # type: ignore[override]
+        self._link._datagram_received(data, addr)
+
+    def error_received(self, exc: Exception) -> None:
+        # ICMP errors (peer not listening yet) are expected; resends cover them.
+        self._link._warnings.warn("socket error", f"front-end link socket error: {exc}")
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self._link._closed.set()
+
+
+class FrontendLink:
+    """One side of the front-end link over UDP.
+
+    ``listen`` is the local address to bind (port 0 picks a free port, see
+    :attr:`listen_port`); ``peer`` is where originated messages go, and its host
+    is the only one whose datagrams are accepted. ``inbound`` is the table of
+    message types this side acts on: :data:`~frog_bt.frontend.messages.EVENTS`
+    for the executive, :data:`~frog_bt.frontend.messages.COMMANDS` for the front
+    end. ``on_message`` is called with every accepted, non-duplicate message, on
+    the event loop, after its ack has been sent. ``on_datagram`` (optional) sees
+    every datagram received (``"in"``, before any filtering) or sent (``"out"``,
+    acks and resends included), stamped with the clock's time.
+    """
+
+    def __init__(
+        self,
+        listen: Address,
+        peer: Address,
+        clock: Clock,
+        *,
+        inbound: dict[str, type[FrontendMessage]] = EVENTS,
+        on_message: Callable[[FrontendMessage], None] | None = None,
+        resend_after: float = 0.25,
+        max_sends: int = 8,
+        dedup_window: float = 10.0,
+        on_datagram: DatagramTap | None = None,
+    ) -> None:
+        if not resend_after > 0:
+            raise ValueError(f"resend_after must be > 0, got {resend_after}")
+        if max_sends < 1:
+            raise ValueError(f"max_sends must be >= 1, got {max_sends}")
+        self.listen = (listen[0], int(listen[1]))
+        self.peer = (peer[0], int(peer[1]))
+        self.clock = clock
+        self.on_message = on_message
+        self.on_datagram = on_datagram
+        self._endpoint = Endpoint(peer[0], inbound, resend_after, max_sends, dedup_window)
+        self._peer_addr: Address = self.peer
+        self._transport: asyncio.DatagramTransport | None = None
+        self._resender: asyncio.Task[None] | None = None
+        self._wakeup = asyncio.Event()
+        self._sleeping_until: float | None = None
+        self._closed = asyncio.Event()
+        self._closing = False
+        self._warnings = WarningLimiter()
+
+    # ------------------------------------------------------------ lifecycle
+
+    async def start(self) -> None:
+        """Bind the listen address and start the resend task."""
+        if self._transport is not None or self._closing:
+            raise RuntimeError("FrontendLink already started or closed")
+        loop = asyncio.get_running_loop()
+        transport, _ = await loop.create_datagram_endpoint(
+            lambda: _DatagramProtocol(self), local_addr=self.listen)
+        self._transport = transport
+        try:
+            host = await _resolve(loop, self.peer, transport.get_extra_info("socket").family)
+        except OSError:
+            self.close()
+            raise
+        # Compare and send by IP: datagram sources are reported as IPs, never names.
+        self._endpoint.peer_host = host
+        self._peer_addr = (host, self.peer[1])
+        self._resender = loop.create_task(self._resend_loop(), name="frontend-resend")
+        self._resender.add_done_callback(_report_crash)
+        log.info("front-end link listening on %s:%d, peer %s:%d",
+                 self.listen[0], self.listen_port, *self.peer)
+
+    def close(self) -> None:
+        """Stop resending and close the socket; idempotent. Pending commands are dropped."""
+        if self._closing:
+            return
+        self._closing = True
+        if self._resender is not None:
+            self._resender.cancel()
+        if self._transport is not None:
+            self._transport.close()
+        else:
+            self._closed.set()
+
+    async def wait_closed(self) -> None:
+        """Return once :meth:`close` has released the socket and the resend task."""
+        if self._resender is not None:
+            with contextlib.suppress(asyncio.CancelledError):
+                await self._resender
+        await self._closed.wait()
+
+    # ------------------------------------------------------------ state
+
+    @property
+    def listen_port(self) -> int:
+        """The bound UDP port (the real one when ``listen`` asked for port 0)."""
+        if self._transport is None:
+            raise RuntimeError("FrontendLink is not started")
+        return int(self._transport.get_extra_info("sockname")[1])
+
+    @property
+    def stats(self) -> LinkStats:
+        """Counters of the underlying :class:`Endpoint` (sent, acked, foreign, ...)."""
+        return self._endpoint.stats
+
+    @property
+    def pending(self) -> int:
+        """Messages sent and not yet acked or given up on."""
+        return self._endpoint.pending
+
+    # ------------------------------------------------------------ sending
+
+    def send(self, message: FrontendMessage) -> None:
+        """Send ``message`` to the peer now; it is resent until acked. Never blocks.
+
+        Raises :class:`RuntimeError` before :meth:`start` and :class:`ValueError`
+        for a message that cannot be encoded (NaN, larger than 8192 bytes). After
+        :meth:`close` the message is dropped.
+        """
+        if self._closing:
+            log.debug("front-end link closed, dropped %s", message.type)
+            return
+        if self._transport is None:
+            raise RuntimeError("FrontendLink is not started")
+        now = self.clock.now()
+        data = self._endpoint.send(message, now)
+        self._sendto(data, self._peer_addr, now)
+        deadline = self._endpoint.next_deadline
+        if deadline is not None and (self._sleeping_until is None
+                                     or deadline < self._sleeping_until):
+            self._wakeup.set()
+
+    def _sendto(self, data: bytes, addr: tuple, now: float) -> None:
+        assert self._transport is not None
+        self._transport.sendto(data, addr)
+        if self.on_datagram is not None:
+            self.on_datagram("out", data, now)
+
+    async def _resend_loop(self) -> None:
+        """Sleep on the project clock until the next resend is due, then poll."""
+        while True:
+            self._wakeup.clear()
+            deadline = self._endpoint.next_deadline
+            self._sleeping_until = deadline
+            if deadline is None:
+                await self._wakeup.wait()
+                continue
+            if deadline > self.clock.now() and not await self._sleep_or_wake(deadline):
+                continue  # an earlier deadline arrived: recompute
+            self._sleeping_until = None
+            now = self.clock.now()
+            for data in self._endpoint.poll(now):
+                self._sendto(data, self._peer_addr, now)
+
+    async def _sleep_or_wake(self, deadline: float) -> bool:
+        """True once the clock reaches ``deadline``; False if woken earlier by :meth:`send`."""
+        sleep = asyncio.ensure_future(self.clock.sleep_until(deadline))
+        wake = asyncio.ensure_future(self._wakeup.wait())
+        try:
+            await asyncio.wait((sleep, wake), return_when=asyncio.FIRST_COMPLETED)
+        finally:
+            sleep.cancel()
+            wake.cancel()
+        return sleep.done() and not sleep.cancelled()
+
+    # ------------------------------------------------------------ receiving
+
+    def _datagram_received(self, data: bytes, addr: tuple) -> None:
+        now = self.clock.now()
+        if self.on_datagram is not None:
+            self.on_datagram("in", data, now)
+        foreign = self._endpoint.stats.foreign
+        received = self._endpoint.receive(data, addr[0], now)
+        if received.reply is not None and not self._closing:
+            self._sendto(received.reply, addr, now)
+        if self._endpoint.stats.foreign != foreign:
+            self._warnings.warn(
+                "foreign", f"dropped a datagram from {addr[0]}:{addr[1]} "
+                           f"(front end is {self._endpoint.peer_host})")
+        if received.error is not None:
+            size = f"{len(data)} bytes" if len(data) <= MAX_DATAGRAM else "oversized"
+            self._warnings.warn(
+                "malformed", f"malformed front-end datagram ({size}) from "
+                             f"{addr[0]}:{addr[1]}: {received.error}")
+        if received.message is not None and self.on_message is not None:
+            try:
+                self.on_message(received.message)
+            except Exception:
+                log.exception("front-end message handler failed on %s", received.message.type)
+
+
+async def _resolve(loop: asyncio.AbstractEventLoop, addr: Address, family: int) -> str:
+    """The peer's IP as datagram sources report it (``localhost`` -> ``127.0.0.1``)."""
+    host = addr[0]
+    try:
+        ipaddress.ip_address(host)
+    except ValueError:
+        infos = await loop.getaddrinfo(host, addr[1], family=family, type=socket.SOCK_DGRAM)
+        if not infos:  # pragma: no cover - getaddrinfo raises instead
+            raise OSError(f"cannot resolve front-end host {host!r}") from None
+        return str(infos[0][4][0])
+    return host
+
+
+def _report_crash(task: asyncio.Task[None]) -> None:
+    if not task.cancelled() and task.exception() is not None:
+        log.error("front-end resend task failed", exc_info=task.exception())
