@@ -39,7 +39,10 @@ def _float(obj: Mapping[str, Any], key: str, path: Path, default: float | None =
     value = _field(obj, key, path)
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise DecodeError(f"expected a number, got {type(value).__name__}", (*path, key))
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # a JSON integer beyond float range (1e400 written out)
+        raise DecodeError("expected a finite number, got a huge integer", (*path, key)) from None
     if not math.isfinite(value):
         raise DecodeError(f"expected a finite number, got {value}", (*path, key))
     return value
@@ -91,6 +94,9 @@ def decode_time(value: Any, path: Path = ()) -> float:
         raise DecodeError("expected {secs, nsecs} or {sec, nanosec}", path)
     if not 0 <= nsecs < 1_000_000_000:
         raise DecodeError(f"nanoseconds {nsecs} out of range", path)
+    # ROS 1 secs is uint32, ROS 2 sec int32; beyond both, float() would overflow.
+    if not -(2**31) <= secs < 2**32:
+        raise DecodeError(f"seconds {secs} out of range", path)
     return secs + nsecs * 1e-9
 
 

@@ -146,6 +146,9 @@ class Session:
         return [self._advertise_frame(topic, type_)] if self.connected else []
 
     def unadvertise(self, topic: str) -> list[str]:
+        # Publishes queued for the topic go with it: sent after the reconnect
+        # they would reach a topic that is no longer advertised.
+        self._queue = deque(item for item in self._queue if item[0] != topic)
         if self.advertised.pop(topic, None) is None or not self.connected:
             return []
         return [dumps({"op": "unadvertise", "id": self._id("unadvertise", topic),

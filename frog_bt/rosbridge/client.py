@@ -1,0 +1,401 @@
+"""Asyncio rosbridge client: a thin shell around the sans-I/O :class:`Session`.
+
+The :class:`~frog_bt.rosbridge.protocol.Session` decides what to send and
+when; this module only moves frames between it and a WebSocket
+(``websockets.asyncio.client``), reconnects, and turns inbound ``publish`` ops
+into typed values with :data:`frog_bt.messages.DECODERS`.
+
+* ``advertise``/``subscribe``/``publish``/... are plain synchronous calls, O(1)
+  and never blocking, so behaviour-tree leaves may call them inside a tick.
+  Frames go onto an outbox drained, in order, by one writer task per
+  connection. While the link is down publishes wait in the Session's bounded
+  queue (oldest dropped and counted).
+* The connect loop reconnects for ever with capped exponential backoff and,
+  on every connection, sends ``Session.on_connected`` frames first (auth,
+  advertise, subscribe, queued publishes).
+* Bad input never stops the receive loop: malformed frames and messages are
+  counted per topic in :attr:`RosbridgeClient.stats` and logged at most once
+  per topic per :data:`WARN_INTERVAL` seconds.
+
+Not thread-safe: call every method from the event loop's thread.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import logging
+import time
+from collections import deque
+from collections.abc import Callable, Iterator
+from dataclasses import replace
+from typing import Any
+
+from websockets.asyncio.client import ClientConnection, connect
+from websockets.exceptions import ConnectionClosed, InvalidURI, WebSocketException
+from websockets.uri import parse_uri
+
+from frog_bt.errors import DecodeError
+from frog_bt.messages import DECODERS
+from frog_bt.rosbridge.link import ClientStats, LinkState
+from frog_bt.rosbridge.protocol import (
+    MAX_FRAME_BYTES,
+    OtherOp,
+    Publish,
+    Session,
+    Status,
+    decode_frame,
+)
+
+__all__ = ["FRAME_TOPIC", "WARN_INTERVAL", "ClientStats", "LinkState", "RosbridgeClient",
+           "WarningThrottle", "backoff_delays"]
+
+log = logging.getLogger(__name__)
+
+WARN_INTERVAL = 5.0  # seconds of wall time between two warnings about one topic
+FRAME_TOPIC = "<frame>"  # stats/warning key for frames too broken to name a topic
+# A frame above decode_frame's guard is counted as malformed; only far larger
+# ones make websockets drop the connection (which would then loop on reconnect).
+_MAX_WS_MESSAGE = 4 * MAX_FRAME_BYTES
+
+
+class WarningThrottle:
+    """At most one warning per key per ``interval``; counts the ones held back.
+
+    Sans-clock: the caller passes ``now`` (monotonic seconds).
+    """
+
+    def __init__(self, interval: float = WARN_INTERVAL) -> None:
+        self.interval = interval
+        self._last: dict[str, float] = {}
+        self._held: dict[str, int] = {}
+
+    def allow(self, key: str, now: float) -> int | None:
+        """``None``: stay quiet. Otherwise log, noting this many suppressed since the last."""
+        last = self._last.get(key)
+        if last is not None and now - last < self.interval:
+            self._held[key] = self._held.get(key, 0) + 1
+            return None
+        self._last[key] = now
+        return self._held.pop(key, 0)
+
+
+class RosbridgeClient:
+    """rosbridge v2 client with reconnect; see the module docstring.
+
+    ``on_message(topic, value)`` gets the typed value of every well-formed
+    message on a subscribed topic; ``on_link(state)`` gets the new
+    :class:`LinkState` each time the link goes up or down. Exceptions from
+    either callback are logged and otherwise ignored.
+
+    The auth frame (sent first on each connection when ``secret`` is set) is
+    stamped with the wall clock: rosauth compares it with the server's time.
+    """
+
+    def __init__(
+        self,
+        url: str,
+        *,
+        secret: str | None = None,
+        queue_limit: int = 1000,
+        backoff_initial: float = 0.25,
+        backoff_max: float = 5.0,
+        on_message: Callable[[str, Any], None] | None = None,
+        on_link: Callable[[LinkState], None] | None = None,
+    ) -> None:
+        try:
+            parse_uri(url)
+        except InvalidURI as exc:
+            raise ValueError(f"rosbridge URL {url!r}: {exc}") from None
+        if queue_limit < 1:
+            raise ValueError(f"queue_limit must be >= 1, got {queue_limit}")
+        if not 0 < backoff_initial <= backoff_max:
+            raise ValueError(f"need 0 < backoff_initial <= backoff_max, got "
+                             f"{backoff_initial}, {backoff_max}")
+        self.url = url
+        self.backoff_initial = backoff_initial
+        self.backoff_max = backoff_max
+        self.on_message = on_message
+        self.on_link = on_link
+        self.session = Session(queue_limit=queue_limit, secret=secret)
+        self.stats = ClientStats()
+        self._link = LinkState(connected=False, since=time.monotonic())
+        self._throttle = WarningThrottle()
+        self._outbox: deque[str] = deque()  # frames for the current connection, in order
+        self._wake = asyncio.Event()  # outbox became non-empty
+        self._up = asyncio.Event()  # set while connected
+        self._ever_connected = False
+        self._closing = False
+        self._loop_task: asyncio.Task[None] | None = None
+        self._run_task: asyncio.Task[None] | None = None
+
+    # ------------------------------------------------------------ program side
+
+    @property
+    def link(self) -> LinkState:
+        return self._link
+
+    @property
+    def queued(self) -> int:
+        """Publishes waiting for the link to come back."""
+        return self.session.queued
+
+    def advertise(self, topic: str, type: str) -> None:
+        self._enqueue(self.session.advertise(topic, type))
+
+    def unadvertise(self, topic: str) -> None:
+        self._enqueue(self.session.unadvertise(topic))
+
+    def subscribe(self, topic: str, type: str, throttle_rate: int = 0,
+                  queue_length: int = 0) -> None:
+        """Subscribe; messages arrive decoded by ``DECODERS[type]``.
+
+        Raises ValueError for a type with no decoder (a programming error).
+        """
+        if type not in DECODERS:
+            raise ValueError(f"subscribe {topic!r}: no decoder for type {type!r}")
+        self._enqueue(self.session.subscribe(topic, type, throttle_rate, queue_length))
+
+    def unsubscribe(self, topic: str) -> None:
+        self._enqueue(self.session.unsubscribe(topic))
+
+    def publish(self, topic: str, msg: Any) -> None:
+        """Send now, or queue while the link is down. Never blocks.
+
+        Raises ValueError for a topic never advertised or a message that is not
+        finite JSON (NaN, Infinity): programming errors, caught at the call.
+        """
+        dropped = self.session.dropped
+        self._enqueue(self.session.publish(topic, msg))
+        self._note_dropped(dropped)
+
+    # ------------------------------------------------------------ lifecycle
+
+    def start(self) -> asyncio.Task[None]:
+        """Run the connect loop in a task (idempotent); returns the task."""
+        if self._run_task is None:
+            self._run_task = asyncio.get_running_loop().create_task(
+                self.run(), name=f"rosbridge {self.url}")
+        return self._run_task
+
+    async def run(self) -> None:
+        """Connect, serve and reconnect until :meth:`close`; then return."""
+        if self._loop_task is not None:
+            raise RuntimeError("RosbridgeClient.run() already called")
+        if self._closing:
+            return  # closed before the loop began (start() then close() at once)
+        task = asyncio.get_running_loop().create_task(self._connect_loop())
+        self._loop_task = task
+        try:
+            await task
+        except asyncio.CancelledError:
+            current = asyncio.current_task()
+            if current is not None and current.cancelling():
+                raise  # run() itself was cancelled (the loop task with it)
+            # otherwise close() cancelled the loop: a normal end
+
+    async def close(self) -> None:
+        """Stop the connect loop and close the connection; final."""
+        self._closing = True
+        for task in (self._loop_task, self._run_task):
+            if task is not None and not task.done():
+                if task is asyncio.current_task():
+                    raise RuntimeError("close() called from inside the client's own task")
+                if task is self._loop_task:
+                    task.cancel()
+                await asyncio.wait({task})
+
+    async def wait_connected(self, timeout: float | None = None) -> bool:
+        """True once connected; False if ``timeout`` seconds pass first."""
+        if self._link.connected:
+            return True
+        try:
+            async with asyncio.timeout(timeout):
+                await self._up.wait()
+        except TimeoutError:
+            return False
+        return True
+
+    # ------------------------------------------------------------ connect loop
+
+    async def _connect_loop(self) -> None:
+        # Backoff waits on real time (asyncio.sleep), never on the executive's
+        # Clock: under --sim-time the link IS the source of /clock, so a sim
+        # clock would stand still exactly while the link is down.
+        delays = backoff_delays(self.backoff_initial, self.backoff_max)
+        while True:
+            error: str | None = None
+            try:
+                async with connect(self.url, proxy=None, max_size=_MAX_WS_MESSAGE,
+                                   open_timeout=10, close_timeout=2) as ws:
+                    self._on_up(ws)
+                    delays = backoff_delays(self.backoff_initial, self.backoff_max)  # reset
+                    error = await self._serve(ws)
+            except asyncio.CancelledError:
+                error = None  # close(): not an error
+                raise
+            except (OSError, TimeoutError, WebSocketException) as exc:
+                error = _describe(exc)
+            except Exception as exc:  # a bug; keep the link alive regardless
+                error = _describe(exc)
+                log.exception("rosbridge %s: unexpected error", self.url)
+            finally:
+                self._on_down(error)
+            await asyncio.sleep(next(delays))
+
+    async def _serve(self, ws: ClientConnection) -> str:
+        """Run reader and writer until the connection ends; say why it ended."""
+        reader = asyncio.create_task(self._read_loop(ws))
+        writer = asyncio.create_task(self._write_loop(ws))
+        try:
+            done, _ = await asyncio.wait((reader, writer), return_when=asyncio.FIRST_COMPLETED)
+        finally:
+            for task in (reader, writer):
+                task.cancel()
+            await asyncio.wait((reader, writer))
+        for task in done:
+            exc = task.exception()
+            if exc is not None and not isinstance(exc, ConnectionClosed):
+                raise exc
+        code = ws.close_code if ws.close_code is not None else 1006
+        return f"connection closed (code {code}{', ' + ws.close_reason if ws.close_reason else ''})"
+
+    async def _read_loop(self, ws: ClientConnection) -> None:
+        async for frame in ws:
+            self._on_frame(frame)
+
+    async def _write_loop(self, ws: ClientConnection) -> None:
+        out = self._outbox
+        while True:
+            if not out:
+                self._wake.clear()
+                await self._wake.wait()
+                continue
+            # Peek, send, then pop: a frame whose send failed is still in the
+            # outbox when the link goes down, and publishes there are re-queued.
+            await ws.send(out[0])
+            out.popleft()
+            self.stats.sent += 1
+
+    def _enqueue(self, frames: list[str]) -> None:
+        if frames:
+            self._outbox.extend(frames)
+            self._wake.set()
+
+    def _on_up(self, ws: ClientConnection) -> None:
+        with contextlib.suppress(Exception):  # addresses only feed the auth MAC
+            self.session.client_addr = str(ws.local_address[0])
+            self.session.dest_addr = str(ws.remote_address[0])
+        self._outbox.clear()
+        self._enqueue(self.session.on_connected(time.time()))
+        if self._ever_connected:
+            self.stats.reconnects += 1
+        self._ever_connected = True
+        self._up.set()
+        log.info("rosbridge %s: connected", self.url)
+        self._set_link(True, None)
+
+    def _on_down(self, error: str | None) -> None:
+        pending = list(self._outbox)
+        self._outbox.clear()
+        self.session.on_disconnected()
+        self._up.clear()
+        dropped = self.session.dropped
+        for text in pending:  # publishes that never made it: back into the Session's queue
+            self._requeue(text)
+        self._note_dropped(dropped)
+        if self._link.connected:
+            if error is None:
+                log.info("rosbridge %s: closed", self.url)
+            else:
+                log.warning("rosbridge %s: link lost: %s", self.url, error)
+            self._set_link(False, error)
+        elif error is not None:
+            self.stats.connect_failures += 1
+            self._link = replace(self._link, last_error=error)
+            self._warn("connect", "rosbridge %s: cannot connect: %s", self.url, error)
+
+    def _requeue(self, text: str) -> None:
+        frame = json.loads(text)
+        if frame.get("op") != "publish":
+            return  # advertise/subscribe/auth are regenerated by on_connected
+        with contextlib.suppress(ValueError):  # unadvertised meanwhile: drop it
+            self.session.publish(frame["topic"], frame["msg"])
+
+    def _set_link(self, connected: bool, error: str | None) -> None:
+        self._link = LinkState(connected, time.monotonic(), self.stats.reconnects, error)
+        if self.on_link is not None:
+            try:
+                self.on_link(self._link)
+            except Exception:
+                log.exception("rosbridge %s: on_link callback failed", self.url)
+
+    # ------------------------------------------------------------ inbound
+
+    def _on_frame(self, frame: str | bytes) -> None:
+        self.stats.received += 1
+        try:
+            event = decode_frame(frame)
+        except DecodeError as exc:
+            self._malformed(FRAME_TOPIC, f"malformed frame: {exc}")
+            return
+        if isinstance(event, Status):
+            log.debug("rosbridge status %s: %s (id %s)", event.level, event.msg, event.id)
+            return
+        if isinstance(event, OtherOp):
+            log.debug("rosbridge: ignoring op %r", event.op)
+            return
+        assert isinstance(event, Publish)
+        sub = self.session.subscriptions.get(event.topic)
+        if sub is None:
+            log.debug("rosbridge: publish on %s, which is not subscribed", event.topic)
+            return
+        try:
+            value = DECODERS[sub.type](event.msg)
+        except DecodeError as exc:
+            self._malformed(event.topic, f"malformed {sub.type} on {event.topic}: msg.{exc}")
+            return
+        if self.on_message is None:
+            return
+        try:
+            self.on_message(event.topic, value)
+        except Exception:
+            held = self._throttle.allow(f"on_message {event.topic}", time.monotonic())
+            if held is not None:
+                log.exception("rosbridge: on_message(%s) failed%s", event.topic, _held(held))
+
+    def _malformed(self, topic: str, text: str) -> None:
+        self.stats.malformed += 1
+        by_topic = self.stats.malformed_by_topic
+        by_topic[topic] = by_topic.get(topic, 0) + 1
+        self._warn(topic, "rosbridge: %s", text)
+
+    def _note_dropped(self, before: int) -> None:
+        self.stats.dropped = self.session.dropped
+        if self.session.dropped > before:
+            self._warn("queue", "rosbridge %s: link down, publish queue full (%d), "
+                       "%d dropped in all", self.url, self.session.queue_limit,
+                       self.session.dropped)
+
+    def _warn(self, key: str, fmt: str, *args: Any) -> None:
+        held = self._throttle.allow(key, time.monotonic())
+        if held is not None:
+            log.warning(fmt + "%s", *args, _held(held))
+
+
+def backoff_delays(initial: float, maximum: float) -> Iterator[float]:
+    """``initial``, doubling each time, capped at ``maximum``; never ends."""
+    delay = initial
+    while True:
+        yield delay
+        delay = min(delay * 2, maximum)
+
+
+def _held(count: int) -> str:
+    return f" ({count} more suppressed)" if count else ""
+
+
+def _describe(exc: BaseException) -> str:
+    text = str(exc)
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
