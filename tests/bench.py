@@ -8,10 +8,10 @@ from typing import Any
 
 import py_trees
 
+from frog_bt.clock import ManualClock
 from frog_bt.config import Site, load_site
 from frog_bt.core import Core
 from frog_bt.frontend.messages import FrontendMessage
-from frog_bt.clock import ManualClock
 from frog_bt.messages import (
     PersonDetection,
     PersonDetections,

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import py_trees
-
 import pytest
 from bench import AFTERNOON, MORNING, Bench, write_tree
 

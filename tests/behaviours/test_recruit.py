@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import py_trees
-
 from bench import Bench, write_tree
 
 from frog_bt.frontend.messages import (

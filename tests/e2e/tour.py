@@ -1,0 +1,93 @@
+"""Run the real executive against the built-in simulator, in one event loop, on sim time."""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+from dataclasses import dataclass
+from typing import Any
+
+from frog_bt.clock import SimClock
+from frog_bt.config import Site, load_site
+from frog_bt.executive import Executive, Outcome
+from frog_bt.sim import Simulator, load_scenario, parse_scenario
+from frog_bt.sim.traffic import Record
+from frog_bt.summary import TourSummary
+from frog_bt.tree.loader import LoadedTree, load_tree
+
+FAST = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+@dataclass
+class Tour:
+    sim: Simulator
+    executive: Executive
+    outcome: Outcome
+    summary: TourSummary
+    site: Site
+
+    def commands(self) -> list[str]:
+        """What the executive sent, as the simulator received it, compactly."""
+        return [describe(r, self.summary) for r in self.sim.received()
+                if r.channel != "ack"]
+
+    def ros_commands(self) -> list[str]:
+        return [c for c in self.commands() if c.startswith("/")]
+
+    def frontend_commands(self) -> list[str]:
+        return [c for c in self.commands() if not c.startswith("/")]
+
+
+def describe(record: Record, summary: TourSummary) -> str:
+    p: Any = record.payload
+    if record.side == "ros":
+        if record.channel == "/GotoWayPoint":
+            return f"/GotoWayPoint {summary.waypoint_of(p)}"
+        return f"{record.channel} {p['data']}"
+    fields = " ".join(str(v) for k, v in p.items() if k not in ("type", "seq"))
+    return f"{record.channel} {fields}".rstrip()
+
+
+
+def merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+    """``over`` on top of ``base``: mappings merge, everything else replaces."""
+    out = dict(base)
+    for key, value in over.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+async def run_tour(scenario_data: dict[str, Any], *, site: Site | None = None,
+                   tree: LoadedTree | None = None, wall_timeout: float = 60.0,
+                   ) -> Tour:
+    site = site or load_site()
+    tree = tree or load_tree(site=site)
+    sc = parse_scenario(merge(load_scenario("default").model_dump(mode="json"),
+                              {**FAST, **scenario_data}))
+    listen = ("127.0.0.1", free_udp_port())
+    sim = Simulator(sc, rosbridge_port=0, frontend_port=0, executive=listen)
+    await sim.start()
+    executive = Executive(site, tree, SimClock(),
+                          rosbridge_url=f"ws://127.0.0.1:{sim.rosbridge_port}",
+                          frontend=("127.0.0.1", sim.frontend_port), listen=listen,
+                          sim_time=True, once=True)
+    summary = TourSummary(site)
+    summary.attach(executive.taps)
+    try:
+        outcome = await asyncio.wait_for(executive.run(), wall_timeout)
+    finally:
+        await sim.stop()
+    return Tour(sim, executive, outcome, summary, site)
+
+
+def tour(scenario_data: dict[str, Any], **kwargs: Any) -> Tour:
+    return asyncio.run(run_tour(scenario_data, **kwargs))
