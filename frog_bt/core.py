@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from typing import Any
 
 import py_trees
@@ -29,6 +30,23 @@ Status = py_trees.common.Status
 
 # High-rate inputs do not each call for a tick; the periodic tick covers them.
 NO_TICK_ROLES = frozenset({"pose", "faces", "people"})
+Tap = Callable[[float, str, Any], None]  # (project-clock time, channel, payload)
+
+
+@dataclass(slots=True)
+class Taps:
+    """Observers of what crosses the core (recording, telemetry, summaries, status line).
+
+    ``ros_in`` gets typed values, ``ros_out`` the ``msg`` dicts sent, ``frontend_in``
+    and ``frontend_out`` typed front-end messages (channel = message type), ``tick``
+    the core after each tick. Taps must be quick: they run on the tick path.
+    """
+
+    ros_in: list[Tap] = field(default_factory=list)
+    ros_out: list[Tap] = field(default_factory=list)
+    frontend_in: list[Tap] = field(default_factory=list)
+    frontend_out: list[Tap] = field(default_factory=list)
+    tick: list[Callable[[Core], None]] = field(default_factory=list)
 
 
 class Core:
@@ -39,11 +57,13 @@ class Core:
         self.tree = tree
         self.clock = clock
         self._publish_topic = publish
+        self._send = send
+        self.taps = Taps()
         self.inputs = Inputs()
         self.roles = {site.topic(role): role for role in INPUTS}
         self.actions = Actions(self._publish, clock)
         py_trees.blackboard.Blackboard.clear()  # one tree per process at a time
-        self.ctx = Context(clock, site, self.actions, send)
+        self.ctx = Context(clock, site, self.actions, self._send_message)
         self.snapshot = Snapshot(self.inputs, clock, self.actions)
         self.bt = py_trees.trees.BehaviourTree(tree.root)
         self.bt.add_pre_tick_handler(lambda _: self.snapshot.write())
@@ -51,7 +71,15 @@ class Core:
         self._setup = False
 
     def _publish(self, role: str, msg: dict[str, Any]) -> None:
-        self._publish_topic(self.site.topic(role), msg)
+        topic = self.site.topic(role)
+        self._publish_topic(topic, msg)
+        for tap in self.taps.ros_out:
+            tap(self.clock.now(), topic, msg)
+
+    def _send_message(self, message: FrontendMessage) -> None:
+        self._send(message)
+        for tap in self.taps.frontend_out:
+            tap(self.clock.now(), message.type, message)
 
     def setup(self) -> None:
         if not self._setup:
@@ -63,6 +91,8 @@ class Core:
     def on_ros(self, topic: str, value: Any) -> bool:
         """Cache one decoded message; True when it calls for a tick."""
         now = self.clock.now()
+        for tap in self.taps.ros_in:
+            tap(now, topic, value)
         role = self.roles.get(topic)
         inp = self.inputs
         if role == "pose":
@@ -84,7 +114,10 @@ class Core:
         return role not in NO_TICK_ROLES
 
     def on_event(self, message: FrontendMessage) -> None:
-        self.inputs.events.append((message, self.clock.now()))
+        now = self.clock.now()
+        for tap in self.taps.frontend_in:
+            tap(now, message.type, message)
+        self.inputs.events.append((message, now))
 
     # ------------------------------------------------------------ ticking
 
@@ -92,6 +125,8 @@ class Core:
         self.setup()
         self.bt.tick()
         self.ticks += 1
+        for tap in self.taps.tick:
+            tap(self)
         return self.bt.root.status
 
     def halt(self) -> None:

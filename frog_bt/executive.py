@@ -32,7 +32,6 @@ from frog_bt.tree.loader import LoadedTree
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
-Tap = Callable[[float, str, Any], None]
 
 
 @dataclass(slots=True)
@@ -44,35 +43,38 @@ class Outcome:
     tours: int = 0
 
 
-@dataclass(slots=True)
-class Taps:
-    """Observers of traffic and ticks (recording, telemetry, status line)."""
+RawTap = Callable[[float, str, Any], None]
 
-    ros_in: list[Tap] = field(default_factory=list)
-    ros_out: list[Tap] = field(default_factory=list)
-    frontend_in: list[Tap] = field(default_factory=list)
-    frontend_out: list[Tap] = field(default_factory=list)
-    tick: list[Callable[[Executive], None]] = field(default_factory=list)
+
+@dataclass(slots=True)
+class WireTaps:
+    """Observers of raw traffic (the recorder): ``ros_in(t, topic, msg_dict)`` for every
+    message received on a subscribed topic, ``datagram(direction, data, t)`` for every
+    UDP datagram in (``"in"``) or out (``"out"``)."""
+
+    ros_in: list[RawTap] = field(default_factory=list)
+    datagram: list[Callable[[str, bytes, float], None]] = field(default_factory=list)
 
 
 class Executive:
     def __init__(self, site: Site, tree: LoadedTree, clock: Clock, *,
                  rosbridge_url: str, frontend: tuple[str, int], listen: tuple[str, int],
-                 sim_time: bool = False, secret: str | None = None, once: bool = False,
-                 taps: Taps | None = None) -> None:
+                 sim_time: bool = False, secret: str | None = None, once: bool = False
+                 ) -> None:
         if sim_time and not isinstance(clock, ManualClock):
             raise ValueError("sim time needs a ManualClock (SimClock)")
         self.site = site
         self.clock = clock
         self.sim_time = sim_time
         self.once = once
-        self.taps = taps or Taps()
         self.outcome = Outcome()
+        self.wire = WireTaps()
         self.client = RosbridgeClient(rosbridge_url, secret=secret, on_message=self._on_ros,
-                                      on_link=self._on_link)
+                                      on_link=self._on_link, on_raw=self._on_raw)
         self.link = FrontendLink(listen, frontend, clock, inbound=EVENTS,
-                                 on_message=self._on_event)
-        self.core = Core(site, tree, clock, self._publish, self._send)
+                                 on_message=self._on_event, on_datagram=self._on_datagram)
+        self.core = Core(site, tree, clock, self.client.publish, self.link.send)
+        self.taps = self.core.taps
         self._wake = asyncio.Event()
         self._stopping = asyncio.Event()
 
@@ -82,32 +84,26 @@ class Executive:
         if topic == CLOCK.name and self.sim_time:
             self.clock.set(value)  # type: ignore[attr-defined]
             return
-        for tap in self.taps.ros_in:
-            tap(self.clock.now(), topic, value)
         if self.core.on_ros(topic, value):
             self._wake.set()
+
+    def _on_raw(self, topic: str, msg: Any) -> None:
+        if self.wire.ros_in:
+            now = self.clock.now()
+            for tap in self.wire.ros_in:
+                tap(now, topic, msg)
 
     def _on_link(self, state: LinkState) -> None:
         self.core.inputs.link = state
         self._wake.set()
 
     def _on_event(self, message: FrontendMessage) -> None:
-        for tap in self.taps.frontend_in:
-            tap(self.clock.now(), message.type, message)
         self.core.on_event(message)
         self._wake.set()
 
-    # ------------------------------------------------------------ outputs (non-blocking)
-
-    def _publish(self, topic: str, msg: dict[str, Any]) -> None:
-        self.client.publish(topic, msg)
-        for tap in self.taps.ros_out:
-            tap(self.clock.now(), topic, msg)
-
-    def _send(self, message: FrontendMessage) -> None:
-        self.link.send(message)
-        for tap in self.taps.frontend_out:
-            tap(self.clock.now(), message.type, message)
+    def _on_datagram(self, direction: str, data: bytes, t: float) -> None:
+        for tap in self.wire.datagram:
+            tap(direction, data, t)
 
     # ------------------------------------------------------------ lifecycle
 
@@ -165,8 +161,6 @@ class Executive:
 
     def tick(self) -> None:
         status = self.core.tick()
-        for tap in self.taps.tick:
-            tap(self)
         if status == Status.SUCCESS:
             self.outcome.tours += 1
             if self.once:

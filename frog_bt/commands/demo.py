@@ -29,6 +29,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--tree", type=Path, help="tour tree (default: trees/tour.yaml)")
     p.add_argument("--timeout", type=float, default=300.0,
                    help="give up after this many wall seconds (default: 300)")
+    p.add_argument("--record", type=Path, default=Path("frog-demo.mcap"), metavar="FILE.mcap",
+                   help="MCAP recording of the tour (default: frog-demo.mcap)")
+    p.add_argument("--rerun", default="save:frog-demo.rrd", metavar="SPEC",
+                   help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve | off "
+                   "(default: save:frog-demo.rrd)")
     p.add_argument("--quiet", action="store_true", help="no live status line")
 
 
@@ -56,6 +61,7 @@ def run(args: argparse.Namespace) -> int:
 
 async def _demo(site, tree, scenario, args) -> int:  # type: ignore[no-untyped-def]
     from frog_bt.clock import SimClock
+    from frog_bt.commands.run import attach_observers
     from frog_bt.executive import Executive
     from frog_bt.sim import Simulator
     from frog_bt.status import StatusLine
@@ -73,7 +79,9 @@ async def _demo(site, tree, scenario, args) -> int:  # type: ignore[no-untyped-d
     summary.attach(executive.taps)
     status = None if args.quiet else StatusLine()
     if status is not None:
-        executive.taps.tick.append(lambda ex: status.update(ex.core))
+        executive.taps.tick.append(status.update)
+    rerun = None if args.rerun == "off" else args.rerun
+    observers = attach_observers(executive, record=args.record, rerun=rerun)
     wall0, sim0 = time.monotonic(), sim.clock.now()
     loop = asyncio.get_running_loop()
     loop.call_later(args.timeout, executive.stop, f"no docked finish within {args.timeout:g} s "
@@ -82,6 +90,8 @@ async def _demo(site, tree, scenario, args) -> int:  # type: ignore[no-untyped-d
         outcome = await executive.run()
     finally:
         await sim.stop()
+        for observer in observers:
+            observer.close()
         if status is not None:
             status.close()
     wall, simulated = time.monotonic() - wall0, sim.clock.now() - sim0
@@ -96,4 +106,8 @@ async def _demo(site, tree, scenario, args) -> int:  # type: ignore[no-untyped-d
         print(f"frog-bt: {outcome.reason}", file=sys.stderr)
         return outcome.code
     print(f"  outcome:   {outcome.reason}")
+    if args.record:
+        print(f"  recording: {args.record}  (replay: frog-bt replay {args.record})")
+    if rerun and rerun.startswith("save:"):
+        print(f"  telemetry: {rerun[5:]}  (view: rerun {rerun[5:]})")
     return 0

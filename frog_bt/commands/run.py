@@ -19,6 +19,7 @@ import os
 import signal
 import sys
 from pathlib import Path
+from typing import Any
 
 from frog_bt.clock import SimClock, WallClock
 from frog_bt.config import Site, load_site, parse_hostport
@@ -39,6 +40,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="take time from /clock (ROS use_sim_time); nothing is timed before it")
     p.add_argument("--record", metavar="FILE.mcap", type=Path,
                    help="record every message in and out to an MCAP file")
+    p.add_argument("--rerun", metavar="SPEC",
+                   help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve (default: off)")
     p.add_argument("--once", action="store_true",
                    help="exit 0 after one tour ends docked; non-zero when it cannot go on")
     p.add_argument("--quiet", action="store_true", help="no live status line")
@@ -52,6 +55,24 @@ def read_secret(site: Site) -> str | None:
     if not secret and links.secret_file:
         secret = Path(links.secret_file).read_text(encoding="utf-8").strip()
     return secret or None
+
+
+def attach_observers(executive: Any, *, record: Path | None, rerun: str | None) -> list[Any]:
+    """Recorder and telemetry, each imported only when asked for; closed by the caller."""
+    observers: list[Any] = []
+    if record is not None:
+        from frog_bt.recording import Recorder
+
+        recorder = Recorder(record)
+        recorder.attach(executive)
+        observers.append(recorder)
+    if rerun:
+        from frog_bt.telemetry import Telemetry
+
+        telemetry = Telemetry.open(rerun, executive.site, executive.core.tree)
+        telemetry.attach(executive.core)
+        observers.append(telemetry)
+    return observers
 
 
 def run(args: argparse.Namespace) -> int:
@@ -78,13 +99,16 @@ def run(args: argparse.Namespace) -> int:
                               once=args.once)
         status = None if args.quiet else StatusLine()
         if status is not None:
-            executive.taps.tick.append(lambda ex: status.update(ex.core))
+            executive.taps.tick.append(status.update)
+        observers = attach_observers(executive, record=args.record, rerun=args.rerun)
         loop = asyncio.get_running_loop()
         for sig in (signal.SIGINT, signal.SIGTERM):
             loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)
         try:
             outcome = await executive.run()
         finally:
+            for observer in observers:
+                observer.close()
             if status is not None:
                 status.close()
         if outcome.code:

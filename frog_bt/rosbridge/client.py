@@ -103,6 +103,7 @@ class RosbridgeClient:
         backoff_max: float = 5.0,
         on_message: Callable[[str, Any], None] | None = None,
         on_link: Callable[[LinkState], None] | None = None,
+        on_raw: Callable[[str, Any], None] | None = None,
     ) -> None:
         try:
             parse_uri(url)
@@ -118,6 +119,7 @@ class RosbridgeClient:
         self.backoff_max = backoff_max
         self.on_message = on_message
         self.on_link = on_link
+        self.on_raw = on_raw  # (topic, msg JSON) of every publish on a subscribed topic
         self.session = Session(queue_limit=queue_limit, secret=secret)
         self.stats = ClientStats()
         self._link = LinkState(connected=False, since=time.monotonic())
@@ -351,6 +353,8 @@ class RosbridgeClient:
         if sub is None:
             log.debug("rosbridge: publish on %s, which is not subscribed", event.topic)
             return
+        if self.on_raw is not None:
+            self.on_raw(event.topic, event.msg)
         try:
             value = DECODERS[sub.type](event.msg)
         except DecodeError as exc:
