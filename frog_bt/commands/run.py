@@ -41,7 +41,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--record", metavar="FILE.mcap", type=Path,
                    help="record every message in and out to an MCAP file")
     p.add_argument("--rerun", metavar="SPEC",
-                   help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve (default: off)")
+                   help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve "
+                   "(default: off)")
     p.add_argument("--once", action="store_true",
                    help="exit 0 after one tour ends docked; non-zero when it cannot go on")
     p.add_argument("--quiet", action="store_true", help="no live status line")

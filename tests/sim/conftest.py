@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 import asyncio
-import json
-from collections.abc import Awaitable, Callable, Coroutine
+from collections.abc import Callable, Coroutine
 from typing import Any, TypeVar
 
 import pytest
-from websockets.asyncio.client import ClientConnection, connect
 
 from frog_bt.sim.scenario import Scenario, parse_scenario
 from frog_bt.sim.site import PoiPose, load_pois
@@ -53,46 +51,3 @@ def arun() -> Callable[[Coroutine[Any, Any, T]], T]:
         return asyncio.run(guarded())
 
     return run
-
-
-class RosClient:
-    """A bare rosbridge client for tests: send ops, await the frames that match."""
-
-    def __init__(self, ws: ClientConnection) -> None:
-        self.ws = ws
-
-    @classmethod
-    async def open(cls, port: int) -> RosClient:
-        return cls(await connect(f"ws://127.0.0.1:{port}"))
-
-    async def send(self, **frame: Any) -> None:
-        await self.ws.send(json.dumps(frame))
-
-    async def subscribe(self, topic: str, type_: str = "") -> None:
-        await self.send(op="subscribe", id=f"subscribe:{topic}", topic=topic, type=type_)
-
-    async def publish(self, topic: str, msg: dict[str, Any]) -> None:
-        await self.send(op="publish", id=f"publish:{topic}", topic=topic, msg=msg)
-
-    async def next(self, predicate: Callable[[dict[str, Any]], bool]) -> dict[str, Any]:
-        """The next frame satisfying ``predicate`` (the others are skipped)."""
-        while True:
-            frame = json.loads(await self.ws.recv())
-            if predicate(frame):
-                return frame
-
-    async def next_publish(self, topic: str,
-                           check: Callable[[dict[str, Any]], bool] = lambda msg: True,
-                           ) -> dict[str, Any]:
-        """The ``msg`` of the next publish on ``topic`` that passes ``check``."""
-        frame = await self.next(lambda f: f.get("op") == "publish" and f.get("topic") == topic
-                                and check(f["msg"]))
-        return frame["msg"]
-
-    async def close(self) -> None:
-        await self.ws.close()
-
-
-@pytest.fixture
-def ros_client() -> Callable[[int], Awaitable[RosClient]]:
-    return RosClient.open
