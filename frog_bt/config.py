@@ -102,6 +102,66 @@ class Follow(_Model):
     grace: NonNegative = 10.0
 
 
+class EngagementCfg(_Model):
+    near: Positive = 2.0  # metres: farther faces are not stored
+    window: Positive = 2.0  # seconds per engagement meter update
+    edge: Annotated[float, Field(gt=0, le=0.5)] = 0.15  # first and last fraction voting
+    on_tie: bool = False  # a tied vote tells more?
+    no_data: bool = False  # no face data at all tells more?
+
+
+class ProjectorCfg(_Model):
+    warmup: Positive = 20.0  # seconds the projector needs to warm up
+    margin: NonNegative = 5.0  # seconds of safety on top of the warm-up
+    radius: Positive = 15.0  # metres: switch on inside this radius of the POI anyway
+    speed_window: Positive = 5.0  # seconds of poses for the recent speed
+
+
+class Circle(_Model):
+    x: Finite
+    y: Finite
+    r: Positive
+
+
+class ZoneShape(_Model):
+    """A circle or a polygon (at least three ``[x, y]`` points), map frame."""
+
+    circle: Circle | None = None
+    polygon: list[tuple[Finite, Finite]] | None = None
+
+    @model_validator(mode="after")
+    def _one_shape(self) -> ZoneShape:
+        if (self.circle is None) == (self.polygon is None):
+            raise ValueError("expected exactly one of circle: {x, y, r} or polygon: [[x, y], ...]")
+        if self.polygon is not None and len(self.polygon) < 3:
+            raise PathError(("polygon",), "expected at least three points")
+        return self
+
+
+class VolumeZone(ZoneShape):
+    name: str
+    percent: int = Field(ge=0, le=100)
+
+
+class Volume(_Model):
+    default: int = Field(100, ge=0, le=100)
+    hysteresis: NonNegative = 1.0  # metres outside a zone before leaving it
+    zones: list[VolumeZone] = []
+
+
+class SpecialSpot(ZoneShape):
+    spot: str
+
+
+class Zones(_Model):
+    arrival: dict[str, Positive] = {"default": 5.0}  # metres around a POI; per POI or default
+    volume: Volume = Volume()
+    special: list[SpecialSpot] = []
+
+    def arrival_radius(self, poi: str) -> float:
+        return self.arrival.get(poi, self.arrival.get("default", 5.0))
+
+
 class Links(_Model):
     rosbridge: str = DEFAULT_ROSBRIDGE_URL
     frontend: str = "{}:{}".format(*DEFAULT_FRONTEND)
@@ -124,6 +184,9 @@ class Site(_Model):
     follow: Follow = Follow()
     links: Links = Links()
     executive: Executive = Executive()
+    engagement: EngagementCfg = EngagementCfg()
+    projector: ProjectorCfg = ProjectorCfg()
+    zones: Zones = Zones()
     topics: dict[Literal[tuple(INPUTS) + tuple(OUTPUTS)], str] = {}  # type: ignore[valid-type]
 
     @model_validator(mode="after")
@@ -142,6 +205,9 @@ class Site(_Model):
         for key in ("dock", "recruit_at"):
             if getattr(self.tour, key) not in self.pois:
                 raise _at(("tour", key), _unknown(getattr(self.tour, key), known))
+        for key in self.zones.arrival:
+            if key != "default" and key not in self.pois and key not in self.variants:
+                raise _at(("zones", "arrival", key), _unknown(key, known))
         for i, stop in enumerate(self.tour.stops):
             if stop.poi not in self.pois and stop.poi not in self.variants:
                 raise _at(("tour", "stops", i, "poi"),

@@ -16,8 +16,10 @@ from frog_bt.core import Core
 
 
 def phase(core: Core) -> str:
-    """The running child of the root: the tour's current phase."""
+    """The running child of the top composite (below any decorators): the tour's phase."""
     root = core.bt.root
+    while isinstance(root, py_trees.decorators.Decorator):
+        root = root.decorated
     for child in getattr(root, "children", ()):
         if child.status == py_trees.common.Status.RUNNING:
             return child.name

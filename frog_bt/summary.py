@@ -10,7 +10,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import py_trees
+
 from frog_bt.config import Site
+from frog_bt.engagement import Decision
 from frog_bt.frontend.messages import StartPoi, UserPositive
 from frog_bt.messages import decode_pose
 from frog_bt.topics import SUCCEEDED
@@ -23,7 +26,9 @@ class TourSummary:
     content: list[tuple[str, str, str]] = field(default_factory=list)  # (poi, waypoint, part)
     approached: list[int] = field(default_factory=list)
     recruited: list[int] = field(default_factory=list)
+    decisions: list[tuple[str, Decision]] = field(default_factory=list)  # (about, decision)
     _goal: str | None = None
+    _last_decision: Any = None
 
     def waypoint_of(self, msg: dict[str, Any]) -> str:
         pose = decode_pose(msg)
@@ -54,7 +59,14 @@ class TourSummary:
         if isinstance(message, UserPositive) and self.approached:
             self.recruited.append(self.approached[-1])
 
+    def tick(self, core: Any) -> None:
+        decision = py_trees.blackboard.Blackboard.storage.get("/engagement_decision")
+        if decision is not None and decision is not self._last_decision:
+            self._last_decision = decision
+            self.decisions.append(decision)
+
     def attach(self, taps: Any) -> None:
+        taps.tick.append(self.tick)
         taps.ros_out.append(self.ros_out)
         taps.ros_in.append(self.ros_in)
         taps.frontend_out.append(self.frontend_out)
@@ -68,4 +80,6 @@ class TourSummary:
             f"content:   {played}",
             f"visitors:  approached {self.approached or 'none'}, "
             f"recruited {self.recruited or 'none'}",
+            *(f"{'engaged?' if i == 0 else '':<10} {about}: {d.describe()}"
+              for i, (about, d) in enumerate(self.decisions)),
         ]

@@ -1,5 +1,15 @@
-"""Every leaf type a tree file can name; importing this package registers them all."""
+"""Every leaf and scope a tree file can name; importing this package registers them all."""
 
-from frog_bt.behaviours import docking, navigation, recruit, tour, visit
+from frog_bt.behaviours import (
+    docking,
+    engagement,
+    location,
+    navigation,
+    projector,
+    recruit,
+    tour,
+    visit,
+)
 
-__all__ = ["docking", "navigation", "recruit", "tour", "visit"]
+__all__ = ["docking", "engagement", "location", "navigation", "projector", "recruit", "tour",
+           "visit"]

@@ -118,14 +118,16 @@ class StartIntroduction(Leaf):
 
 @register
 class AskTour(Leaf):
-    """Ask the visitor to join (``ask_tour``).
+    """Ask the visitor to join (``ask_tour``), worded by their engagement.
 
-    ``engaged`` is null for now: the engagement measure comes with the
-    engagement issue. SUCCESS.
+    Reads ``/engaged`` (optional): the decision over the introduction's face
+    samples, None (sent as null) without face data. SUCCESS.
     """
 
+    optional_reads = ("/engaged",)
+
     def update(self) -> Status:
-        self.ctx.send(AskTourCommand(None))
+        self.ctx.send(AskTourCommand(self.get("/engaged")))
         return SUCCESS
 
 

@@ -32,15 +32,15 @@ class TourStatus(Leaf):
     """Send ``tour`` with ``state`` and ``reason`` to the front end.
 
     Writes ``/frontend_ready`` (False: the next tour needs a fresh
-    ``frontend_idle``), ``/declined`` (cleared when a tour starts) and
-    ``/tour_state``. SUCCESS.
+    ``frontend_idle``), ``/declined`` and ``/special_done`` (cleared when a tour
+    starts) and ``/tour_state``. SUCCESS.
     """
 
     class Params(Params):
         state: Literal["started", "ended", "aborted"]
         reason: str = ""
 
-    writes = ("/frontend_ready", "/declined", "/tour_state")
+    writes = ("/frontend_ready", "/declined", "/special_done", "/tour_state")
 
     def update(self) -> Status:
         p = self.params
@@ -50,6 +50,7 @@ class TourStatus(Leaf):
         self.set("/tour_state", p.state)
         if p.state == "started":
             self.set("/declined", frozenset())
+            self.set("/special_done", frozenset())
         return SUCCESS
 
 

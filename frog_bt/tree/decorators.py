@@ -1,30 +1,35 @@
-"""Decorators that keep time on the project clock (py_trees' own ``Timeout`` reads the wall clock).
+"""Decorators of tour trees, and the project-clock ones every tree may use.
+
+A decorator declares parameters and blackboard keys like a leaf does (see
+:mod:`frog_bt.tree.leaf`) and is registered in :data:`DECORATORS` with
+:func:`register_decorator`; tree files name it by class name.
 
 * :class:`Retry` — runs its child again after FAILURE, up to ``attempts`` runs in
   all (``None``: until it succeeds); the child starts afresh each time.
 * :class:`Timeout` — FAILURE (and the child stopped) once ``seconds`` of
-  project-clock time have passed while the child is RUNNING.
-* :class:`FaceStream` — a scope: ``/ICL_command`` ``start`` when entered, ``stop``
-  when left for any reason (success, failure or interruption). Writes ``/icl``.
+  project-clock time have passed while the child is RUNNING. (py_trees' own
+  ``Timeout`` reads the wall clock.)
+* :class:`FailureIsSuccess` — an optional part: its child's FAILURE is SUCCESS.
 
-Every decorator declares a pydantic ``Params`` model like a leaf does, so tree
-files are checked the same way.
+Domain scopes (face stream, projector, follow-me, location) live with their
+behaviours in :mod:`frog_bt.behaviours`.
 """
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 import py_trees
 from pydantic import BaseModel, Field
 
 from frog_bt.context import Context
-from frog_bt.tree.leaf import FAILURE, RUNNING, Params, Status
+from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Params, Status
 
 
-class _ClockDecorator(py_trees.decorators.Decorator):
+class FrogDecorator(py_trees.decorators.Decorator):
     Params: ClassVar[type[BaseModel]] = Params
     reads: ClassVar[tuple[str, ...]] = ()
+    optional_reads: ClassVar[tuple[str, ...]] = ()
     writes: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour,
@@ -32,6 +37,12 @@ class _ClockDecorator(py_trees.decorators.Decorator):
         super().__init__(name=name, child=child)
         self.params: Any = params if params is not None else type(self).Params()
         self._ctx: Context | None = None
+        if self.reads or self.optional_reads or self.writes:
+            self.bb = self.attach_blackboard_client(name=name)
+            for key in (*self.reads, *self.optional_reads):
+                self.bb.register_key(key, access=py_trees.common.Access.READ)
+            for key in self.writes:
+                self.bb.register_key(key, access=py_trees.common.Access.WRITE)
 
     def setup(self, **kwargs: Any) -> None:
         self._ctx = kwargs["ctx"]
@@ -42,19 +53,43 @@ class _ClockDecorator(py_trees.decorators.Decorator):
             raise RuntimeError(f"{self.name}: ticked before setup(ctx=...)")
         return self._ctx
 
+    def get(self, key: str, default: Any = None) -> Any:
+        try:
+            return self.bb.get(key)
+        except KeyError:
+            return default
+
+    def set(self, key: str, value: Any) -> None:
+        self.bb.set(key, value, overwrite=True)
+
     def describe(self) -> dict[str, Any]:
         return self.params.model_dump(exclude_none=True)
 
 
-class Retry(_ClockDecorator):
+D = TypeVar("D", bound=type[FrogDecorator])
+DECORATORS: dict[str, type[FrogDecorator]] = {}
+
+
+def register_decorator(cls: D) -> D:
+    if cls.__name__ in DECORATORS:
+        raise ValueError(f"decorator type {cls.__name__} registered twice")
+    DECORATORS[cls.__name__] = cls
+    return cls
+
+
+@register_decorator
+class Retry(FrogDecorator):
     """Run the child again after FAILURE, up to ``attempts`` runs in all (None: forever).
 
-    Returns the child's SUCCESS; RUNNING while retrying; FAILURE once the last
-    attempt failed. Reads and writes nothing.
+    Returns the child's SUCCESS; RUNNING while retrying (the child restarts on
+    the next tick); FAILURE once the last attempt failed. Reads and writes nothing.
     """
 
     class Params(Params):
         attempts: int | None = Field(None, ge=1)
+
+    def describe(self) -> dict[str, Any]:
+        return {"attempts": self.params.attempts or "until success"}
 
     def initialise(self) -> None:
         self.failures = 0
@@ -71,7 +106,8 @@ class Retry(_ClockDecorator):
         return RUNNING
 
 
-class Timeout(_ClockDecorator):
+@register_decorator
+class Timeout(FrogDecorator):
     """FAILURE once ``seconds`` of project-clock time pass with the child RUNNING.
 
     Otherwise returns the child's status. Reads and writes nothing.
@@ -92,37 +128,10 @@ class Timeout(_ClockDecorator):
         return status
 
 
-class FaceStream(_ClockDecorator):
-    """Face data stream on while the child runs: ``/ICL_command`` start on entry, stop on exit.
-
-    Writes ``/icl`` (True while the stream is on). Returns the child's status.
-    """
-
-    writes = ("/icl",)
-
-    def __init__(self, name: str, child: py_trees.behaviour.Behaviour,
-                 params: BaseModel | None = None) -> None:
-        super().__init__(name, child, params)
-        self.bb = self.attach_blackboard_client(name=name)
-        self.bb.register_key("/icl", access=py_trees.common.Access.WRITE)
-        self.bb.set("/icl", False, overwrite=False)
-        self._on = False
-
-    def initialise(self) -> None:
-        self.ctx.actions.icl(True)
-        self._on = True
-        self.bb.set("/icl", True, overwrite=True)
+@register_decorator
+class FailureIsSuccess(FrogDecorator):
+    """An optional part: SUCCESS when the child fails, else the child's status."""
 
     def update(self) -> Status:
-        return self.decorated.status
-
-    def terminate(self, new_status: Status) -> None:
-        if self._on:  # idempotent: py_trees may call terminate twice
-            self._on = False
-            self.ctx.actions.icl(False)
-            self.bb.set("/icl", False, overwrite=True)
-
-
-DECORATORS: dict[str, type[_ClockDecorator]] = {
-    cls.__name__: cls for cls in (Retry, Timeout, FaceStream)
-}
+        status = self.decorated.status
+        return SUCCESS if status == FAILURE else status

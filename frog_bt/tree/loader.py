@@ -83,16 +83,14 @@ def site_variables(site: Site | None) -> dict[str, Any]:
 
 
 class _Builder:
-    def __init__(self, site: Site | None, tree_dir: Path) -> None:
+    def __init__(self, site: Site | None) -> None:
         self.site = site
-        self.tree_dir = tree_dir
         self.where: dict[int, Where] = {}
         self.stack: list[Path] = []
 
     # ------------------------------------------------------------ files
 
     def file(self, path: Path, variables: dict[str, Any]) -> tuple[Behaviour | None, str]:
-        path = path if path.is_absolute() else self.tree_dir / path
         if path.resolve() in (p.resolve() for p in self.stack):
             raise TreeError(str(path), (), "includes itself (directly or through others)")
         data = load_yaml(path, TreeError)
@@ -221,9 +219,7 @@ class _Builder:
         scope = dict(variables)
         for k, v in extra.items():
             scope[str(k)] = self._subst(v, file, (*path, "with", k), variables)
-        base = Path(file).parent
-        node, _ = self.file(base / target if not Path(target).is_absolute() else Path(target),
-                            scope)
+        node, _ = self.file(Path(file).parent / target, scope)
         return [node] if node is not None else []
 
     def _foreach(self, data: dict[str, Any], file: str, path: Path_,
@@ -303,7 +299,7 @@ def check_keys(tree: LoadedTree) -> None:
 def load_tree(path: str | Path | None = None, site: Site | None = None) -> LoadedTree:
     """Load, expand, build and check a tree file (default ``trees/tour.yaml``)."""
     path = Path(path) if path is not None else DEFAULT_TREE
-    builder = _Builder(site, path.parent)
+    builder = _Builder(site)
     root, description = builder.file(path, site_variables(site))
     if root is None:
         raise TreeError(str(path), ("root",), "the whole tree was left out by 'when'")

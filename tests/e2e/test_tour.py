@@ -5,17 +5,19 @@ from __future__ import annotations
 from tour import tour
 
 RECRUIT_7 = ["/ApproachPeopleFar 7", "/ICL_command start", "/ICL_command stop"]
+FACES = ["/ICL_command start", "/ICL_command stop"]
+STORY = ("tour", "start_introduction", "ask_tour", "start_poi", "finish_poi")
 AFTER_RECRUIT = ["/GotoWayPoint POI3", "/GotoWayPoint POI4", "/GotoWayPoint POI5",
                  "/GotoWayPoint TEMP", "/GotoWayPoint END", "/GotoWayPoint SHOP",
                  "/docking/dock dock"]
 
 
-def intro(icl: bool = True) -> list[str]:
-    return [f"start_introduction {icl}", "ask_tour None"]
+def intro(engaged: bool | None = True) -> list[str]:
+    return ["start_introduction True", f"ask_tour {engaged}"]
 
 
-def content(poi: str, waypoint: str | None = None) -> list[str]:
-    return [f"start_poi {poi} {waypoint or poi} a", f"finish_poi {poi}"]
+def content(poi: str, waypoint: str | None = None, parts: str = "a") -> list[str]:
+    return [*(f"start_poi {poi} {waypoint or poi} {p}" for p in parts), f"finish_poi {poi}"]
 
 
 def test_morning_tour_takes_the_a_variants_and_ends_docked():
@@ -23,10 +25,10 @@ def test_morning_tour_takes_the_a_variants_and_ends_docked():
     assert t.outcome.code == 0, t.outcome.reason
     assert t.ros_commands() == [
         "/docking/dock undock", "/GotoWayPoint POI0", *RECRUIT_7,
-        "/GotoWayPoint POI1a", "/GotoWayPoint POI2a", *AFTER_RECRUIT]
-    assert t.frontend_commands() == [
+        "/GotoWayPoint POI1a", *FACES, "/GotoWayPoint POI2a", *FACES, *AFTER_RECRUIT]
+    assert t.frontend_commands(*STORY) == [
         "tour started", *intro(),
-        *content("POI1", "POI1a"), *content("POI2", "POI2a"), *content("POI3"),
+        *content("POI1", "POI1a", "ab"), *content("POI2", "POI2a", "ab"), *content("POI3"),
         *content("POI4"), *content("POI5"), *content("END"), "tour ended"]
     assert t.sim.world.docking.state == "docked"
 
@@ -35,8 +37,9 @@ def test_afternoon_tour_takes_the_b_variants():
     t = tour({"start_time": "2026-06-01T15:10:00+02:00"})
     assert t.outcome.code == 0, t.outcome.reason
     assert t.summary.visited[:3] == ["POI0", "POI1b", "POI2b"]
-    assert [c for c in t.frontend_commands() if c.startswith("start_poi")][:2] == [
-        "start_poi POI1 POI1b a", "start_poi POI2 POI2b a"]
+    assert t.frontend_commands("start_poi")[:4] == [
+        "start_poi POI1 POI1b a", "start_poi POI1 POI1b b",
+        "start_poi POI2 POI2b a", "start_poi POI2 POI2b b"]
 
 
 def test_rejected_approach_seeks_again_and_is_then_accepted():
@@ -56,9 +59,8 @@ def test_user_negative_then_a_second_visitor_who_says_yes():
     assert t.outcome.code == 0, t.outcome.reason
     assert t.ros_commands()[:9] == [
         "/docking/dock undock", "/GotoWayPoint POI0", *RECRUIT_7,
-        "/ApproachPeopleFar 8", "/ICL_command start", "/ICL_command stop",
-        "/GotoWayPoint POI1a"]
-    assert t.frontend_commands()[:5] == ["tour started", *intro(), *intro()]
+        "/ApproachPeopleFar 8", *FACES, "/GotoWayPoint POI1a"]
+    assert t.frontend_commands(*STORY)[:5] == ["tour started", *intro(), *intro()]
     assert t.summary.recruited == [8]
 
 
@@ -76,12 +78,12 @@ def test_visitor_wandering_off_before_poi2_sends_the_robot_back_to_recruit():
          "wander_off": {"heading_to": "POI2"}},
         {"id": 9, "position": [102.0, 35.0], "facing": True, "appear_at": 200}]})
     assert t.outcome.code == 0, t.outcome.reason
-    assert t.ros_commands()[:11] == [
+    assert t.ros_commands()[:13] == [
         "/docking/dock undock", "/GotoWayPoint POI0", *RECRUIT_7,
-        "/GotoWayPoint POI1a", "/GotoWayPoint POI2a",  # nobody follows on arrival
-        "/GotoWayPoint POI0", "/ApproachPeopleFar 9", "/ICL_command start",
-        "/ICL_command stop"]
-    starts = [c for c in t.frontend_commands() if c.startswith("start_poi")]
+        "/GotoWayPoint POI1a", *FACES,
+        "/GotoWayPoint POI2a",  # nobody follows on arrival: no content
+        "/GotoWayPoint POI0", "/ApproachPeopleFar 9", *FACES]
+    starts = [c for c in t.frontend_commands("start_poi") if c.endswith(" a")]
     assert starts[:3] == ["start_poi POI1 POI1a a", "start_poi POI1 POI1a a",
                           "start_poi POI2 POI2a a"]  # the new visitor gets the tour from POI1
     assert t.summary.recruited == [7, 9]
@@ -97,5 +99,5 @@ def test_navigation_failure_is_retried_then_the_stop_is_skipped():
                      "/GotoWayPoint POI2a", "/GotoWayPoint POI3", "/GotoWayPoint POI3",
                      "/GotoWayPoint POI3", "/GotoWayPoint POI4", "/GotoWayPoint POI5",
                      "/GotoWayPoint TEMP", "/GotoWayPoint END", "/GotoWayPoint SHOP"]
-    starts = [c.split()[1] for c in t.frontend_commands() if c.startswith("start_poi")]
+    starts = [c.split()[1] for c in t.frontend_commands("start_poi") if c.endswith(" a")]
     assert starts == ["POI1", "POI2", "POI4", "POI5", "END"]  # POI3 skipped

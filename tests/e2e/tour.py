@@ -40,8 +40,10 @@ class Tour:
     def ros_commands(self) -> list[str]:
         return [c for c in self.commands() if c.startswith("/")]
 
-    def frontend_commands(self) -> list[str]:
-        return [c for c in self.commands() if not c.startswith("/")]
+    def frontend_commands(self, *types: str) -> list[str]:
+        """Front-end commands, only of ``types`` when given."""
+        return [c for c in self.commands() if not c.startswith("/")
+                and (not types or c.split()[0] in types)]
 
 
 def describe(record: Record, summary: TourSummary) -> str:

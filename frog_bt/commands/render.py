@@ -1,0 +1,90 @@
+"""Draw a tour tree as text, Graphviz DOT, Mermaid, or an SVG/PNG image.
+
+Loads and checks the site configuration and the tree as `frog-bt run` does (a bad
+file: one line naming the file and the path in it, exit 2). Needs no robot and no
+network; svg and png need Graphviz's `dot` program (exit 1 without it). Text
+formats go to stdout unless -o FILE is given.
+
+Each node shows its name, its type and its parameters (composites: memory,
+policy); --keys adds each node's blackboard keys (`/key?`: an optional read).
+
+Examples:
+
+  frog-bt render                                 the tour as an indented tree
+  frog-bt render --format unicode --keys         with guide lines and blackboard keys
+  frog-bt render trees/recruit.yaml --format mermaid
+  frog-bt render --format svg --rankdir LR -o docs/tour-tree.svg
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from frog_bt import render
+from frog_bt.config import load_site
+from frog_bt.errors import DefinitionError
+from frog_bt.tree.loader import DEFAULT_TREE, load_tree
+
+FORMATS = ("ascii", "unicode", "dot", "svg", "png", "mermaid")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("tree", nargs="?", type=Path, metavar="TREE",
+                   help=f"tree file (default: trees/{DEFAULT_TREE.name})")
+    p.add_argument("-f", "--format", choices=FORMATS, default="ascii",
+                   help="output format (default: ascii)")
+    p.add_argument("-o", "--output", type=Path, metavar="FILE",
+                   help="write to FILE instead of stdout")
+    p.add_argument("--config", type=Path, metavar="FILE",
+                   help="site configuration (default: config/site.yaml)")
+    p.add_argument("--keys", action="store_true",
+                   help="show each node's blackboard keys (reads, optional reads?, writes)")
+    p.add_argument("--rankdir", choices=("TB", "LR"), default="TB",
+                   help="graph direction for dot, svg, png and mermaid: TB top-down "
+                   "(default) or LR left-to-right")
+
+
+def draw(root: render.Node, fmt: str, *, keys: bool = False, rankdir: str = "TB") -> bytes:
+    """The tree in ``fmt`` as bytes (text formats UTF-8); raises GraphvizError for svg/png."""
+    if fmt in ("ascii", "unicode"):
+        return render.text(root, unicode=fmt == "unicode", keys=keys).encode("utf-8")
+    if fmt == "mermaid":
+        return render.mermaid(root, keys=keys, rankdir=rankdir).encode("utf-8")
+    graph = render.dot(root, keys=keys, rankdir=rankdir)
+    return graph.encode("utf-8") if fmt == "dot" else render.graphviz(graph, fmt)
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        site = load_site(args.config)
+        # absolute: load_tree resolves a relative path against the tree's own folder
+        tree = load_tree(args.tree.absolute() if args.tree else None, site)
+    except DefinitionError as exc:
+        print(f"frog-bt: {exc}", file=sys.stderr)
+        return 2
+    if args.format == "png" and args.output is None and sys.stdout.isatty():
+        print("frog-bt: png is binary: give -o FILE (or redirect stdout)", file=sys.stderr)
+        return 2
+    try:
+        data = draw(render.outline(tree.root), args.format, keys=args.keys,
+                    rankdir=args.rankdir)
+    except render.GraphvizError as exc:
+        print(f"frog-bt: {exc}", file=sys.stderr)
+        return 1
+    if args.output is None:
+        try:
+            sys.stdout.flush()
+            sys.stdout.buffer.write(data)
+            sys.stdout.buffer.flush()
+        except BrokenPipeError:  # e.g. `| head`: the reader has what it wanted
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    try:
+        args.output.write_bytes(data)
+    except OSError as exc:
+        print(f"frog-bt: {args.output}: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+    return 0

@@ -1,0 +1,108 @@
+"""Engagement from the ICL face data stream (seed: "ICL FaceDataStream"), sans-I/O.
+
+* A face sample is stored only while the face is near (``distance <= near``)
+  and facing the robot.
+* A sample is *engaged* when its level is in [0, 1] and not engaged in [-1, 0).
+* The **meter** is the majority vote over each ``window`` (2 s): its level is
+  the mean of the samples on the winning side (the mean of all of them on a
+  tie), or None when the window holds no sample.
+* The **decision** (tell more at a POI; the wording of ``ask_tour``) is the
+  majority vote over the first and the last ``edge`` fraction (15%) of the
+  samples stored from the start of the POI to the end of part a: ``ceil(edge·n)``
+  samples from each end, each sample counted once. A tie gives ``on_tie``; no
+  sample at all gives None (the caller applies its no-data rule).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from frog_bt.messages import Face
+
+
+def qualifies(face: Face, near: float) -> bool:
+    return face.facing and face.distance <= near
+
+
+@dataclass(frozen=True, slots=True)
+class Decision:
+    """Outcome of a majority vote over the edge samples."""
+
+    engaged: bool | None  # None: no data
+    engaged_votes: int
+    votes: int  # samples voting (first and last edge fraction)
+    stored: int  # samples stored in all
+    tie: bool = False
+
+    def describe(self) -> str:
+        if self.engaged is None:
+            return "no face data"
+        verdict = "engaged" if self.engaged else "not engaged"
+        tie = " (tie)" if self.tie else ""
+        return (f"{verdict}{tie}: {self.engaged_votes} of {self.votes} edge samples engaged, "
+                f"{self.stored} stored")
+
+
+def vote(levels: np.ndarray) -> tuple[int, int]:
+    """(engaged votes, not-engaged votes) of ``levels``."""
+    engaged = int(np.count_nonzero(levels >= 0.0))
+    return engaged, int(levels.size) - engaged
+
+
+def meter(levels: np.ndarray) -> float | None:
+    """The meter level for one window's samples (see the module docstring)."""
+    if levels.size == 0:
+        return None
+    engaged, not_engaged = vote(levels)
+    if engaged > not_engaged:
+        side = levels[levels >= 0.0]
+    elif not_engaged > engaged:
+        side = levels[levels < 0.0]
+    else:
+        side = levels
+    return float(np.clip(side.mean(), -1.0, 1.0))
+
+
+def edge_indices(n: int, edge: float) -> np.ndarray:
+    """Indices of the first and last ``ceil(edge·n)`` of ``n`` samples, each once."""
+    if n == 0:
+        return np.empty(0, dtype=np.intp)
+    k = min(n, math.ceil(edge * n - 1e-9))
+    return np.union1d(np.arange(k), np.arange(n - k, n))
+
+
+def decide(levels: np.ndarray, edge: float = 0.15, on_tie: bool = False) -> Decision:
+    n = int(levels.size)
+    if n == 0:
+        return Decision(None, 0, 0, 0)
+    chosen = levels[edge_indices(n, edge)]
+    engaged, not_engaged = vote(chosen)
+    if engaged == not_engaged:
+        return Decision(on_tie, engaged, int(chosen.size), n, tie=True)
+    return Decision(engaged > not_engaged, engaged, int(chosen.size), n)
+
+
+class Samples:
+    """Stored samples ``(t, level)`` of one engagement session, in arrival order."""
+
+    def __init__(self) -> None:
+        self._t: list[float] = []
+        self._level: list[float] = []
+
+    def add(self, t: float, level: float) -> None:
+        self._t.append(t)
+        self._level.append(level)
+
+    def __len__(self) -> int:
+        return len(self._t)
+
+    def levels(self) -> np.ndarray:
+        return np.asarray(self._level, dtype=float)
+
+    def window(self, start: float, end: float) -> np.ndarray:
+        """Levels of the samples with ``start < t <= end``."""
+        t = np.asarray(self._t, dtype=float)
+        return self.levels()[(t > start) & (t <= end)]
