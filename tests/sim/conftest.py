@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import asyncio
+import sys
 from collections.abc import Callable, Coroutine
+from pathlib import Path
 from typing import Any, TypeVar
 
 import pytest
@@ -13,6 +15,9 @@ from frog_bt.sim.site import PoiPose, load_pois
 from frog_bt.sim.world import World
 
 T = TypeVar("T")
+
+# Test helpers (sim_clients.py, roslibpy_client.py) live beside this file.
+sys.path.insert(0, str(Path(__file__).parent))
 
 
 @pytest.fixture(scope="session")

@@ -171,3 +171,10 @@ def test_world_refuses_unknown_pois(pois: dict[str, PoiPose]) -> None:
     with pytest.raises(ConfigError, match=r"robot\.start"):
         World(parse_scenario({"robot": {"start": "NOWHERE"}}), pois)
     World(parse_scenario({"navigation": {"failures": [{"poi": "POI2"}]}}), pois)  # variants ok
+
+
+@pytest.mark.parametrize("name", builtin_scenarios())
+def test_a_scenario_survives_a_json_round_trip(name: str) -> None:
+    s = load_scenario(name)
+    s = s.model_copy(update={"content": {**s.content, "POI1": ContentParts(a=40)}})
+    assert parse_scenario(s.model_dump(mode="json")) == s

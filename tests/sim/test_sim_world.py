@@ -69,7 +69,7 @@ def test_starts_docked_at_the_shop_and_publishes_at_its_rates(world: MakeWorld,
     assert len(poses) == 10
     shop = pois["SHOP"]
     assert (poses[-1].x, poses[-1].y) == pytest.approx(shop[:2])
-    assert (poses[-1].qz, poses[-1].qw) == pytest.approx(shop[2:], abs=1e-4)
+    assert (poses[-1].qz, poses[-1].qw) == shop[2:]  # exactly as in the POI table
     assert poses[-1].frame_id == "map" and poses[-1].stamp == pytest.approx(w.now)
     assert len(on(outs, "/UvA_PersonDetectionAndPose")) == 5
     assert len(on(outs, "/PeopleUPO")) == 5

@@ -27,7 +27,8 @@ def test_the_shipped_tour_loads_and_has_every_stop(site):
     names = [n.name for n in tree.nodes()]
     for stop in site.tour.stops:
         assert f"Visit {stop.poi}" in names
-    assert tree.root.name == "FROG tour"
+    assert tree.root.name == "Location awareness"
+    assert tree.root.decorated.name == "FROG tour"
     # TEMP has no content and no follower check
     present_temp = next(n for n in tree.nodes() if n.name == "Present TEMP")
     assert present_temp.children == []

@@ -1,0 +1,190 @@
+"""Run the built-in simulator: a rosbridge v2 server playing the FROG robot, and a
+UDP front end playing the content screen, until interrupted (Ctrl-C / SIGTERM).
+
+Point the executive at it and run it on simulated time:
+
+    frog-bt sim --scenario default --speed 50
+    frog-bt run --rosbridge ws://127.0.0.1:9090 --sim-time
+
+Time: the simulator is the master clock. It publishes /clock, starting at the
+scenario's start_time, and runs `speed` times faster than real time (--speed
+overrides the scenario; 50 = 50x). When the machine cannot keep up, simulated
+time just runs slower.
+
+Scenarios: --scenario takes a built-in name (default, morning, afternoon,
+bored, no_visitor, declines, wander_off, nav_failure, undock_failure, fault,
+silent_frontend) or the path of a YAML file. Every key is
+optional; `extends: NAME|FILE` starts from another scenario. Times called `at`
+are seconds of simulated time after the start.
+
+    extends: default
+    start_time: 2026-06-01T15:00:00+02:00   # local time picks POI1b / POI2b
+    speed: 50                     # x real time
+    dt: 0.1                       # simulated seconds per step
+    seed: 0                       # face data randomness
+    detection_range: 15           # metres: people farther away are not seen
+    robot: {start: SHOP, docked: true}      # or pose: {x, y, yaw (degrees)}
+    navigation:
+      speed: 0.6                  # m/s, straight line to each /GotoWayPoint
+      approach_time: 3            # s per /ApproachPeopleFar
+      failures:                   # 3 failed / 4 aborted after `after` s of driving
+        - {goal: 2, result: aborted, after: 5}      # the 2nd goal of the run
+        - {poi: POI2, times: 1, result: failed}     # the first goal to POI2a/b
+    docking: {undock_time: 5, dock_time: 10, undock_failures: 0, dock_failures: 0}
+    battery: {start: 90, drain_per_hour: 5, charge_per_hour: 20}
+    faults: [{at: 600, name: motors, level: 2, message: overheated, duration: 60}]
+    visitors:
+      - id: 7
+        position: [103, 36]       # map frame
+        facing: true              # or orientation: 180 (degrees, 180 = facing)
+        appear_at: 0              # s; never: does not appear
+        approach: [aborted, succeeded]   # results of successive approaches
+        answer: positive          # or negative (the visitor then leaves)
+        faces: engaged            # bored, mixed, far, not_facing, or [0.5, -0.3]
+        follow: true              # follows the robot once the tour starts
+        wander_off: {heading_to: POI2}   # or {at: 900}
+        after_tour: leave         # stay, or return (a new visitor comes)
+    frontend:
+      idle_at: 1                  # first frontend_idle
+      idle_after_tour: 5          # frontend_idle again after a tour; null: never
+      answer_delay: 2             # ask_tour -> user_positive / user_negative
+      restarts: [1200]            # the front end restarts and says idle again
+      ack: true                   # false: never acks commands
+      silent: false               # true: a dead front end (sends nothing)
+    content: {default: 30, introduction: 20, POI1: {a: 40, b: 20}, POI3: 25}
+
+What the robot does: drives straight to each goal and answers /FROG_response
+1 then 2 (3/4 as scripted); undocks and docks with /docking/state; reports
+people within range on /UvA_PersonDetectionAndPose and /PeopleUPO; streams
+/ICL_FaceDataStream between /ICL_command start and stop; /diagnostic at 1 Hz.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import json
+import logging
+import signal
+import sys
+from datetime import datetime
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from frog_bt.clock import SITE_TZ
+
+if TYPE_CHECKING:
+    from frog_bt.sim.scenario import Scenario
+    from frog_bt.sim.traffic import Record
+
+log = logging.getLogger(__name__)
+
+
+def _address(text: str) -> tuple[str, int]:
+    """``HOST:PORT`` (or ``ws://HOST:PORT``) -> (host, port)."""
+    rest = text.split("://", 1)[-1].rstrip("/")
+    host, sep, port = rest.rpartition(":")
+    if not sep or not host or not port.isdigit() or int(port) > 65535:
+        raise argparse.ArgumentTypeError(f"expected HOST:PORT, got {text!r}")
+    return host, int(port)
+
+
+def _speed(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a speed factor > 0, got {text!r}")
+    return value
+
+
+def describe(record: Record) -> str:
+    """One ``--log`` line: local time of day, side, direction, channel, compact JSON."""
+    when = datetime.fromtimestamp(record.t, SITE_TZ).strftime("%H:%M:%S.%f")[:-5]
+    arrow = "->" if record.direction == "out" else "<-"
+    payload = json.dumps(record.payload, separators=(",", ":"), default=str)
+    return f"{when} {record.side:<8} {arrow} {record.channel} {payload}"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenario", default="default", metavar="NAME|FILE",
+                        help="built-in scenario name or YAML file (default: default)")
+    parser.add_argument("--speed", type=_speed, metavar="X",
+                        help="speed factor, simulated seconds per real second "
+                             "(default: the scenario's)")
+    parser.add_argument("--rosbridge", type=_address, default=("127.0.0.1", 9090),
+                        metavar="HOST:PORT",
+                        help="where the rosbridge server listens (default 127.0.0.1:9090)")
+    parser.add_argument("--frontend", type=_address, default=("127.0.0.1", 5005),
+                        metavar="HOST:PORT",
+                        help="where the simulated front end listens (default 127.0.0.1:5005)")
+    parser.add_argument("--executive", type=_address, default=("127.0.0.1", 5006),
+                        metavar="HOST:PORT",
+                        help="where the executive listens for the front end "
+                             "(default 127.0.0.1:5006)")
+    parser.add_argument("--config", type=Path, default=None, metavar="FILE",
+                        help="site configuration with the POI table (default config/site.yaml)")
+    parser.add_argument("--secret", default=None,
+                        help="require rosbridge clients to authenticate with this secret")
+    parser.add_argument("--log", action="store_true",
+                        help="print every message as it is sent or received, one line each")
+
+
+def run(args: argparse.Namespace) -> int:
+    from frog_bt.errors import ConfigError
+    from frog_bt.sim.scenario import load_scenario
+    from frog_bt.sim.site import DEFAULT_SITE, load_pois
+
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    try:
+        scenario = load_scenario(args.scenario)
+        pois = load_pois(args.config or DEFAULT_SITE)
+    except ConfigError as exc:
+        print(f"frog-bt sim: {exc}", file=sys.stderr)
+        return 2
+    if args.speed is not None:
+        scenario = scenario.model_copy(update={"speed": args.speed})
+    try:
+        return asyncio.run(_serve(args, scenario, pois))
+    except ConfigError as exc:
+        print(f"frog-bt sim: {exc}", file=sys.stderr)
+        return 2
+
+
+async def _serve(args: argparse.Namespace, scenario: Scenario, pois: dict) -> int:
+    from frog_bt.sim.simulator import Simulator
+
+    sim = Simulator(scenario, host=args.rosbridge[0], rosbridge_port=args.rosbridge[1],
+                    frontend_host=args.frontend[0], frontend_port=args.frontend[1],
+                    executive=args.executive, pois=pois, secret=args.secret)
+    if args.log:
+        sim.log.add_listener(lambda record: print(describe(record), flush=True))
+    try:
+        await sim.start()
+    except OSError as exc:
+        print(f"frog-bt sim: cannot listen: {exc}", file=sys.stderr)
+        return 1
+    print(f"frog-bt sim: rosbridge ws://{args.rosbridge[0]}:{sim.rosbridge_port}, "
+          f"front end udp {args.frontend[0]}:{sim.frontend_port} -> executive "
+          f"{args.executive[0]}:{args.executive[1]}, scenario {sim.scenario.name or '?'}, "
+          f"{sim.speed:g}x from {sim.scenario.start_time.isoformat()}", flush=True)
+    stop = asyncio.Event()
+    loop = asyncio.get_running_loop()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        with contextlib.suppress(NotImplementedError):
+            loop.add_signal_handler(sig, stop.set)
+    stopping = asyncio.create_task(stop.wait())
+    clock = asyncio.create_task(sim.wait_clock_stopped())
+    await asyncio.wait([stopping, clock], return_when=asyncio.FIRST_COMPLETED)
+    stopping.cancel()
+    clock.cancel()
+    try:
+        await sim.stop()
+    except Exception as exc:  # the time loop died of a bug; it was logged
+        print(f"frog-bt sim: simulation failed: {exc!r}", file=sys.stderr)
+        return 1
+    print(f"frog-bt sim: stopped at {sim.clock.local_time().isoformat(timespec='seconds')}",
+          flush=True)
+    return 0

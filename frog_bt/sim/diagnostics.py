@@ -1,0 +1,37 @@
+"""Electronics as ``/diagnostic`` reports them: the battery and scripted faults.
+
+The battery drains at ``drain_per_hour`` percent per hour while off the dock
+and charges at ``charge_per_hour`` on it (clamped to 0..100). Each scripted
+fault is a status at level 2 (ERROR) or 3 (STALE) from its ``at`` time on, for
+``duration`` seconds or for good.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from frog_bt.sim.msgs import DiagnosticStatus
+from frog_bt.sim.scenario import BatterySpec, FaultSpec
+
+
+class Battery:
+    """Battery charge in percent, stepped by ``dt``."""
+
+    def __init__(self, spec: BatterySpec) -> None:
+        self.spec = spec
+        self.percentage = spec.start
+
+    def step(self, dt: float, docked: bool) -> None:
+        rate = self.spec.charge_per_hour if docked else -self.spec.drain_per_hour
+        self.percentage = min(100.0, max(0.0, self.percentage + rate * dt / 3600.0))
+
+    def status(self) -> DiagnosticStatus:
+        return DiagnosticStatus(0, "battery", "", "frog",
+                                (("percentage", f"{self.percentage:.1f}"),))
+
+
+def active_faults(faults: Iterable[FaultSpec], elapsed: float) -> list[DiagnosticStatus]:
+    """Statuses of the faults active ``elapsed`` seconds after the scenario start."""
+    t = elapsed + 1e-9  # a step time of 2.9999999 is 3
+    return [DiagnosticStatus(f.level, f.name, f.message, "frog")
+            for f in faults if f.at <= t and (f.duration is None or t < f.at + f.duration)]

@@ -1,0 +1,181 @@
+"""The simulator: world, rosbridge server, front end and the clock, wired together.
+
+The simulator is the master of time. It owns a
+:class:`~frog_bt.clock.ManualClock` that starts at the scenario's
+``start_time``; each step advances the world by ``dt`` simulated seconds,
+publishes ``/clock`` and whatever is due, and lets the front end send what is
+due. The time loop paces steps to the wall clock by the speed factor
+(``speed: 50`` = 50x real time); when the process cannot keep up, simulated
+time simply runs slower (it never jumps to catch up).
+
+Tests can also skip the time loop (``await sim.start(run_clock=False)``) and
+move the world by hand with :meth:`Simulator.step` / :meth:`Simulator.advance`.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+from collections.abc import Mapping
+from typing import Any
+
+from frog_bt.clock import ManualClock
+from frog_bt.sim import msgs
+from frog_bt.sim.frontend import FrontendModel
+from frog_bt.sim.frontend_udp import Address, FrontendSocket
+from frog_bt.sim.rosbridge_protocol import BridgeServer, Incoming
+from frog_bt.sim.rosbridge_server import RosbridgeServer
+from frog_bt.sim.scenario import Scenario
+from frog_bt.sim.site import PoiPose, load_pois
+from frog_bt.sim.traffic import MessageLog, Predicate, Record
+from frog_bt.sim.world import World
+from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
+
+log = logging.getLogger(__name__)
+
+MAX_LAG = 0.05  # wall seconds behind schedule before the loop stops trying to catch up
+
+
+class Simulator:
+    """The simulated robot (rosbridge server) and front end (UDP) of one scenario."""
+
+    def __init__(self, scenario: Scenario, *, host: str = "127.0.0.1",
+                 rosbridge_port: int = 9090, frontend_port: int = 5005,
+                 executive: tuple[str, int] = ("127.0.0.1", 5006),
+                 pois: Mapping[str, PoiPose] | None = None,
+                 secret: str | None = None, frontend_host: str | None = None) -> None:
+        self.scenario = scenario
+        self.speed = scenario.speed
+        self.pois = dict(pois) if pois is not None else load_pois()
+        self.world = World(scenario, self.pois)
+        self.clock = ManualClock(self.world.now)
+        self.log = MessageLog()
+        types = {t.name: t.type for t in (*INPUTS.values(), *OUTPUTS.values(), CLOCK)}
+        self.bridge = BridgeServer(secret, types)
+        self._rosbridge = RosbridgeServer(self.bridge, host, rosbridge_port, self._on_incoming,
+                                          self.clock.now)
+        self.frontend = FrontendModel(scenario, executive[0], self._visitor_says_yes,
+                                      self._on_frontend_traffic)
+        self._udp = FrontendSocket(frontend_host or host, frontend_port,
+                                   (executive[0], executive[1]), self._on_datagram)
+        self._loop_task: asyncio.Task[None] | None = None
+        self._started = False
+
+    # ------------------------------------------------------------ lifecycle
+
+    @property
+    def rosbridge_port(self) -> int:
+        return self._rosbridge.port
+
+    @property
+    def frontend_port(self) -> int:
+        return self._udp.port
+
+    @property
+    def running(self) -> bool:
+        return self._loop_task is not None and not self._loop_task.done()
+
+    async def wait_clock_stopped(self) -> None:
+        """Return when the time loop ends (only by :meth:`stop`, or a bug: then it raises)."""
+        if self._loop_task is not None:
+            await asyncio.shield(self._loop_task)
+
+    async def start(self, *, run_clock: bool = True) -> None:
+        """Bind the rosbridge server and the front-end socket; start the time loop."""
+        await self._rosbridge.start()
+        try:
+            await self._udp.open()
+        except OSError:
+            await self._rosbridge.stop()
+            raise
+        if not self._started:
+            self.frontend.start(self.clock.now())
+            self._started = True
+        if run_clock:
+            self._loop_task = asyncio.create_task(self._run(), name="frog-bt sim clock")
+
+    async def stop(self) -> None:
+        """Stop the time loop, drop the clients, close the sockets."""
+        task, self._loop_task = self._loop_task, None
+        if task is not None:
+            task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await task
+        await self._rosbridge.stop()
+        self._udp.close()
+
+    async def stop_rosbridge(self) -> None:
+        """Drop all rosbridge clients and stop listening; the world keeps running."""
+        await self._rosbridge.stop()
+
+    async def start_rosbridge(self) -> None:
+        """Listen again, on the same port."""
+        await self._rosbridge.start()
+
+    # ------------------------------------------------------------ time
+
+    async def _run(self) -> None:
+        loop = asyncio.get_running_loop()
+        deadline = loop.time()
+        while True:
+            try:
+                self.step()
+            except Exception:
+                log.exception("simulation step failed; the clock stops")
+                raise
+            deadline += self.scenario.dt / self.speed
+            now = loop.time()
+            if now > deadline + MAX_LAG:
+                deadline = now  # behind: simulated time runs slower, no catching up
+            await asyncio.sleep(max(0.0, deadline - now))
+
+    def step(self) -> None:
+        """One step of ``dt`` simulated seconds, without pacing."""
+        outputs = self.world.step(self.scenario.dt)
+        self.clock.set(self.world.now)
+        self._publish(CLOCK.name, msgs.clock(self.world.now), logged=False)
+        for topic, msg in outputs:
+            self._publish(topic, msg)
+        for data in self.frontend.step(self.world.now):
+            self._udp.send(data)
+
+    def advance(self, seconds: float) -> None:
+        """Step by hand until ``seconds`` more of simulated time have passed."""
+        end = self.world.elapsed + seconds - 1e-9
+        while self.world.elapsed < end:
+            self.step()
+
+    # ------------------------------------------------------------ traffic
+
+    def _publish(self, topic: str, msg: dict[str, Any], logged: bool = True) -> None:
+        if logged:
+            self.log.append(Record(self.world.now, "ros", "out", topic, msg))
+        self._rosbridge.publish(topic, msg)
+
+    def _on_incoming(self, incoming: Incoming) -> None:
+        self.log.append(Record(self.world.now, "ros", "in", incoming.topic, incoming.msg))
+        for topic, msg in self.world.handle(incoming.topic, incoming.msg):
+            self._publish(topic, msg)
+
+    def _on_datagram(self, data: bytes, addr: Address) -> None:
+        for reply in self.frontend.receive(data, addr[0], self.world.now):
+            self._udp.send(reply)
+
+    def _on_frontend_traffic(self, direction: str, channel: str, fields: dict[str, Any]) -> None:
+        self.log.append(Record(self.world.now, "frontend", direction, channel, fields))
+        self.world.on_frontend(direction, channel, fields)
+
+    def _visitor_says_yes(self) -> bool:
+        visitor = self.world.current_visitor
+        return visitor is None or visitor.spec.answer == "positive"
+
+    # ------------------------------------------------------------ for tests
+
+    def received(self, channel: str | None = None, side: str | None = None) -> list[Record]:
+        """What the executive sent (log records with direction ``in``)."""
+        return self.log.received(channel, side)
+
+    async def wait_for(self, predicate: Predicate, timeout: float) -> Record:
+        """The first log record satisfying ``predicate``; TimeoutError after ``timeout`` wall s."""
+        return await self.log.wait_for(predicate, timeout)

@@ -1,0 +1,93 @@
+"""``frog-bt sim`` from the command line: help text, and roslibpy against a running sim."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import select
+import signal
+import socket
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from frog_bt.cli import main
+from frog_bt.sim.scenario import builtin_scenarios
+
+HERE = Path(__file__).parent
+
+
+def test_help_explains_scenarios_and_speed(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(["sim", "--help"])
+    assert info.value.code == 0
+    text = capsys.readouterr().out
+    for needle in ("--scenario", "--speed", "speed factor", "extends:", "visitors:",
+                   "start_time", "--rosbridge", "--frontend", "--executive", "--log"):
+        assert needle in text, needle
+    for name in builtin_scenarios():
+        assert name in text, name
+
+
+def test_a_bad_scenario_is_a_one_line_error(tmp_path: Path,
+                                            capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("visitors: [{id: 1, position: [0, 0], faces: happy}]\n")
+    assert main(["sim", "--scenario", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}: visitors[0].faces: expected one of engaged" in err
+
+
+def read_line(proc: subprocess.Popen[str], timeout: float) -> str:
+    assert proc.stdout is not None
+    ready, _, _ = select.select([proc.stdout], [], [], timeout)
+    assert ready, "frog-bt sim printed nothing"
+    return proc.stdout.readline()
+
+
+def test_roslibpy_drives_the_robot(tmp_path: Path) -> None:
+    scenario = tmp_path / "undocked.yaml"
+    scenario.write_text("extends: default\nrobot: {docked: false}\n")
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as executive, \
+            open(tmp_path / "sim.log", "w") as log:
+        executive.bind(("127.0.0.1", 0))  # soaks up the front end's datagrams
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "frog_bt", "sim", "--scenario", str(scenario),
+             "--speed", "20", "--rosbridge", "127.0.0.1:0", "--frontend", "127.0.0.1:0",
+             "--executive", f"127.0.0.1:{executive.getsockname()[1]}"],
+            stdout=subprocess.PIPE, stderr=log, text=True,
+            env={**os.environ, "PYTHONUNBUFFERED": "1"})
+        try:
+            banner = read_line(proc, 15)
+            match = re.search(r"rosbridge ws://127\.0\.0\.1:(\d+)", banner)
+            assert match, banner
+            client = subprocess.run(
+                [sys.executable, str(HERE / "roslibpy_client.py"), match.group(1)],
+                capture_output=True, text=True, timeout=60)
+            result = json.loads(client.stdout.strip().splitlines()[-1])
+            assert result["codes"] == [1, 2], client.stderr[-2000:]
+            assert client.returncode == 0
+        finally:
+            proc.send_signal(signal.SIGINT)
+            code = proc.wait(timeout=15)
+        assert code == 0
+        assert "stopped at" in (proc.stdout.read() if proc.stdout else "")
+
+
+def test_the_help_example_is_a_valid_scenario(tmp_path: Path, pois: dict) -> None:
+    from frog_bt.sim.command import __doc__ as doc
+    from frog_bt.sim.scenario import load_scenario
+    from frog_bt.sim.world import World
+
+    lines = (doc or "").splitlines()
+    start = lines.index("    extends: default")
+    end = lines.index("", start)
+    example = tmp_path / "example.yaml"
+    example.write_text("\n".join(line[4:] for line in lines[start:end]) + "\n")
+    scenario = load_scenario(example)
+    assert scenario.visitors[0].wander_off is not None
+    assert scenario.navigation.failures[1].poi == "POI2"
+    World(scenario, pois)
