@@ -41,6 +41,7 @@ class Clock(ABC):
         """Return once ``now() >= deadline``."""
 
     async def sleep(self, seconds: float) -> None:
+        await self.wait_ready()  # a duration counts from the first meaningful time
         await self.sleep_until(self.now() + max(0.0, seconds))
 
     async def wait_ready(self) -> None:  # noqa: B027 - wall clock is always ready

@@ -236,7 +236,8 @@ def _at(path: tuple[str | int, ...], message: str) -> PathError:
 
 
 def _unknown(name: str, known: list[str]) -> str:
-    return f"unknown POI {name!r} (known: {', '.join(known)})"
+    return f"unknown POI {name!r} (" + (f"known: {', '.join(known)})" if known
+                                        else "no POIs are defined)")
 
 
 def load_site(path: str | Path | None = None) -> Site:
