@@ -34,6 +34,8 @@ class Request:
     kind: str  # "goto" | "approach"
     target: str
     sent_at: float
+    role: str = ""
+    msg: dict[str, Any] | None = None
     code: int = 0
     answered_at: float | None = None
 
@@ -58,13 +60,24 @@ class Actions:
 
     def goto(self, waypoint: str, poi: Poi) -> Request:
         now = self._clock.now()
-        self._publish("goto", encode_pose(poi.x, poi.y, poi.z, poi.w, now))
-        return self._replace(Request(next(self._ids), "goto", waypoint, now))
+        msg = encode_pose(poi.x, poi.y, poi.z, poi.w, now)
+        self._publish("goto", msg)
+        return self._replace(Request(next(self._ids), "goto", waypoint, now, "goto", msg))
 
     def approach(self, person_id: int) -> Request:
-        self._publish("approach", encode_int32(person_id))
+        msg = encode_int32(person_id)
+        self._publish("approach", msg)
         return self._replace(Request(next(self._ids), "approach", str(person_id),
-                                     self._clock.now()))
+                                     self._clock.now(), "approach", msg))
+
+    def resend_pending(self) -> Request | None:
+        """Publish the pending goal or approach again (after a reconnect its answer may
+        have been lost while the link was down). The request keeps waiting as before."""
+        request = self.pending
+        if request is not None and request.msg is not None:
+            self._publish(request.role, request.msg)
+            log.info("re-sent %s %s after a reconnect", request.kind, request.target)
+        return request
 
     def _replace(self, request: Request) -> Request:
         self.pending = request

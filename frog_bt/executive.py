@@ -95,6 +95,10 @@ class Executive:
 
     def _on_link(self, state: LinkState) -> None:
         self.core.inputs.link = state
+        if state.connected and state.reconnects > 0:
+            request = self.core.actions.resend_pending()
+            if request is not None:
+                self.core.ctx.note(f"link back: re-sent {request.kind} to {request.target}")
         self._wake.set()
 
     def _on_event(self, message: FrontendMessage) -> None:
@@ -174,6 +178,7 @@ class Executive:
     async def _shutdown(self) -> None:
         """Halt the tree (scopes switch the face stream off, ...) and flush the links."""
         self.core.halt()
+        await self.client.flush(0.5)
         await self.client.close()
         self.link.close()
         await self.link.wait_closed()

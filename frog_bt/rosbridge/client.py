@@ -197,6 +197,18 @@ class RosbridgeClient:
                 raise  # run() itself was cancelled (the loop task with it)
             # otherwise close() cancelled the loop: a normal end
 
+    async def flush(self, timeout: float) -> bool:
+        """Wait (at most ``timeout`` wall seconds) until every queued frame is written.
+
+        True when the outbox drained; False on timeout or while disconnected
+        (frames then stay queued for the next connection).
+        """
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + timeout
+        while self._outbox and self._link.connected and loop.time() < deadline:
+            await asyncio.sleep(0.005)
+        return not self._outbox
+
     async def close(self) -> None:
         """Stop the connect loop and close the connection; final."""
         self._closing = True
