@@ -162,6 +162,19 @@ class Zones(_Model):
         return self.arrival.get(poi, self.arrival.get("default", 5.0))
 
 
+class Safety(_Model):
+    battery_low: Annotated[float, Field(ge=0, le=100)] = 20.0  # percent: abort the tour below
+    battery_resume: Annotated[float, Field(ge=0, le=100)] = 30.0  # percent: start a tour from
+    diagnostics_max_age: Positive = 5.0  # seconds: older /diagnostic is stale (not acted on)
+    pose_max_age: Positive = 2.0  # seconds: older /FROG_pose is stale
+    people_max_age: Positive = 2.0  # seconds: older /PeopleUPO is stale
+    face_silence: Positive = 3.0  # seconds without face data while the stream is on: say so
+
+
+class Checkpoint(_Model):
+    confirm: Positive = 3.0  # seconds to wait for /docking/state before resuming a tour
+
+
 class Links(_Model):
     rosbridge: str = DEFAULT_ROSBRIDGE_URL
     frontend: str = "{}:{}".format(*DEFAULT_FRONTEND)
@@ -187,6 +200,8 @@ class Site(_Model):
     engagement: EngagementCfg = EngagementCfg()
     projector: ProjectorCfg = ProjectorCfg()
     zones: Zones = Zones()
+    safety: Safety = Safety()
+    checkpoint: Checkpoint = Checkpoint()
     topics: dict[Literal[tuple(INPUTS) + tuple(OUTPUTS)], str] = {}  # type: ignore[valid-type]
 
     @model_validator(mode="after")

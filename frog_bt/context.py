@@ -10,6 +10,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from frog_bt.actions import Actions
+from frog_bt.checkpoint import Progress, Resume
 from frog_bt.clock import Clock
 from frog_bt.config import Site
 from frog_bt.frontend.messages import FrontendMessage
@@ -22,6 +23,8 @@ class Context:
     actions: Actions
     send: Callable[[FrontendMessage], None]
     notes: list[tuple[float, str]] = field(default_factory=list)
+    progress: Progress = field(default_factory=Progress)
+    resume: Resume | None = None  # set at start-up from a checkpoint file
     note_limit: int = 1000
 
     def note(self, text: str) -> None:

@@ -16,10 +16,13 @@ import asyncio
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import py_trees
 
+from frog_bt.checkpoint import load as load_checkpoint
+from frog_bt.checkpoint import save as save_checkpoint
 from frog_bt.clock import Clock, ManualClock
 from frog_bt.config import Site
 from frog_bt.core import Core
@@ -59,8 +62,8 @@ class WireTaps:
 class Executive:
     def __init__(self, site: Site, tree: LoadedTree, clock: Clock, *,
                  rosbridge_url: str, frontend: tuple[str, int], listen: tuple[str, int],
-                 sim_time: bool = False, secret: str | None = None, once: bool = False
-                 ) -> None:
+                 sim_time: bool = False, secret: str | None = None, once: bool = False,
+                 checkpoint: Path | None = None, fresh: bool = False) -> None:
         if sim_time and not isinstance(clock, ManualClock):
             raise ValueError("sim time needs a ManualClock (SimClock)")
         self.site = site
@@ -75,6 +78,10 @@ class Executive:
                                  on_message=self._on_event, on_datagram=self._on_datagram)
         self.core = Core(site, tree, clock, self.client.publish, self.link.send)
         self.taps = self.core.taps
+        self.checkpoint = checkpoint
+        self._saved = 0
+        if checkpoint is not None and not fresh:
+            self.core.ctx.resume = load_checkpoint(checkpoint)
         self._wake = asyncio.Event()
         self._stopping = asyncio.Event()
 
@@ -165,15 +172,26 @@ class Executive:
 
     def tick(self) -> None:
         status = self.core.tick()
+        progress = self.core.ctx.progress
+        if self.checkpoint is not None and progress.changes != self._saved:
+            self._saved = progress.changes
+            save_checkpoint(self.checkpoint, progress)
         if status == Status.SUCCESS:
+            storage = py_trees.blackboard.Blackboard.storage
+            if storage.get("/tour_state") == "aborted":
+                reason = f"tour aborted: {storage.get('/abort_reason_last') or self.core.last_note}"
+                log.warning("%s", reason)
+                if self.once:
+                    self.stop(reason, 1)
+                return
             self.outcome.tours += 1
             if self.once:
                 self.stop("tour ended docked", 0)
         elif status == Status.FAILURE:
-            reason = self.core.last_note or "the tour tree failed"
-            log.error("tour failed: %s", reason)
-            if self.once:
-                self.stop(reason, 1)
+            # the tree gave up (GiveUp told the front end): the robot cannot go on
+            reason = self.core.last_note.removeprefix("giving up: ") or "the tour tree failed"
+            log.error("cannot go on: %s", reason)
+            self.stop(reason, 1)
 
     async def _shutdown(self) -> None:
         """Halt the tree (scopes switch the face stream off, ...) and flush the links."""

@@ -16,14 +16,19 @@ from frog_bt.core import Core
 
 
 def phase(core: Core) -> str:
-    """The running child of the top composite (below any decorators): the tour's phase."""
-    root = core.bt.root
-    while isinstance(root, py_trees.decorators.Decorator):
-        root = root.decorated
-    for child in getattr(root, "children", ()):
-        if child.status == py_trees.common.Status.RUNNING:
+    """The running child of the first sequence on the running path: the tour's phase."""
+    node = core.bt.root
+    running = py_trees.common.Status.RUNNING
+    while True:
+        if isinstance(node, py_trees.decorators.Decorator):
+            node = node.decorated
+            continue
+        child = next((c for c in getattr(node, "children", ()) if c.status == running), None)
+        if child is None:
+            return node.status.value.lower()
+        if isinstance(node, py_trees.composites.Sequence):
             return child.name
-    return root.status.value.lower()
+        node = child
 
 
 def status_line(core: Core) -> str:

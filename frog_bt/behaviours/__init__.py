@@ -7,9 +7,10 @@ from frog_bt.behaviours import (
     navigation,
     projector,
     recruit,
+    safety,
     tour,
     visit,
 )
 
-__all__ = ["docking", "engagement", "location", "navigation", "projector", "recruit", "tour",
-           "visit"]
+__all__ = ["docking", "engagement", "location", "navigation", "projector", "recruit", "safety",
+           "tour", "visit"]

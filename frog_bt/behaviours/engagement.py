@@ -50,6 +50,7 @@ class FaceStream(FrogDecorator):
         self.ctx.actions.icl(True)
         self._on = True
         self.samples = Samples()
+        self.last_face_data = self.ctx.clock.now()
         self.next_meter = self.ctx.clock.now() + self.ctx.site.engagement.window
         self.set("/icl", True)
         self.set("/engagement", self.samples)
@@ -63,7 +64,13 @@ class FaceStream(FrogDecorator):
 
     def _collect(self) -> None:
         near = self.ctx.site.engagement.near
-        for t, face in self.get("/faces", ()):
+        faces = self.get("/faces", ())
+        now = self.ctx.clock.now()
+        if faces:
+            self.last_face_data = now
+        elif now - self.last_face_data > self.ctx.site.safety.face_silence:
+            self.feedback_message = f"no face data for {now - self.last_face_data:.0f} s"
+        for t, face in faces:
             if qualifies(face, near):
                 self.samples.add(t, face.engagement)
 

@@ -1,5 +1,8 @@
 """Location awareness (seed: "Location based"): volume zones, follow-me, special content.
 
+A pose older than ``safety.pose_max_age`` is not acted on: the location
+features pause (and say so) until poses flow again.
+
 * :class:`LocationAware` — around the whole tour: ``volume`` for the zone the
   robot is in (shop 50%, Tapestry and Vault Rooms 80%, elsewhere the default),
   sent on entering a zone, with hysteresis.
@@ -23,6 +26,16 @@ from frog_bt.tree.leaf import Status
 from frog_bt.zones import Membership, Shape
 
 
+def fresh_pose(node: FrogDecorator) -> Reading[Pose] | None:
+    """``/pose`` when fresher than ``safety.pose_max_age``; else None, and the node says so."""
+    pose: Reading[Pose] | None = node.get("/pose")
+    if pose is None or pose.age(node.get("/now")) > node.ctx.site.safety.pose_max_age:
+        node.feedback_message = "pose stale or missing: location features paused"
+        return None
+    node.feedback_message = ""
+    return pose
+
+
 def shape_of(zone: ZoneShape) -> Shape:
     if zone.circle is not None:
         return Shape(center=(zone.circle.x, zone.circle.y), radius=zone.circle.r)
@@ -38,7 +51,7 @@ class LocationAware(FrogDecorator):
     hysteresis at the borders. Returns the child's status.
     """
 
-    reads = ("/pose",)
+    reads = ("/pose", "/now")
 
     def initialise(self) -> None:
         cfg = self.ctx.site.zones.volume
@@ -47,7 +60,7 @@ class LocationAware(FrogDecorator):
         self.percent: int | None = None
 
     def update(self) -> Status:
-        pose: Reading[Pose] | None = self.get("/pose")
+        pose = fresh_pose(self)
         if pose is not None:
             index = self.membership.update((pose.value.x, pose.value.y))
             zone = self.zones[index] if index is not None else None
@@ -71,7 +84,7 @@ class GuidedDrive(FrogDecorator):
     """
 
     Params = PoiParams
-    reads = ("/pose",)
+    reads = ("/pose", "/now")
     optional_reads = ("/waypoint", "/special_done")
     writes = ("/special_done",)
 
@@ -85,7 +98,7 @@ class GuidedDrive(FrogDecorator):
         self.spots = [(s.spot, shape_of(s)) for s in self.ctx.site.zones.special]
 
     def update(self) -> Status:
-        pose: Reading[Pose] | None = self.get("/pose")
+        pose = fresh_pose(self)
         if pose is not None:
             p = (pose.value.x, pose.value.y)
             site = self.ctx.site

@@ -63,6 +63,9 @@ class Projector(FrogDecorator):
         target = self.ctx.site.pois.get(self.get("/waypoint") or self.params.poi)
         if pose is None or target is None:
             return
+        if pose.age(self.get("/now")) > self.ctx.site.safety.pose_max_age:
+            self.feedback_message = "pose stale: no arrival estimate"
+            return
         cfg = self.ctx.site.projector
         x, y = pose.value.x, pose.value.y
         if not self.history or pose.at > self.history[-1][0]:

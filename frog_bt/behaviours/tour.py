@@ -13,14 +13,29 @@ from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, r
 
 @register
 class WaitFrontendIdle(Leaf):
-    """Wait until the front end says it is ready (``frontend_idle``).
+    """Wait until the front end says it is ready (``frontend_idle``) and the robot is fit.
 
-    Reads ``/frontend_ready``. RUNNING until it is true, then SUCCESS.
+    Reads ``/frontend_ready``, ``/now`` and ``/diagnostics``: while fresh
+    diagnostics show a fault or a battery below ``safety.battery_resume``, it
+    waits (charging) and says so. Stale or missing diagnostics do not hold a
+    tour back. RUNNING until ready, then SUCCESS.
     """
 
-    reads = ("/frontend_ready",)
+    reads = ("/frontend_ready", "/now", "/diagnostics")
 
     def update(self) -> Status:
+        cfg = self.ctx.site.safety
+        reading = self.get("/diagnostics")
+        diagnostics = (reading.value if reading is not None
+                       and reading.age(self.get("/now")) <= cfg.diagnostics_max_age else None)
+        if diagnostics is not None and diagnostics.faults:
+            self.feedback_message = "fault: " + "; ".join(diagnostics.faults)
+            return RUNNING
+        if (diagnostics is not None and diagnostics.battery is not None
+                and diagnostics.battery < cfg.battery_resume):
+            self.feedback_message = (f"charging: battery {diagnostics.battery:.0f}% "
+                                     f"< {cfg.battery_resume:g}%")
+            return RUNNING
         if self.get("/frontend_ready"):
             return SUCCESS
         self.feedback_message = "waiting for frontend_idle"
@@ -31,6 +46,9 @@ class WaitFrontendIdle(Leaf):
 class TourStatus(Leaf):
     """Send ``tour`` with ``state`` and ``reason`` to the front end.
 
+    An ``aborted`` tour without a ``reason`` gives ``/abort_reason`` (optional read).
+    Ending or aborting a tour clears the checkpointed progress.
+
     Writes ``/frontend_ready`` (False: the next tour needs a fresh
     ``frontend_idle``), ``/declined`` and ``/special_done`` (cleared when a tour
     starts) and ``/tour_state``. SUCCESS.
@@ -40,12 +58,16 @@ class TourStatus(Leaf):
         state: Literal["started", "ended", "aborted"]
         reason: str = ""
 
+    optional_reads = ("/abort_reason",)
     writes = ("/frontend_ready", "/declined", "/special_done", "/tour_state")
 
     def update(self) -> Status:
         p = self.params
-        self.ctx.send(Tour(p.state, p.reason))
-        self.ctx.note(f"tour {p.state}" + (f": {p.reason}" if p.reason else ""))
+        reason = p.reason or (self.get("/abort_reason") or "" if p.state == "aborted" else "")
+        self.ctx.send(Tour(p.state, reason))
+        self.ctx.note(f"tour {p.state}" + (f": {reason}" if reason else ""))
+        if p.state != "started":
+            self.ctx.progress.clear()
         self.set("/frontend_ready", False)
         self.set("/tour_state", p.state)
         if p.state == "started":

@@ -12,7 +12,7 @@ from frog_bt.blackboard import EventLog, Reading
 from frog_bt.frontend.messages import ContentDone, StartPoi
 from frog_bt.frontend.messages import FinishPoi as FinishPoiCommand
 from frog_bt.messages import Pose, TrackedPeople
-from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
+from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
 
 
 def someone_within(people: TrackedPeople, pose: Pose, radius: float) -> bool:
@@ -27,6 +27,10 @@ class VisitorFollows(Leaf):
     Reads ``/people``, ``/pose``, ``/now``. SUCCESS as soon as a tracked person is
     within ``radius`` metres (default: site ``follow.radius``); RUNNING for up to
     ``grace`` seconds while nobody is (default: site ``follow.grace``), then FAILURE.
+    Stale tracks or pose (``safety.people_max_age``, ``safety.pose_max_age``) are
+    not evidence either way: it waits and says so, and if tracking is still
+    stale after ``grace`` it gives the visitor the benefit of the doubt (SUCCESS,
+    with a note) rather than abandon them over a sensor dropout.
     """
 
     class Params(Params):
@@ -45,14 +49,20 @@ class VisitorFollows(Leaf):
         people: Reading[TrackedPeople] | None = self.get("/people")
         pose: Reading[Pose] | None = self.get("/pose")
         now = self.get("/now")
-        fresh = people is not None and people.age(now) <= max(1.0, self.grace)
-        if fresh and pose is not None and someone_within(people.value, pose.value, self.radius):
+        safety = self.ctx.site.safety
+        fresh = (people is not None and people.age(now) <= safety.people_max_age
+                 and pose is not None and pose.age(now) <= safety.pose_max_age)
+        if fresh and someone_within(people.value, pose.value, self.radius):
             return SUCCESS
         if now - self.started >= self.grace:
+            if not fresh:
+                self.ctx.note("laser tracking or pose stale: assuming the visitor follows")
+                return SUCCESS
             self.ctx.note(f"nobody within {self.radius:g} m for {self.grace:g} s: "
                           "visitor lost, back to recruit")
             return FAILURE
-        self.feedback_message = "waiting for the visitor to catch up"
+        self.feedback_message = ("waiting for the visitor to catch up" if fresh
+                                 else "laser tracking or pose stale: waiting")
         return RUNNING
 
 
@@ -64,6 +74,7 @@ class PlayContent(Leaf):
     initialise. Reads ``/events``, ``/now`` and, optionally, ``/waypoint``. SUCCESS on the
     matching ``content_done``, or after ``timeout`` seconds (default: site
     ``timeouts.content``) with a note: a silent front end must not stop the tour.
+    Interrupted while playing, it sends ``finish_poi`` to stop the content.
     """
 
     class Params(PoiParams):
@@ -81,6 +92,12 @@ class PlayContent(Leaf):
         self.timeout = p.timeout or self.ctx.site.timeouts.content
         waypoint = self.get("/waypoint") or p.poi
         self.ctx.send(StartPoi(p.poi, waypoint, p.part))
+
+    def terminate(self, new_status: Status) -> None:
+        # Interrupted (a tour aborted, a shutdown): stop the content that is playing.
+        if new_status == INVALID and self.status == RUNNING:
+            self.ctx.send(FinishPoiCommand(self.params.poi))
+            self.ctx.note(f"{self.params.poi} interrupted: content stopped")
 
     def update(self) -> Status:
         p = self.params

@@ -45,8 +45,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "(default: off)")
     p.add_argument("--once", action="store_true",
                    help="exit 0 after one tour ends docked; non-zero when it cannot go on")
+    p.add_argument("--checkpoint", type=Path, default=DEFAULT_CHECKPOINT, metavar="FILE",
+                   help=f"tour progress, so that a restart resumes the tour (default: "
+                   f"{DEFAULT_CHECKPOINT}); 'none' disables it")
+    p.add_argument("--fresh", action="store_true",
+                   help="ignore the checkpoint: start a fresh tour")
     p.add_argument("--quiet", action="store_true", help="no live status line")
     p.add_argument("-v", "--verbose", action="store_true", help="log at debug level")
+
+
+DEFAULT_CHECKPOINT = Path(os.environ.get("XDG_STATE_HOME", Path.home() / ".local" / "state")
+                          ) / "frog-bt" / "checkpoint.json"
 
 
 def read_secret(site: Site) -> str | None:
@@ -97,7 +106,9 @@ def run(args: argparse.Namespace) -> int:
         url = args.rosbridge or site.links.rosbridge
         executive = Executive(site, tree, clock, rosbridge_url=url, frontend=frontend,
                               listen=listen, sim_time=args.sim_time, secret=secret,
-                              once=args.once)
+                              once=args.once, fresh=args.fresh,
+                              checkpoint=None if str(args.checkpoint) == "none"
+                              else args.checkpoint)
         status = None if args.quiet else StatusLine()
         if status is not None:
             executive.taps.tick.append(status.update)

@@ -18,8 +18,9 @@ per tour stop of the site configuration, with that stop's variables.
 
 Strings may use ``{VAR}``; a string that is exactly ``"{VAR}"`` takes the
 variable's value and type. Variables: ``dock``, ``recruit_at``,
-``nav_attempts`` from the site, and per stop ``poi``, ``content``,
-``face_stream``, ``projector``, ``check_follower``, ``content_timeout``.
+``nav_attempts`` from the site, and per stop ``index`` (from 0), ``poi``,
+``content``, ``face_stream``, ``projector``, ``check_follower``,
+``content_timeout``.
 
 Every error is a :class:`~frog_bt.errors.TreeError` naming the file, the path
 inside it and what was expected; blackboard keys read by a leaf that nothing
@@ -228,7 +229,8 @@ class _Builder:
             raise TreeError(file, (*path, "foreach"), "expected 'stops' (the site's tour stops)")
         if "include" not in data:
             raise TreeError(file, (*path, "include"), "missing required key: foreach needs include")
-        stops = [] if self.site is None else [s.model_dump() for s in self.site.tour.stops]
+        stops = [] if self.site is None else [
+            {**s.model_dump(), "index": i} for i, s in enumerate(self.site.tour.stops)]
         out: list[Behaviour] = []
         for stop in stops:
             out += self._include({k: v for k, v in data.items() if k != "foreach"}, file, path,

@@ -14,6 +14,7 @@ def test_visitor_follows_when_someone_is_tracked_within_the_radius(tmp_path):
     bench.people((1, 14.0, 10.0))  # 4 m away
     assert bench.tick() == RUNNING
     bench.advance(5)
+    bench.pose(10.0, 10.0)
     bench.people((1, 12.5, 10.0))
     assert bench.tick() == SUCCESS
 
@@ -24,10 +25,25 @@ def test_visitor_lost_after_the_grace_period(tmp_path):
     bench.people()
     assert bench.tick() == RUNNING
     bench.advance(9.9)
+    bench.pose(10.0, 10.0)
+    bench.people()
     assert bench.tick() == RUNNING
     bench.advance(0.1)
     assert bench.tick() == FAILURE
     assert "visitor lost" in bench.core.last_note
+
+
+def test_stale_tracking_is_not_taken_for_a_lost_visitor(tmp_path):
+    bench = Bench(write_tree(tmp_path, "root: {type: VisitorFollows, radius: 3, grace: 10}"))
+    bench.pose(10.0, 10.0)
+    bench.people()  # nobody near, but this reading goes stale: the laser drops out
+    bench.tick()
+    bench.advance(3)
+    assert bench.tick() == RUNNING
+    assert bench.core.bt.root.feedback_message == "laser tracking or pose stale: waiting"
+    bench.advance(7)
+    assert bench.tick() == SUCCESS
+    assert "stale: assuming the visitor follows" in bench.core.last_note
 
 
 def test_content_plays_the_chosen_waypoint_and_waits_for_its_own_done(tmp_path):

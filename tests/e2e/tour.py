@@ -91,5 +91,52 @@ async def run_tour(scenario_data: dict[str, Any], *, site: Site | None = None,
     return Tour(sim, executive, outcome, summary, site)
 
 
+class Running:
+    """A simulator and an executive running in this loop, for tests that act mid-tour.
+
+    ``async with Running({...}) as run:`` then e.g. ``await run.sim.wait_for(...)``,
+    ``await run.finish()`` for the executive's outcome.
+    """
+
+    def __init__(self, scenario_data: dict[str, Any], *, site: Site | None = None,
+                 sim: Simulator | None = None, listen: tuple[str, int] | None = None,
+                 **executive_kwargs: Any) -> None:
+        self.site = site or load_site()
+        self.listen = listen  # with sim=: the address that simulator sends events to
+        self.scenario_data = scenario_data
+        self.sim = sim
+        self.own_sim = sim is None
+        self.executive_kwargs = executive_kwargs
+
+    async def __aenter__(self) -> Running:
+        if self.sim is None:
+            sc = parse_scenario(merge(load_scenario("default").model_dump(mode="json"),
+                                      {**FAST, **self.scenario_data}))
+            self.listen = ("127.0.0.1", free_udp_port())
+            self.sim = Simulator(sc, rosbridge_port=0, frontend_port=0, executive=self.listen)
+            await self.sim.start()
+        assert self.listen is not None
+        self.executive = Executive(self.site, load_tree(site=self.site), SimClock(),
+                                   rosbridge_url=f"ws://127.0.0.1:{self.sim.rosbridge_port}",
+                                   frontend=("127.0.0.1", self.sim.frontend_port),
+                                   listen=self.listen, sim_time=True, **self.executive_kwargs)
+        self.summary = TourSummary(self.site)
+        self.summary.attach(self.executive.taps)
+        self.task = asyncio.create_task(self.executive.run())
+        return self
+
+    async def finish(self, timeout: float = 60.0) -> Outcome:
+        return await asyncio.wait_for(asyncio.shield(self.task), timeout)
+
+    async def __aexit__(self, *exc: object) -> None:
+        self.executive.stop("test over")
+        await asyncio.wait_for(self.task, 10)
+        if self.own_sim:
+            await self.sim.stop()
+
+    def tour(self) -> Tour:
+        return Tour(self.sim, self.executive, self.executive.outcome, self.summary, self.site)
+
+
 def tour(scenario_data: dict[str, Any], **kwargs: Any) -> Tour:
     return asyncio.run(run_tour(scenario_data, **kwargs))

@@ -1,0 +1,154 @@
+"""Tour faults on sim time: abort politely, give up cleanly, resume after a restart."""
+
+from __future__ import annotations
+
+import asyncio
+
+from tour import Running, describe
+
+from frog_bt.checkpoint import load as load_checkpoint
+
+
+def commands_after(run: Running, t: float) -> list[str]:
+    return [describe(r, run.summary) for r in run.sim.received()
+            if r.t >= t and r.channel not in ("ack", "engagement", "volume")]
+
+
+def is_(channel: str, **fields: object):
+    return lambda r: r.direction == "in" and r.channel == channel and all(
+        r.payload.get(k) == v for k, v in fields.items())
+
+
+async def _battery_low_during_content() -> tuple[list[str], int, str, str]:
+    async with Running({}, once=True) as run:
+        await run.sim.wait_for(is_("start_poi", poi="POI1", part="a"), 60)
+        run.sim.world.battery.percentage = 12.0  # the battery sags mid-content
+        t = run.sim.clock.now()
+        outcome = await run.finish()
+        return commands_after(run, t), outcome.code, outcome.reason, \
+            run.sim.world.docking_state
+
+
+def test_battery_low_mid_content_aborts_politely_and_docks():
+    after, code, reason, docking = asyncio.run(_battery_low_during_content())
+    after = [c for c in after if c != "/ICL_command start"]  # may reach the sim late
+    # in the tick that aborts: content stopped, face stream off, the front end told why;
+    # then home to the dock
+    assert set(after[:4]) == {"finish_poi POI1", "/ICL_command stop",
+                              "tour aborted battery 12% below 20%", "/GotoWayPoint SHOP"}
+    assert after[4:] == ["/docking/dock dock"]
+    assert (code, reason, docking) == (1, "tour aborted: battery 12% below 20%", "docked")
+
+
+async def _battery_low_with_projector_on() -> list[str]:
+    async with Running({}, once=True) as run:
+        on = await run.sim.wait_for(is_("projector", on=True), 60)
+        run.sim.world.battery.percentage = 15.0
+        await run.finish()
+        return commands_after(run, on.t)
+
+
+def test_abort_switches_the_projector_off():
+    after = asyncio.run(_battery_low_with_projector_on())
+    assert after[0] == "projector True"
+    assert {"projector False", "tour aborted battery 15% below 20%",
+            "/GotoWayPoint SHOP"} <= set(after[1:5])
+    assert after.count("projector False") == 1 and after[-1] == "/docking/dock dock"
+
+
+async def _fault() -> tuple[list[str], int, str]:
+    async with Running({"faults": [{"at": 120, "name": "motors", "level": 2,
+                                    "message": "overheated"}]}, once=True) as run:
+        outcome = await run.finish()
+        return [describe(r, run.summary) for r in run.sim.received("tour")], outcome.code, \
+            outcome.reason
+
+
+def test_electronics_fault_aborts_with_its_reason():
+    tours, code, reason = asyncio.run(_fault())
+    assert tours == ["tour started", "tour aborted electronics fault: motors: overheated"]
+    assert (code, reason) == (1, "tour aborted: electronics fault: motors: overheated")
+
+
+async def _undock_fails() -> tuple[list[str], int, str]:
+    async with Running({"docking": {"undock_failures": 5}}, once=True) as run:
+        outcome = await run.finish()
+        return [c for c in commands_after(run, 0) if not c.startswith("follow")], \
+            outcome.code, outcome.reason
+
+
+def test_undocking_failure_is_retried_then_stops_with_a_reason():
+    commands, code, reason = asyncio.run(_undock_fails())
+    assert commands == ["tour started", "/docking/dock undock", "/docking/dock undock",
+                        "/docking/dock undock", "tour aborted undock failed"]
+    assert (code, reason) == (1, "undock failed")
+
+
+async def _dock_fails() -> tuple[list[str], int, str]:
+    async with Running({"docking": {"dock_failures": 5}}, once=True) as run:
+        outcome = await run.finish(90)
+        return [c for c in commands_after(run, 0) if c.startswith(("/docking", "tour"))], \
+            outcome.code, outcome.reason
+
+
+def test_docking_failure_is_retried_then_stops_with_a_reason():
+    commands, code, reason = asyncio.run(_dock_fails())
+    assert commands[-5:] == ["/docking/dock dock"] * 3 + ["tour aborted dock failed"] \
+        or commands[-4:] == ["/docking/dock dock"] * 3 + ["tour aborted dock failed"]
+    assert (code, reason) == (1, "dock failed")
+
+
+async def _crash_and_resume(tmp_path) -> tuple[list[str], list[str], int]:
+    checkpoint = tmp_path / "checkpoint.json"
+    async with Running({}, checkpoint=checkpoint) as first:
+        sim, listen = first.sim, first.listen
+        # the executive "crashes" while the visitor watches POI2's content
+        await sim.wait_for(is_("start_poi", poi="POI2", part="a"), 60)
+        first.own_sim = False
+    saved = load_checkpoint(checkpoint)
+    assert saved is not None and saved.order == ["start", "recruit", "stop 0"]
+    assert saved.visitor == 7
+    restart_t = sim.clock.now()
+    async with Running({}, sim=sim, listen=listen, checkpoint=checkpoint, once=True) as second:
+        outcome = await second.finish()
+        resumed = commands_after(second, restart_t)
+    await sim.stop()
+    return resumed, [describe(r, second.summary) for r in sim.received("tour")], outcome.code
+
+
+def test_a_restarted_executive_resumes_the_tour_at_the_current_stop(tmp_path):
+    resumed, tours, code = asyncio.run(_crash_and_resume(tmp_path))
+    assert code == 0
+    gotos = [c for c in resumed if c.startswith("/GotoWayPoint")]
+    assert gotos[0] == "/GotoWayPoint POI2a"  # re-navigates to the current stop
+    assert "/docking/dock undock" not in resumed and not any(
+        c.startswith("/Approach") for c in resumed)  # no new start, no new recruitment
+    assert tours == ["tour started", "tour ended"]  # one tour, resumed, not a second one
+    assert not (tmp_path / "checkpoint.json").exists()  # cleared when the tour ended
+
+
+async def _fresh_ignores(tmp_path) -> list[str]:
+    checkpoint = tmp_path / "checkpoint.json"
+    checkpoint.write_text('{"version": 1, "done": ["start", "recruit", "stop 0"], "visitor": 7}')
+    async with Running({}, checkpoint=checkpoint, fresh=True, once=True) as run:
+        await run.finish()
+        return commands_after(run, 0)
+
+
+def test_fresh_ignores_the_checkpoint(tmp_path):
+    commands = asyncio.run(_fresh_ignores(tmp_path))
+    assert commands[:2] == ["tour started", "/docking/dock undock"]
+
+
+async def _docked_robot_does_not_resume(tmp_path) -> list[str]:
+    checkpoint = tmp_path / "checkpoint.json"
+    checkpoint.write_text('{"version": 1, "done": ["start", "recruit", "stop 0"], "visitor": 7}')
+    async with Running({}, checkpoint=checkpoint, once=True) as run:
+        await run.finish()
+        return commands_after(run, 0)
+
+
+def test_a_checkpoint_is_dropped_when_the_robot_is_docked(tmp_path):
+    # a robot at its dock is not in the middle of a tour, whatever the file says
+    commands = asyncio.run(_docked_robot_does_not_resume(tmp_path))
+    assert commands[:2] == ["tour started", "/docking/dock undock"]
