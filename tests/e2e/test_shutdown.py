@@ -1,0 +1,46 @@
+"""SIGINT / SIGTERM halt the tree (face stream off, content stopped) and exit within 2 s."""
+
+from __future__ import annotations
+
+import asyncio
+import signal
+import sys
+import time
+
+import pytest
+from tour import FAST, free_udp_port, merge
+
+from frog_bt.sim import Simulator, load_scenario, parse_scenario
+
+
+async def _signal_mid_content(sig: int) -> tuple[int, float, list[str]]:
+    scenario = parse_scenario(merge(load_scenario("default").model_dump(mode="json"), FAST))
+    listen = free_udp_port()
+    sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=("127.0.0.1", listen))
+    await sim.start()
+    try:
+        proc = await asyncio.create_subprocess_exec(
+            sys.executable, "-m", "frog_bt", "run", "--sim-time", "--quiet",
+            "--checkpoint", "none", "--rosbridge", f"ws://127.0.0.1:{sim.rosbridge_port}",
+            "--frontend", f"127.0.0.1:{sim.frontend_port}", "--listen", f"127.0.0.1:{listen}")
+        await sim.wait_for(lambda r: r.channel == "start_poi" and r.payload["poi"] == "POI1",
+                           60)
+        t = sim.clock.now()
+        sent = time.monotonic()
+        proc.send_signal(sig)
+        code = await asyncio.wait_for(proc.wait(), 10)
+        elapsed = time.monotonic() - sent
+        after = [f"{r.channel} {r.payload.get('data', r.payload.get('poi', ''))}"
+                 for r in sim.received() if r.t >= t and r.channel not in ("ack", "engagement")]
+        return code, elapsed, after
+    finally:
+        await sim.stop()
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_signal_halts_the_tree_and_exits_within_two_seconds(sig):
+    code, elapsed, after = asyncio.run(_signal_mid_content(sig))
+    assert code == 0
+    assert elapsed < 2.0
+    assert "/ICL_command stop" in after  # face stream stopped
+    assert "finish_poi POI1" in after  # content stopped
