@@ -109,13 +109,13 @@ def run(args: argparse.Namespace) -> int:
                               once=args.once, fresh=args.fresh,
                               checkpoint=None if str(args.checkpoint) == "none"
                               else args.checkpoint)
+        loop = asyncio.get_running_loop()
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)
         status = None if args.quiet else StatusLine()
         if status is not None:
             executive.taps.tick.append(status.update)
         observers = attach_observers(executive, record=args.record, rerun=args.rerun)
-        loop = asyncio.get_running_loop()
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)
         try:
             outcome = await executive.run()
         finally:

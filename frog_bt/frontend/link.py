@@ -96,8 +96,10 @@ class FrontendLink:
     for the executive, :data:`~frog_bt.frontend.messages.COMMANDS` for the front
     end. ``on_message`` is called with every accepted, non-duplicate message, on
     the event loop, after its ack has been sent. ``on_datagram`` (optional) sees
-    every datagram received (``"in"``, before any filtering) or sent (``"out"``,
-    acks and resends included), stamped with the clock's time.
+    every datagram received from the peer host (``"in"``, malformed and duplicate
+    ones included; datagrams from other hosts are dropped and counted, never
+    shown, so a recording holds nothing a replay must not act on) or sent
+    (``"out"``, acks and resends included), stamped with the clock's time.
     """
 
     def __init__(
@@ -252,7 +254,7 @@ class FrontendLink:
 
     def _datagram_received(self, data: bytes, addr: tuple) -> None:
         now = self.clock.now()
-        if self.on_datagram is not None:
+        if self.on_datagram is not None and addr[0] == self._endpoint.peer_host:
             self.on_datagram("in", data, now)
         foreign = self._endpoint.stats.foreign
         received = self._endpoint.receive(data, addr[0], now)

@@ -1,0 +1,301 @@
+"""MCAP recordings of everything the executive receives and sends (CONTRACT §6).
+
+:class:`Recorder` writes one MCAP file with JSON message encoding:
+
+* one channel per ROS topic the executive subscribes to or publishes (channel
+  topic = ROS topic, schema name = ROS type, e.g. ``geometry_msgs/PoseStamped``),
+  ``/clock`` included under sim time; the message data is the rosbridge ``msg``
+  object, exactly as received or sent;
+* ``/frontend/in`` and ``/frontend/out``: every UDP datagram from the front-end
+  host and to the front end (acks and resends included), data = the datagram's
+  bytes;
+* ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``).
+  Live ticks coalesce bursts of inputs and fall wherever the event loop gets to
+  them, so replay ticks exactly where the live executive did
+  (:mod:`frog_bt.replay`).
+
+Every message is stamped (``log_time`` = ``publish_time``, ns) with the
+project-clock time it was received or sent; ``/clock`` with the time it carries
+(the time it starts). Under sim time, what arrives before the first ``/clock``
+is held and stamped with that first time, so a recording has no zero stamps.
+
+Each channel carries a JSON Schema (encoding ``jsonschema``), so Foxglove
+can browse and plot the fields. Writing costs one ``json.dumps`` and one
+``add_message`` per message; chunks are bounded (:data:`CHUNK_SIZE`) and
+flushed at least every :data:`FLUSH_EVERY` wall seconds, so memory stays small
+and a crash loses little. :meth:`Recorder.close` (idempotent, also run at
+interpreter exit) writes the summary and footer: a recording stays valid MCAP
+when the run command stops on SIGTERM, or on an exception.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import time
+import weakref
+from collections.abc import Callable
+from pathlib import Path
+from typing import IO, Any
+
+from mcap.writer import CompressionType, Writer
+
+from frog_bt import __version__
+from frog_bt.errors import DecodeError
+from frog_bt.messages import decode_clock
+from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
+
+log = logging.getLogger(__name__)
+
+FRONTEND_IN = "/frontend/in"
+FRONTEND_OUT = "/frontend/out"
+TICK = "/frog_bt/tick"
+DATAGRAM_TYPE = "frog_bt/FrontendDatagram"
+TICK_TYPE = "frog_bt/Tick"
+CHUNK_SIZE = 256 * 1024  # bytes of uncompressed messages per chunk
+FLUSH_EVERY = 2.0  # wall seconds between forced chunk flushes
+HELD_LIMIT = 10_000  # messages held before the first /clock
+
+# ------------------------------------------------------------------ JSON Schemas
+
+_INT = {"type": "integer"}
+_NUM = {"type": "number"}
+_STR = {"type": "string"}
+_BOOL = {"type": "boolean"}
+
+
+def _obj(title: str | None = None, **props: Any) -> dict[str, Any]:
+    schema: dict[str, Any] = {"type": "object", "properties": props}
+    if title:
+        schema["title"] = title
+    return schema
+
+
+def _array(items: dict[str, Any]) -> dict[str, Any]:
+    return {"type": "array", "items": items}
+
+
+_TIME = {**_obj(secs=_INT, nsecs=_INT, sec=_INT, nanosec=_INT),
+         "description": "ROS 1 {secs, nsecs} or ROS 2 {sec, nanosec}"}
+_HEADER = _obj("std_msgs/Header", seq=_INT, stamp=_TIME, frame_id=_STR)
+_POINT = _obj("geometry_msgs/Point", x=_NUM, y=_NUM, z=_NUM)
+_QUATERNION = _obj("geometry_msgs/Quaternion", x=_NUM, y=_NUM, z=_NUM, w=_NUM)
+
+SCHEMAS: dict[str, dict[str, Any]] = {
+    "geometry_msgs/PoseStamped": _obj(
+        "geometry_msgs/PoseStamped", header=_HEADER,
+        pose=_obj("geometry_msgs/Pose", position=_POINT, orientation=_QUATERNION)),
+    "std_msgs/Int32": _obj("std_msgs/Int32", data=_INT),
+    "std_msgs/String": _obj("std_msgs/String", data=_STR),
+    "diagnostic_msgs/DiagnosticArray": _obj(
+        "diagnostic_msgs/DiagnosticArray", header=_HEADER, status=_array(_obj(
+            "diagnostic_msgs/DiagnosticStatus",
+            level={"type": "integer", "minimum": 0, "maximum": 3,
+                   "description": "0 OK, 1 WARN, 2 ERROR, 3 STALE"},
+            name=_STR, message=_STR, hardware_id=_STR,
+            values=_array(_obj("diagnostic_msgs/KeyValue", key=_STR, value=_STR))))),
+    "frog_msgs/PersonDetections": _obj(
+        "frog_msgs/PersonDetections", header=_HEADER, persons=_array(_obj(
+            "frog_msgs/PersonDetection", id=_INT, position=_POINT,
+            orientation={**_NUM, "description": "degrees 0..360 relative to the robot, "
+                                                "180 = facing it"}))),
+    "frog_msgs/FaceData": _obj(
+        "frog_msgs/FaceData", header=_HEADER, faces=_array(_obj(
+            "frog_msgs/Face", id=_INT,
+            engagement={"type": "number", "minimum": -1, "maximum": 1},
+            distance={**_NUM, "description": "metres"}, facing=_BOOL))),
+    "frog_msgs/TrackedPeople": _obj(
+        "frog_msgs/TrackedPeople", header=_HEADER,
+        people=_array(_obj("frog_msgs/TrackedPerson", id=_INT, position=_POINT))),
+    "rosgraph_msgs/Clock": _obj("rosgraph_msgs/Clock", clock=_TIME),
+    DATAGRAM_TYPE: {
+        **_obj("frog_bt/FrontendDatagram",
+               type={**_STR, "description": "command, event or ack (CONTRACT §2)"},
+               seq={"type": "integer", "minimum": 0}, icl=_BOOL,
+               engaged={"type": ["boolean", "null"]}, poi=_STR, waypoint=_STR,
+               part={"enum": ["a", "b"]}, level={"type": ["number", "null"]}, on=_BOOL,
+               percent=_INT, spot=_STR, state=_STR, reason=_STR),
+        "required": ["type", "seq"]},
+    TICK_TYPE: _obj("frog_bt/Tick", tick=_INT,
+                    status={"enum": ["INVALID", "RUNNING", "SUCCESS", "FAILURE"]}),
+}
+
+
+def to_ns(t: float) -> int:
+    """Clock seconds to integer nanoseconds; :func:`from_ns` gives ``t`` back exactly for
+    any epoch time (float spacing there is far above a nanosecond)."""
+    whole = math.floor(t)
+    return whole * 1_000_000_000 + round((t - whole) * 1e9)
+
+
+def from_ns(ns: int) -> float:
+    """Integer nanoseconds to clock seconds (the float :func:`to_ns` was given)."""
+    whole, frac = divmod(ns, 1_000_000_000)
+    return whole + frac / 1e9
+
+
+def _dumps(msg: Any) -> bytes:
+    return json.dumps(msg, separators=(",", ":")).encode()
+
+
+def _finish(writer: Writer, stream: IO[bytes]) -> None:
+    """Write summary and footer, close the file (the finalizer: runs once)."""
+    try:
+        writer.finish()
+    except Exception:
+        log.exception("recording: cannot finish the MCAP file")
+    finally:
+        stream.close()
+
+
+class Recorder:
+    """Writes an MCAP recording of one executive run; see the module docstring.
+
+    ``Recorder(path)`` creates the file (``OSError`` when it cannot);
+    :meth:`attach` hooks it to an :class:`~frog_bt.executive.Executive`;
+    :meth:`close` finishes it. A write error is logged once and stops the
+    recording; it never reaches the tick path.
+    """
+
+    def __init__(self, path: Path, *, chunk_size: int = CHUNK_SIZE,
+                 flush_every: float = FLUSH_EVERY) -> None:
+        self.path = Path(path)
+        self._stream: IO[bytes] = open(self.path, "wb")  # noqa: SIM115 - closed by _finish
+        compression = CompressionType.NONE
+        try:
+            import lz4.frame  # noqa: F401 - optional, chosen only when installed
+
+            compression = CompressionType.LZ4
+        except ImportError:
+            pass
+        self._writer = Writer(self._stream, chunk_size=chunk_size, compression=compression)
+        self._writer.start(profile="", library=f"frog-bt {__version__}")
+        self._finalizer = weakref.finalize(self, _finish, self._writer, self._stream)
+        self._flush_every = flush_every
+        self._flushed_at = time.monotonic()
+        self._schemas: dict[str, int] = {}
+        self._channels: dict[str, int] = {}
+        self._sequence: dict[int, int] = {}
+        self._last_ns = 0
+        self._held: list[tuple[int, bytes]] = []
+        self._ready: Callable[[], bool] = lambda: True
+        self._clock_topic: str | None = None
+        self.messages = 0
+        self.dropped = 0  # held before the first /clock beyond HELD_LIMIT
+        self.closed = False
+
+    # ------------------------------------------------------------ wiring
+
+    def attach(self, executive: Any) -> None:
+        """Register every channel and hook the executive's wire and core taps."""
+        site = executive.site
+        for role, topic in (*INPUTS.items(), *OUTPUTS.items()):
+            self.channel(site.topic(role), topic.type)
+        if executive.sim_time:
+            self._clock_topic = CLOCK.name
+            self.channel(CLOCK.name, CLOCK.type)
+        self.channel(FRONTEND_IN, DATAGRAM_TYPE)
+        self.channel(FRONTEND_OUT, DATAGRAM_TYPE)
+        self.channel(TICK, TICK_TYPE)
+        clock = executive.clock
+        self._ready = lambda: bool(clock.ready)
+        executive.wire.ros_in.append(self.on_ros_in)
+        executive.taps.ros_out.append(self.on_ros_out)
+        executive.wire.datagram.append(self.on_datagram)
+        executive.taps.tick.append(self.on_tick)
+
+    def channel(self, topic: str, type_: str) -> int:
+        """The channel id of ``topic``, registering it (and its schema) on first use."""
+        cid = self._channels.get(topic)
+        if cid is None:
+            sid = self._schemas.get(type_)
+            if sid is None:
+                schema = SCHEMAS.get(type_, {"type": "object"})
+                sid = self._writer.register_schema(type_, "jsonschema", _dumps(schema))
+                self._schemas[type_] = sid
+            cid = self._writer.register_channel(topic, "json", sid)
+            self._channels[topic] = cid
+        return cid
+
+    # ------------------------------------------------------------ taps (tick path: keep cheap)
+
+    def on_ros_in(self, t: float, topic: str, msg: Any) -> None:
+        cid = self._channels.get(topic)
+        if cid is None:
+            cid = self.channel(topic, "unknown")
+        if topic == self._clock_topic:
+            try:  # /clock is seen before the clock takes it: stamp it with its own time
+                t = max(t, decode_clock(msg)) if self._ready() else decode_clock(msg)
+            except DecodeError:
+                pass
+            else:
+                self._write(cid, t, _dumps(msg))
+                return
+        self._write(cid, t if self._ready() else None, _dumps(msg))
+
+    def on_ros_out(self, t: float, topic: str, msg: Any) -> None:
+        self._write(self._channels.get(topic) or self.channel(topic, "unknown"), t, _dumps(msg))
+
+    def on_datagram(self, direction: str, data: bytes, t: float) -> None:
+        topic = FRONTEND_IN if direction == "in" else FRONTEND_OUT
+        cid = self._channels.get(topic) or self.channel(topic, DATAGRAM_TYPE)
+        self._write(cid, t if self._ready() else None, bytes(data))
+
+    def on_tick(self, core: Any) -> None:
+        status = core.bt.root.status.name
+        self._write(self._channels.get(TICK) or self.channel(TICK, TICK_TYPE), core.clock.now(),
+                    b'{"tick":%d,"status":"%s"}' % (core.ticks, status.encode()))
+
+    # ------------------------------------------------------------ writing
+
+    def _write(self, cid: int, t: float | None, data: bytes) -> None:
+        if self.closed:
+            return
+        if t is None:  # before the first /clock: no time yet
+            if len(self._held) < HELD_LIMIT:
+                self._held.append((cid, data))
+            else:
+                self.dropped += 1
+            return
+        try:
+            ns = max(to_ns(t), self._last_ns)
+            if self._held:
+                held, self._held = self._held, []
+                for held_cid, held_data in held:
+                    self._add(held_cid, ns, held_data)
+            self._add(cid, ns, data)
+            self._last_ns = ns
+            now = time.monotonic()
+            if now - self._flushed_at >= self._flush_every:
+                self._flushed_at = now
+                self._writer.flush()
+        except Exception as exc:  # disk full, ...: stop recording, never stop the robot
+            log.error("recording to %s stopped: %s", self.path, exc)
+            self.close()
+
+    def _add(self, cid: int, ns: int, data: bytes) -> None:
+        seq = self._sequence.get(cid, 0)
+        self._sequence[cid] = seq + 1
+        self._writer.add_message(cid, log_time=ns, data=data, publish_time=ns,
+                                 sequence=seq & 0xFFFFFFFF)
+        self.messages += 1
+
+    def close(self) -> None:
+        """Write the summary and footer and close the file; idempotent."""
+        if self.closed:
+            return
+        self.closed = True
+        if self._held:
+            log.warning("recording: %d messages before the first /clock were never stamped",
+                        len(self._held))
+            self._held = []
+        if self.dropped:
+            log.warning("recording: %d messages before the first /clock dropped", self.dropped)
+        self._finalizer()
+
+    def __enter__(self) -> Recorder:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -1,0 +1,319 @@
+"""Re-run the tree offline on a recording's inputs, on the recording's clock.
+
+:class:`Replay` reads an MCAP recording (:mod:`frog_bt.recording`) in log-time
+order and feeds a fresh :class:`~frog_bt.core.Core` on a
+:class:`~frog_bt.clock.ManualClock` that takes the recorded times: ROS inputs
+go through :data:`~frog_bt.messages.DECODERS` (by the channel's schema name) to
+``Core.on_ros``; ``/frontend/in`` datagrams go through a fresh
+:class:`~frog_bt.frontend.protocol.Endpoint`, so duplicates are suppressed exactly
+as live, to ``Core.on_event``; ``/clock`` moves the clock (under sim time what
+arrived before the first ``/clock`` is fed with the clock not yet ready, as live).
+
+Ticks: a recording made by :class:`~frog_bt.recording.Recorder` has the live
+ticks (``/frog_bt/tick``), and replay ticks exactly there, in the same place
+among the inputs. Live ticks coalesce bursts of inputs and land wherever the
+event loop gets to them, so no rule can recompute them; with the recorded ones,
+replaying the same tree is exact. A recording without ticks is replayed by the
+live rules instead (periodic ticks at ``executive.tick_hz`` on the clock, and a
+tick after each input that calls for one and after each front-end event), which
+is close but not guaranteed identical.
+
+The commands the replayed tree sends are compared, in order, with the recorded
+ones: ROS outputs (``header.stamp`` left out) and new front-end commands
+(``/frontend/out`` without acks and resends; ``seq`` left out). The first
+difference is a :class:`Divergence`. With a changed tree or configuration this
+answers "what would the robot have done": until the first divergence the
+recorded inputs are exactly what the new tree would have seen.
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+from typing import Any
+
+from mcap.exceptions import InvalidMagic, McapError
+from mcap.reader import make_reader
+
+from frog_bt.clock import SITE_TZ, ManualClock
+from frog_bt.config import Site, parse_hostport
+from frog_bt.core import Core
+from frog_bt.errors import DecodeError, FrogError
+from frog_bt.frontend.messages import EVENTS, FrontendMessage, message_fields
+from frog_bt.frontend.protocol import Endpoint
+from frog_bt.messages import DECODERS, decode_clock
+from frog_bt.recording import FRONTEND_IN, FRONTEND_OUT, TICK, from_ns
+from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
+from frog_bt.tree.loader import LoadedTree
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+class ReplayError(FrogError):
+    """The recording cannot be replayed (not a file, not MCAP, channels missing)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Command:
+    """One command sent: when, on which channel (ROS topic or ``/frontend/out``), what."""
+
+    t: float
+    channel: str
+    payload: dict[str, Any]
+
+    def __str__(self) -> str:
+        return f"{self.channel} {json.dumps(self.payload, sort_keys=True)}"
+
+
+@dataclass(frozen=True, slots=True)
+class Divergence:
+    """The first command that differs: its number (from 1), the recorded one, the replayed one."""
+
+    number: int
+    expected: Command | None
+    got: Command | None
+
+    @property
+    def t(self) -> float:
+        """When the runs parted: the earlier of the two commands."""
+        return min(c.t for c in (self.expected, self.got) if c is not None)
+
+
+@dataclass(slots=True)
+class ReplayResult:
+    start: float  # first and last recorded times
+    end: float
+    covered: float  # last recorded time replayed
+    inputs: int = 0  # ROS messages and front-end datagrams fed in
+    ticks: int = 0
+    ros_commands: int = 0  # recorded commands, compared
+    frontend_commands: int = 0
+    exact: bool = True  # ticks taken from the recording
+    divergence: Divergence | None = None
+    wall: float = 0.0  # seconds the replay took
+
+    @property
+    def identical(self) -> bool:
+        return self.divergence is None
+
+
+def local_time(t: float) -> str:
+    """``2026-06-01 10:42:13.2`` at the site."""
+    return datetime.fromtimestamp(t, SITE_TZ).strftime("%Y-%m-%d %H:%M:%S.%f")[:-5]
+
+
+def _plain(value: Any) -> Any:
+    """JSON round trip: the values a recording gives back (lists, not tuples)."""
+    return json.loads(json.dumps(value))
+
+
+def _without_stamp(msg: Any) -> Any:
+    header = msg.get("header") if isinstance(msg, dict) else None
+    if isinstance(header, dict) and "stamp" in header:
+        msg = {**msg, "header": {k: v for k, v in header.items() if k != "stamp"}}
+    return msg
+
+
+class Replay:
+    """One replay of ``path`` with ``site`` and ``tree``; see the module docstring.
+
+    Raises :class:`ReplayError` when the file is no frog-bt recording. Attach
+    observers (telemetry) to :attr:`core` before :meth:`run`.
+    """
+
+    def __init__(self, path: Path, site: Site, tree: LoadedTree) -> None:
+        self.path = Path(path)
+        self.site = site
+        self._peer = parse_hostport(site.links.frontend, "links.frontend")[0]
+        if not self.path.is_file():
+            raise ReplayError(f"{self.path}: not a file")
+        self._stream = open(self.path, "rb")  # noqa: SIM115 - closed by close()
+        if self._stream.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
+            self.close()
+            raise ReplayError(f"{self.path}: not an MCAP file")
+        self._stream.seek(0)
+        try:
+            self._reader = make_reader(self._stream)
+            summary = self._reader.get_summary()
+        except InvalidMagic:
+            self.close()
+            raise ReplayError(f"{self.path}: not an MCAP file") from None
+        except (McapError, ValueError, EOFError, OSError, IndexError, struct.error) as exc:
+            self.close()
+            raise ReplayError(f"{self.path}: damaged MCAP file, cut short? ({exc})") from None
+        if summary is None:
+            self.close()
+            raise ReplayError(f"{self.path}: MCAP file without a summary, cut short?")
+        schemas = summary.schemas
+        self.types = {ch.topic: schemas[ch.schema_id].name if ch.schema_id in schemas else ""
+                      for ch in summary.channels.values()}
+        self.outputs = {site.topic(role) for role in OUTPUTS}
+        missing = sorted({FRONTEND_IN, FRONTEND_OUT, *self.outputs} - set(self.types))
+        if missing:
+            self.close()
+            raise ReplayError(f"{self.path}: not a frog-bt recording for this configuration: "
+                              f"no channel {', '.join(missing)}")
+        stats = summary.statistics
+        self.start = from_ns(stats.message_start_time) if stats else 0.0
+        self.end = from_ns(stats.message_end_time) if stats else 0.0
+        self.sim_time = CLOCK.name in self.types
+        self.exact = TICK in self.types
+        self.period = 1.0 / site.executive.tick_hz
+        self.clock = ManualClock(None)
+        self.core = Core(site, tree, self.clock, self._publish, self._send)
+        self.inputs = {site.topic(role): topic.type for role, topic in INPUTS.items()}
+        self.endpoint = Endpoint(self._peer, EVENTS)  # the same dedup as the live link
+        self._expected: deque[Command] = deque()
+        self._got: deque[Command] = deque()
+        self._seqs: set[int] = set()
+        self._compared = 0
+        self._next_tick = 0.0
+        self.result = ReplayResult(self.start, self.end, self.start, exact=self.exact)
+
+    def close(self) -> None:
+        self._stream.close()
+
+    # ------------------------------------------------------------ outputs of the replayed tree
+
+    def _publish(self, topic: str, msg: dict[str, Any]) -> None:
+        self._got.append(Command(self.clock.now(), topic, _without_stamp(_plain(msg))))
+        self._compare()
+
+    def _send(self, message: FrontendMessage) -> None:
+        payload = _plain({"type": message.type, **message_fields(message)})
+        self._got.append(Command(self.clock.now(), FRONTEND_OUT, payload))
+        self._compare()
+
+    def _compare(self) -> None:
+        while self._expected and self._got and self.result.divergence is None:
+            expected, got = self._expected.popleft(), self._got.popleft()
+            self._compared += 1
+            if (expected.channel, expected.payload) != (got.channel, got.payload):
+                self.result.divergence = Divergence(self._compared, expected, got)
+
+    # ------------------------------------------------------------ the run
+
+    def run(self, progress: Callable[[float], None] | None = None) -> ReplayResult:
+        """Replay to the end, or to the first divergence; the result says which."""
+        wall0 = time.monotonic()
+        result = self.result
+        try:
+            for _schema, channel, message in self._reader.iter_messages(log_time_order=True):
+                t = from_ns(message.log_time)
+                self._on_message(channel.topic, t, message.data)
+                result.covered = t
+                if progress is not None:
+                    progress(t)
+                if result.divergence is not None:
+                    break
+            else:
+                self.core.halt()  # as the executive does when it stops (face stream off, ...)
+                if result.divergence is None and (self._expected or self._got):
+                    expected = self._expected.popleft() if self._expected else None
+                    got = self._got.popleft() if self._got else None
+                    result.divergence = Divergence(self._compared + 1, expected, got)
+        finally:
+            self.close()
+        result.ticks = self.core.ticks
+        result.wall = time.monotonic() - wall0
+        return result
+
+    def _on_message(self, topic: str, t: float, data: bytes) -> None:
+        if topic == CLOCK.name and self.sim_time:
+            try:
+                t = decode_clock(json.loads(data))
+            except (ValueError, DecodeError):
+                return  # live, a malformed /clock does not move the clock either
+            self._advance(t)
+            return
+        if self.clock.ready or not self.sim_time:
+            self._advance(t)
+        if topic in self.inputs:
+            self._on_ros(topic, data)
+        elif topic == FRONTEND_IN:
+            self._on_datagram(data)
+        elif topic == TICK:
+            if self.exact:
+                self._tick()
+        elif topic == FRONTEND_OUT:
+            self._expect_datagram(t, data)
+        elif topic in self.outputs:
+            self.result.ros_commands += 1
+            self._expected.append(Command(t, topic, _without_stamp(json.loads(data))))
+            self._compare()
+
+    def _on_ros(self, topic: str, data: bytes) -> None:
+        decoder = DECODERS.get(self.types.get(topic, "")) or DECODERS[self.inputs[topic]]
+        try:
+            value = decoder(json.loads(data))
+        except (ValueError, DecodeError):
+            return  # live, the client drops a malformed message before the core
+        self.result.inputs += 1
+        if self.core.on_ros(topic, value) and not self.exact and self.clock.ready:
+            self._tick()
+
+    def _on_datagram(self, data: bytes) -> None:
+        self.result.inputs += 1
+        received = self.endpoint.receive(data, self._peer, self.clock.now())
+        if received.message is not None:
+            self.core.on_event(received.message)
+            if not self.exact and self.clock.ready:
+                self._tick()
+
+    def _expect_datagram(self, t: float, data: bytes) -> None:
+        try:
+            obj = json.loads(data)
+        except ValueError:
+            return
+        if not isinstance(obj, dict) or obj.get("type") == "ack":
+            return
+        seq = obj.pop("seq", None)
+        if seq in self._seqs:
+            return  # a resend
+        self._seqs.add(seq)
+        self.result.frontend_commands += 1
+        self._expected.append(Command(t, FRONTEND_OUT, obj))
+        self._compare()
+
+    # ------------------------------------------------------------ time and ticks
+
+    def _advance(self, t: float) -> None:
+        """Move the clock to ``t``; without recorded ticks, tick as the live loop would."""
+        clock = self.clock
+        if not clock.ready:
+            clock.set(t)
+            self.core.setup()
+            if not self.exact:  # the link came up before the clock: the loop ticks at once
+                self._next_tick = clock.now() + self.period
+                self._tick()
+            return
+        if self.exact or t < self._next_tick:
+            clock.set(t)
+            return
+        if self.sim_time:  # the clock jumps: one periodic tick at the new time
+            clock.set(t)
+            self._periodic(t)
+            self._tick()
+            return
+        while self._next_tick <= t:  # wall-clock recording: ticks at their deadlines
+            clock.set(self._next_tick)
+            self._periodic(self._next_tick)
+            self._tick()
+        clock.set(t)
+
+    def _periodic(self, now: float) -> None:
+        """The live periodic task's next deadline after waking at ``now``."""
+        while self._next_tick <= now:
+            self._next_tick = max(self._next_tick + self.period, now)
+            if self._next_tick <= now:
+                self._next_tick = now + self.period
+
+    def _tick(self) -> None:
+        if self.result.divergence is None:
+            self.core.tick()

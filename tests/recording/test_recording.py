@@ -1,0 +1,189 @@
+"""MCAP recordings (CONTRACT §6): channels, schemas, stamps; valid after SIGTERM or a crash."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+from hypothesis import given
+from hypothesis import strategies as st
+from mcap.reader import make_reader
+from recorded_tour import RecordedTour, free_udp_port, scenario
+
+from frog_bt.clock import SimClock
+from frog_bt.config import load_site
+from frog_bt.core import Taps
+from frog_bt.executive import WireTaps
+from frog_bt.messages import encode_clock
+from frog_bt.recording import (
+    DATAGRAM_TYPE,
+    FRONTEND_IN,
+    FRONTEND_OUT,
+    SCHEMAS,
+    TICK,
+    Recorder,
+    from_ns,
+    to_ns,
+)
+from frog_bt.sim import Simulator
+from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
+
+ROOT = Path(__file__).resolve().parents[2]
+JSON_TYPES: dict[str, Any] = {"object": dict, "array": list, "string": str, "boolean": bool,
+                              "null": type(None), "number": (int, float), "integer": int}
+
+
+def conforms(value: Any, schema: dict[str, Any]) -> bool:
+    """The subset of JSON Schema the recorder writes: type, properties, items, enum, required."""
+    if "enum" in schema and value not in schema["enum"]:
+        return False
+    types = schema.get("type")
+    if types is not None:
+        types = [types] if isinstance(types, str) else types
+        ok = [t for t in types if isinstance(value, JSON_TYPES[t])
+              and not (t in ("number", "integer") and isinstance(value, bool))]
+        if not ok:
+            return False
+    if isinstance(value, dict):
+        props = schema.get("properties", {})
+        return (all(k in value for k in schema.get("required", ()))
+                and all(k in props and conforms(v, props[k]) for k, v in value.items()))
+    if isinstance(value, list) and "items" in schema:
+        return all(conforms(v, schema["items"]) for v in value)
+    return True
+
+
+def read_all(path: Path) -> tuple[Any, list[tuple[Any, Any, Any]]]:
+    """Summary and every message, in file order (make_reader fails on an invalid file)."""
+    with open(path, "rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        messages = list(reader.iter_messages(log_time_order=False))
+    return summary, messages
+
+
+def test_a_recorded_tour_has_every_channel_typed_and_stamped(tour: RecordedTour) -> None:
+    summary, messages = read_all(tour.path)
+    assert summary is not None and summary.statistics.message_count == len(messages)
+    types = {t.name: t.type for t in (*INPUTS.values(), *OUTPUTS.values(), CLOCK)}
+    types |= {FRONTEND_IN: DATAGRAM_TYPE, FRONTEND_OUT: DATAGRAM_TYPE}
+    counts: dict[str, int] = {}
+    last = 0
+    for schema, channel, message in messages:
+        counts[channel.topic] = counts.get(channel.topic, 0) + 1
+        if channel.topic in types:
+            assert schema.name == types[channel.topic], channel.topic
+        assert channel.message_encoding == "json" and schema.encoding == "jsonschema"
+        assert json.loads(schema.data) == SCHEMAS[schema.name]
+        assert message.publish_time == message.log_time >= last
+        last = message.log_time
+        assert tour.start <= from_ns(message.log_time) <= tour.end
+        assert conforms(json.loads(message.data), SCHEMAS[schema.name]), (channel.topic,
+                                                                         message.data)
+    assert set(types) <= set(counts), set(types) - set(counts)  # every channel had traffic
+    assert counts[TICK] == tour.executive.core.ticks
+
+    # The ROS commands recorded are the ones the robot got, in order.
+    recorded = [(c.topic, json.loads(m.data)) for _, c, m in messages if c.topic in
+                {t.name for t in OUTPUTS.values()}]
+    assert recorded == [(r.channel, r.payload) for r in tour.received if r.side == "ros"]
+    # Front-end commands too (resends share a seq; acks are the executive's answers).
+    commands: dict[int, tuple[str, dict[str, Any]]] = {}
+    for _, c, m in messages:
+        if c.topic == FRONTEND_OUT:
+            data = json.loads(m.data)
+            if data["type"] != "ack":
+                commands.setdefault(data.pop("seq"), (data.pop("type"), data))
+    got = [(r.channel, r.payload) for r in tour.received
+           if r.side == "frontend" and r.channel != "ack"]
+    assert len(got) > 10 and got == list(commands.values())[:len(got)]
+
+
+def fake_executive() -> Any:
+    site = load_site()
+    taps = Taps()
+    return SimpleNamespace(site=site, sim_time=True, clock=SimClock(), wire=WireTaps(),
+                           taps=taps)
+
+
+def test_what_arrives_before_the_first_clock_is_stamped_with_it(tmp_path: Path) -> None:
+    path = tmp_path / "early.mcap"
+    executive = fake_executive()
+    with Recorder(path) as recorder:
+        recorder.attach(executive)
+        (datagram,) = executive.wire.datagram
+        (ros_in,) = executive.wire.ros_in
+        datagram("in", b'{"type":"frontend_idle","seq":1}', 0.0)
+        ros_in(0.0, "/docking/state", {"data": "docked"})
+        ros_in(0.0, "/clock", encode_clock(1_780_000_000.5))
+        executive.clock.set(1_780_000_000.5)
+        ros_in(1_780_000_000.5, "/clock", encode_clock(1_780_000_000.6))
+    recorder.close()  # idempotent
+    datagram("in", b"{}", 1.0)  # after close: ignored
+    _, messages = read_all(path)
+    assert [(c.topic, from_ns(m.log_time)) for _, c, m in messages] == [
+        (FRONTEND_IN, 1_780_000_000.5), ("/docking/state", 1_780_000_000.5),
+        ("/clock", 1_780_000_000.5), ("/clock", 1_780_000_000.6)]
+
+
+@given(st.floats(min_value=1e7, max_value=4e9))  # ns stamps hold any epoch time exactly
+def test_nanosecond_stamps_give_the_clock_time_back(t: float) -> None:
+    assert from_ns(to_ns(t)) == t
+
+
+def test_a_crash_still_leaves_valid_mcap(tmp_path: Path) -> None:
+    path = tmp_path / "crash.mcap"
+    code = ("import sys; from pathlib import Path; from frog_bt.recording import Recorder\n"
+            "r = Recorder(Path(sys.argv[1]))\n"
+            "r.on_datagram('out', b'{\"type\":\"tour\",\"seq\":1}', 1.0)\n"
+            "raise RuntimeError('boom')\n")
+    proc = subprocess.run([sys.executable, "-c", code, str(path)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=30)
+    assert proc.returncode == 1 and "boom" in proc.stderr
+    summary, messages = read_all(path)
+    assert summary is not None and len(messages) == 1
+
+
+def test_sigterm_stops_the_run_within_2_s_and_leaves_valid_mcap(tmp_path: Path) -> None:
+    path = tmp_path / "run.mcap"
+
+    async def main() -> tuple[int | None, float, str]:
+        listen = free_udp_port()
+        sim = Simulator(scenario({"speed": 100.0}), rosbridge_port=0, frontend_port=0,
+                        executive=("127.0.0.1", listen))
+        await sim.start()
+        proc = await asyncio.create_subprocess_exec(
+            sys.executable, "-m", "frog_bt", "run", "--sim-time", "--record", str(path),
+            "--quiet", "--rosbridge", f"ws://127.0.0.1:{sim.rosbridge_port}",
+            "--frontend", f"127.0.0.1:{sim.frontend_port}", "--listen", f"127.0.0.1:{listen}",
+            cwd=ROOT, stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE)
+        try:
+            await sim.wait_for(lambda r: r.channel == "/GotoWayPoint", timeout=30)
+            proc.send_signal(signal.SIGTERM)
+            wall0 = time.monotonic()
+            _, err = await asyncio.wait_for(proc.communicate(), 10)
+            return proc.returncode, time.monotonic() - wall0, err.decode()
+        finally:
+            if proc.returncode is None:
+                proc.kill()
+                await proc.wait()
+            await sim.stop()
+
+    code, wall, err = asyncio.run(main())
+    assert code == 0, err
+    assert wall < 2.0
+    summary, messages = read_all(path)
+    assert summary is not None and summary.statistics.message_count == len(messages)
+    topics = {c.topic for _, c, _ in messages}
+    assert {"/clock", "/GotoWayPoint", FRONTEND_IN, FRONTEND_OUT, TICK} <= topics
+
+    from frog_bt.cli import main as cli  # the cut-short tour replays identically too
+
+    assert cli(["replay", str(path), "--quiet"]) == 0
