@@ -1,0 +1,100 @@
+"""A whole simulated tour recorded with telemetry, read back with rerun's RrdReader."""
+
+from __future__ import annotations
+
+import itertools
+
+from rerun.chunk import RrdReader
+from telemetry_tour import Recorded
+
+
+def test_the_tour_itself_went_fine(recorded: Recorded):
+    assert recorded.outcome.code == 0, recorded.outcome.reason
+    assert recorded.telemetry.rows.core is None  # close() took the taps off the core
+    assert recorded.telemetry.write_errors == 0
+
+
+def test_robot_pose_rows_cover_the_tour(recorded: Recorded):
+    poses = recorded.rows("/map/robot")
+    assert poses > 500  # /FROG_pose at 10 Hz for minutes of sim time
+    assert recorded.rows("/map/robot/heading") == poses
+    assert recorded.rows("/map/robot/trail") >= poses // 20
+    positions = recorded.values("/map/robot", "Points2D:positions")
+    xs = [p[0][0] for p in positions]
+    ys = [p[0][1] for p in positions]
+    # the tour reaches from the shop (y 17) to the Vault Room (y 141)
+    assert min(ys) < 25 and max(ys) > 130 and max(xs) - min(xs) > 50
+
+
+def test_every_node_has_a_status_lane_and_several_ran_and_succeeded(recorded: Recorded):
+    index = recorded.telemetry.index
+    lanes = {n.key: [s for row in recorded.values(f"/bt/status/{n.key}", "StateChange:state")
+                     for s in row] for n in index.nodes}
+    assert all(f"/bt/status/{key}" in recorded.chunks for key in lanes)
+    ran = [key for key, states in lanes.items() if "RUNNING" in states]
+    succeeded = [key for key, states in lanes.items() if "SUCCESS" in states]
+    assert len(ran) > 10 and len(succeeded) > 10
+    navigate = next(k for k in lanes if k.endswith("_Navigate_POI0"))
+    assert lanes[navigate][:3] == ["INVALID", "RUNNING", "SUCCESS"]
+    for states in lanes.values():  # logged on change only
+        assert all(a != b for a, b in itertools.pairwise(states))
+
+
+def test_graph_is_static_with_temporal_colours(recorded: Recorded):
+    n = len(recorded.telemetry.index)
+    ids = recorded.values("/bt/graph", "GraphNodes:node_ids", static=True)
+    assert [len(row) for row in ids] == [n]
+    positions = recorded.values("/bt/graph", "GraphNodes:positions", static=True)[0]
+    assert len(positions) == n
+    edges = recorded.values("/bt/graph", "GraphEdges:edges", static=True)[0]
+    assert len(edges) == n - 1
+    colours = recorded.values("/bt/graph", "GraphNodes:colors")
+    assert len(colours) > 10 and all(len(row) == n for row in colours)
+    assert recorded.values("/bt/graph", "GraphNodes:colors", static=True) == []
+
+
+def test_text_log_has_commands_events_and_decisions(recorded: Recorded):
+    ros = recorded.texts("/log/ros/out")
+    assert "→ robot /docking/dock undock" in ros
+    assert any(t.startswith("→ robot /GotoWayPoint POI0 (") for t in ros)
+    assert "→ robot /ApproachPeopleFar 7" in ros
+    frontend = recorded.texts("/log/frontend/out")
+    assert "→ front end tour state=started" in frontend
+    assert "→ front end tour state=ended" in frontend
+    assert "← front end frontend_idle" in recorded.texts("/log/frontend/in")
+    assert "← robot /FROG_response 2 (succeeded)" in recorded.texts("/log/ros/in")
+    notes = recorded.texts("/log/notes")
+    assert "arrived at POI0" in notes and "approach visitor 7" in notes
+
+
+def test_map_scene_and_series(recorded: Recorded):
+    labels = [label for row in recorded.values("/map/pois", "Points2D:labels", static=True)
+              for label in row]
+    assert "POI0" in labels and "POI1a/POI1b" in labels and "SHOP" in labels
+    assert recorded.values("/map/route", "LineStrips2D:strips", static=True)
+    assert recorded.rows("/map/visitors") > 10
+    assert "7" in [label for row in recorded.values("/map/visitors", "Points2D:labels")
+                   for label in row]
+    assert recorded.rows("/plots/battery") > 10
+    assert recorded.rows("/plots/people/persons") > 10
+    assert recorded.rows("/plots/engagement/faces/7") > 10  # the face stream at stops
+    goals = recorded.values("/map/goal", "Points2D:labels")
+    assert ["goal POI0"] in goals
+
+
+def test_blueprint_is_in_the_file(recorded: Recorded):
+    reader = RrdReader(recorded.path)
+    [blueprint] = reader.blueprints()
+    views = {}
+    for chunk in reader.stream(store=blueprint):
+        batch = chunk.to_record_batch()
+        if "ViewBlueprint:class_identifier" in batch.schema.names:
+            kind = batch.column("ViewBlueprint:class_identifier").to_pylist()[0][0]
+            name = batch.column("ViewBlueprint:display_name").to_pylist()[0][0]
+            views[name] = kind
+    assert views["Map"] == "2D"
+    assert views["Behaviour tree"] == "Graph"
+    assert views["Tour phases"] == "StateTimeline"
+    assert views["All nodes"] == "StateTimeline"
+    assert views["Log"] == "TextLog"
+    assert views["Engagement"] == "TimeSeries"
