@@ -7,6 +7,12 @@ receives, resends what is not acked every ``resend_after`` seconds up to
 received within ``dedup_window`` seconds (acked again, not acted on). Datagrams
 from any host but the peer's are dropped and counted.
 
+A peer that restarts numbers from 1 again, and its new datagrams must not be
+taken for duplicates of the old ones. A restart is recognised by a valid
+message that is not a recent duplicate and whose ``seq`` is below the highest
+seen: a ``frontend_idle`` (what a front end says first after starting; any of
+``restart_types``), or ``seq`` 1. The seqs seen so far are then forgotten.
+
 Time is passed in (``now``) and bytes are returned: no socket, no clock.
 """
 
@@ -65,6 +71,7 @@ class LinkStats:
     duplicates: int = 0
     malformed: int = 0
     foreign: int = 0
+    peer_restarts: int = 0  # the peer started numbering from 1 again
 
 
 @dataclass(slots=True)
@@ -90,7 +97,8 @@ class Endpoint:
     """One side of the front-end link.
 
     ``inbound`` is the table of message types this side acts on (events for the
-    executive, commands for the front end).
+    executive, commands for the front end). ``restart_types`` are the types a
+    peer sends first after (re)starting (see the module docstring).
     """
 
     peer_host: str
@@ -100,8 +108,10 @@ class Endpoint:
     dedup_window: float = 10.0
     stats: LinkStats = field(default_factory=LinkStats)
     next_seq: int = 1
+    restart_types: frozenset[str] = frozenset({"frontend_idle"})
     _pending: OrderedDict[int, _Pending] = field(default_factory=OrderedDict)
     _seen: OrderedDict[int, float] = field(default_factory=OrderedDict)
+    _highest: int = 0  # highest seq of a valid message since the peer (re)started
 
     def send(self, message: FrontendMessage, now: float) -> bytes:
         """Datagram for a new message; it is resent by :meth:`poll` until acked."""
@@ -131,15 +141,25 @@ class Endpoint:
             return Received(acked=pending.message)
         reply = encode_datagram("ack", seq)
         self._prune(now)
-        if seq in self._seen:
+        restart = seq < self._highest and (
+            obj["type"] in self.restart_types or (seq == 1 and seq not in self._seen))
+        if seq in self._seen and not restart:
             self.stats.duplicates += 1
             return Received(reply=reply)
-        self._seen[seq] = now
         try:
             message = decode_message(obj, self.inbound)
         except DecodeError as exc:
+            self._seen[seq] = now
             self.stats.malformed += 1
             return Received(reply=reply, error=exc)
+        if restart:
+            # Only a valid message may reset the numbering: garbage must not.
+            self.stats.peer_restarts += 1
+            log.info("peer %s restarted: %s seq %d after seq %d; forgetting seen seqs",
+                     self.peer_host, obj["type"], seq, self._highest)
+            self.forget_seen()
+        self._seen[seq] = now
+        self._highest = max(self._highest, seq)
         self.stats.received += 1
         return Received(message=message, reply=reply)
 
@@ -153,6 +173,7 @@ class Endpoint:
     def forget_seen(self) -> None:
         """Forget received seqs (the peer restarted and numbers from 1 again)."""
         self._seen.clear()
+        self._highest = 0
 
     def poll(self, now: float) -> list[bytes]:
         """Datagrams to resend now; commands past ``max_sends`` are given up on."""

@@ -131,6 +131,7 @@ class RosbridgeClient:
         self._closing = False
         self._loop_task: asyncio.Task[None] | None = None
         self._run_task: asyncio.Task[None] | None = None
+        self._ws: ClientConnection | None = None  # the current connection
 
     # ------------------------------------------------------------ program side
 
@@ -210,8 +211,14 @@ class RosbridgeClient:
         return not self._outbox
 
     async def close(self) -> None:
-        """Stop the connect loop and close the connection; final."""
+        """Stop the connect loop and close the connection (code 1000); final."""
         self._closing = True
+        ws = self._ws
+        if ws is not None:
+            # A clean close handshake first: cancelling the loop inside ``connect``
+            # would close with 1011 (internal error), which a server may log as one.
+            with contextlib.suppress(Exception):
+                await asyncio.wait_for(ws.close(), 2)
         for task in (self._loop_task, self._run_task):
             if task is not None and not task.done():
                 if task is asyncio.current_task():
@@ -246,6 +253,8 @@ class RosbridgeClient:
                     self._on_up(ws)
                     delays = backoff_delays(self.backoff_initial, self.backoff_max)  # reset
                     error = await self._serve(ws)
+                    if self._closing:
+                        error = None  # close(): not an error
             except asyncio.CancelledError:
                 error = None  # close(): not an error
                 raise
@@ -255,7 +264,10 @@ class RosbridgeClient:
                 error = _describe(exc)
                 log.exception("rosbridge %s: unexpected error", self.url)
             finally:
+                self._ws = None
                 self._on_down(error)
+            if self._closing:
+                return
             await asyncio.sleep(next(delays))
 
     async def _serve(self, ws: ClientConnection) -> str:
@@ -301,6 +313,7 @@ class RosbridgeClient:
         with contextlib.suppress(Exception):  # addresses only feed the auth MAC
             self.session.client_addr = str(ws.local_address[0])
             self.session.dest_addr = str(ws.remote_address[0])
+        self._ws = ws
         self._outbox.clear()
         self._enqueue(self.session.on_connected(time.time()))
         if self._ever_connected:
@@ -358,12 +371,14 @@ class RosbridgeClient:
             log.debug("rosbridge status %s: %s (id %s)", event.level, event.msg, event.id)
             return
         if isinstance(event, OtherOp):
-            log.debug("rosbridge: ignoring op %r", event.op)
+            self.stats.ignored += 1
+            log.debug("rosbridge: ignoring op %r", event.op[:80])
             return
         assert isinstance(event, Publish)
         sub = self.session.subscriptions.get(event.topic)
         if sub is None:
-            log.debug("rosbridge: publish on %s, which is not subscribed", event.topic)
+            self.stats.ignored += 1
+            log.debug("rosbridge: publish on %s, which is not subscribed", event.topic[:80])
             return
         if self.on_raw is not None:
             self.on_raw(event.topic, event.msg)

@@ -39,6 +39,8 @@ class ClientStats:
       itself was unreadable, so no topic is known).
     * ``dropped``: publishes dropped (oldest first) from the full queue while
       the link was down.
+    * ``ignored``: well-formed frames not meant for the program: unknown ops,
+      publishes on topics it did not subscribe to.
     * ``reconnects``: successful connections after the first.
     * ``sent``: frames written to the socket.
     * ``connect_failures``: attempts to connect that failed.
@@ -46,6 +48,7 @@ class ClientStats:
 
     received: int = 0
     malformed: int = 0
+    ignored: int = 0
     dropped: int = 0
     reconnects: int = 0
     sent: int = 0

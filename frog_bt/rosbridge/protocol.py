@@ -111,7 +111,7 @@ class Session:
     """
 
     queue_limit: int = 1000
-    secret: str | None = None
+    secret: str | None = field(default=None, repr=False)  # never in a repr, log or traceback
     client_addr: str = "127.0.0.1"
     dest_addr: str = "127.0.0.1"
     connected: bool = False

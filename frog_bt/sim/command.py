@@ -51,6 +51,8 @@ are seconds of simulated time after the start.
       restarts: [1200]            # the front end restarts and says idle again
       ack: true                   # false: never acks commands
       silent: false               # true: a dead front end (sends nothing)
+      silent_between: [[900, 960]]  # s: hangs then (no acks, no events), then wakes
+      silent_from: null           # s: hangs from then on
     content: {default: 30, introduction: 20, POI1: {a: 40, b: 20}, POI3: 25}
 
 What the robot does: drives straight to each goal and answers /FROG_response

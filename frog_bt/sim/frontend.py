@@ -16,6 +16,9 @@ simulated time:
 * resends its events every 0.25 s until acked (:meth:`FrontendModel.step`).
 
 ``silent: true`` makes it a dead front end: it receives, but never sends.
+``silent_from`` / ``silent_between`` (or :meth:`FrontendModel.silence`) make it
+hang for a while: it receives (and logs) commands but neither acks nor acts on
+them, sends nothing, and its timers wait; when it wakes, what came due goes out.
 Every message sent or acted on is reported through ``notify(direction,
 channel, fields)`` (resends and duplicates are not).
 """
@@ -60,6 +63,8 @@ class FrontendModel:
         self.endpoint = self._new_endpoint()
         self.timers: list[_Timer] = []
         self.playing: tuple[str, str] | None = None  # (poi, part)
+        self.silences: list[tuple[float, float]] = []  # [start, end) in simulated time
+        self.restarts = 0
 
     def _new_endpoint(self) -> Endpoint:
         # Unlike the executive, the front end keeps resending until acked: the
@@ -70,6 +75,16 @@ class FrontendModel:
         """Schedule the first ``frontend_idle`` and the scripted restarts."""
         self.timers.append(_Timer(now + self.spec.idle_at, "idle"))
         self.timers += [_Timer(now + t, "restart") for t in self.spec.restarts]
+        for start, end in self.spec.silences():
+            self.silence(now + start, now + end)
+
+    def silence(self, start: float, end: float) -> None:
+        """Hang from ``start`` until ``end`` (simulated time; ``inf``: for ever)."""
+        self.silences.append((start, end))
+
+    def silent(self, now: float) -> bool:
+        return self.spec.silent or any(a - EPSILON <= now < b - EPSILON
+                                       for a, b in self.silences)
 
     # ------------------------------------------------------------ inbound
 
@@ -82,13 +97,14 @@ class FrontendModel:
             seq = json.loads(data)["seq"]
             self._notify("in", "ack", {"seq": seq, "type": received.acked.type})
         out: list[bytes] = []
-        if received.reply is not None and self.spec.ack and not self.spec.silent:
+        silent = self.silent(now)
+        if received.reply is not None and self.spec.ack and not silent:
             out.append(received.reply)
             self._notify("out", "ack", {"seq": json.loads(received.reply)["seq"]})
         message = received.message
         if message is not None:
             self._notify("in", message.type, fm.message_fields(message))
-            if not self.spec.silent:
+            if not silent:
                 self._act(message, now)
         return out
 
@@ -123,7 +139,7 @@ class FrontendModel:
 
     def step(self, now: float) -> list[bytes]:
         """Events that are due and resends of unacked ones, at simulated time ``now``."""
-        if self.spec.silent:
+        if self.silent(now):
             return []
         now_ish = now + EPSILON
         due = sorted((t for t in self.timers if t.due <= now_ish), key=lambda t: t.due)
@@ -134,11 +150,7 @@ class FrontendModel:
 
     def _fire(self, timer: _Timer, now: float) -> list[bytes]:
         if timer.kind == "restart":
-            log.info("front end restarts")
-            self.endpoint = self._new_endpoint()
-            self.timers = [t for t in self.timers if t.kind == "restart"]
-            self.playing = None
-            return [self._send(fm.FrontendIdle(), now)]
+            return self.restart(now)
         if timer.kind == "idle":
             return [self._send(fm.FrontendIdle(), now)]
         if timer.kind == "introduction":
@@ -148,6 +160,15 @@ class FrontendModel:
             return [self._send(fm.UserPositive() if yes else fm.UserNegative(), now)]
         self.playing = None
         return [self._send(fm.ContentDone(timer.poi, timer.part), now)]
+
+    def restart(self, now: float) -> list[bytes]:
+        """Restart now: forget everything (numbering from 1 again) and say idle."""
+        log.info("front end restarts")
+        self.restarts += 1
+        self.endpoint = self._new_endpoint()
+        self.timers = [t for t in self.timers if t.kind == "restart"]
+        self.playing = None
+        return [self._send(fm.FrontendIdle(), now)]
 
     def _send(self, message: fm.FrontendMessage, now: float) -> bytes:
         data = self.endpoint.send(message, now)

@@ -49,6 +49,14 @@ class FrontendSocket:
         log.info("front end listening on udp %s:%d, sending to %s:%d",
                  self.host, self.port, *self.executive)
 
+    @property
+    def address(self) -> Address | None:
+        """(host, port) the socket is bound to; None when closed."""
+        if self._transport is None:
+            return None
+        host, port = self._transport.get_extra_info("sockname")[:2]
+        return host, port
+
     def send(self, data: bytes) -> None:
         if self._transport is None or self._transport.is_closing():
             return

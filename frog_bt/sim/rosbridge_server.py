@@ -51,6 +51,14 @@ class RosbridgeServer:
     def listening(self) -> bool:
         return self._server is not None
 
+    @property
+    def addresses(self) -> list[tuple[str, int]]:
+        """(host, port) of every socket it listens on (none when stopped)."""
+        if self._server is None:
+            return []
+        names = [sock.getsockname() for sock in self._server.sockets]
+        return [(str(name[0]), int(name[1])) for name in names]
+
     async def start(self) -> None:
         """Listen (again: on the port bound the first time)."""
         if self._server is not None:

@@ -186,11 +186,31 @@ class VisitorSpec(_Model):
 
 class FrontendSpec(_Model):
     silent: bool = False  # sends nothing at all: no acks, no events
+    # Silent from this time on, or in these [start, end) intervals: hung, it neither
+    # sends (no acks, no events) nor acts on commands; due events go out when it wakes.
+    silent_from: NonNegative | None = None
+    silent_between: list[tuple[NonNegative, NonNegative]] = []
     ack: bool = True  # false: never acks commands, but still plays and answers
     idle_at: NonNegative = 1.0  # first frontend_idle
     idle_after_tour: NonNegative | None = 5.0  # frontend_idle again after tour ended/aborted
     restarts: list[NonNegative] = []  # the front end restarts (seq from 1) and says idle
     answer_delay: NonNegative = 2.0  # ask_tour -> user_positive / user_negative
+
+    @field_validator("silent_between")
+    @classmethod
+    def _intervals(cls, value: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        for i, (start, end) in enumerate(value):
+            if not end > start:
+                raise PathError((i,), f"expected [start, end] with end > start, got "
+                                      f"[{start:g}, {end:g}]")
+        return value
+
+    def silences(self) -> list[tuple[float, float]]:
+        """Every silent interval, in seconds after the start (end ``inf``: for ever)."""
+        out = [(float(a), float(b)) for a, b in self.silent_between]
+        if self.silent_from is not None:
+            out.append((self.silent_from, math.inf))
+        return out
 
 
 class ContentParts(_Model):

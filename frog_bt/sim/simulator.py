@@ -73,6 +73,12 @@ class Simulator:
         return self._udp.port
 
     @property
+    def addresses(self) -> dict[str, list[Address]]:
+        """What the simulator listens on: ``rosbridge`` (TCP) and ``frontend`` (UDP)."""
+        udp = self._udp.address
+        return {"rosbridge": self._rosbridge.addresses, "frontend": [udp] if udp else []}
+
+    @property
     def running(self) -> bool:
         return self._loop_task is not None and not self._loop_task.done()
 
@@ -112,6 +118,15 @@ class Simulator:
     async def start_rosbridge(self) -> None:
         """Listen again, on the same port."""
         await self._rosbridge.start()
+
+    def restart_frontend(self) -> None:
+        """The front end restarts now (as a scenario ``frontend.restarts`` time would)."""
+        for data in self.frontend.restart(self.world.now):
+            self._udp.send(data)
+
+    def silence_frontend(self, seconds: float) -> None:
+        """The front end hangs for ``seconds`` of simulated time from now (``inf``: for ever)."""
+        self.frontend.silence(self.world.now, self.world.now + seconds)
 
     # ------------------------------------------------------------ time
 

@@ -210,6 +210,48 @@ def test_forget_seen_accepts_a_restarted_peer() -> None:
     assert ep.receive(event("frontend_idle", 1), PEER, T0 + 1).message is not None
 
 
+def test_frontend_idle_below_the_highest_seq_is_a_restart() -> None:
+    ep = executive()
+    for seq, type_ in enumerate(["frontend_idle", "finish_introduction", "user_positive"], 1):
+        assert ep.receive(event(type_, seq), PEER, T0 + seq).message is not None
+    # Restarted 2 s later: seq 1 again (still within the dedup window), then seqs 2, 3.
+    assert ep.receive(event("frontend_idle", 1), PEER, T0 + 5).message is not None
+    assert ep.receive(event("content_done", 2, poi="POI1", part="a"), PEER, T0 + 6).message \
+        == ContentDone("POI1", "a")
+    assert ep.receive(event("user_positive", 3), PEER, T0 + 7).message == UserPositive()
+    assert ep.stats.peer_restarts == 1 and ep.stats.duplicates == 0
+
+
+def test_seq_one_after_higher_seqs_is_a_restart_of_any_peer() -> None:
+    fe = front_end()  # the front end's side: a restarted executive numbers from 1 again
+    for seq in range(1, 13):
+        fe.receive(event("follow_me", seq, on=True), PEER, T0 + seq)
+    assert fe.receive(event("volume", 1, percent=50), PEER, T0 + 20).message == Volume(50)
+    assert fe.receive(event("follow_me", 2, on=False), PEER, T0 + 21).message is not None
+    assert fe.stats.peer_restarts == 1
+
+
+def test_resends_are_not_taken_for_a_restart() -> None:
+    ep = executive()
+    ep.receive(event("frontend_idle", 1), PEER, T0)
+    assert ep.receive(event("frontend_idle", 1), PEER, T0 + 0.25).reply is not None  # ack lost
+    ep.receive(event("finish_introduction", 2), PEER, T0 + 1)
+    ep.receive(event("user_positive", 3), PEER, T0 + 2)
+    got = ep.receive(event("finish_introduction", 2), PEER, T0 + 2.25)  # a late resend
+    assert got.message is None and got.reply is not None and loads(got.reply)["seq"] == 2
+    assert ep.stats.duplicates == 2 and ep.stats.peer_restarts == 0
+
+
+def test_only_a_valid_message_from_the_peer_can_signal_a_restart() -> None:
+    ep = executive()
+    for seq in (1, 2, 3):
+        ep.receive(event("user_positive", seq), PEER, T0)
+    ep.receive(event("no_such_event", 1), PEER, T0 + 1)  # seq 1, but malformed
+    ep.receive(event("frontend_idle", 1), "127.0.0.2", T0 + 1)  # foreign
+    assert ep.stats.peer_restarts == 0
+    assert ep.receive(event("user_positive", 3), PEER, T0 + 2).message is None  # still seen
+
+
 @pytest.mark.parametrize("host", ["127.0.0.2", "10.0.0.5", "::1", "localhost"])
 def test_foreign_host_dropped_without_reply(host: str) -> None:
     ep = executive()

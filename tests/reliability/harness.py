@@ -1,0 +1,211 @@
+"""A simulated tour run in this event loop, for tests that break things mid-tour.
+
+:class:`TourRun` starts the built-in simulator and the real
+:class:`~frog_bt.executive.Executive` (sim time, ``once``) and records, beside
+the simulator's own message log, what the executive published on rosbridge
+(with whether its link was up at that moment) and each change of its link.
+Tests wait on those records and on the simulator's log, never on sleeps::
+
+    async with TourRun({"speed": 200}) as run:
+        await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 10)
+        await run.outage(until=...)
+        outcome = await run.finish()
+"""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+from collections.abc import Awaitable, Callable
+from dataclasses import dataclass
+from typing import Any
+
+from frog_bt.clock import SimClock
+from frog_bt.config import Site, load_site
+from frog_bt.executive import Executive, Outcome
+from frog_bt.rosbridge.link import LinkState
+from frog_bt.sim import Simulator, load_scenario, parse_scenario
+from frog_bt.sim.traffic import Record
+from frog_bt.summary import TourSummary
+from frog_bt.tree.loader import load_tree
+
+FAST = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
+WAIT = 30.0  # wall seconds: a safety net for every wait, never a pace
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+    out = dict(base)
+    for key, value in over.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class Published:
+    """One rosbridge publish of the executive, and whether its link was up then."""
+
+    t: float  # executive clock
+    topic: str
+    msg: dict[str, Any]
+    link_up: bool
+
+
+Event = Published | LinkState
+
+
+class TourRun:
+    def __init__(self, scenario: dict[str, Any] | None = None, *, site: Site | None = None,
+                 secret: str | None = None, sim_secret: str | None = None) -> None:
+        self.site = site or load_site()
+        sc = parse_scenario(merge(load_scenario("default").model_dump(mode="json"),
+                                  merge(FAST, scenario or {})))
+        listen = ("127.0.0.1", free_udp_port())
+        self.sim = Simulator(sc, rosbridge_port=0, frontend_port=0, executive=listen,
+                             secret=sim_secret)
+        self._listen = listen
+        self._secret = secret
+        self.events: list[Event] = []
+        self._waiters: list[tuple[Callable[[Event], bool], asyncio.Future[Event]]] = []
+        self.summary = TourSummary(self.site)
+
+    async def __aenter__(self) -> TourRun:
+        await self.sim.start()
+        exe = Executive(self.site, load_tree(site=self.site), SimClock(),
+                        rosbridge_url=f"ws://127.0.0.1:{self.sim.rosbridge_port}",
+                        frontend=("127.0.0.1", self.sim.frontend_port), listen=self._listen,
+                        sim_time=True, secret=self._secret, once=True)
+        self.executive = exe
+        self.summary.attach(exe.taps)
+        exe.taps.ros_out.append(
+            lambda t, topic, msg: self._add(Published(t, topic, msg, exe.client.link.connected)))
+        on_link = exe.client.on_link
+
+        def link_changed(state: LinkState) -> None:
+            if on_link is not None:
+                on_link(state)  # the executive's own handler first (it re-sends the goal)
+            self._add(state)
+
+        exe.client.on_link = link_changed
+        self.task = asyncio.create_task(exe.run())
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
+        try:
+            if not self.task.done():
+                self.executive.stop("test over")
+            await asyncio.wait_for(self.task, 10)
+        finally:
+            await self.sim.stop()
+
+    async def finish(self, timeout: float = 60.0) -> Outcome:
+        """The executive's outcome once it stops by itself (``once``: after the tour)."""
+        return await asyncio.wait_for(asyncio.shield(self.task), timeout)
+
+    # ------------------------------------------------------------ records and waits
+
+    def _add(self, event: Event) -> None:
+        self.events.append(event)
+        keep = []
+        for predicate, fut in self._waiters:
+            if fut.done():
+                continue
+            if predicate(event):
+                fut.set_result(event)
+            else:
+                keep.append((predicate, fut))
+        self._waiters = keep
+
+    async def wait_event(self, predicate: Callable[[Event], bool], *,
+                         since: int = 0, timeout: float = WAIT) -> Event:
+        """The first event from index ``since`` on (logged or to come) satisfying ``predicate``."""
+        for event in self.events[since:]:
+            if predicate(event):
+                return event
+        fut: asyncio.Future[Event] = asyncio.get_running_loop().create_future()
+        self._waiters.append((predicate, fut))
+        return await asyncio.wait_for(fut, timeout)
+
+    async def link(self, up: bool) -> LinkState:
+        """Wait until the executive's rosbridge link is up (or down)."""
+        if self.executive.client.link.connected == up:
+            return self.executive.client.link
+        event = await self.wait_event(lambda e: isinstance(e, LinkState) and e.connected == up,
+                                      since=len(self.events))
+        assert isinstance(event, LinkState)
+        return event
+
+    @property
+    def published(self) -> list[Published]:
+        return [e for e in self.events if isinstance(e, Published)]
+
+    async def outage(self, until: Awaitable[Any]) -> Outage:
+        """Stop the simulator's rosbridge, await ``until``, start it again; wait for the link.
+
+        Checks on the way that the executive's clock stood still while the link was down
+        (under sim time ``/clock`` comes over that link).
+        """
+        await self.sim.stop_rosbridge()
+        await self.link(False)
+        frozen = self.executive.clock.now()
+        sim_down = self.sim.world.now
+        result = await until
+        assert self.executive.clock.now() == frozen, "the executive's clock moved while down"
+        await self.sim.start_rosbridge()
+        await self.link(True)
+        return Outage(sim_down, self.sim.world.now, frozen, result)
+
+    # ------------------------------------------------------------ what the simulator saw
+
+    def describe(self, record: Record) -> str:
+        p: Any = record.payload
+        if record.side == "ros":
+            if record.channel == self.site.topic("goto"):
+                return f"{record.channel} {self.summary.waypoint_of(p)}"
+            return f"{record.channel} {p.get('data')}"
+        fields = " ".join(str(v) for k, v in p.items() if k not in ("type", "seq"))
+        return f"{record.channel} {fields}".rstrip()
+
+    def commands(self, *types: str) -> list[str]:
+        """What the simulator received from the executive (acks left out), compactly;
+        only front-end commands of ``types`` when given."""
+        out = [self.describe(r) for r in self.sim.received() if r.channel != "ack"]
+        if types:
+            out = [c for c in out if not c.startswith("/") and c.split()[0] in types]
+        return out
+
+    def ros_commands(self) -> list[str]:
+        return [c for c in self.commands() if c.startswith("/")]
+
+
+@dataclass(frozen=True, slots=True)
+class Outage:
+    sim_down: float  # simulated time when the server stopped
+    sim_up: float  # ... and when the executive was connected again
+    frozen: float  # the executive's clock all that time
+    result: Any  # what ``until`` returned
+
+    @property
+    def seconds(self) -> float:
+        return self.sim_up - self.sim_down
+
+
+def arrived(sim: Simulator, since: float) -> Callable[[Record], bool]:
+    """A simulator log predicate: /FROG_response 2 (arrival) published at or after ``since``."""
+    return lambda r: (r.direction == "out" and r.channel == "/FROG_response"
+                      and r.payload.get("data") == 2 and r.t >= since)
+
+
+def received(channel: str, *, where: Callable[[Any], bool] = lambda p: True,
+             since: float = 0.0) -> Callable[[Record], bool]:
+    """A simulator log predicate: the executive's ``channel`` message, received from ``since``."""
+    return lambda r: (r.direction == "in" and r.channel == channel and r.t >= since
+                      and where(r.payload))
