@@ -84,6 +84,8 @@ class Executive:
             self.core.ctx.resume = load_checkpoint(checkpoint)
         self._wake = asyncio.Event()
         self._stopping = asyncio.Event()
+        self._pending_at_loss: object = None
+        self._refusals = 0  # consecutive connections refused (auth)
 
     # ------------------------------------------------------------ I/O callbacks (cache only)
 
@@ -102,10 +104,19 @@ class Executive:
 
     def _on_link(self, state: LinkState) -> None:
         self.core.inputs.link = state
-        if state.connected and state.reconnects > 0:
-            request = self.core.actions.resend_pending()
-            if request is not None:
-                self.core.ctx.note(f"link back: re-sent {request.kind} to {request.target}")
+        actions = self.core.actions
+        if not state.connected:
+            self._pending_at_loss = actions.pending
+            self._refusals = self._refusals + 1 if "1008" in (state.last_error or "") else 0
+            if self._refusals >= 3 and self.once:
+                self.stop("rosbridge refused authentication (check the secret)", 1)
+        elif (state.reconnects > 0 and actions.pending is not None
+              and actions.pending is self._pending_at_loss):
+            # A goal sent before the loss may have been answered while we could not hear:
+            # send it again. One issued while down went out from the queue just now.
+            actions.resend_pending()
+            self.core.ctx.note(f"link back: re-sent {actions.pending.kind} to "
+                               f"{actions.pending.target}")
         self._wake.set()
 
     def _on_event(self, message: FrontendMessage) -> None:

@@ -10,6 +10,8 @@ from frog_bt.blackboard import Reading
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
 
 TARGET = {"dock": "docked", "undock": "undocked"}
+BUSY = {"dock": "docking", "undock": "undocking"}
+FAILED_GRACE = 2.0  # seconds after the command from which a "failed" is surely about it
 
 
 @register
@@ -19,8 +21,10 @@ class Docking(Leaf):
     Reads ``/docking`` and ``/now``. Sends ``/docking/dock`` ``action`` in
     initialise (not when the robot already reports the target state). SUCCESS
     on ``docked`` / ``undocked`` received after the command; FAILURE on
-    ``failed`` received after the command, or after ``timeout`` seconds
-    (default: site ``timeouts.dock`` / ``timeouts.undock``).
+    ``failed`` once the robot has shown it took this command (``docking`` /
+    ``undocking`` seen, or :data:`FAILED_GRACE` seconds passed: a ``failed`` left
+    over from the previous attempt, re-published, must not fail this one), or
+    after ``timeout`` seconds (default: site ``timeouts.dock`` / ``timeouts.undock``).
     """
 
     class Params(Params):
@@ -34,6 +38,7 @@ class Docking(Leaf):
         state: Reading[str] | None = self.get("/docking")
         self.sent_at = self.ctx.clock.now()
         self.already = state is not None and state.value == TARGET[action]
+        self.took = False
         if not self.already:
             self.ctx.actions.dock(action)
             self.ctx.note(f"{action}")
@@ -47,7 +52,10 @@ class Docking(Leaf):
         if state is not None and state.at >= self.sent_at:
             if state.value == TARGET[self.params.action]:
                 return SUCCESS
-            if state.value == "failed":
+            if state.value == BUSY[self.params.action]:
+                self.took = True
+            if state.value == "failed" and (
+                    self.took or state.at - self.sent_at >= FAILED_GRACE):
                 self.ctx.note(f"{self.params.action} failed")
                 return FAILURE
         if self.get("/now") - self.sent_at >= self.timeout:

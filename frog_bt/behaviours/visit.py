@@ -9,7 +9,7 @@ from pydantic import Field
 
 from frog_bt.behaviours.navigation import PoiParams
 from frog_bt.blackboard import EventLog, Reading
-from frog_bt.frontend.messages import ContentDone, StartPoi
+from frog_bt.frontend.messages import ContentDone, FrontendIdle, StartPoi
 from frog_bt.frontend.messages import FinishPoi as FinishPoiCommand
 from frog_bt.messages import Pose, TrackedPeople
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
@@ -90,8 +90,9 @@ class PlayContent(Leaf):
         self.since = events.last_index
         self.started = self.ctx.clock.now()
         self.timeout = p.timeout or self.ctx.site.timeouts.content
-        waypoint = self.get("/waypoint") or p.poi
-        self.ctx.send(StartPoi(p.poi, waypoint, p.part))
+        self.waypoint = self.get("/waypoint") or p.poi
+        self.restart_seen = self.since
+        self.ctx.send(StartPoi(p.poi, self.waypoint, p.part))
 
     def terminate(self, new_status: Status) -> None:
         # Interrupted (a tour aborted, a shutdown): stop the content that is playing.
@@ -104,6 +105,12 @@ class PlayContent(Leaf):
         events: EventLog = self.get("/events")
         if events.first_since(self.since, ContentDone, poi=p.poi, part=p.part) is not None:
             return SUCCESS
+        restart = events.first_since(self.restart_seen, FrontendIdle)
+        if restart is not None:
+            # the front end restarted and lost what it was playing: play it again
+            self.restart_seen = restart.index
+            self.ctx.send(StartPoi(p.poi, self.waypoint, p.part))
+            self.ctx.note(f"front end restarted: {p.poi} part {p.part} sent again")
         if self.get("/now") - self.started >= self.timeout:
             self.ctx.note(f"{p.poi} part {p.part}: no content_done within "
                           f"{self.timeout:g} s, going on")

@@ -76,3 +76,18 @@ def test_silent_front_end_content_times_out_and_the_tour_goes_on(tmp_path):
     bench.advance(1)
     assert bench.tick() == SUCCESS
     assert "no content_done within 60 s" in bench.core.last_note
+
+
+def test_content_is_sent_again_when_the_front_end_restarts(tmp_path):
+    from frog_bt.frontend.messages import FrontendIdle
+
+    bench = Bench(write_tree(tmp_path, "root: {type: PlayContent, poi: POI4}"))
+    bench.tick()
+    assert bench.take_sent() == [StartPoi("POI4", "POI4", "a")]
+    bench.event(FrontendIdle())  # it restarted and lost what it was playing
+    assert bench.tick() == RUNNING
+    assert bench.take_sent() == [StartPoi("POI4", "POI4", "a")]
+    assert bench.tick() == RUNNING
+    assert bench.take_sent() == []  # once per restart
+    bench.event(ContentDone("POI4", "a"))
+    assert bench.tick() == SUCCESS

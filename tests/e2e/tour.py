@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import asyncio
 import socket
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from frog_bt.clock import SimClock
@@ -31,6 +31,7 @@ class Tour:
     outcome: Outcome
     summary: TourSummary
     site: Site
+    sent: list[tuple[float, Any]] = field(default_factory=list)  # (executive time, message)
 
     def commands(self) -> list[str]:
         """What the executive sent, as the simulator received it, compactly."""
@@ -84,11 +85,13 @@ async def run_tour(scenario_data: dict[str, Any], *, site: Site | None = None,
                           sim_time=True, once=True)
     summary = TourSummary(site)
     summary.attach(executive.taps)
+    sent: list[tuple[float, Any]] = []
+    executive.taps.frontend_out.append(lambda t, _type, message: sent.append((t, message)))
     try:
         outcome = await asyncio.wait_for(executive.run(), wall_timeout)
     finally:
         await sim.stop()
-    return Tour(sim, executive, outcome, summary, site)
+    return Tour(sim, executive, outcome, summary, site, sent)
 
 
 class Running:
