@@ -60,6 +60,7 @@ class Simulator:
         self._udp = FrontendSocket(frontend_host or host, frontend_port,
                                    (executive[0], executive[1]), self._on_datagram)
         self._loop_task: asyncio.Task[None] | None = None
+        self._dropped: dict[str, float] = {}  # topic -> simulated time its drop-out ends
         self._started = False
 
     # ------------------------------------------------------------ lifecycle
@@ -163,7 +164,16 @@ class Simulator:
 
     # ------------------------------------------------------------ traffic
 
+    def drop(self, topic: str, seconds: float) -> None:
+        """A sensor drop-out: ``topic`` is not published for ``seconds`` of simulated time."""
+        self._dropped[topic] = self.world.now + seconds
+
     def _publish(self, topic: str, msg: dict[str, Any], logged: bool = True) -> None:
+        until = self._dropped.get(topic)
+        if until is not None:
+            if self.world.now < until:
+                return
+            del self._dropped[topic]
         if logged:
             self.log.append(Record(self.world.now, "ros", "out", topic, msg))
         self._rosbridge.publish(topic, msg)
