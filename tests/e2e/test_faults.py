@@ -154,3 +154,26 @@ def test_a_checkpoint_is_dropped_when_the_robot_is_docked(tmp_path):
     # a robot at its dock is not in the middle of a tour, whatever the file says
     commands = asyncio.run(_docked_robot_does_not_resume(tmp_path))
     assert commands[:2] == ["tour started", "/docking/dock undock"]
+
+
+async def _wrong_secret() -> tuple[int, str]:
+    from tour import FAST, free_udp_port, merge
+
+    from frog_bt.sim import Simulator, load_scenario, parse_scenario
+
+    scenario = parse_scenario(merge(load_scenario("default").model_dump(mode="json"), FAST))
+    listen = ("127.0.0.1", free_udp_port())
+    sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=listen,
+                    secret="the right one")
+    await sim.start()
+    try:
+        async with Running({}, sim=sim, listen=listen, secret="a wrong one", once=True) as run:
+            outcome = await run.finish(30)
+            return outcome.code, outcome.reason
+    finally:
+        await sim.stop()
+
+
+def test_once_stops_when_rosbridge_keeps_refusing_the_secret():
+    assert asyncio.run(_wrong_secret()) == (
+        1, "rosbridge refused authentication (check the secret)")
