@@ -11,7 +11,6 @@ from __future__ import annotations
 import argparse
 import asyncio
 import logging
-import socket
 import sys
 import time
 from pathlib import Path
@@ -37,12 +36,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", action="store_true", help="no live status line")
 
 
-def free_udp_port(host: str = "127.0.0.1") -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind((host, 0))
-        return int(s.getsockname()[1])
-
-
 def run(args: argparse.Namespace) -> int:
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     from frog_bt.sim import load_scenario
@@ -60,44 +53,42 @@ def run(args: argparse.Namespace) -> int:
 
 
 async def _demo(site, tree, scenario, args) -> int:  # type: ignore[no-untyped-def]
-    from frog_bt.clock import SimClock
     from frog_bt.commands.run import attach_observers
-    from frog_bt.executive import Executive
-    from frog_bt.sim import Simulator
+    from frog_bt.rehearsal import Rehearsal
     from frog_bt.status import StatusLine
     from frog_bt.summary import TourSummary
 
-    listen = ("127.0.0.1", free_udp_port())
-    sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=listen)
-    await sim.start()
-    clock = SimClock()
-    executive = Executive(site, tree, clock,
-                          rosbridge_url=f"ws://127.0.0.1:{sim.rosbridge_port}",
-                          frontend=("127.0.0.1", sim.frontend_port), listen=listen,
-                          sim_time=True, once=True)
     summary = TourSummary(site)
-    summary.attach(executive.taps)
     status = None if args.quiet else StatusLine()
-    if status is not None:
-        executive.taps.tick.append(status.update)
     rerun = None if args.rerun == "off" else args.rerun
-    observers = attach_observers(executive, record=args.record, rerun=rerun)
-    wall0, sim0 = time.monotonic(), sim.clock.now()
-    loop = asyncio.get_running_loop()
-    loop.call_later(args.timeout, executive.stop, f"no docked finish within {args.timeout:g} s "
-                    "of wall time", 1)
+    observers: list = []
+
+    def prepare(executive) -> None:  # type: ignore[no-untyped-def]
+        summary.attach(executive.taps)
+        if status is not None:
+            executive.taps.tick.append(status.update)
+        observers.extend(attach_observers(executive, record=args.record, rerun=rerun))
+
+    wall0 = time.monotonic()
+    rehearsal = Rehearsal(scenario, site=site, tree=tree, prepare=prepare)
+    sim0 = rehearsal.sim.clock.now()
     try:
-        outcome = await executive.run()
+        async with rehearsal:
+            try:
+                outcome = await rehearsal.finish(args.timeout)
+            except TimeoutError:
+                outcome = rehearsal.executive.outcome
+                outcome.code, outcome.reason = 1, (f"no docked finish within {args.timeout:g} s "
+                                                   "of wall time")
     finally:
-        await sim.stop()
         for observer in observers:
             observer.close()
         if status is not None:
             status.close()
-    wall, simulated = time.monotonic() - wall0, sim.clock.now() - sim0
+    clock = rehearsal.executive.clock
+    wall, simulated = time.monotonic() - wall0, rehearsal.sim.clock.now() - sim0
     print(f"frog-bt demo: scenario {args.scenario!r}, started "
-          f"{clock.local_time().strftime('%Y-%m-%d') if clock.ready else '-'} "
-          f"{scenario.start_time.astimezone(clock.tz):%H:%M} local time")
+          f"{scenario.start_time.astimezone(clock.tz):%Y-%m-%d %H:%M} local time")
     for line in summary.lines():
         print("  " + line)
     print(f"  time:      {simulated / 60:.1f} min simulated in {wall:.1f} s "

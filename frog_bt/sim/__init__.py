@@ -25,7 +25,13 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from frog_bt.sim.scenario import Scenario, builtin_scenarios, load_scenario, parse_scenario
+    from frog_bt.sim.scenario import (
+        Scenario,
+        builtin_scenarios,
+        load_scenario,
+        parse_scenario,
+        scenario_from,
+    )
     from frog_bt.sim.simulator import Simulator
     from frog_bt.sim.traffic import MessageLog, Record
     from frog_bt.sim.world import World
@@ -40,6 +46,7 @@ _EXPORTS = {
     "builtin_scenarios": "frog_bt.sim.scenario",
     "load_scenario": "frog_bt.sim.scenario",
     "parse_scenario": "frog_bt.sim.scenario",
+    "scenario_from": "frog_bt.sim.scenario",
 }
 __all__ = [
     "MessageLog",
@@ -50,6 +57,7 @@ __all__ = [
     "builtin_scenarios",
     "load_scenario",
     "parse_scenario",
+    "scenario_from",
 ]
 
 

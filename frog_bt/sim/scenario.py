@@ -353,6 +353,13 @@ def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
+def scenario_from(base: str | Path = "default", overrides: dict[str, Any] | None = None
+                  ) -> Scenario:
+    """Scenario ``base`` with ``overrides`` on top (mappings merge, lists replace)."""
+    data = load_scenario(base).model_dump(mode="json")
+    return parse_scenario(_merge(data, overrides or {}), f"{base} + overrides")
+
+
 def parse_scenario(data: Any, file: str = "<scenario>") -> Scenario:
     """A :class:`Scenario` from an already-loaded mapping (tests build them this way)."""
     return validate(Scenario, {} if data is None else data, file, ConfigError)

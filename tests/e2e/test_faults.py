@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import asyncio
 
-from tour import Running, describe
+from tour import Running, describe, fast
 
 from frog_bt.checkpoint import load as load_checkpoint
+from frog_bt.config import load_site
+from frog_bt.rehearsal import Rehearsal
 
 
 def commands_after(run: Running, t: float) -> list[str]:
@@ -157,21 +159,10 @@ def test_a_checkpoint_is_dropped_when_the_robot_is_docked(tmp_path):
 
 
 async def _wrong_secret() -> tuple[int, str]:
-    from tour import FAST, free_udp_port, merge
-
-    from frog_bt.sim import Simulator, load_scenario, parse_scenario
-
-    scenario = parse_scenario(merge(load_scenario("default").model_dump(mode="json"), FAST))
-    listen = ("127.0.0.1", free_udp_port())
-    sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=listen,
-                    secret="the right one")
-    await sim.start()
-    try:
-        async with Running({}, sim=sim, listen=listen, secret="a wrong one", once=True) as run:
-            outcome = await run.finish(30)
-            return outcome.code, outcome.reason
-    finally:
-        await sim.stop()
+    async with Rehearsal(fast(), site=load_site(), sim_secret="the right one",
+                         secret="a wrong one") as run:
+        outcome = await run.finish(30)
+        return outcome.code, outcome.reason
 
 
 def test_once_stops_when_rosbridge_keeps_refusing_the_secret():

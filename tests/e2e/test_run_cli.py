@@ -6,13 +6,13 @@ import asyncio
 import subprocess
 import sys
 
-from tour import FAST, free_udp_port, merge
+from tour import fast, free_udp_port
 
-from frog_bt.sim import Simulator, load_scenario, parse_scenario
+from frog_bt.sim import Simulator
 
 
 async def _run_once() -> tuple[int, bytes, list[str]]:
-    scenario = parse_scenario(merge(load_scenario("default").model_dump(mode="json"), FAST))
+    scenario = fast()
     listen = free_udp_port()
     sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=("127.0.0.1", listen))
     await sim.start()

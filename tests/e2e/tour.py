@@ -1,27 +1,34 @@
-"""Run the real executive against the built-in simulator, in one event loop, on sim time."""
+"""Whole tours of the real executive against the built-in simulator, on sim time.
+
+Built on :class:`frog_bt.rehearsal.Rehearsal`; adds what tests assert on: the
+commands the simulator received, compactly, and what the executive sent to the
+front end with its own clock's times.
+"""
 
 from __future__ import annotations
 
 import asyncio
-import socket
 from dataclasses import dataclass, field
 from typing import Any
 
-from frog_bt.clock import SimClock
 from frog_bt.config import Site, load_site
 from frog_bt.executive import Executive, Outcome
-from frog_bt.sim import Simulator, load_scenario, parse_scenario
+from frog_bt.rehearsal import Rehearsal, free_udp_port
+from frog_bt.sim import Simulator, scenario_from
+from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.traffic import Record
 from frog_bt.summary import TourSummary
-from frog_bt.tree.loader import LoadedTree, load_tree
+from frog_bt.tree.loader import LoadedTree
 
-FAST = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
+# High speed and short content: a whole tour takes a few seconds of wall time.
+FAST: dict[str, Any] = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
+
+__all__ = ["FAST", "Running", "Tour", "describe", "fast", "free_udp_port", "tour"]
 
 
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
+def fast(overrides: dict[str, Any] | None = None) -> Scenario:
+    """The default scenario, fast, with ``overrides`` on top."""
+    return scenario_from("default", {**FAST, **(overrides or {})})
 
 
 @dataclass
@@ -57,88 +64,35 @@ def describe(record: Record, summary: TourSummary) -> str:
     return f"{record.channel} {fields}".rstrip()
 
 
+class Running(Rehearsal):
+    """A rehearsal of the default scenario (fast, with ``scenario_data`` on top) that
+    keeps a tour summary and the front-end commands sent; ``once`` is off unless asked."""
 
-def merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
-    """``over`` on top of ``base``: mappings merge, everything else replaces."""
-    out = dict(base)
-    for key, value in over.items():
-        if isinstance(value, dict) and isinstance(out.get(key), dict):
-            out[key] = merge(out[key], value)
-        else:
-            out[key] = value
-    return out
+    def __init__(self, scenario_data: dict[str, Any], *, site: Site | None = None,
+                 tree: LoadedTree | None = None, sim: Simulator | None = None,
+                 listen: tuple[str, int] | None = None, **executive_kwargs: Any) -> None:
+        site = site or load_site()
+        self.summary = TourSummary(site)
+        self.sent: list[tuple[float, Any]] = []
+        executive_kwargs.setdefault("once", False)
+        super().__init__(None if sim is not None else fast(scenario_data), site=site,
+                         tree=tree, sim=sim, listen=listen, prepare=self._prepare,
+                         **executive_kwargs)
+
+    def _prepare(self, executive: Executive) -> None:
+        self.summary.attach(executive.taps)
+        executive.taps.frontend_out.append(lambda t, _type, m: self.sent.append((t, m)))
+
+    def tour(self) -> Tour:
+        return Tour(self.sim, self.executive, self.executive.outcome, self.summary, self.site,
+                    self.sent)
 
 
 async def run_tour(scenario_data: dict[str, Any], *, site: Site | None = None,
-                   tree: LoadedTree | None = None, wall_timeout: float = 60.0,
-                   ) -> Tour:
-    site = site or load_site()
-    tree = tree or load_tree(site=site)
-    sc = parse_scenario(merge(load_scenario("default").model_dump(mode="json"),
-                              {**FAST, **scenario_data}))
-    listen = ("127.0.0.1", free_udp_port())
-    sim = Simulator(sc, rosbridge_port=0, frontend_port=0, executive=listen)
-    await sim.start()
-    executive = Executive(site, tree, SimClock(),
-                          rosbridge_url=f"ws://127.0.0.1:{sim.rosbridge_port}",
-                          frontend=("127.0.0.1", sim.frontend_port), listen=listen,
-                          sim_time=True, once=True)
-    summary = TourSummary(site)
-    summary.attach(executive.taps)
-    sent: list[tuple[float, Any]] = []
-    executive.taps.frontend_out.append(lambda t, _type, message: sent.append((t, message)))
-    try:
-        outcome = await asyncio.wait_for(executive.run(), wall_timeout)
-    finally:
-        await sim.stop()
-    return Tour(sim, executive, outcome, summary, site, sent)
-
-
-class Running:
-    """A simulator and an executive running in this loop, for tests that act mid-tour.
-
-    ``async with Running({...}) as run:`` then e.g. ``await run.sim.wait_for(...)``,
-    ``await run.finish()`` for the executive's outcome.
-    """
-
-    def __init__(self, scenario_data: dict[str, Any], *, site: Site | None = None,
-                 sim: Simulator | None = None, listen: tuple[str, int] | None = None,
-                 **executive_kwargs: Any) -> None:
-        self.site = site or load_site()
-        self.listen = listen  # with sim=: the address that simulator sends events to
-        self.scenario_data = scenario_data
-        self.sim = sim
-        self.own_sim = sim is None
-        self.executive_kwargs = executive_kwargs
-
-    async def __aenter__(self) -> Running:
-        if self.sim is None:
-            sc = parse_scenario(merge(load_scenario("default").model_dump(mode="json"),
-                                      {**FAST, **self.scenario_data}))
-            self.listen = ("127.0.0.1", free_udp_port())
-            self.sim = Simulator(sc, rosbridge_port=0, frontend_port=0, executive=self.listen)
-            await self.sim.start()
-        assert self.listen is not None
-        self.executive = Executive(self.site, load_tree(site=self.site), SimClock(),
-                                   rosbridge_url=f"ws://127.0.0.1:{self.sim.rosbridge_port}",
-                                   frontend=("127.0.0.1", self.sim.frontend_port),
-                                   listen=self.listen, sim_time=True, **self.executive_kwargs)
-        self.summary = TourSummary(self.site)
-        self.summary.attach(self.executive.taps)
-        self.task = asyncio.create_task(self.executive.run())
-        return self
-
-    async def finish(self, timeout: float = 60.0) -> Outcome:
-        return await asyncio.wait_for(asyncio.shield(self.task), timeout)
-
-    async def __aexit__(self, *exc: object) -> None:
-        self.executive.stop("test over")
-        await asyncio.wait_for(self.task, 10)
-        if self.own_sim:
-            await self.sim.stop()
-
-    def tour(self) -> Tour:
-        return Tour(self.sim, self.executive, self.executive.outcome, self.summary, self.site)
+                   tree: LoadedTree | None = None, wall_timeout: float = 60.0) -> Tour:
+    async with Running(scenario_data, site=site, tree=tree, once=True) as run:
+        await run.finish(wall_timeout)
+        return run.tour()
 
 
 def tour(scenario_data: dict[str, Any], **kwargs: Any) -> Tour:
