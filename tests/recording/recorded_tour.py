@@ -3,43 +3,25 @@
 from __future__ import annotations
 
 import asyncio
-import socket
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from frog_bt.clock import SimClock
 from frog_bt.config import Site, load_site
 from frog_bt.executive import Executive, Outcome
 from frog_bt.recording import Recorder
-from frog_bt.sim import Simulator, load_scenario, parse_scenario
+from frog_bt.rehearsal import Rehearsal
+from frog_bt.sim import scenario_from
+from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.traffic import Record
-from frog_bt.tree.loader import LoadedTree, load_tree
+from frog_bt.tree.loader import LoadedTree
 
-# High speed and short content, as in tests/e2e: a tour takes about a second of wall time.
+# High speed and short content, as in tests/e2e: a tour takes a few seconds of wall time.
 FAST: dict[str, Any] = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
 
 
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
-def merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
-    """``over`` on top of ``base``: mappings merge, everything else replaces."""
-    out = dict(base)
-    for key, value in over.items():
-        if isinstance(value, dict) and isinstance(out.get(key), dict):
-            out[key] = merge(out[key], value)
-        else:
-            out[key] = value
-    return out
-
-
-def scenario(data: dict[str, Any] | None = None) -> Any:
-    base = load_scenario("default").model_dump(mode="json")
-    return parse_scenario(merge(base, {**FAST, **(data or {})}))
+def scenario(data: dict[str, Any] | None = None) -> Scenario:
+    return scenario_from("default", {**FAST, **(data or {})})
 
 
 @dataclass
@@ -56,23 +38,16 @@ class RecordedTour:
 async def _record(path: Path, data: dict[str, Any] | None, site: Site | None,
                   tree: LoadedTree | None, wall_timeout: float) -> RecordedTour:
     site = site or load_site()
-    tree = tree or load_tree(site=site)
-    listen = ("127.0.0.1", free_udp_port())
-    sim = Simulator(scenario(data), rosbridge_port=0, frontend_port=0, executive=listen)
-    start = sim.clock.now()
-    await sim.start()
-    executive = Executive(site, tree, SimClock(),
-                          rosbridge_url=f"ws://127.0.0.1:{sim.rosbridge_port}",
-                          frontend=("127.0.0.1", sim.frontend_port), listen=listen,
-                          sim_time=True, once=True)
     recorder = Recorder(path)
-    recorder.attach(executive)
+    rehearsal = Rehearsal(scenario(data), site=site, tree=tree, prepare=recorder.attach)
+    start = rehearsal.sim.clock.now()
     try:
-        outcome = await asyncio.wait_for(executive.run(), wall_timeout)
+        async with rehearsal:
+            outcome = await rehearsal.finish(wall_timeout)
     finally:
-        await sim.stop()
         recorder.close()
-    return RecordedTour(path, outcome, start, sim.clock.now(), site, executive, sim.received())
+    return RecordedTour(path, outcome, start, rehearsal.sim.clock.now(), site,
+                        rehearsal.executive, rehearsal.sim.received())
 
 
 def record_tour(path: Path, data: dict[str, Any] | None = None, *, site: Site | None = None,

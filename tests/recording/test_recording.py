@@ -15,7 +15,7 @@ from typing import Any
 from hypothesis import given
 from hypothesis import strategies as st
 from mcap.reader import make_reader
-from recorded_tour import RecordedTour, free_udp_port, scenario
+from recorded_tour import RecordedTour, scenario
 
 from frog_bt.clock import SimClock
 from frog_bt.config import load_site
@@ -32,6 +32,7 @@ from frog_bt.recording import (
     from_ns,
     to_ns,
 )
+from frog_bt.rehearsal import free_udp_port
 from frog_bt.sim import Simulator
 from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
 

@@ -15,38 +15,20 @@ Tests wait on those records and on the simulator's log, never on sleeps::
 from __future__ import annotations
 
 import asyncio
-import socket
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from typing import Any
 
-from frog_bt.clock import SimClock
 from frog_bt.config import Site, load_site
-from frog_bt.executive import Executive, Outcome
+from frog_bt.executive import Executive
+from frog_bt.rehearsal import Rehearsal
 from frog_bt.rosbridge.link import LinkState
-from frog_bt.sim import Simulator, load_scenario, parse_scenario
+from frog_bt.sim import Simulator, scenario_from
 from frog_bt.sim.traffic import Record
 from frog_bt.summary import TourSummary
-from frog_bt.tree.loader import load_tree
 
 FAST = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
 WAIT = 30.0  # wall seconds: a safety net for every wait, never a pace
-
-
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
-def merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
-    out = dict(base)
-    for key, value in over.items():
-        if isinstance(value, dict) and isinstance(out.get(key), dict):
-            out[key] = merge(out[key], value)
-        else:
-            out[key] = value
-    return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,28 +44,17 @@ class Published:
 Event = Published | LinkState
 
 
-class TourRun:
+class TourRun(Rehearsal):
     def __init__(self, scenario: dict[str, Any] | None = None, *, site: Site | None = None,
                  secret: str | None = None, sim_secret: str | None = None) -> None:
-        self.site = site or load_site()
-        sc = parse_scenario(merge(load_scenario("default").model_dump(mode="json"),
-                                  merge(FAST, scenario or {})))
-        listen = ("127.0.0.1", free_udp_port())
-        self.sim = Simulator(sc, rosbridge_port=0, frontend_port=0, executive=listen,
-                             secret=sim_secret)
-        self._listen = listen
-        self._secret = secret
+        site = site or load_site()
         self.events: list[Event] = []
         self._waiters: list[tuple[Callable[[Event], bool], asyncio.Future[Event]]] = []
-        self.summary = TourSummary(self.site)
+        self.summary = TourSummary(site)
+        super().__init__(scenario_from("default", {**FAST, **(scenario or {})}), site=site,
+                         sim_secret=sim_secret, secret=secret, prepare=self._prepare)
 
-    async def __aenter__(self) -> TourRun:
-        await self.sim.start()
-        exe = Executive(self.site, load_tree(site=self.site), SimClock(),
-                        rosbridge_url=f"ws://127.0.0.1:{self.sim.rosbridge_port}",
-                        frontend=("127.0.0.1", self.sim.frontend_port), listen=self._listen,
-                        sim_time=True, secret=self._secret, once=True)
-        self.executive = exe
+    def _prepare(self, exe: Executive) -> None:
         self.summary.attach(exe.taps)
         exe.taps.ros_out.append(
             lambda t, topic, msg: self._add(Published(t, topic, msg, exe.client.link.connected)))
@@ -95,20 +66,6 @@ class TourRun:
             self._add(state)
 
         exe.client.on_link = link_changed
-        self.task = asyncio.create_task(exe.run())
-        return self
-
-    async def __aexit__(self, *exc: object) -> None:
-        try:
-            if not self.task.done():
-                self.executive.stop("test over")
-            await asyncio.wait_for(self.task, 10)
-        finally:
-            await self.sim.stop()
-
-    async def finish(self, timeout: float = 60.0) -> Outcome:
-        """The executive's outcome once it stops by itself (``once``: after the tour)."""
-        return await asyncio.wait_for(asyncio.shield(self.task), timeout)
 
     # ------------------------------------------------------------ records and waits
 

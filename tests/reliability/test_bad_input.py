@@ -34,7 +34,6 @@ from garbage import (
     classify_datagram,
     classify_frame,
 )
-from harness import free_udp_port
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from websockets.asyncio.server import ServerConnection, serve
@@ -46,6 +45,7 @@ from frog_bt.executive import Executive
 from frog_bt.frontend import messages as fm
 from frog_bt.frontend.protocol import Endpoint, decode_datagram, encode_datagram
 from frog_bt.messages import DECODERS, encode_clock
+from frog_bt.rehearsal import free_udp_port
 from frog_bt.rosbridge.protocol import Publish, decode_frame
 from frog_bt.tree.loader import load_tree
 

@@ -15,12 +15,11 @@ from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "e2e"))
-from tour import FAST, free_udp_port, merge
+from tour import fast
 
-from frog_bt.clock import SimClock
 from frog_bt.config import Site, load_site
-from frog_bt.executive import Executive, Outcome
-from frog_bt.sim import Simulator, load_scenario, parse_scenario
+from frog_bt.executive import Outcome
+from frog_bt.rehearsal import Rehearsal
 from frog_bt.telemetry import Telemetry
 from frog_bt.tree.loader import LoadedTree, load_tree
 
@@ -62,21 +61,15 @@ async def _run_tour(path: Path) -> Recorded:
     rr.set_strict_mode(True)  # a bad archetype raises (and counts in write_errors)
     site = load_site()
     tree = load_tree(site=site)
-    scenario = parse_scenario(merge(load_scenario("default").model_dump(mode="json"), FAST))
-    listen = ("127.0.0.1", free_udp_port())
-    sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=listen)
-    await sim.start()
-    executive = Executive(site, tree, SimClock(),
-                          rosbridge_url=f"ws://127.0.0.1:{sim.rosbridge_port}",
-                          frontend=("127.0.0.1", sim.frontend_port), listen=listen,
-                          sim_time=True, once=True)
     telemetry = Telemetry.open(f"save:{path}", site, tree)
-    telemetry.attach(executive.core)
+    rehearsal = Rehearsal(fast(), site=site, tree=tree,
+                          prepare=lambda executive: telemetry.attach(executive.core))
     try:
-        outcome = await asyncio.wait_for(executive.run(), 60.0)
+        async with rehearsal:
+            outcome = await rehearsal.finish(60.0)
     finally:
-        await sim.stop()
         telemetry.close()
+    executive = rehearsal.executive
     return Recorded(path, outcome, site, tree, telemetry, executive.core.ticks)
 
 
