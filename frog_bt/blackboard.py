@@ -124,23 +124,33 @@ class Snapshot:
         self.write()
 
     def write(self) -> None:
-        inp, bb = self.inputs, self.bb
-        bb.set("/now", self.clock.now())
-        bb.set("/pose", inp.pose)
-        bb.set("/persons", inp.persons)
-        bb.set("/people", inp.people)
-        bb.set("/docking", inp.docking)
-        bb.set("/diagnostics", inp.diagnostics)
-        bb.set("/link", inp.link)
-        bb.set("/faces", tuple(inp.faces))
-        inp.faces.clear()
-        for code, at in inp.responses:
-            self.actions.on_response(code, at)
-        inp.responses.clear()
+        inp = self.inputs
+        if py_trees.blackboard.Blackboard.activity_stream is not None:
+            set_ = self.bb.set  # py_trees' own path, so that the stream sees every write
+        else:
+            # The keys were registered for writing in __init__; a client's set() would
+            # check that again, ten times a tick (~3 µs each).
+            set_ = py_trees.blackboard.Blackboard.storage.__setitem__
+        set_("/now", self.clock.now())
+        set_("/pose", inp.pose)
+        set_("/persons", inp.persons)
+        set_("/people", inp.people)
+        set_("/docking", inp.docking)
+        set_("/diagnostics", inp.diagnostics)
+        set_("/link", inp.link)
+        if inp.faces:
+            set_("/faces", tuple(inp.faces))
+            inp.faces.clear()
+        else:
+            set_("/faces", ())
+        if inp.responses:
+            for code, at in inp.responses:
+                self.actions.on_response(code, at)
+            inp.responses.clear()
         if inp.events:
             for message, at in inp.events:
                 self.events.append(message, at)
                 if isinstance(message, FrontendIdle):
-                    bb.set("/frontend_ready", True)
+                    set_("/frontend_ready", True)
             inp.events.clear()
-        bb.set("/events", self.events)
+        set_("/events", self.events)

@@ -9,6 +9,7 @@ so the same tick code runs everywhere.
 
 from __future__ import annotations
 
+import functools
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -31,6 +32,13 @@ Status = py_trees.common.Status
 # High-rate inputs do not each call for a tick; the periodic tick covers them.
 NO_TICK_ROLES = frozenset({"pose", "faces", "people"})
 Tap = Callable[[float, str, Any], None]  # (project-clock time, channel, payload)
+Behaviour = py_trees.behaviour.Behaviour
+
+
+def _stop_noting(stop: Callable[..., None], node: Behaviour, touched: list[Behaviour],
+                 *args: Any, **kwargs: Any) -> None:
+    touched.append(node)
+    stop(node, *args, **kwargs)
 
 
 @dataclass(slots=True)
@@ -69,6 +77,13 @@ class Core:
         self.bt.add_pre_tick_handler(lambda _: self.snapshot.write())
         self.ticks = 0
         self._setup = False
+        # Nodes ticked or stopped since the last tick's taps ran: every node whose status
+        # changed is among them (a status changes only in its node's tick or in stop()),
+        # so observers can follow the tree in O(active path) rather than O(tree).
+        self.touched: list[Behaviour] = []
+        for node in tree.root.iterate():
+            # the class's own stop, so that a tree reused by a later Core is not wrapped twice
+            node.stop = functools.partial(_stop_noting, type(node).stop, node, self.touched)
 
     def _publish(self, role: str, msg: dict[str, Any]) -> None:
         topic = self.site.topic(role)
@@ -122,11 +137,27 @@ class Core:
     # ------------------------------------------------------------ ticking
 
     def tick(self) -> Status:
+        """Snapshot the inputs, tick the tree once, run the tick taps; the root's status."""
         self.setup()
-        self.bt.tick()
+        bt, touched = self.bt, self.touched
+        if bt.visitors:
+            bt.tick()
+            touched.extend(bt.root.iterate())
+        else:
+            # BehaviourTree.tick walks the *whole* tree after every tick for its "full"
+            # visitors, even when there are none: a cost that grows with the tour, not with
+            # the active path. Without visitors, tick the root directly (same order:
+            # pre-tick handlers, the tick, post-tick handlers).
+            for handler in bt.pre_tick_handlers:
+                handler(bt)
+            touched.extend(bt.root.tick())  # every node ticked is yielded
+            for handler in bt.post_tick_handlers:
+                handler(bt)
+            bt.count += 1
         self.ticks += 1
         for tap in self.taps.tick:
             tap(self)
+        touched.clear()
         return self.bt.root.status
 
     def halt(self) -> None:

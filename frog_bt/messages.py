@@ -154,7 +154,7 @@ class Pose:
         return 2.0 * math.atan2(self.qz, self.qw)
 
 
-def decode_pose(msg: Any) -> Pose:
+def _decode_pose_checked(msg: Any) -> Pose:
     obj = _obj(msg, ())
     stamp, frame = _header(obj, ())
     pose = _obj(_field(obj, "pose", ()), ("pose",))
@@ -257,7 +257,7 @@ class PersonDetections:
     persons: tuple[PersonDetection, ...]
 
 
-def decode_person_detections(msg: Any) -> PersonDetections:
+def _decode_person_detections_checked(msg: Any) -> PersonDetections:
     obj = _obj(msg, ())
     stamp, _ = _header(obj, ())
     persons = []
@@ -288,7 +288,7 @@ class FaceData:
     faces: tuple[Face, ...]
 
 
-def decode_face_data(msg: Any) -> FaceData:
+def _decode_face_data_checked(msg: Any) -> FaceData:
     obj = _obj(msg, ())
     stamp, _ = _header(obj, ())
     faces = []
@@ -318,7 +318,7 @@ class TrackedPeople:
     people: tuple[TrackedPerson, ...]
 
 
-def decode_tracked_people(msg: Any) -> TrackedPeople:
+def _decode_tracked_people_checked(msg: Any) -> TrackedPeople:
     obj = _obj(msg, ())
     stamp, _ = _header(obj, ())
     people = []
@@ -337,6 +337,148 @@ def decode_clock(msg: Any) -> float:
 
 def encode_clock(t: float) -> dict:
     return {"clock": encode_time(t)}
+
+
+# ---------------------------------------------------------------- fast paths
+#
+# The decoders below run for every inbound message (poses at 10 Hz, faces, detections).
+# Each first tries a straight read of a well-formed message: exact JSON types (a float
+# where a float is due, an int where an int), no field-by-field paths. Whatever that read
+# does not accept, including everything malformed, goes through the checked decoder
+# above, which gives the same value or the DecodeError naming the field. The fast read
+# accepts only what the checked one accepts, and builds the same value from it.
+
+_INT32_MIN, _INT32_MAX = -(2**31), 2**31
+
+
+def _fast_float(obj: dict, key: str) -> float | None:
+    v = obj[key]
+    return v if type(v) is float and v - v == 0.0 else None  # finite: inf - inf is NaN
+
+
+def _fast_opt_float(obj: dict, key: str) -> float | None:
+    if key not in obj:
+        return 0.0
+    v = obj[key]
+    return v if type(v) is float and v - v == 0.0 else None
+
+
+def _fast_int32(obj: dict, key: str) -> int | None:
+    v = obj[key]
+    return v if type(v) is int and _INT32_MIN <= v < _INT32_MAX else None
+
+
+def _fast_header(obj: dict) -> tuple[float, str] | None:
+    if "header" not in obj:
+        return 0.0, ""
+    header = obj["header"]
+    if type(header) is not dict:
+        return None
+    frame = header.get("frame_id", "")
+    if type(frame) is not str:
+        return None
+    if "stamp" not in header:
+        return 0.0, frame
+    stamp = header["stamp"]
+    if type(stamp) is not dict:
+        return None
+    if "secs" in stamp:
+        secs, nsecs = stamp["secs"], stamp["nsecs"]
+    elif "sec" in stamp:
+        secs, nsecs = stamp["sec"], stamp["nanosec"]
+    else:
+        return None
+    if (type(secs) is int and type(nsecs) is int and 0 <= nsecs < 1_000_000_000
+            and -(2**31) <= secs < 2**32):
+        return secs + nsecs * 1e-9, frame
+    return None
+
+
+def _fast_point(value: Any) -> Point | None:
+    if type(value) is not dict:
+        return None
+    x, y, z = _fast_float(value, "x"), _fast_float(value, "y"), _fast_opt_float(value, "z")
+    if x is None or y is None or z is None:
+        return None
+    return Point(x, y, z)
+
+
+def decode_pose(msg: Any) -> Pose:
+    try:
+        if type(msg) is dict:
+            head = _fast_header(msg)
+            pose = msg["pose"]
+            pos, ori = _fast_point(pose["position"]), pose["orientation"]
+            if head is not None and pos is not None and type(ori) is dict:
+                qz, qw = _fast_opt_float(ori, "z"), _fast_float(ori, "w")
+                if qz is not None and qw is not None:
+                    return Pose(head[0], head[1], pos.x, pos.y, qz, qw)
+    except (KeyError, TypeError):
+        pass
+    return _decode_pose_checked(msg)
+
+
+def decode_face_data(msg: Any) -> FaceData:
+    try:
+        if type(msg) is dict and type(msg["faces"]) is list:
+            head = _fast_header(msg)
+            faces = []
+            for f in msg["faces"]:
+                if type(f) is not dict:
+                    break
+                e, d, i, facing = (_fast_float(f, "engagement"), _fast_float(f, "distance"),
+                                   _fast_int32(f, "id"), f["facing"])
+                if (e is None or not -1.0 <= e <= 1.0 or d is None or d < 0 or i is None
+                        or type(facing) is not bool):
+                    break
+                faces.append(Face(i, e, d, facing))
+            else:
+                if head is not None:
+                    return FaceData(head[0], tuple(faces))
+    except (KeyError, TypeError):
+        pass
+    return _decode_face_data_checked(msg)
+
+
+def decode_person_detections(msg: Any) -> PersonDetections:
+    try:
+        if type(msg) is dict and type(msg["persons"]) is list:
+            head = _fast_header(msg)
+            persons = []
+            for p in msg["persons"]:
+                if type(p) is not dict:
+                    break
+                o, i, pos = _fast_float(p, "orientation"), _fast_int32(p, "id"), \
+                    _fast_point(p["position"])
+                if o is None or not 0.0 <= o <= 360.0 or i is None or pos is None:
+                    break
+                persons.append(PersonDetection(i, pos, o))
+            else:
+                if head is not None:
+                    return PersonDetections(head[0], tuple(persons))
+    except (KeyError, TypeError):
+        pass
+    return _decode_person_detections_checked(msg)
+
+
+def decode_tracked_people(msg: Any) -> TrackedPeople:
+    try:
+        if type(msg) is dict and type(msg["people"]) is list:
+            head = _fast_header(msg)
+            people = []
+            for p in msg["people"]:
+                if type(p) is not dict:
+                    break
+                i, pos = _fast_int32(p, "id"), _fast_point(p["position"])
+                if i is None or pos is None:
+                    break
+                people.append(TrackedPerson(i, pos))
+            else:
+                if head is not None:
+                    return TrackedPeople(head[0], tuple(people))
+    except (KeyError, TypeError):
+        pass
+    return _decode_tracked_people_checked(msg)
 
 
 # ROS type name -> decoder; the subscriber side looks decoders up by type.

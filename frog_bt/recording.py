@@ -21,7 +21,8 @@ is held and stamped with that first time, so a recording has no zero stamps.
 
 Each channel carries a JSON Schema (encoding ``jsonschema``), so Foxglove
 can browse and plot the fields. Writing costs one ``json.dumps`` and one
-``add_message`` per message; chunks are bounded (:data:`CHUNK_SIZE`) and
+``add_message`` per message, the latter once the event loop's current callback
+(a tick, an input) is over, in order; chunks are bounded (:data:`CHUNK_SIZE`) and
 flushed at least every :data:`FLUSH_EVERY` wall seconds, so memory stays small
 and a crash loses little. :meth:`Recorder.close` (idempotent, also run at
 interpreter exit) writes the summary and footer: a recording stays valid MCAP
@@ -30,6 +31,7 @@ when the run command stops on SIGTERM, or on an exception.
 
 from __future__ import annotations
 
+import asyncio
 import json
 import logging
 import math
@@ -139,9 +141,19 @@ def _dumps(msg: Any) -> bytes:
     return json.dumps(msg, separators=(",", ":")).encode()
 
 
-def _finish(writer: Writer, stream: IO[bytes]) -> None:
-    """Write summary and footer, close the file (the finalizer: runs once)."""
+Queued = tuple[int, int, bytes, int]  # channel id, log time (ns), data, sequence
+
+
+def _write_queued(writer: Writer, queue: list[Queued]) -> None:
+    for cid, ns, data, seq in queue:
+        writer.add_message(cid, log_time=ns, data=data, publish_time=ns, sequence=seq)
+    queue.clear()
+
+
+def _finish(writer: Writer, stream: IO[bytes], queue: list[Queued]) -> None:
+    """Write what is queued, summary and footer, close the file (the finalizer: runs once)."""
     try:
+        _write_queued(writer, queue)
         writer.finish()
     except Exception:
         log.exception("recording: cannot finish the MCAP file")
@@ -171,7 +183,14 @@ class Recorder:
             pass
         self._writer = Writer(self._stream, chunk_size=chunk_size, compression=compression)
         self._writer.start(profile="", library=f"frog-bt {__version__}")
-        self._finalizer = weakref.finalize(self, _finish, self._writer, self._stream)
+        # Messages wait in _incoming until the event loop's current callback (a tick, an
+        # input) is over, so that a tick pays a list append per message, not an MCAP
+        # record each; _queue holds them stamped, for the writer (and the finalizer).
+        self._incoming: list[tuple[int, float | None, bytes]] = []
+        self._queue: list[Queued] = []
+        self._drain_scheduled = False
+        self._finalizer = weakref.finalize(self, _finish, self._writer, self._stream,
+                                           self._queue)
         self._flush_every = flush_every
         self._flushed_at = time.monotonic()
         self._schemas: dict[str, int] = {}
@@ -250,15 +269,30 @@ class Recorder:
     # ------------------------------------------------------------ writing
 
     def _write(self, cid: int, t: float | None, data: bytes) -> None:
+        """Take a message (``t`` None: before the clock has a time); it is stamped and
+        written once the event loop's current callback is over (at once without a loop)."""
         if self.closed:
             return
-        if t is None:  # before the first /clock: no time yet
-            if len(self._held) < HELD_LIMIT:
-                self._held.append((cid, data))
-            else:
-                self.dropped += 1
-            return
-        try:
+        self._incoming.append((cid, t, data))
+        if not self._drain_scheduled:
+            try:
+                loop = asyncio.get_running_loop()
+            except RuntimeError:  # no event loop: write now
+                self._drain()
+                return
+            self._drain_scheduled = True
+            loop.call_soon(self._drain)
+
+    def _stamp(self) -> None:
+        """Give the incoming messages their log times and sequence numbers, in order."""
+        incoming, self._incoming = self._incoming, []
+        for cid, t, data in incoming:
+            if t is None:  # before the first /clock: no time yet
+                if len(self._held) < HELD_LIMIT:
+                    self._held.append((cid, data))
+                else:
+                    self.dropped += 1
+                continue
             ns = max(to_ns(t), self._last_ns)
             if self._held:
                 held, self._held = self._held, []
@@ -266,25 +300,38 @@ class Recorder:
                     self._add(held_cid, ns, held_data)
             self._add(cid, ns, data)
             self._last_ns = ns
+
+    def _add(self, cid: int, ns: int, data: bytes) -> None:
+        seq = self._sequence.get(cid, 0)
+        self._sequence[cid] = seq + 1
+        self._queue.append((cid, ns, data, seq & 0xFFFFFFFF))
+        self.messages += 1
+
+    def _drain(self) -> None:
+        """Write the queued messages, in order; flush a chunk every ``flush_every`` s."""
+        self._drain_scheduled = False
+        if self.closed:
+            return  # close() wrote them
+        try:
+            self._stamp()
+            _write_queued(self._writer, self._queue)
             now = time.monotonic()
             if now - self._flushed_at >= self._flush_every:
                 self._flushed_at = now
                 self._writer.flush()
         except Exception as exc:  # disk full, ...: stop recording, never stop the robot
             log.error("recording to %s stopped: %s", self.path, exc)
+            self._queue.clear()
             self.close()
-
-    def _add(self, cid: int, ns: int, data: bytes) -> None:
-        seq = self._sequence.get(cid, 0)
-        self._sequence[cid] = seq + 1
-        self._writer.add_message(cid, log_time=ns, data=data, publish_time=ns,
-                                 sequence=seq & 0xFFFFFFFF)
-        self.messages += 1
 
     def close(self) -> None:
         """Write the summary and footer and close the file; idempotent."""
         if self.closed:
             return
+        try:
+            self._stamp()
+        except Exception as exc:  # a bug: what is stamped is still written
+            log.error("recording to %s: %s", self.path, exc)
         self.closed = True
         if self._held:
             log.warning("recording: %d messages before the first /clock were never stamped",

@@ -53,7 +53,9 @@ def decode_frame(text: str | bytes) -> Inbound:
     if len(text) > MAX_FRAME_BYTES:
         raise DecodeError(f"frame of {len(text)} bytes exceeds {MAX_FRAME_BYTES}")
     try:
-        obj = json.loads(text, parse_constant=_reject_constant)
+        # One decoder for every frame: json.loads with an argument builds a new one each call.
+        obj = (_DECODER.decode(text) if isinstance(text, str)
+               else json.loads(text, parse_constant=_reject_constant))
     except (ValueError, UnicodeDecodeError, RecursionError) as exc:
         raise DecodeError(f"not JSON: {exc}") from None
     if not isinstance(obj, dict):
@@ -76,6 +78,9 @@ def decode_frame(text: str | bytes) -> Inbound:
 
 def _reject_constant(name: str) -> Any:
     raise ValueError(f"{name} is not valid JSON")
+
+
+_DECODER = json.JSONDecoder(parse_constant=_reject_constant)
 
 
 def dumps(obj: dict[str, Any]) -> str:

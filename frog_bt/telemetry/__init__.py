@@ -16,7 +16,10 @@ logged where: ``docs/TELEMETRY.md``.
 
 from __future__ import annotations
 
+import asyncio
 import logging
+from collections import deque
+from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
 from frog_bt.telemetry.layout import TreeIndex, tidy_layout
@@ -32,6 +35,7 @@ __all__ = ["Sink", "Telemetry", "TreeIndex", "parse_spec", "tidy_layout"]
 log = logging.getLogger(__name__)
 BATCH_TICKS = 50  # rows are written every this many ticks (5 s at 10 Hz), and on flush()
 CLOSE_TIMEOUT = 5.0  # seconds close() waits for the sink
+STEP_PAUSE = 0.0005  # seconds between two steps of writing a batch (see Telemetry._step)
 
 
 class Telemetry:
@@ -47,9 +51,11 @@ class Telemetry:
         rec.set_log_time_enabled(False)  # only the tick and project-clock timelines
         rec.set_log_tick_enabled(False)
         self.index = TreeIndex.of(tree.root)
-        self.rows = Rows(site, self.index, batch_ticks=batch_ticks, on_full=self.flush)
+        self.rows = Rows(site, self.index, batch_ticks=batch_ticks, on_full=self._full)
         self.writer = Writer(rec, site, self.index)
         self._closed = False
+        self._flush_pending = False
+        self._writing: deque[tuple[int, Iterator[None]]] = deque()  # batches being written
         self.write_errors = 0  # batches that could not be written (logged, never raised)
         rec.send_blueprint(default_blueprint(self.index), make_active=True, make_default=True)
         self.writer.write_static()
@@ -81,10 +87,61 @@ class Telemetry:
         """Append the taps to ``core.taps`` (one core per telemetry)."""
         self.rows.attach(core)
 
-    def flush(self) -> None:
-        """Write the buffered rows to the recording now."""
+    def _full(self) -> None:
+        """Rows are full (called inside a tick): write them once the tick is over, so that
+        what the tick sent leaves first and the tick itself stays short; at once when no
+        event loop runs (replay)."""
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:
+            self.flush()
+            return
+        if not self._flush_pending:
+            self._flush_pending = True
+            loop.call_soon(self._flush_later)
+
+    def _flush_later(self) -> None:
+        """Write the rows in steps (:meth:`Writer.steps`) with short pauses between them,
+        so that an input arriving meanwhile waits for one step (a fraction of a
+        millisecond), not for the whole batch."""
+        self._flush_pending = False
         if self._closed:
             return
+        batch = self.rows.drain()
+        if len(batch):
+            self._writing.append((len(batch), self.writer.steps(batch)))
+            if len(self._writing) == 1:
+                self._step()
+
+    def _step(self) -> None:
+        while self._writing and not self._next_step():
+            pass
+        if self._writing:
+            # A short pause between steps lets what is ready (an input, the tick it calls
+            # for, the frames that tick sends) go first; with batches queued, no pause.
+            pause = STEP_PAUSE if len(self._writing) == 1 else 0.0
+            asyncio.get_running_loop().call_later(pause, self._step)
+
+    def _next_step(self) -> bool:
+        """One step of the oldest batch being written; False when that batch is done."""
+        rows, steps = self._writing[0]
+        try:
+            next(steps)
+            return True
+        except StopIteration:
+            pass
+        except Exception:  # telemetry must never stop the robot
+            self.write_errors += 1
+            log.exception("rerun telemetry: could not write %d rows", rows)
+        self._writing.popleft()
+        return False
+
+    def flush(self) -> None:
+        """Write the buffered rows to the recording now (and any batch still in steps)."""
+        if self._closed:
+            return
+        while self._writing:
+            self._next_step()
         batch = self.rows.drain()
         if len(batch):
             try:

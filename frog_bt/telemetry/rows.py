@@ -76,7 +76,10 @@ class Rows:
         self.on_full = on_full
         self.core: Core | None = None
         self._behaviours = list(index.behaviours)
+        self._position = {b: i for i, b in enumerate(self._behaviours)}  # by identity
         self._statuses: tuple[Status, ...] = ()
+        self._current: list[Status] = []
+        self._scan_all = True  # read every node's status at the next tick
         self._last_note: tuple[float, str] | None = None
         self._blackboard: dict[str, Any] = {}
         self._ticks_since_drain = 0
@@ -144,13 +147,29 @@ class Rows:
     def tick(self, core: Core) -> None:
         """After each tick: what changed in the tree, the notes, the engagement keys."""
         if not core.clock.ready:
+            self._scan_all = True  # this tick's changes are not followed
             return
         tick, t, batch = core.ticks, core.clock.now(), self.batch
         if self._unstamped:
             batch.restamp(t)
             self._unstamped = False
-        statuses = tuple([b.status for b in self._behaviours])
-        if statuses != self._statuses:
+        touched = getattr(core, "touched", None)
+        if self._scan_all or touched is None:
+            statuses = tuple([b.status for b in self._behaviours])
+            self._current = list(statuses)
+            self._scan_all = touched is None
+            changed = statuses != self._statuses
+        else:
+            # Only the nodes the tick reached or stopped can have changed (Core.touched):
+            # the cost follows the active path, not the size of the tour.
+            current, position, changed = self._current, self._position, False
+            for node in touched:
+                i = position.get(node)
+                if i is not None and current[i] is not node.status:
+                    current[i] = node.status
+                    changed = True
+            statuses = tuple(current) if changed else self._statuses
+        if changed:
             self._statuses = statuses
             batch.statuses.append((tick, t, statuses))
         notes = core.ctx.notes

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import re
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from typing import Any
 
 import numpy as np
@@ -47,6 +47,8 @@ PERIODIC = frozenset({"engagement"})  # front-end commands sent on a timer: DEBU
 TRAIL_STEP = 0.5  # metres between trail points
 TRAIL_POINTS = 1000  # the trail keeps the last 500 m or so
 TRAIL_EVERY = 20  # poses between two logged trails (2 s at 10 Hz)
+LANES_PER_STEP = 4  # status lanes written per step of a batch
+STATUSES_PER_STEP = 2000  # node statuses (rows x nodes) read per step of a batch
 Goal = tuple[str, float, float, float]  # waypoint, x, y, yaw
 GoalRow = tuple[int, int, float, Goal | None]  # tick, 0 input / 1 output, t, goal or cleared
 
@@ -57,8 +59,11 @@ def status_path(key: str) -> str:
 
 
 def _times(rows: Sequence[tuple[Any, ...]]) -> list[rr.TimeColumn]:
+    # Nanoseconds as rerun rounds them one by one (round(1e9 * t)), but in one numpy pass:
+    # a list of floats costs rerun a Python conversion per row.
+    ns = np.round(np.array([r[1] for r in rows], dtype=np.float64) * 1e9).astype(np.int64)
     return [rr.TimeColumn(TICK, sequence=[r[0] for r in rows]),
-            rr.TimeColumn(TIME, timestamp=[r[1] for r in rows])]
+            rr.TimeColumn(TIME, timestamp=ns.astype("datetime64[ns]"))]
 
 
 class Writer:
@@ -143,18 +148,26 @@ class Writer:
     # ------------------------------------------------------------ batches
 
     def write(self, batch: Batch) -> None:
+        for _ in self.steps(batch):
+            pass
+
+    def steps(self, batch: Batch) -> Iterator[None]:
+        """:meth:`write` in steps of a few rerun calls each. A batch of a busy tree takes
+        milliseconds to write; between two steps a caller on an event loop lets inputs
+        through (see :meth:`frog_bt.telemetry.Telemetry.flush`)."""
         if batch.statuses:
-            self._write_statuses(batch.statuses)
+            yield from self._write_statuses(batch.statuses)
         if batch.poses:
-            self._write_poses(batch.poses)
+            yield from self._write_poses(batch.poses)
         logs: dict[str, list[tuple[int, float, str, str]]] = {}
         goals: list[GoalRow] = []
-        self._read_inputs(batch, logs, goals)
+        yield from self._read_inputs(batch, logs, goals)
         self._read_outputs(batch, logs, goals)
         # inputs of a tick come before what it sends: order by (tick, input first, time)
         for tick, _, t, goal in sorted(goals, key=lambda g: g[:3]):
             if goal is not None or self._goal is not None:
                 self._log_goal(tick, t, goal)
+                yield
         for tick, t, _, message in batch.events:
             logs.setdefault("log/frontend/in", []).append(
                 (tick, t, "INFO", "← front end " + _describe(message)))
@@ -165,33 +178,47 @@ class Writer:
         for path, rows in logs.items():
             if not rows:  # an empty temporal chunk crashes the 0.41 viewer's time panel
                 continue
+            yield
             rows.sort(key=lambda r: (r[0], r[1]))
             self.rec.send_columns(path, indexes=_times(rows), columns=rr.TextLog.columns(
                 text=[r[3] for r in rows], level=[r[2] for r in rows]))
 
-    def _write_statuses(self, rows: list[tuple[int, float, tuple[Status, ...]]]) -> None:
-        colors = np.array([[STATUS_COLORS[s] for s in statuses] for _, _, statuses in rows],
-                          dtype=np.uint32)
-        self.rec.send_columns("bt/graph", indexes=_times(rows), columns=rr.GraphNodes.columns(
-            colors=colors.reshape(-1)).partition([len(self.index)] * len(rows)))
+    def _write_statuses(self, rows: list[tuple[int, float, tuple[Status, ...]]]
+                        ) -> Iterator[None]:
+        # A step reads about STATUSES_PER_STEP node statuses: a few rows of a big tree.
+        per_step = max(1, STATUSES_PER_STEP // max(1, len(self.index)))
         changes: dict[int, list[tuple[int, float, str]]] = {}
+        colors: list[np.ndarray] = []
         previous = self._statuses
-        for tick, t, statuses in rows:
-            for i, status in enumerate(statuses):
-                if not previous or previous[i] is not status:
-                    changes.setdefault(i, []).append((tick, t, status.name))
-            previous = statuses
+        for start in range(0, len(rows), per_step):
+            part = rows[start:start + per_step]
+            colors.append(np.array([[STATUS_COLORS[s] for s in statuses]
+                                    for _, _, statuses in part], dtype=np.uint32))
+            for tick, t, statuses in part:
+                for i, status in enumerate(statuses):
+                    if not previous or previous[i] is not status:
+                        changes.setdefault(i, []).append((tick, t, status.name))
+                previous = statuses
+            yield
         self._statuses = previous
-        for i, lane in changes.items():
+        self.rec.send_columns("bt/graph", indexes=_times(rows), columns=rr.GraphNodes.columns(
+            colors=np.concatenate(colors).reshape(-1)).partition([len(self.index)] * len(rows)))
+        yield
+        for n, (i, lane) in enumerate(changes.items(), 1):
             self.rec.send_columns(status_path(self.index.nodes[i].key), indexes=_times(lane),
                                   columns=rr.StateChange.columns(state=[r[2] for r in lane]))
+            if n % LANES_PER_STEP == 0:
+                yield
+        yield
 
-    def _write_poses(self, rows: list[tuple[int, float, float, float, float]]) -> None:
+    def _write_poses(self, rows: list[tuple[int, float, float, float, float]]
+                     ) -> Iterator[None]:
         xy = np.array([(r[2], r[3]) for r in rows], dtype=np.float64)
         yaw = np.array([r[4] for r in rows], dtype=np.float64)
         times = _times(rows)
         self.rec.send_columns("map/robot", indexes=times,
                               columns=rr.Points2D.columns(positions=xy))
+        yield
         self.rec.send_columns("map/robot/heading", indexes=times, columns=rr.Arrows2D.columns(
             origins=xy, vectors=np.stack([6 * np.cos(yaw), 6 * np.sin(yaw)], axis=1)))
         trail_rows, strips = [], []
@@ -204,12 +231,14 @@ class Writer:
                 self._poses_since_trail = 0
                 trail_rows.append(row)
                 strips.append(np.array(self._trail, dtype=np.float32))
+        yield
         if trail_rows:
             self.rec.send_columns("map/robot/trail", indexes=_times(trail_rows),
                                   columns=rr.LineStrips2D.columns(strips=strips))
+            yield
 
     def _read_inputs(self, batch: Batch, logs: dict[str, list[tuple[int, float, str, str]]],
-                     goals: list[GoalRow]) -> None:
+                     goals: list[GoalRow]) -> Iterator[None]:
         scalars: dict[str, list[tuple[int, float, float]]] = {}
         visitors: list[tuple[int, float, Any]] = []
         people: list[tuple[int, float, Any]] = []
@@ -248,6 +277,7 @@ class Writer:
         for path, rows in scalars.items():
             self.rec.send_columns(path, indexes=_times(rows),
                                   columns=rr.Scalars.columns(scalars=[r[2] for r in rows]))
+            yield
         for face_id, rows in faces.items():
             path = f"plots/engagement/faces/{face_id}"
             if face_id not in self._faces:
@@ -256,10 +286,13 @@ class Writer:
                                                   widths=1.0), static=True)
             self.rec.send_columns(path, indexes=_times(rows),
                                   columns=rr.Scalars.columns(scalars=[r[2] for r in rows]))
+            yield
         if visitors:
             self._write_people("map/visitors", visitors, labelled=True)
+            yield
         if people:
             self._write_people("map/people", people, labelled=False)
+            yield
 
     def _write_people(self, path: str, rows: list[tuple[int, float, Any]], *, labelled: bool
                       ) -> None:

@@ -25,6 +25,20 @@ Status = py_trees.common.Status
 SUCCESS, FAILURE, RUNNING, INVALID = Status.SUCCESS, Status.FAILURE, Status.RUNNING, Status.INVALID
 
 
+_BB = py_trees.blackboard.Blackboard
+
+
+def direct_keys(client: py_trees.blackboard.Client, keys: tuple[str, ...]) -> frozenset[str]:
+    """The keys of ``client`` that a plain dict access can serve: absolute and not remapped.
+
+    py_trees' ``Client.get``/``set`` resolve the name and check access on every call
+    (about 3 µs each, a large share of a tick). Access was checked when the key was
+    registered, so while no activity stream is on a read or write of one of these keys
+    is just ``Blackboard.storage[key]``; any other key takes py_trees' own path.
+    """
+    return frozenset(k for k in keys if client.remappings.get(k) == k)
+
+
 class Params(BaseModel):
     """Base of every leaf's parameter model: unknown keys are errors."""
 
@@ -45,6 +59,9 @@ class Leaf(py_trees.behaviour.Behaviour):
             self.bb.register_key(key, access=py_trees.common.Access.READ)
         for key in self.writes:
             self.bb.register_key(key, access=py_trees.common.Access.WRITE)
+        self._direct_reads = direct_keys(self.bb, (*self.reads, *self.optional_reads,
+                                                   *self.writes))
+        self._direct_writes = direct_keys(self.bb, self.writes)
         self._ctx: Context | None = None
 
     def setup(self, **kwargs: Any) -> None:
@@ -58,13 +75,18 @@ class Leaf(py_trees.behaviour.Behaviour):
 
     def get(self, key: str, default: Any = None) -> Any:
         """The blackboard value of ``key``, or ``default`` while nothing has written it."""
+        if key in self._direct_reads and _BB.activity_stream is None:
+            return _BB.storage.get(key, default)
         try:
             return self.bb.get(key)
         except KeyError:
             return default
 
     def set(self, key: str, value: Any) -> None:
-        self.bb.set(key, value, overwrite=True)
+        if key in self._direct_writes and _BB.activity_stream is None:
+            _BB.storage[key] = value
+        else:
+            self.bb.set(key, value, overwrite=True)
 
     def describe(self) -> dict[str, Any]:
         """Parameters as shown by ``render`` (unset ones omitted)."""

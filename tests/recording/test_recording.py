@@ -161,7 +161,8 @@ def test_sigterm_stops_the_run_within_2_s_and_leaves_valid_mcap(tmp_path: Path) 
                         executive=("127.0.0.1", listen))
         await sim.start()
         proc = await asyncio.create_subprocess_exec(
-            sys.executable, "-m", "frog_bt", "run", "--sim-time", "--record", str(path),
+            sys.executable, "-m", "frog_bt", "run", "--sim-time", "--checkpoint", "none",
+            "--record", str(path),
             "--quiet", "--rosbridge", f"ws://127.0.0.1:{sim.rosbridge_port}",
             "--frontend", f"127.0.0.1:{sim.frontend_port}", "--listen", f"127.0.0.1:{listen}",
             cwd=ROOT, stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE)

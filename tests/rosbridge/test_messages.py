@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from frog_bt import messages
 from frog_bt.errors import DecodeError, format_path
 from frog_bt.messages import (
     DECODERS,
@@ -367,3 +368,33 @@ def test_decode_time_round_trip(secs: int, nsecs: int, ros2: bool) -> None:
     back = encode_time(decode_time(shape))
     error_ns = abs((back["secs"] - secs) * 1_000_000_000 + back["nsecs"] - nsecs)
     assert error_ns <= math.ulp(float(secs + 1)) * 1e9 + 1  # a float holds ~0.2 µs at 2**32
+
+
+# ---------------------------------------------------------------- fast paths
+
+CHECKED: dict[str, Callable[[Any], Any]] = {
+    "geometry_msgs/PoseStamped": messages._decode_pose_checked,
+    "frog_msgs/FaceData": messages._decode_face_data_checked,
+    "frog_msgs/PersonDetections": messages._decode_person_detections_checked,
+    "frog_msgs/TrackedPeople": messages._decode_tracked_people_checked,
+}
+
+
+def _outcome(decoder: Callable[[Any], Any], msg: Any) -> tuple[str, Any]:
+    try:
+        return "value", decoder(msg)
+    except DecodeError as exc:
+        return "error", str(exc)
+
+
+@pytest.mark.parametrize("ros_type", sorted(CHECKED))
+@settings(max_examples=300, deadline=None)
+@given(data=st.data())
+def test_fast_path_decodes_as_the_checked_decoder(ros_type: str, data: st.DataObject) -> None:
+    """The straight read of a well-formed message gives what the checked decoder gives."""
+    make, _ = EXAMPLES[ros_type]
+    header = data.draw(st.sampled_from([ROS1_HEADER, ROS2_HEADER, {"frame_id": "map"}]))
+    msg = data.draw(mutated(make(header=header)) | json_like)
+    if data.draw(st.booleans()):
+        msg = data.draw(mutated(msg))  # a second change
+    assert _outcome(DECODERS[ros_type], msg) == _outcome(CHECKED[ros_type], msg)

@@ -1,0 +1,101 @@
+"""The executive under test, in a process of its own, reporting on stdout as JSON lines.
+
+Built as ``frog-bt run`` builds it (site, tree, clock, :class:`Executive`, the
+observers of ``--record`` / ``--rerun``), with no status line and no checkpoint.
+It prints ``{"event": "tour", ...}`` with its memory each time a tour ends, answers
+``stats`` on stdin with counters and memory, and stops on ``quit`` or when stdin
+closes, printing ``{"event": "exit", ...}``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import json
+import logging
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from bench_support import memory_kb
+
+
+def say(event: str, **fields: Any) -> None:
+    sys.stdout.write(json.dumps({"event": event, "t": time.monotonic(), **fields}) + "\n")
+    sys.stdout.flush()
+
+
+async def serve(args: argparse.Namespace) -> None:
+    from frog_bt.clock import SimClock, WallClock
+    from frog_bt.commands.run import attach_observers
+    from frog_bt.config import load_site, parse_hostport
+    from frog_bt.executive import Executive
+    from frog_bt.tree.loader import load_tree
+
+    site = load_site(args.config)
+    tree = load_tree(site=site)
+    executive = Executive(site, tree, SimClock() if args.sim_time else WallClock(),
+                          rosbridge_url=args.rosbridge,
+                          frontend=parse_hostport(args.frontend),
+                          listen=parse_hostport(args.listen), sim_time=args.sim_time)
+    observers = attach_observers(executive, record=args.record, rerun=args.rerun)
+    tours = 0
+    plain_tick = executive.tick
+
+    def tick() -> None:
+        nonlocal tours
+        plain_tick()
+        if executive.outcome.tours != tours:
+            tours = executive.outcome.tours
+            say("tour", tours=tours, ticks=executive.core.ticks, **memory_kb())
+
+    executive.tick = tick  # type: ignore[method-assign]
+
+    def stats() -> dict[str, Any]:
+        client = executive.client.stats
+        return {"received": client.received, "malformed": client.malformed,
+                "ticks": executive.core.ticks, "tours": tours,
+                "connected": executive.client.link.connected, **memory_kb()}
+
+    loop = asyncio.get_running_loop()
+    reader = asyncio.StreamReader()
+    await loop.connect_read_pipe(lambda: asyncio.StreamReaderProtocol(reader), sys.stdin)
+
+    async def commands() -> None:
+        async for line in reader:
+            word = line.decode().strip()
+            if word == "stats":
+                say("stats", **stats())
+            elif word == "quit":
+                break
+        executive.stop("told to stop")
+
+    control = asyncio.create_task(commands())
+    try:
+        await executive.run()
+    finally:
+        control.cancel()
+        for observer in observers:
+            observer.close()
+    say("exit", **stats())
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--config", type=Path)
+    p.add_argument("--rosbridge", required=True)
+    p.add_argument("--frontend", required=True)
+    p.add_argument("--listen", required=True)
+    p.add_argument("--sim-time", action="store_true")
+    p.add_argument("--record", type=Path)
+    p.add_argument("--rerun")
+    args = p.parse_args()
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    asyncio.run(serve(args))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,174 @@
+"""Tick cost of the tour tree, phase by phase, for one tour size, telemetry off or on.
+
+One whole tour of a synthetic site with ``--stops`` stops runs in this process: the
+built-in simulator and the real executive in one event loop, on sim time (as the
+end-to-end tests run them). Every ``Core.tick`` is timed with ``perf_counter_ns``
+(snapshot, tree, taps: everything a tick costs, telemetry and recording taps
+included when on) and filed under the phase the tree is in after it, read off the
+leaf at the tip of the running path.
+
+    .venv/bin/python scripts/bench_ticks.py --stops 30 --telemetry on
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import gc
+import sys
+import tempfile
+import time
+from collections import defaultdict
+from pathlib import Path
+from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from bench_support import (
+    emit,
+    free_port,
+    scenario,
+    small_log,
+    summary_us,
+    synthetic_site,
+)
+
+RECRUIT = {"SeekVisitor", "ApproachVisitor", "StartIntroduction", "AskTour", "WaitAnswer",
+           "WaitEvent"}
+CONTENT = {"VisitorFollows", "PlayContent", "FinishPoi", "Engaged", "SkipStop", "Skipped"}
+PHASES = ("waiting", "undocking", "recruiting", "driving", "content", "returning", "other")
+
+# Short content and a fast clock (as the end-to-end tests), but long enough phases for
+# percentiles: the front end says idle after 20 s, the visitor turns up after 60 s.
+SCENARIO: dict[str, Any] = {
+    "speed": 400.0, "content": {"default": 10, "introduction": 8},
+    "frontend": {"idle_at": 20.0},
+    "visitors": [{"id": 7, "position": [103.0, 36.0], "facing": True, "answer": "positive",
+                  "faces": "engaged", "follow": True, "after_tour": "leave", "appear_at": 60.0}],
+}
+
+
+def phase_of(node: Any, dock: str, recruit_at: str) -> str:
+    kind = type(node).__name__
+    if kind in ("WaitFrontendIdle", "ConfirmResume"):
+        return "waiting"
+    if kind == "Docking":
+        return "undocking" if node.params.action == "undock" else "returning"
+    if kind in RECRUIT:
+        return "recruiting"
+    if kind == "DecideEngagement":
+        return "recruiting" if node.params.about == "introduction" else "content"
+    if kind == "Navigate":
+        return "returning" if node.params.poi == dock else "driving"
+    if kind in CONTENT:
+        return "content"
+    if kind == "TourStatus":
+        return "returning" if node.params.state != "started" else "undocking"
+    return "other"
+
+
+async def one_tour(stops: int, telemetry: bool, workdir: Path) -> dict[str, Any]:
+    from frog_bt.clock import SimClock
+    from frog_bt.config import load_site
+    from frog_bt.executive import Executive
+    from frog_bt.sim import Simulator
+    from frog_bt.sim.site import load_pois
+    from frog_bt.tree.loader import load_tree
+
+    site_path = synthetic_site(stops, workdir)
+    site = load_site(site_path)
+    tree = load_tree(site=site)
+    nodes = sum(1 for _ in tree.nodes())
+    listen = ("127.0.0.1", free_port())
+    sim = Simulator(scenario(SCENARIO), rosbridge_port=0, frontend_port=0, executive=listen,
+                    pois=load_pois(site_path))
+    small_log(sim)
+    await sim.start()
+    executive = Executive(site, tree, SimClock(), rosbridge_url=f"ws://127.0.0.1:{sim.rosbridge_port}",
+                          frontend=("127.0.0.1", sim.frontend_port), listen=listen,
+                          sim_time=True, once=True)
+    observers: list[Any] = []
+    writes: list[int] = []
+    if telemetry:
+        from frog_bt.recording import Recorder
+        from frog_bt.telemetry import Telemetry
+
+        tel = Telemetry.open(f"save:{workdir / 'ticks.rrd'}", site, tree)
+        tel.attach(executive.core)
+        # Rows go to rerun every 50 ticks, after the tick, in steps between other work:
+        # time those too (what telemetry costs beyond the tick itself).
+        plain_write, plain_step = tel.writer.write, getattr(tel, "_next_step", None)
+
+        def timed_write(batch: Any) -> None:
+            t0 = time.perf_counter_ns()
+            plain_write(batch)
+            writes.append(time.perf_counter_ns() - t0)
+
+        def timed_step() -> bool:
+            t0 = time.perf_counter_ns()
+            more = plain_step()
+            writes.append(time.perf_counter_ns() - t0)
+            return more
+
+        tel.writer.write = timed_write  # type: ignore[method-assign]
+        if plain_step is not None:  # writing in steps (else all in one write)
+            tel._next_step = timed_step  # type: ignore[method-assign]
+        recorder = Recorder(workdir / "ticks.mcap")
+        recorder.attach(executive)
+        observers = [tel, recorder]
+
+    core = executive.core
+    inner = core.tick
+    samples: dict[str, list[int]] = defaultdict(list)
+    phases: dict[int, str] = {}
+    dock, recruit_at = site.tour.dock, site.tour.recruit_at
+    clock = time.perf_counter_ns
+
+    def timed_tick() -> Any:
+        t0 = clock()
+        status = inner()
+        dt = clock() - t0
+        tip = core.bt.root.tip()
+        phase = phases.get(id(tip))
+        if phase is None:
+            phase = phases[id(tip)] = phase_of(tip, dock, recruit_at)
+        samples[phase].append(dt)
+        return status
+
+    core.tick = timed_tick  # type: ignore[method-assign]
+    sim0, wall0 = sim.clock.now(), time.monotonic()
+    try:
+        outcome = await asyncio.wait_for(executive.run(), 600)
+    finally:
+        await sim.stop()
+        close0 = time.perf_counter()
+        for observer in observers:
+            observer.close()
+        close_s = time.perf_counter() - close0
+    wall = time.monotonic() - wall0
+    every = [dt for values in samples.values() for dt in values]
+    return {
+        "stops": stops, "telemetry": telemetry, "nodes": nodes, "outcome": outcome.reason,
+        "tours": outcome.tours, "sim_s": sim.clock.now() - sim0, "wall_s": wall,
+        "observers_close_s": close_s if observers else 0.0,
+        "all": summary_us(every),
+        "phases": {p: summary_us(samples[p]) for p in PHASES if samples.get(p)},
+        "telemetry_writes": summary_us(writes),  # steps of writing rows to rerun
+        "telemetry_write_us_per_tick": sum(writes) / 1e3 / max(1, len(every)),
+        "gc_collections": [s["collections"] for s in gc.get_stats()],
+    }
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--stops", type=int, default=7)
+    p.add_argument("--telemetry", choices=("on", "off"), default="off")
+    p.add_argument("--out", help="write the JSON result here (default: stdout)")
+    args = p.parse_args()
+    with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
+        result = asyncio.run(one_tour(args.stops, args.telemetry == "on", Path(tmp)))
+    emit(result, args.out)
+
+
+if __name__ == "__main__":
+    main()
