@@ -15,8 +15,10 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import tempfile
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -47,7 +49,8 @@ class Progress:
             self.changes += 1
 
     def to_json(self) -> dict[str, object]:
-        return {"version": VERSION, "done": list(self.done), "visitor": self.visitor}
+        return {"version": VERSION, "done": list(self.done), "visitor": self.visitor,
+                "written": time.time()}
 
 
 @dataclass
@@ -83,13 +86,17 @@ def save(path: Path, progress: Progress) -> None:
         raise
 
 
-def load(path: Path) -> Resume | None:
-    """The resume point in ``path``; None when there is none or it is unreadable."""
+def load(path: Path, max_age: float = math.inf) -> Resume | None:
+    """The resume point in ``path``; None when there is none, it is unreadable, or it was
+    written more than ``max_age`` wall seconds ago (a tour that old is over, whatever)."""
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
     if not isinstance(data, dict) or data.get("version") != VERSION:
+        return None
+    written = data.get("written")
+    if not isinstance(written, int | float) or not 0 <= time.time() - written <= max_age:
         return None
     done = data.get("done")
     visitor = data.get("visitor")

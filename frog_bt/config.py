@@ -173,6 +173,7 @@ class Safety(_Model):
 
 class Checkpoint(_Model):
     confirm: Positive = 3.0  # seconds to wait for /docking/state before resuming a tour
+    max_age: Positive = 900.0  # wall seconds: an older checkpoint is not resumed
 
 
 class Links(_Model):

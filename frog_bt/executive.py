@@ -81,7 +81,7 @@ class Executive:
         self.checkpoint = checkpoint
         self._saved = 0
         if checkpoint is not None and not fresh:
-            self.core.ctx.resume = load_checkpoint(checkpoint)
+            self.core.ctx.resume = load_checkpoint(checkpoint, site.checkpoint.max_age)
         self._wake = asyncio.Event()
         self._stopping = asyncio.Event()
         self._pending_at_loss: object = None

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import asyncio
+import json
+import time
 
 from tour import Running, describe, fast
 
@@ -133,7 +135,8 @@ def test_a_restarted_executive_resumes_the_tour_at_the_current_stop(tmp_path):
 
 async def _fresh_ignores(tmp_path) -> list[str]:
     checkpoint = tmp_path / "checkpoint.json"
-    checkpoint.write_text('{"version": 1, "done": ["start", "recruit", "stop 0"], "visitor": 7}')
+    checkpoint.write_text(json.dumps({"version": 1, "done": ["start", "recruit", "stop 0"],
+                                      "visitor": 7, "written": time.time()}))
     async with Running({}, checkpoint=checkpoint, fresh=True, once=True) as run:
         await run.finish()
         return commands_after(run, 0)
@@ -146,7 +149,8 @@ def test_fresh_ignores_the_checkpoint(tmp_path):
 
 async def _docked_robot_does_not_resume(tmp_path) -> list[str]:
     checkpoint = tmp_path / "checkpoint.json"
-    checkpoint.write_text('{"version": 1, "done": ["start", "recruit", "stop 0"], "visitor": 7}')
+    checkpoint.write_text(json.dumps({"version": 1, "done": ["start", "recruit", "stop 0"],
+                                      "visitor": 7, "written": time.time()}))
     async with Running({}, checkpoint=checkpoint, once=True) as run:
         await run.finish()
         return commands_after(run, 0)

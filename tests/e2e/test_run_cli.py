@@ -19,6 +19,7 @@ async def _run_once() -> tuple[int, bytes, list[str]]:
     try:
         proc = await asyncio.create_subprocess_exec(
             sys.executable, "-m", "frog_bt", "run", "--sim-time", "--once", "--quiet",
+            "--checkpoint", "none",
             "--rosbridge", f"ws://127.0.0.1:{sim.rosbridge_port}",
             "--frontend", f"127.0.0.1:{sim.frontend_port}", "--listen", f"127.0.0.1:{listen}",
             stderr=asyncio.subprocess.PIPE)
