@@ -17,65 +17,19 @@ behaviours in :mod:`frog_bt.behaviours`.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, TypeVar
+from typing import Any, TypeVar
 
 import py_trees
 from pydantic import BaseModel, Field
 
-from frog_bt.context import Context
-from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Params, Status, direct_keys
-
-_BB = py_trees.blackboard.Blackboard
+from frog_bt.tree.node import FAILURE, RUNNING, SUCCESS, Declared, Params, Status
 
 
-class FrogDecorator(py_trees.decorators.Decorator):
-    Params: ClassVar[type[BaseModel]] = Params
-    reads: ClassVar[tuple[str, ...]] = ()
-    optional_reads: ClassVar[tuple[str, ...]] = ()
-    writes: ClassVar[tuple[str, ...]] = ()
-
+class FrogDecorator(Declared, py_trees.decorators.Decorator):
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour,
                  params: BaseModel | None = None) -> None:
         super().__init__(name=name, child=child)
-        self.params: Any = params if params is not None else type(self).Params()
-        self._ctx: Context | None = None
-        self._direct_reads: frozenset[str] = frozenset()
-        self._direct_writes: frozenset[str] = frozenset()
-        if self.reads or self.optional_reads or self.writes:
-            self.bb = self.attach_blackboard_client(name=name)
-            for key in (*self.reads, *self.optional_reads):
-                self.bb.register_key(key, access=py_trees.common.Access.READ)
-            for key in self.writes:
-                self.bb.register_key(key, access=py_trees.common.Access.WRITE)
-            self._direct_reads = direct_keys(self.bb, (*self.reads, *self.optional_reads,
-                                                       *self.writes))
-            self._direct_writes = direct_keys(self.bb, self.writes)
-
-    def setup(self, **kwargs: Any) -> None:
-        self._ctx = kwargs["ctx"]
-
-    @property
-    def ctx(self) -> Context:
-        if self._ctx is None:
-            raise RuntimeError(f"{self.name}: ticked before setup(ctx=...)")
-        return self._ctx
-
-    def get(self, key: str, default: Any = None) -> Any:
-        if key in self._direct_reads and _BB.activity_stream is None:  # see direct_keys
-            return _BB.storage.get(key, default)
-        try:
-            return self.bb.get(key)
-        except KeyError:
-            return default
-
-    def set(self, key: str, value: Any) -> None:
-        if key in self._direct_writes and _BB.activity_stream is None:
-            _BB.storage[key] = value
-        else:
-            self.bb.set(key, value, overwrite=True)
-
-    def describe(self) -> dict[str, Any]:
-        return self.params.model_dump(exclude_none=True)
+        self._declare(params)
 
 
 D = TypeVar("D", bound=type[FrogDecorator])
