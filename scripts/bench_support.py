@@ -80,17 +80,6 @@ def memory_kb(pid: int | str = "self") -> dict[str, int]:
 # ------------------------------------------------------------------ sites and scenarios
 
 
-def merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
-    """``over`` on top of ``base``: mappings merge, everything else replaces."""
-    out = dict(base)
-    for key, value in over.items():
-        if isinstance(value, dict) and isinstance(out.get(key), dict):
-            out[key] = merge(out[key], value)
-        else:
-            out[key] = value
-    return out
-
-
 def synthetic_site(stops: int, directory: Path, *, flags: dict[str, Any] | None = None,
                    over: dict[str, Any] | None = None) -> Path:
     """A copy of ``config/site.yaml`` whose tour has ``stops`` synthetic stops.
@@ -117,6 +106,8 @@ def synthetic_site(stops: int, directory: Path, *, flags: dict[str, Any] | None 
     data["pois"] = pois
     data["variants"] = {}
     tour["stops"] = new_stops
+    from frog_bt.sim.scenario import merge
+
     data = merge(data, over or {})
     path = Path(directory) / f"site-{stops}.yaml"
     path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
@@ -125,10 +116,9 @@ def synthetic_site(stops: int, directory: Path, *, flags: dict[str, Any] | None 
 
 def scenario(over: dict[str, Any] | None = None) -> Any:
     """The simulator's default scenario with ``over`` on top, validated."""
-    from frog_bt.sim import load_scenario, parse_scenario
+    from frog_bt.sim import scenario_from
 
-    base = load_scenario("default").model_dump(mode="json")
-    return parse_scenario(merge(base, over or {}))
+    return scenario_from("default", over)
 
 
 def small_log(sim: Any) -> None:

@@ -340,14 +340,15 @@ def _raw(path: Path, depth: int = 0) -> dict[str, Any]:
         raise ConfigError(str(path), ("extends",), f"more than {MAX_EXTENDS} levels of extends")
     base = _raw(_resolve(base_ref, path.parent), depth + 1)
     base.pop("name", None)
-    return _merge(base, data)
+    return merge(base, data)
 
 
-def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+def merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+    """``over`` on top of ``base``: mappings merge key by key, everything else replaces."""
     out = dict(base)
     for key, value in over.items():
         if isinstance(value, dict) and isinstance(out.get(key), dict):
-            out[key] = _merge(out[key], value)
+            out[key] = merge(out[key], value)
         else:
             out[key] = value
     return out
@@ -357,7 +358,7 @@ def scenario_from(base: str | Path = "default", overrides: dict[str, Any] | None
                   ) -> Scenario:
     """Scenario ``base`` with ``overrides`` on top (mappings merge, lists replace)."""
     data = load_scenario(base).model_dump(mode="json")
-    return parse_scenario(_merge(data, overrides or {}), f"{base} + overrides")
+    return parse_scenario(merge(data, overrides or {}), f"{base} + overrides")
 
 
 def parse_scenario(data: Any, file: str = "<scenario>") -> Scenario:
