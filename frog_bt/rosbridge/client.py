@@ -126,6 +126,7 @@ class RosbridgeClient:
         self._throttle = WarningThrottle()
         self._outbox: deque[str] = deque()  # frames for the current connection, in order
         self._wake = asyncio.Event()  # outbox became non-empty
+        self._drained = asyncio.Event()  # the writer found the outbox empty
         self._up = asyncio.Event()  # set while connected
         self._ever_connected = False
         self._closing = False
@@ -204,10 +205,10 @@ class RosbridgeClient:
         True when the outbox drained; False on timeout or while disconnected
         (frames then stay queued for the next connection).
         """
-        loop = asyncio.get_running_loop()
-        deadline = loop.time() + timeout
-        while self._outbox and self._link.connected and loop.time() < deadline:
-            await asyncio.sleep(0.005)
+        if self._outbox and self._link.connected:
+            self._drained.clear()
+            with contextlib.suppress(TimeoutError):
+                await asyncio.wait_for(self._drained.wait(), timeout)
         return not self._outbox
 
     async def close(self) -> None:
@@ -295,6 +296,7 @@ class RosbridgeClient:
         out = self._outbox
         while True:
             if not out:
+                self._drained.set()
                 self._wake.clear()
                 await self._wake.wait()
                 continue
