@@ -207,6 +207,13 @@ class Executive:
     async def _shutdown(self) -> None:
         """Halt the tree (scopes switch the face stream off, ...) and flush the links."""
         self.core.halt()
+        # Leave the robot's rosbridge tidy: the last commands out, then unsubscribe and
+        # unadvertise (only sent while connected; nothing is queued for later).
+        if self.client.link.connected:
+            for topic in list(self.client.session.subscriptions):
+                self.client.unsubscribe(topic)
+            for topic in list(self.client.session.advertised):
+                self.client.unadvertise(topic)
         await self.client.flush(0.5)
         await self.client.close()
         self.link.close()
