@@ -258,9 +258,11 @@ def test_running_executive_survives_a_flood_of_bad_input(
             exe.stop("test over")
             assert (await asyncio.wait_for(task, 10)).code == 0
             assert not list(exe.core.inputs.events)
-        # It advertised and subscribed, and sent nothing else: no tour began.
+        # It advertised and subscribed, and sent nothing else but its goodbyes at the
+        # shutdown (unsubscribe, unadvertise): no tour began.
         ops = Counter(f["op"] for f in from_executive)
-        assert ops == {"advertise": 4, "subscribe": len(TOPIC_TYPES)}, ops
+        assert ops == {"advertise": 4, "subscribe": len(TOPIC_TYPES),
+                       "unadvertise": 4, "unsubscribe": len(TOPIC_TYPES)}, ops
         with pytest.raises(BlockingIOError):
             front_end.recv(65536)  # no command to the front end either
         for sock in (front_end, peer, stranger):
