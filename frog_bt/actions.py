@@ -34,8 +34,7 @@ class Request:
     kind: str  # "goto" | "approach"
     target: str
     sent_at: float
-    role: str = ""
-    msg: dict[str, Any] | None = None
+    msg: dict[str, Any] | None = None  # as published, for a re-send
     code: int = 0
     answered_at: float | None = None
 
@@ -62,20 +61,20 @@ class Actions:
         now = self._clock.now()
         msg = encode_pose(poi.x, poi.y, poi.z, poi.w, now)
         self._publish("goto", msg)
-        return self._replace(Request(next(self._ids), "goto", waypoint, now, "goto", msg))
+        return self._replace(Request(next(self._ids), "goto", waypoint, now, msg))
 
     def approach(self, person_id: int) -> Request:
         msg = encode_int32(person_id)
         self._publish("approach", msg)
         return self._replace(Request(next(self._ids), "approach", str(person_id),
-                                     self._clock.now(), "approach", msg))
+                                     self._clock.now(), msg))
 
     def resend_pending(self) -> Request | None:
         """Publish the pending goal or approach again (after a reconnect its answer may
         have been lost while the link was down). The request keeps waiting as before."""
         request = self.pending
         if request is not None and request.msg is not None:
-            self._publish(request.role, request.msg)
+            self._publish(request.kind, request.msg)  # the kind is the output role
             log.info("re-sent %s %s after a reconnect", request.kind, request.target)
         return request
 

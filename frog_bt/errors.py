@@ -6,8 +6,10 @@
     ├── DefinitionError          a file the user wrote is wrong; raised before anything connects
     │   ├── ConfigError          config/*.yaml, scenario files
     │   └── TreeError            trees/*.yaml
-    ├── DecodeError              one inbound message or datagram is malformed; counted, never fatal
-    └── RuntimeFault             the tour cannot go on (link down for good, docking failed, ...)
+    └── DecodeError              one inbound message or datagram is malformed; counted, never fatal
+
+When the tour cannot go on (docking failed, authentication refused) the
+executive stops with an exit code and a one-line reason instead (``Outcome``).
 
 Definition errors name the file, the path inside it and what was expected, so a
 content designer can fix a YAML file without reading Python.
@@ -62,7 +64,3 @@ class DecodeError(FrogError):
         self.detail = message
         where = format_path(self.path) if self.path else ""
         super().__init__(f"{where}: {message}" if where else message)
-
-
-class RuntimeFault(FrogError):
-    """The executive cannot go on; the message is the one-line reason printed on exit."""

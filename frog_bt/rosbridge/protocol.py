@@ -15,7 +15,6 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
-import math
 import secrets
 from collections import deque
 from dataclasses import dataclass, field
@@ -206,14 +205,3 @@ class Session:
 
     def on_disconnected(self) -> None:
         self.connected = False
-
-
-def is_finite_json(value: Any) -> bool:
-    """True when ``value`` holds no NaN or infinite float anywhere."""
-    if isinstance(value, float):
-        return math.isfinite(value)
-    if isinstance(value, dict):
-        return all(is_finite_json(v) for v in value.values())
-    if isinstance(value, list):
-        return all(is_finite_json(v) for v in value)
-    return True

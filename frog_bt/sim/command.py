@@ -135,14 +135,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from frog_bt.config import DEFAULT_CONFIG
     from frog_bt.errors import ConfigError
     from frog_bt.sim.scenario import load_scenario
-    from frog_bt.sim.site import DEFAULT_SITE, load_pois
+    from frog_bt.sim.site import load_pois
 
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
     try:
         scenario = load_scenario(args.scenario)
-        pois = load_pois(args.config or DEFAULT_SITE)
+        pois = load_pois(args.config or DEFAULT_CONFIG)
     except ConfigError as exc:
         print(f"frog-bt sim: {exc}", file=sys.stderr)
         return 2

@@ -14,30 +14,15 @@ import math
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
-import frog_bt
-from frog_bt.errors import ConfigError
-from frog_bt.yamlfile import load_yaml
+from frog_bt.config import DEFAULT_CONFIG, load_site
 
 PoiPose = tuple[float, float, float, float]
-DEFAULT_SITE = Path(frog_bt.__file__).parent.parent / "config" / "site.yaml"
 MATCH_RADIUS = 0.5  # metres
 
 
-def load_pois(path: str | Path = DEFAULT_SITE) -> dict[str, PoiPose]:
-    """``name -> (x, y, z, w)`` from the ``pois:`` mapping of a site file."""
-    data = load_yaml(path, ConfigError)
-    pois = data.get("pois") if isinstance(data, dict) else None
-    if not isinstance(pois, dict) or not pois:
-        raise ConfigError(str(path), ("pois",), "expected a mapping of POI name -> {x, y, z, w}")
-    table: dict[str, PoiPose] = {}
-    for name, entry in pois.items():
-        try:
-            table[str(name)] = (float(entry["x"]), float(entry["y"]),
-                                float(entry["z"]), float(entry["w"]))
-        except (TypeError, KeyError, ValueError):
-            raise ConfigError(str(path), ("pois", str(name)),
-                              "expected {x, y, z, w} numbers") from None
-    return table
+def load_pois(path: str | Path = DEFAULT_CONFIG) -> dict[str, PoiPose]:
+    """``name -> (x, y, z, w)`` from a site file, validated as the executive validates it."""
+    return {name: (p.x, p.y, p.z, p.w) for name, p in load_site(path).pois.items()}
 
 
 def pois_at(pois: Mapping[str, PoiPose], x: float, y: float,
