@@ -38,7 +38,8 @@ are seconds of simulated time after the start.
         position: [103, 36]       # map frame
         facing: true              # or orientation: 180 (degrees, 180 = facing)
         appear_at: 0              # s; never: does not appear
-        approach: [aborted, succeeded]   # results of successive approaches
+        approach: [aborted, succeeded]   # results of successive approaches; or
+                                  # one result for every approach (failed)
         answer: positive          # or negative (the visitor then leaves)
         faces: engaged            # bored, mixed, far, not_facing, or [0.5, -0.3]
         follow: true              # follows the robot once the tour starts
@@ -53,6 +54,8 @@ are seconds of simulated time after the start.
       silent: false               # true: a dead front end (sends nothing)
       silent_between: [[900, 960]]  # s: hangs then (no acks, no events), then wakes
       silent_from: null           # s: hangs from then on
+      loss: 0.2                   # each datagram, either way, lost with this probability
+      never_sends: [finish_introduction]  # events it never sends (a broken player)
     content: {default: 30, introduction: 20, POI1: {a: 40, b: 20}, POI3: 25}
 
 What the robot does: drives straight to each goal and answers /FROG_response

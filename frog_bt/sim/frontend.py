@@ -15,6 +15,8 @@ simulated time:
   ``start_poi`` replaces the one playing, ``finish_poi`` stops it;
 * resends its events every 0.25 s until acked (:meth:`FrontendModel.step`).
 
+``never_sends`` lists events it never sends (as if a content player broke), and
+``loss`` is applied by the simulator to every datagram either way.
 ``silent: true`` makes it a dead front end: it receives, but never sends.
 ``silent_from`` / ``silent_between`` (or :meth:`FrontendModel.silence`) make it
 hang for a while: it receives (and logs) commands but neither acks nor acts on
@@ -152,14 +154,14 @@ class FrontendModel:
         if timer.kind == "restart":
             return self.restart(now)
         if timer.kind == "idle":
-            return [self._send(fm.FrontendIdle(), now)]
+            return self._send(fm.FrontendIdle(), now)
         if timer.kind == "introduction":
-            return [self._send(fm.FinishIntroduction(), now)]
+            return self._send(fm.FinishIntroduction(), now)
         if timer.kind == "answer":
             yes = self._answer()
-            return [self._send(fm.UserPositive() if yes else fm.UserNegative(), now)]
+            return self._send(fm.UserPositive() if yes else fm.UserNegative(), now)
         self.playing = None
-        return [self._send(fm.ContentDone(timer.poi, timer.part), now)]
+        return self._send(fm.ContentDone(timer.poi, timer.part), now)
 
     def restart(self, now: float) -> list[bytes]:
         """Restart now: forget everything (numbering from 1 again) and say idle."""
@@ -168,9 +170,12 @@ class FrontendModel:
         self.endpoint = self._new_endpoint()
         self.timers = [t for t in self.timers if t.kind == "restart"]
         self.playing = None
-        return [self._send(fm.FrontendIdle(), now)]
+        return self._send(fm.FrontendIdle(), now)
 
-    def _send(self, message: fm.FrontendMessage, now: float) -> bytes:
+    def _send(self, message: fm.FrontendMessage, now: float) -> list[bytes]:
+        if message.type in self.spec.never_sends:
+            log.info("front end does not send %s (never_sends)", message.type)
+            return []
         data = self.endpoint.send(message, now)
         self._notify("out", message.type, fm.message_fields(message))
-        return data
+        return [data]

@@ -99,7 +99,8 @@ class Crowd:
         appears_now = spec.appear_at is not None and spec.appear_at <= 0
         state = PRESENT if generation or appears_now else HIDDEN
         visitor = Visitor(spec, vid, spec.position.x, spec.position.y, state,
-                          spec.detected_orientation, list(spec.approach),
+                          spec.detected_orientation,
+                          [] if isinstance(spec.approach, str) else list(spec.approach),
                           EngagementScript(spec.faces, vid, self.seed), generation)
         self.visitors[vid] = visitor
         return visitor
@@ -168,6 +169,8 @@ class Crowd:
         if v is None or v.state not in (PRESENT, WITH_ROBOT, FOLLOWING) \
                 or robot.distance_to(v.x, v.y) > self.detection_range:
             return None
+        if isinstance(v.spec.approach, str):
+            return v.spec.approach
         return v.approach_results.pop(0) if v.approach_results else "succeeded"
 
     def approached(self, vid: int, robot: RobotPose) -> None:

@@ -25,6 +25,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from frog_bt.clock import SITE_TZ
 from frog_bt.errors import ConfigError
+from frog_bt.frontend import messages as fm
 from frog_bt.yamlfile import PathError, load_yaml, validate
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -145,7 +146,7 @@ class VisitorSpec(_Model):
     orientation: Annotated[float, Field(ge=0, le=360)] | None = None
     facing: bool | None = None
     appear_at: NonNegative | None = 0.0  # null or "never": never appears
-    approach: list[Outcome] = []
+    approach: list[Outcome] | Outcome = []  # one outcome: every approach ends so
     answer: Literal["positive", "negative"] = "positive"
     faces: str | tuple[float, ...] = "engaged"  # a profile name or values cycled
     follow: bool = True
@@ -195,6 +196,9 @@ class FrontendSpec(_Model):
     idle_after_tour: NonNegative | None = 5.0  # frontend_idle again after tour ended/aborted
     restarts: list[NonNegative] = []  # the front end restarts (seq from 1) and says idle
     answer_delay: NonNegative = 2.0  # ask_tour -> user_positive / user_negative
+    # Each datagram, either way, is lost with this probability (seeded by ``seed``).
+    loss: Annotated[float, Field(ge=0, le=0.9)] = 0.0
+    never_sends: list[Literal[tuple(fm.EVENTS)]] = []  # type: ignore[valid-type]
 
     @field_validator("silent_between")
     @classmethod

@@ -17,6 +17,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
+import random
 from collections.abc import Mapping
 from typing import Any
 
@@ -61,6 +62,8 @@ class Simulator:
                                    (executive[0], executive[1]), self._on_datagram)
         self._loop_task: asyncio.Task[None] | None = None
         self._dropped: dict[str, float] = {}  # topic -> simulated time its drop-out ends
+        self._loss_rng = random.Random(scenario.seed)
+        self.datagrams_lost = 0
         self._started = False
 
     # ------------------------------------------------------------ lifecycle
@@ -123,7 +126,7 @@ class Simulator:
     def restart_frontend(self) -> None:
         """The front end restarts now (as a scenario ``frontend.restarts`` time would)."""
         for data in self.frontend.restart(self.world.now):
-            self._udp.send(data)
+            self._send_udp(data)
 
     def silence_frontend(self, seconds: float) -> None:
         """The front end hangs for ``seconds`` of simulated time from now (``inf``: for ever)."""
@@ -154,7 +157,7 @@ class Simulator:
         for topic, msg in outputs:
             self._publish(topic, msg)
         for data in self.frontend.step(self.world.now):
-            self._udp.send(data)
+            self._send_udp(data)
 
     def advance(self, seconds: float) -> None:
         """Step by hand until ``seconds`` more of simulated time have passed."""
@@ -184,8 +187,22 @@ class Simulator:
             self._publish(topic, msg)
 
     def _on_datagram(self, data: bytes, addr: Address) -> None:
+        if self._lost():
+            return
         for reply in self.frontend.receive(data, addr[0], self.world.now):
-            self._udp.send(reply)
+            self._send_udp(reply)
+
+    def _send_udp(self, data: bytes) -> None:
+        if not self._lost():
+            self._udp.send(data)
+
+    def _lost(self) -> bool:
+        """Scenario ``frontend.loss``: this datagram is lost (seeded, so runs repeat)."""
+        loss = self.scenario.frontend.loss
+        if loss and self._loss_rng.random() < loss:
+            self.datagrams_lost += 1
+            return True
+        return False
 
     def _on_frontend_traffic(self, direction: str, channel: str, fields: dict[str, Any]) -> None:
         self.log.append(Record(self.world.now, "frontend", direction, channel, fields))
