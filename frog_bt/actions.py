@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import itertools
 import logging
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -56,6 +57,7 @@ class Actions:
         self.pending: Request | None = None
         self.stale_responses = 0
         self.face_stream = False
+        self.last_approach_at = -math.inf  # project-clock time of the last approach sent
 
     def goto(self, waypoint: str, poi: Poi) -> Request:
         now = self._clock.now()
@@ -66,8 +68,8 @@ class Actions:
     def approach(self, person_id: int) -> Request:
         msg = encode_int32(person_id)
         self._publish("approach", msg)
-        return self._replace(Request(next(self._ids), "approach", str(person_id),
-                                     self._clock.now(), msg))
+        self.last_approach_at = now = self._clock.now()
+        return self._replace(Request(next(self._ids), "approach", str(person_id), now, msg))
 
     def resend_pending(self) -> Request | None:
         """Publish the pending goal or approach again (after a reconnect its answer may

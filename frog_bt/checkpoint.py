@@ -9,18 +9,32 @@ and deletes it when a tour ends or is aborted.
 
 On start-up, :func:`load` gives a :class:`Resume`: the checkpoints a resumed
 tour skips, once each, and the visitor to restore.
+
+A checkpoint belongs to one executive. The default file is scoped by the site
+configuration and the listen address (:func:`default_path`), and
+:func:`claim` locks it for the executive's lifetime, so two executives on one
+machine (two robots, or a test beside a live run) never resume each other's
+tours.
 """
 
 from __future__ import annotations
 
 import contextlib
+import fcntl
+import hashlib
 import json
 import math
 import os
+import re
 import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import IO
+
+from frog_bt.errors import UsageError
+
+STATE_DIR = Path(os.environ.get("XDG_STATE_HOME", Path.home() / ".local" / "state")) / "frog-bt"
 
 VERSION = 1
 
@@ -60,10 +74,67 @@ class Resume:
     done: set[str]
     visitor: int | None
     order: list[str] = field(default_factory=list)
+    written: float = 0.0  # wall time the checkpoint was written
 
     def describe(self) -> str:
         last = self.order[-1] if self.order else "nothing"
         return f"after {last}" + (f", visitor {self.visitor}" if self.visitor is not None else "")
+
+    def announce(self, stops: list[str], now: float | None = None) -> str:
+        """``resuming the tour at POI4: checkpoint 3 min old`` (``stops``: the tour's POIs)."""
+        return f"resuming the tour {self.where(stops)}: checkpoint {self.age_text(now)} old"
+
+    def where(self, stops: list[str]) -> str:
+        """Where the resumed tour picks up, in the tour's words."""
+        done_stops = [int(n.split()[1]) for n in self.order if re.fullmatch(r"stop \d+", n)]
+        if done_stops:
+            following = max(done_stops) + 1
+            return (f"at {stops[following]}" if following < len(stops)
+                    else "on the way back to the dock")
+        if "recruit" in self.order:
+            return f"at {stops[0]}" if stops else "after recruiting"
+        return "at the recruitment"
+
+    def age_text(self, now: float | None = None) -> str:
+        age = max(0.0, (time.time() if now is None else now) - self.written)
+        return f"{age:.0f} s" if age < 90 else f"{age / 60:.0f} min"
+
+
+def default_path(config: Path, listen: tuple[str, int], state_dir: Path = STATE_DIR) -> Path:
+    """The checkpoint file of the executive of site ``config`` listening on ``listen``."""
+    site = hashlib.sha256(str(config.resolve()).encode()).hexdigest()[:8]
+    host = re.sub(r"[^\w.-]", "_", listen[0])
+    return state_dir / f"checkpoint-{host}-{listen[1]}-{site}.json"
+
+
+def claim(path: Path, option: str = "--checkpoint") -> IO[str]:
+    """Lock ``path`` for this executive (held until the returned file is closed).
+
+    Raises UsageError when the directory cannot be written or another running
+    executive holds the checkpoint.
+    """
+    lock_path = path.with_name(path.name + ".lock")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle = open(lock_path, "a+", encoding="utf-8")  # noqa: SIM115 - held open
+    except (FileExistsError, NotADirectoryError):
+        raise UsageError(option, path, f"cannot write there: {path.parent} is not a directory"
+                         ) from None
+    except OSError as exc:
+        raise UsageError(option, path, f"cannot write there: {exc.strerror or exc}") from None
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        handle.seek(0)
+        holder = handle.read().strip() or "?"
+        handle.close()
+        raise UsageError(option, path, f"in use by another running executive (pid {holder}); "
+                         "give each executive its own --checkpoint") from None
+    handle.seek(0)
+    handle.truncate()
+    handle.write(str(os.getpid()))
+    handle.flush()
+    return handle
 
 
 def save(path: Path, progress: Progress) -> None:
@@ -104,4 +175,4 @@ def load(path: Path, max_age: float = math.inf) -> Resume | None:
         return None
     if visitor is not None and (isinstance(visitor, bool) or not isinstance(visitor, int)):
         visitor = None
-    return Resume(set(done), visitor, list(done))
+    return Resume(set(done), visitor, list(done), float(written))

@@ -12,10 +12,11 @@ import math
 from datetime import time as dtime
 from pathlib import Path
 from typing import Annotated, Any, Literal
+from urllib.parse import urlsplit
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from frog_bt.errors import ConfigError
+from frog_bt.errors import ConfigError, UsageError
 from frog_bt.topics import DEFAULT_FRONTEND, DEFAULT_LISTEN, DEFAULT_ROSBRIDGE_URL, INPUTS, OUTPUTS
 from frog_bt.yamlfile import PathError, load_yaml, validate
 
@@ -95,6 +96,10 @@ class Recruit(_Model):
     facing_min: Finite = 135.0
     facing_max: Finite = 225.0
     detection_max_age: Positive = 1.0
+    # seconds a person whose approach failed (or was rejected) is not sought again:
+    # the seed's "try to find new participant"
+    retry_after: NonNegative = 60.0
+    approach_interval: NonNegative = 5.0  # seconds at least between two /ApproachPeopleFar
 
 
 class Follow(_Model):
@@ -183,6 +188,21 @@ class Links(_Model):
     secret_env: str = "FROG_ROSBRIDGE_SECRET"
     secret_file: str | None = None
 
+    @field_validator("rosbridge")
+    @classmethod
+    def _ws_url(cls, value: str) -> str:
+        problem = ws_url_problem(value)
+        if problem:
+            raise ValueError(problem)
+        return value
+
+    @field_validator("frontend", "listen")
+    @classmethod
+    def _hostport(cls, value: str) -> str:
+        if hostport_problem(value):
+            raise ValueError(f"expected HOST:PORT (e.g. 127.0.0.1:5005), got {value!r}")
+        return value
+
 
 class Executive(_Model):
     tick_hz: Positive = 10.0
@@ -243,6 +263,12 @@ class Site(_Model):
         default = INPUTS.get(role) or OUTPUTS[role]
         return self.topics.get(role, default.name)
 
+    def timeout(self, name: str) -> float:
+        """The ``timeouts`` entry ``name`` (seconds); KeyError for an unknown name."""
+        if name not in Timeouts.model_fields:
+            raise KeyError(name)
+        return float(getattr(self.timeouts, name))
+
     def stop_timeout(self, stop: Stop) -> float:
         return stop.content_timeout or self.timeouts.content
 
@@ -265,8 +291,43 @@ def load_site(path: str | Path | None = None) -> Site:
     return validate(Site, data, path, ConfigError)
 
 
-def parse_hostport(text: str, what: str = "address") -> tuple[str, int]:
+def hostport_problem(text: str) -> str | None:
     host, sep, port = text.rpartition(":")
-    if not sep or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
-        raise ValueError(f"{what} {text!r}: expected HOST:PORT")
-    return host, int(port)
+    if not sep or not host:
+        return "expected HOST:PORT (e.g. 127.0.0.1:5005)"
+    if not port.isdigit() or not 0 <= int(port) <= 65535:
+        return f"expected HOST:PORT with a port from 0 to 65535, got port {port!r}"
+    return None
+
+
+def parse_hostport(text: str, what: str = "address") -> tuple[str, int]:
+    """``HOST:PORT`` as a tuple; UsageError naming ``what`` (the option) when malformed."""
+    problem = hostport_problem(text)
+    if problem:
+        raise UsageError(what, text, problem)
+    host, _, port = text.rpartition(":")
+    return host.strip("[]"), int(port)
+
+
+def ws_url_problem(text: str) -> str | None:
+    """Why ``text`` is not a rosbridge WebSocket URL (``ws://HOST:PORT``); None when it is."""
+    example = "expected ws://HOST:PORT, e.g. ws://127.0.0.1:9090"
+    try:
+        parts = urlsplit(text)
+        port = parts.port
+    except ValueError as exc:  # a port that is not a number or out of range
+        return f"{example} ({exc})"
+    if parts.scheme not in ("ws", "wss"):
+        return example + (f" (not {parts.scheme}://)" if parts.scheme and "//" in text else "")
+    if not parts.hostname:
+        return f"{example} (no host)"
+    if port == 0:
+        return f"{example} (port 0)"
+    return None
+
+
+def check_ws_url(text: str, what: str = "--rosbridge") -> str:
+    problem = ws_url_problem(text)
+    if problem:
+        raise UsageError(what, text, problem)
+    return text

@@ -6,6 +6,7 @@
     ├── DefinitionError          a file the user wrote is wrong; raised before anything connects
     │   ├── ConfigError          config/*.yaml, scenario files
     │   └── TreeError            trees/*.yaml
+    ├── UsageError               a command-line value (or a path or address it names) is unusable
     └── DecodeError              one inbound message or datagram is malformed; counted, never fatal
 
 When the tour cannot go on (docking failed, authentication refused) the
@@ -42,7 +43,8 @@ class DefinitionError(FrogError):
         self.file = str(file)
         self.path = tuple(path)
         self.detail = message
-        super().__init__(f"{self.file}: {format_path(self.path)}: {message}")
+        where = f"{format_path(self.path)}: " if self.path else ""
+        super().__init__(f"{self.file}: {where}{message}")
 
 
 class ConfigError(DefinitionError):
@@ -51,6 +53,21 @@ class ConfigError(DefinitionError):
 
 class TreeError(DefinitionError):
     """A tree file is invalid."""
+
+
+class UsageError(FrogError, ValueError):
+    """A command-line value cannot be used: ``OPTION VALUE: what was expected``.
+
+    Raised before the executive runs (a bad URL, an address that cannot be bound, a
+    path that cannot be written), so a deployer gets one line and exit code 2.
+    """
+
+    def __init__(self, option: str, value: object, message: str) -> None:
+        self.option = option
+        self.value = value
+        self.detail = message
+        shown = f" {value}" if value not in (None, "") else ""
+        super().__init__(f"{option}{shown}: {message}")
 
 
 class DecodeError(FrogError):

@@ -26,15 +26,17 @@ from frog_bt.checkpoint import save as save_checkpoint
 from frog_bt.clock import Clock, ManualClock
 from frog_bt.config import Site
 from frog_bt.core import Core
-from frog_bt.frontend.link import FrontendLink
+from frog_bt.frontend.link import FrontendLink, WarningLimiter
 from frog_bt.frontend.messages import EVENTS, FrontendMessage
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.rosbridge.link import LinkState
+from frog_bt.status import link_line, status_line
 from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
 from frog_bt.tree.loader import LoadedTree
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
+FRONTEND_DRAIN = 1.2  # wall seconds for the last commands' acks (of a 2 s shutdown budget)
 
 
 @dataclass(slots=True)
@@ -86,6 +88,8 @@ class Executive:
         self._stopping = asyncio.Event()
         self._pending_at_loss: object = None
         self._refusals = 0  # consecutive connections refused (auth)
+        self._peer_restarts = 0
+        self._checkpoint_warnings = WarningLimiter(60.0)
 
     # ------------------------------------------------------------ I/O callbacks (cache only)
 
@@ -147,6 +151,11 @@ class Executive:
             await self._shutdown()
         return self.outcome
 
+    def status_text(self) -> str:
+        """The live status: the rosbridge link while it keeps the tree waiting, else the tree."""
+        return (link_line(self.client.url, self.client.link, self.clock.ready)
+                or status_line(self.core))
+
     async def _until_stopped(self, awaitable: Any) -> bool:
         """Await ``awaitable`` unless stop() comes first; True when it completed."""
         task = asyncio.ensure_future(awaitable)
@@ -182,11 +191,20 @@ class Executive:
             self._wake.set()
 
     def tick(self) -> None:
+        restarts = self.link.stats.peer_restarts
+        if restarts != self._peer_restarts:
+            self._peer_restarts = restarts
+            self.core.ctx.note("front end restarted", incident="front end restarted")
         status = self.core.tick()
         progress = self.core.ctx.progress
         if self.checkpoint is not None and progress.changes != self._saved:
             self._saved = progress.changes
-            save_checkpoint(self.checkpoint, progress)
+            try:
+                save_checkpoint(self.checkpoint, progress)
+            except OSError as exc:  # a full disk must not stop the tour; warn once a minute
+                self._checkpoint_warnings.warn(
+                    "checkpoint", f"cannot write the checkpoint {self.checkpoint}: "
+                                  f"{exc.strerror or exc}")
         if status == Status.SUCCESS:
             storage = py_trees.blackboard.Blackboard.storage
             if storage.get("/tour_state") == "aborted":
@@ -200,13 +218,17 @@ class Executive:
                 self.stop("tour ended docked", 0)
         elif status == Status.FAILURE:
             # the tree gave up (GiveUp told the front end): the robot cannot go on
-            reason = self.core.last_note.removeprefix("giving up: ") or "the tour tree failed"
+            reason = self.core.ctx.gave_up or "the tour tree failed"
             log.error("cannot go on: %s", reason)
             self.stop(reason, 1)
 
     async def _shutdown(self) -> None:
         """Halt the tree (scopes switch the face stream off, ...) and flush the links."""
         self.core.halt()
+        # The last front-end commands (tour ended, projector off, finish_poi) are resent
+        # until acked, within the shutdown budget. First: on sim time the resends need
+        # /clock, which stops with the unsubscriptions below.
+        await self.link.drain(FRONTEND_DRAIN)
         # Leave the robot's rosbridge tidy: the last commands out, then unsubscribe and
         # unadvertise (only sent while connected; nothing is queued for later).
         if self.client.link.connected:

@@ -1,4 +1,9 @@
-"""The live one-line status: phase, POI, tree tip, visitor, battery.
+"""The live one-line status: phase, POI, tree tip, visitor, battery — or the links.
+
+While rosbridge is unreachable (or, on sim time, no ``/clock`` has come) the line
+says so instead of showing a tree that cannot tick::
+
+    rosbridge: connecting to ws://frog:9090 (attempt 4, next in 2.0 s): connection refused
 
 On a terminal the line is redrawn in place (at most every ``interval`` wall
 seconds); elsewhere a line is printed only when it changes.
@@ -8,7 +13,8 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import TextIO
+from collections.abc import Callable
+from typing import Any, TextIO
 
 import py_trees
 
@@ -31,6 +37,31 @@ def phase(core: Core) -> str:
         node = child
 
 
+def link_line(url: str, link: Any, clock_ready: bool = True) -> str | None:
+    """What the rosbridge link is doing, while it keeps the tree from running; else None."""
+    if link.connected:
+        return None if clock_ready else f"rosbridge: connected to {url}, waiting for /clock"
+    attempt = getattr(link, "attempt", 0)
+    retry_in = getattr(link, "retry_in", None)
+    detail = ", ".join(part for part in (
+        f"attempt {attempt}" if attempt else "",
+        f"next in {retry_in:.1f} s" if retry_in is not None else "") if part)
+    error = _plain_error(link.last_error) if link.last_error else ""
+    return (f"rosbridge: connecting to {url}" + (f" ({detail})" if detail else "")
+            + (f": {error}" if error else ""))
+
+
+def _plain_error(error: str) -> str:
+    """``ConnectionRefusedError: [Errno 111] Connect call failed ...`` -> ``connection refused``."""
+    lowered = error.lower()
+    for needle, words in (("refused", "connection refused"), ("timed out", "timed out"),
+                          ("name or service not known", "unknown host"),
+                          ("no route", "no route to host"), ("unreachable", "unreachable")):
+        if needle in lowered:
+            return words
+    return error[:80]
+
+
 def status_line(core: Core) -> str:
     storage = py_trees.blackboard.Blackboard.storage
     tip = core.bt.root.tip()
@@ -43,22 +74,33 @@ def status_line(core: Core) -> str:
         f"visitor {storage.get('/visitor') if storage.get('/visitor') is not None else '-'}",
         f"battery {battery:.0f}%" if battery is not None else "battery -",
     ]
+    if core.ctx.resumed:
+        parts.insert(0, core.ctx.resumed)
     return " | ".join(parts)
 
 
 class StatusLine:
-    def __init__(self, out: TextIO = sys.stderr, interval: float = 0.2) -> None:
+    """Draws ``source()`` (default: :func:`status_line` of the core ticked)."""
+
+    def __init__(self, out: TextIO = sys.stderr, interval: float = 0.2,
+                 source: Callable[[], str] | None = None) -> None:
         self.out = out
         self.tty = out.isatty()
         self.interval = interval
+        self.source = source
         self._last = ""
         self._drawn_at = 0.0
 
-    def update(self, core: Core) -> None:
+    def update(self, core: Core | None = None) -> None:
         now = time.monotonic()
         if self.tty and now - self._drawn_at < self.interval:
             return
-        line = status_line(core)
+        if self.source is not None:
+            line = self.source()
+        elif core is not None:
+            line = status_line(core)
+        else:
+            return
         if line == self._last:
             return
         self._last, self._drawn_at = line, now

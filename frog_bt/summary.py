@@ -7,14 +7,16 @@ approached and recruited.
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
 import py_trees
 
 from frog_bt.config import Site
+from frog_bt.context import Incident
 from frog_bt.engagement import Decision
-from frog_bt.frontend.messages import StartPoi, UserPositive
+from frog_bt.frontend.messages import StartPoi, Tour, UserPositive
 from frog_bt.messages import decode_pose
 from frog_bt.topics import SUCCEEDED
 
@@ -27,8 +29,13 @@ class TourSummary:
     approached: list[int] = field(default_factory=list)
     recruited: list[int] = field(default_factory=list)
     decisions: list[tuple[str, Decision]] = field(default_factory=list)  # (about, decision)
+    incidents: list[Incident] = field(default_factory=list)
+    tours: list[str] = field(default_factory=list)  # "ended" / "aborted: reason", in order
+    skipped: list[str] = field(default_factory=list)  # stops skipped in the latest tour
+    resumed: str | None = None
     _goal: str | None = None
     _last_decision: Any = None
+    _seen_incidents: int = 0
 
     def waypoint_of(self, msg: dict[str, Any]) -> str:
         pose = decode_pose(msg)
@@ -54,6 +61,12 @@ class TourSummary:
     def frontend_out(self, t: float, type_: str, message: Any) -> None:
         if isinstance(message, StartPoi):
             self.content.append((message.poi, message.waypoint, message.part))
+        elif isinstance(message, Tour):
+            if message.state == "started":
+                self.skipped.clear()
+            else:
+                self.tours.append(message.state + (f": {message.reason}" if message.reason
+                                                   else ""))
 
     def frontend_in(self, t: float, type_: str, message: Any) -> None:
         if isinstance(message, UserPositive) and self.approached:
@@ -64,6 +77,15 @@ class TourSummary:
         if decision is not None and decision is not self._last_decision:
             self._last_decision = decision
             self.decisions.append(decision)
+        ctx = core.ctx
+        if ctx.incident_total != self._seen_incidents:
+            for incident in ctx.incidents[self._seen_incidents - ctx.incident_total:]:
+                self.incidents.append(incident)
+                if incident.kind == "stop skipped":
+                    self.skipped.append(incident.subject)
+            self._seen_incidents = ctx.incident_total
+        if ctx.resumed and self.resumed is None:
+            self.resumed = ctx.resumed
 
     def attach(self, taps: Any) -> None:
         taps.tick.append(self.tick)
@@ -72,14 +94,66 @@ class TourSummary:
         taps.frontend_out.append(self.frontend_out)
         taps.frontend_in.append(self.frontend_in)
 
-    def lines(self) -> list[str]:
+    # ------------------------------------------------------------ verdict
+
+    @property
+    def complete(self) -> bool:
+        """The latest tour ended docked with every stop visited."""
+        return bool(self.tours) and self.tours[-1] == "ended" and not self.skipped
+
+    def verdict(self) -> str:
+        if not self.tours:
+            return "no tour ended"
+        last = self.tours[-1]
+        if last != "ended":
+            return f"tour {last}"
+        if self.skipped:
+            return f"tour ended docked, but {_words(self.skipped)} skipped"
+        return "tour ended docked, every stop visited"
+
+    def lines(self, frontend: Any = None) -> list[str]:
+        """The summary, one line each; ``frontend`` (the link's stats) adds its restarts
+        and the commands it never acked."""
         played = ", ".join(f"{poi} {part}" + (f" ({wp})" if wp != poi else "")
                            for poi, wp, part in self.content) or "none"
-        return [
+        out = [
             f"route:     {' -> '.join(self.visited) or 'nowhere'}",
             f"content:   {played}",
-            f"visitors:  approached {self.approached or 'none'}, "
-            f"recruited {self.recruited or 'none'}",
+            f"visitors:  {_visitors(self.approached, self.recruited)}",
             *(f"{'engaged?' if i == 0 else '':<10} {about}: {d.describe()}"
               for i, (about, d) in enumerate(self.decisions)),
         ]
+        if self.resumed:
+            out.append(f"resumed:   {self.resumed}")
+        counts = Counter(i.kind for i in self.incidents if i.kind != "resumed")
+        if frontend is not None and frontend.peer_restarts:
+            counts["front end restarted"] = frontend.peer_restarts
+        if frontend is not None and frontend.unacked:
+            counts["front-end commands never acked"] = frontend.unacked
+        if counts:
+            out.append("problems:  " + "; ".join(f"{kind} ({n})" if n > 1 else kind
+                                                 for kind, n in counts.items()))
+            out += [f"{'':<10} {i.text}" for i in self.incidents[-MAX_LISTED:]
+                    if i.kind != "resumed"]
+        out.append(f"outcome:   {self.verdict()}")
+        return out
+
+
+MAX_LISTED = 12  # incidents listed one per line (the counts cover all of them)
+
+
+def _words(items: list[Any]) -> str:
+    items = [str(i) for i in items]
+    if len(items) <= 1:
+        return "".join(items)
+    return ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def _visitors(approached: list[int], recruited: list[int]) -> str:
+    if not approached:
+        return "nobody approached"
+    times = Counter(approached)
+    people = [f"{pid}" + (f" ({n} times)" if n > 1 else "") for pid, n in times.items()]
+    text = f"approached {_words(people)}"
+    return text + (f"; recruited {_words(list(dict.fromkeys(recruited)))}" if recruited
+                   else "; nobody recruited")

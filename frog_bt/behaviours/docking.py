@@ -56,11 +56,11 @@ class Docking(Leaf):
                 self.took = True
             if state.value == "failed" and (
                     self.took or state.at - self.sent_at >= FAILED_GRACE):
-                self.ctx.note(f"{self.params.action} failed")
+                self.ctx.note(f"{self.params.action} failed", incident="docking failed")
                 return FAILURE
         if self.get("/now") - self.sent_at >= self.timeout:
             self.ctx.note(f"{self.params.action}: no {TARGET[self.params.action]} "
-                          f"within {self.timeout:g} s")
+                          f"within {self.timeout:g} s", incident="docking failed")
             return FAILURE
         self.feedback_message = f"{state.value if state else 'no state'}"
         return RUNNING

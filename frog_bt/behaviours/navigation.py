@@ -58,13 +58,15 @@ class Navigate(Leaf):
             self.ctx.note(f"arrived at {request.target}")
             return SUCCESS
         if request.done:
-            self.ctx.note(f"navigation to {request.target} {CODE_NAMES[request.code]}")
+            self.ctx.note(f"navigation to {request.target} {CODE_NAMES[request.code]}",
+                          incident="navigation failed")
             return FAILURE
         if self.ctx.actions.pending is not request:
             self.ctx.note(f"navigation to {request.target} replaced by another goal")
             return FAILURE
         if self.get("/now") - request.sent_at >= self.timeout:
-            self.ctx.note(f"navigation to {request.target}: no arrival within {self.timeout:g} s")
+            self.ctx.note(f"navigation to {request.target}: no arrival within {self.timeout:g} s",
+                          incident="navigation failed")
             return FAILURE
         self.feedback_message = f"{request.target}: {CODE_NAMES.get(request.code, 'sent')}"
         return RUNNING
@@ -86,7 +88,8 @@ class SkipStop(Leaf):
 
     def update(self) -> Status:
         self.set("/skipped", self.params.poi)
-        self.ctx.note(f"skip {self.params.poi}: navigation kept failing")
+        self.ctx.note(f"skipped {self.params.poi}: navigation kept failing",
+                      incident="stop skipped", subject=self.params.poi)
         return SUCCESS
 
 

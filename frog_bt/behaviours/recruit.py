@@ -28,17 +28,27 @@ def facing_visitor(persons: tuple[PersonDetection, ...], pose: Pose, lo: float, 
                key=lambda p: (math.hypot(p.position.x - pose.x, p.position.y - pose.y), p.id))
 
 
+def cooling_down(failed: dict[int, float] | None, now: float, retry_after: float
+                 ) -> frozenset[int]:
+    """People whose approach failed less than ``retry_after`` seconds before ``now``."""
+    if not failed:
+        return frozenset()
+    return frozenset(pid for pid, at in failed.items() if now - at < retry_after)
+
+
 @register
 class SeekVisitor(Leaf):
     """Look for a visitor: a person facing the robot, the nearest when several.
 
     Reads ``/persons`` (ignored when older than site ``recruit.detection_max_age``),
-    ``/pose``, ``/now`` and ``/declined`` (people who said no this tour).
+    ``/pose``, ``/now``, ``/declined`` (people who said no this tour) and
+    ``/approach_failed`` (person -> time their approach failed: passed over for
+    ``recruit.retry_after`` seconds, so another facing visitor is tried first).
     Writes ``/visitor`` (the person id). RUNNING until someone qualifies, then SUCCESS.
     """
 
     reads = ("/persons", "/pose", "/now")
-    optional_reads = ("/declined",)
+    optional_reads = ("/declined", "/approach_failed")
     writes = ("/visitor",)
 
     def update(self) -> Status:
@@ -53,10 +63,14 @@ class SeekVisitor(Leaf):
             self.feedback_message = "no recent person detections"
             return RUNNING
         declined = self.get("/declined") or frozenset()
+        cooling = cooling_down(self.get("/approach_failed"), now, cfg.retry_after)
         person = facing_visitor(persons.value.persons, pose.value, cfg.facing_min,
-                                cfg.facing_max, declined)
+                                cfg.facing_max, declined | cooling)
         if person is None:
-            self.feedback_message = f"{len(persons.value.persons)} seen, none facing"
+            seen = len(persons.value.persons)
+            self.feedback_message = f"{seen} seen, none facing" + (
+                f" but {', '.join(map(str, sorted(cooling)))} (approach failed)"
+                if cooling else "")
             return RUNNING
         self.set("/visitor", person.id)
         self.ctx.note(f"visitor {person.id} faces the robot "
@@ -66,36 +80,63 @@ class SeekVisitor(Leaf):
 
 @register
 class ApproachVisitor(Leaf):
-    """Approach ``/visitor`` with ``/ApproachPeopleFar``.
+    """Approach ``/visitor`` with ``/ApproachPeopleFar``, never faster than the site allows.
 
-    Reads ``/visitor``, ``/now``. SUCCESS on ``/FROG_response`` 2; FAILURE on 3
-    or 4, or after ``timeout`` (default: site ``timeouts.approach``).
+    Reads ``/visitor``, ``/now``, ``/approach_failed``; writes ``/approach_failed``.
+    The command goes out once ``recruit.approach_interval`` seconds have passed
+    since the previous approach (RUNNING until then). SUCCESS on
+    ``/FROG_response`` 2; FAILURE on 3 or 4, or after ``timeout`` (default: site
+    ``timeouts.approach``), recording the person in ``/approach_failed`` so that
+    the next search passes them over for ``recruit.retry_after`` seconds.
     """
 
     class Params(Params):
         timeout: float | None = Timeout
 
     reads = ("/visitor", "/now")
+    optional_reads = ("/approach_failed",)
+    writes = ("/approach_failed",)
 
     def initialise(self) -> None:
         self.visitor = self.get("/visitor")
-        self.request: Request = self.ctx.actions.approach(self.visitor)
+        self.request: Request | None = None
         self.timeout = self.params.timeout or self.ctx.site.timeouts.approach
+        self._send_when_due()
+
+    def _send_when_due(self) -> None:
+        actions, now = self.ctx.actions, self.ctx.clock.now()
+        due = actions.last_approach_at + self.ctx.site.recruit.approach_interval
+        if now < due:
+            self.feedback_message = f"next approach in {due - now:.1f} s"
+            return
+        self.request = actions.approach(self.visitor)
         self.ctx.note(f"approach visitor {self.visitor}")
 
     def update(self) -> Status:
+        if self.request is None:
+            self._send_when_due()
+            if self.request is None:
+                return RUNNING
         request = self.request
         if request.code == SUCCEEDED:
             self.ctx.note(f"approached visitor {self.visitor}")
             return SUCCESS
         if request.done or self.ctx.actions.pending is not request:
-            self.ctx.note(f"approach of visitor {self.visitor} "
-                          f"{CODE_NAMES.get(request.code, 'replaced')}: seek again")
-            return FAILURE
+            return self._failed(CODE_NAMES.get(request.code, "replaced"))
         if self.get("/now") - request.sent_at >= self.timeout:
-            self.ctx.note(f"approach of visitor {self.visitor} timed out: seek again")
-            return FAILURE
+            return self._failed("timed out")
         return RUNNING
+
+    def _failed(self, how: str) -> Status:
+        failed = dict(self.get("/approach_failed") or {})
+        now = self.get("/now")
+        retry_after = self.ctx.site.recruit.retry_after
+        failed = {pid: at for pid, at in failed.items() if now - at < retry_after}
+        failed[self.visitor] = now
+        self.set("/approach_failed", failed)
+        self.ctx.note(f"approach of visitor {self.visitor} {how}: seek again "
+                      f"(not them for {retry_after:g} s)", incident="approach failed")
+        return FAILURE
 
     def terminate(self, new_status: Status) -> None:
         if new_status in (INVALID, FAILURE):
@@ -169,5 +210,5 @@ class WaitAnswer(Leaf):
 
     def _decline(self, visitor: int, why: str) -> Status:
         self.set("/declined", (self.get("/declined") or frozenset()) | {visitor})
-        self.ctx.note(f"visitor {visitor} {why}: seek again")
+        self.ctx.note(f"visitor {visitor} {why}: seek again", incident="visitor declined")
         return FAILURE

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Iterator
 
 import py_trees
@@ -12,6 +13,8 @@ from frog_bt.frontend.messages import Tour
 from frog_bt.messages import Diagnostics
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
+
+log = logging.getLogger(__name__)
 
 
 def fresh_diagnostics(reading: Reading[Diagnostics] | None, now: float,
@@ -56,7 +59,7 @@ class MustAbort(Leaf):
             self.feedback_message = ""
             return FAILURE
         self.set("/abort_reason", reason)
-        self.ctx.note(f"abort the tour: {reason}")
+        self.ctx.note(f"abort the tour: {reason}", incident="tour aborted")
         return SUCCESS
 
 
@@ -88,7 +91,8 @@ class GiveUp(Leaf):
         self.ctx.send(Tour("aborted", reason))
         self.set("/tour_state", "aborted")
         self.ctx.progress.clear()
-        self.ctx.note(f"giving up: {reason}")
+        self.ctx.gave_up = reason
+        self.ctx.note(f"giving up: {reason}", incident="gave up")
         self.feedback_message = reason
         return FAILURE
 
@@ -114,7 +118,10 @@ class ConfirmResume(Leaf):
             return SUCCESS
         state: Reading[str] | None = self.get("/docking")
         if state is not None and state.value not in ("docked", "docking"):
-            self.ctx.note(f"resuming the tour {resume.describe()}")
+            announce = resume.announce([stop.poi for stop in self.ctx.site.tour.stops])
+            self.ctx.resumed = announce
+            self.ctx.note(f"{announce} ({resume.describe()})", incident="resumed")
+            log.warning("%s", announce)
             return SUCCESS
         if state is not None or self.get("/now") - self.started >= self.ctx.site.checkpoint.confirm:
             why = f"the robot is {state.value}" if state else "no docking state"

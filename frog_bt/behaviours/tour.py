@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import Field
 
 from frog_bt.blackboard import EventLog
+from frog_bt.config import Timeouts
 from frog_bt.frontend.messages import EVENTS, Tour
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
 
@@ -76,18 +77,24 @@ class TourStatus(Leaf):
         return SUCCESS
 
 
+TimeoutName = Literal[tuple(Timeouts.model_fields)]  # type: ignore[valid-type]
+
+
 @register
 class WaitEvent(Leaf):
-    """Wait for a front-end event that arrives after this leaf starts.
+    """Wait for a front-end event that arrives after this leaf starts; never for ever.
 
-    Reads ``/events`` and ``/now``. SUCCESS when an ``event`` arrives (matching
-    ``poi``/``part`` when given); FAILURE after ``timeout`` seconds (project
-    clock; none: wait for ever).
+    Reads ``/events`` and ``/now``. SUCCESS when an ``event`` arrives. After
+    ``timeout`` — seconds of project-clock time, or the name of a site
+    ``timeouts`` entry (``introduction``) — it returns ``on_timeout`` (FAILURE
+    by default; SUCCESS to carry on as if the event had come, e.g. ask the
+    visitor anyway when ``finish_introduction`` was lost) and notes why.
     """
 
     class Params(Params):
         event: Literal[tuple(EVENTS)]  # type: ignore[valid-type]
-        timeout: float | None = Field(None, gt=0, allow_inf_nan=False)
+        timeout: Annotated[float, Field(gt=0, allow_inf_nan=False)] | TimeoutName
+        on_timeout: Literal["failure", "success"] = "failure"
 
     reads = ("/events", "/now")
 
@@ -95,14 +102,17 @@ class WaitEvent(Leaf):
         events: EventLog = self.get("/events")
         self.since = events.last_index
         self.started = self.ctx.clock.now()
+        timeout = self.params.timeout
+        self.timeout = self.ctx.site.timeout(timeout) if isinstance(timeout, str) else timeout
 
     def update(self) -> Status:
         events: EventLog = self.get("/events")
         if events.first_since(self.since, EVENTS[self.params.event]) is not None:
             return SUCCESS
-        timeout = self.params.timeout
-        if timeout is not None and self.get("/now") - self.started >= timeout:
-            self.ctx.note(f"{self.name}: no {self.params.event} within {timeout:g} s")
-            return FAILURE
+        if self.get("/now") - self.started >= self.timeout:
+            success = self.params.on_timeout == "success"
+            self.ctx.note(f"no {self.params.event} within {self.timeout:g} s"
+                          + (": carrying on" if success else ""), incident="event missing")
+            return SUCCESS if success else FAILURE
         self.feedback_message = f"waiting for {self.params.event}"
         return RUNNING

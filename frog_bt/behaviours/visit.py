@@ -59,7 +59,7 @@ class VisitorFollows(Leaf):
                 self.ctx.note("laser tracking or pose stale: assuming the visitor follows")
                 return SUCCESS
             self.ctx.note(f"nobody within {self.radius:g} m for {self.grace:g} s: "
-                          "visitor lost, back to recruit")
+                          "visitor lost, back to recruit", incident="visitor lost")
             return FAILURE
         self.feedback_message = ("waiting for the visitor to catch up" if fresh
                                  else "laser tracking or pose stale: waiting")
@@ -113,7 +113,7 @@ class PlayContent(Leaf):
             self.ctx.note(f"front end restarted: {p.poi} part {p.part} sent again")
         if self.get("/now") - self.started >= self.timeout:
             self.ctx.note(f"{p.poi} part {p.part}: no content_done within "
-                          f"{self.timeout:g} s, going on")
+                          f"{self.timeout:g} s, going on", incident="content timeout")
             return SUCCESS
         self.feedback_message = f"playing {p.poi} part {p.part}"
         return RUNNING

@@ -3,7 +3,10 @@
 Starts the built-in simulator (frog-bt sim) on free loopback ports, runs the
 executive against it with --sim-time --once, and prints a summary: the route
 with the time-of-day variants chosen, the content played, the visitors
-recruited, and how much simulated and wall time the tour took.
+recruited, what went wrong (stops skipped and why, navigation retries, failed
+approaches, content timeouts, front-end restarts, aborts), and how much
+simulated and wall time the tour took. Exits 0 only when the tour ended docked
+with every stop visited.
 """
 
 from __future__ import annotations
@@ -89,14 +92,16 @@ async def _demo(site, tree, scenario, args) -> int:  # type: ignore[no-untyped-d
     wall, simulated = time.monotonic() - wall0, rehearsal.sim.clock.now() - sim0
     print(f"frog-bt demo: scenario {args.scenario!r}, started "
           f"{scenario.start_time.astimezone(clock.tz):%Y-%m-%d %H:%M} local time")
-    for line in summary.lines():
+    for line in summary.lines(rehearsal.executive.link.stats):
         print("  " + line)
     print(f"  time:      {simulated / 60:.1f} min simulated in {wall:.1f} s "
           f"({simulated / max(wall, 1e-9):.0f}x real time)")
     if outcome.code:
         print(f"frog-bt: {outcome.reason}", file=sys.stderr)
         return outcome.code
-    print(f"  outcome:   {outcome.reason}")
+    if not summary.complete:
+        print(f"frog-bt: {summary.verdict()}", file=sys.stderr)
+        return 1
     if args.record:
         print(f"  recording: {args.record}  (replay: frog-bt replay {args.record})")
     if rerun and rerun.startswith("save:"):

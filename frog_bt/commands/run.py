@@ -15,15 +15,21 @@ from __future__ import annotations
 import argparse
 import asyncio
 import logging
-import os
 import signal
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from frog_bt import __version__
+from frog_bt.checkpoint import STATE_DIR
+from frog_bt.checkpoint import claim as claim_checkpoint
+from frog_bt.checkpoint import default_path as default_checkpoint
 from frog_bt.clock import SimClock, WallClock
-from frog_bt.config import Site, load_site, parse_hostport
-from frog_bt.errors import DefinitionError
+from frog_bt.commands.options import read_secret, rerun_spec, writable_file
+from frog_bt.config import DEFAULT_CONFIG, Site, check_ws_url, load_site, parse_hostport
+from frog_bt.errors import FrogError, UsageError
+from frog_bt.frontend.link import AddressError
 from frog_bt.tree.loader import DEFAULT_TREE, load_tree
 
 
@@ -45,26 +51,65 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "(default: off)")
     p.add_argument("--once", action="store_true",
                    help="exit 0 after one tour ends docked; non-zero when it cannot go on")
-    p.add_argument("--checkpoint", type=Path, default=DEFAULT_CHECKPOINT, metavar="FILE",
-                   help=f"tour progress, so that a restart resumes the tour (default: "
-                   f"{DEFAULT_CHECKPOINT}); 'none' disables it")
+    p.add_argument("--checkpoint", type=Path, metavar="FILE",
+                   help=f"tour progress, so that a restart resumes the tour (default: one file "
+                   f"per site config and listen address in {STATE_DIR}); 'none' disables it")
     p.add_argument("--fresh", action="store_true",
                    help="ignore the checkpoint: start a fresh tour")
     p.add_argument("--quiet", action="store_true", help="no live status line")
     p.add_argument("-v", "--verbose", action="store_true", help="log at debug level")
 
 
-DEFAULT_CHECKPOINT = Path(os.environ.get("XDG_STATE_HOME", Path.home() / ".local" / "state")
-                          ) / "frog-bt" / "checkpoint.json"
+@dataclass(frozen=True, slots=True)
+class Settings:
+    """Everything ``run`` resolved and checked from its options and the site config."""
+
+    url: str
+    frontend: tuple[str, int]
+    listen: tuple[str, int]
+    checkpoint: Path | None
+    record: Path | None
+    rerun: str | None
+    secret: str | None
 
 
-def read_secret(site: Site) -> str | None:
-    """The rosbridge auth secret: from the configured environment variable, else file."""
-    links = site.links
-    secret = os.environ.get(links.secret_env)
-    if not secret and links.secret_file:
-        secret = Path(links.secret_file).read_text(encoding="utf-8").strip()
-    return secret or None
+def resolve(args: argparse.Namespace, site: Site) -> Settings:
+    """Check every option against the site config's defaults; UsageError on the first bad one."""
+    listen = parse_hostport(args.listen or site.links.listen, "--listen")
+    checkpoint = args.checkpoint
+    if checkpoint is None:
+        checkpoint = default_checkpoint(Path(args.config or DEFAULT_CONFIG), listen)
+    elif str(checkpoint) == "none":
+        checkpoint = None
+    elif checkpoint.is_dir():
+        raise UsageError("--checkpoint", checkpoint, "is a directory; expected a file path")
+    return Settings(
+        url=check_ws_url(args.rosbridge or site.links.rosbridge, "--rosbridge"),
+        frontend=parse_hostport(args.frontend or site.links.frontend, "--frontend"),
+        listen=listen,
+        checkpoint=checkpoint,
+        record=None if args.record is None else writable_file(args.record, "--record"),
+        rerun=rerun_spec(args.rerun),
+        secret=read_secret(site),
+    )
+
+
+def banner(args: argparse.Namespace, settings: Settings) -> list[str]:
+    """What this executive runs and where it talks, for the first lines of its output."""
+    def shown(path: Path | None) -> str:
+        return str(path) if path is not None else "off"
+    return [
+        f"frog-bt {__version__}: tree {args.tree or DEFAULT_TREE}, "
+        f"config {args.config or DEFAULT_CONFIG}",
+        f"  clock {'sim time (/clock)' if args.sim_time else 'wall clock'}; "
+        f"rosbridge {settings.url}{' (auth)' if settings.secret else ''}; "
+        "front end {}:{}; listening on {}:{}".format(*settings.frontend, *settings.listen),
+        f"  checkpoint {shown(settings.checkpoint)}; recording {shown(settings.record)}; "
+        f"telemetry {settings.rerun or 'off'}",
+    ]
+
+
+__all__ = ["add_arguments", "attach_observers", "read_secret", "run"]
 
 
 def attach_observers(executive: Any, *, record: Path | None, rerun: str | None) -> list[Any]:
@@ -91,44 +136,65 @@ def run(args: argparse.Namespace) -> int:
     try:
         site = load_site(args.config)
         tree = load_tree(args.tree, site)
-        frontend = parse_hostport(args.frontend or site.links.frontend, "--frontend")
-        listen = parse_hostport(args.listen or site.links.listen, "--listen")
-        secret = read_secret(site)
-    except (DefinitionError, ValueError, OSError) as exc:
+        settings = resolve(args, site)
+        lock = claim_checkpoint(settings.checkpoint) if settings.checkpoint else None
+    except FrogError as exc:
         print(f"frog-bt: {exc}", file=sys.stderr)
         return 2
+    print("\n".join(banner(args, settings)), flush=True)
+    try:
+        return asyncio.run(_main(args, site, tree, settings))
+    except AddressError as exc:  # the listen port is taken, the front end's host unknown
+        option = "--listen" if exc.which == "listen" else "--frontend"
+        print(f"frog-bt: {option} {exc}", file=sys.stderr)
+        return 2
+    finally:
+        if lock is not None:
+            lock.close()
+
+
+async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Settings) -> int:
     from frog_bt.executive import Executive  # the network stack only when running
     from frog_bt.status import StatusLine
+    from frog_bt.summary import TourSummary
 
     clock = SimClock() if args.sim_time else WallClock()
-
-    async def main() -> int:
-        url = args.rosbridge or site.links.rosbridge
-        executive = Executive(site, tree, clock, rosbridge_url=url, frontend=frontend,
-                              listen=listen, sim_time=args.sim_time, secret=secret,
-                              once=args.once, fresh=args.fresh,
-                              checkpoint=None if str(args.checkpoint) == "none"
-                              else args.checkpoint)
-        loop = asyncio.get_running_loop()
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)
-        status = None if args.quiet else StatusLine()
-        if status is not None:
-            executive.taps.tick.append(status.update)
-        observers = attach_observers(executive, record=args.record, rerun=args.rerun)
-        try:
-            outcome = await executive.run()
-        finally:
-            for observer in observers:
-                observer.close()
-            if status is not None:
-                status.close()
-        if outcome.code:
-            print(f"frog-bt: {outcome.reason}", file=sys.stderr)
-        return outcome.code
-
+    executive = Executive(site, tree, clock, rosbridge_url=settings.url,
+                          frontend=settings.frontend, listen=settings.listen,
+                          sim_time=args.sim_time, secret=settings.secret, once=args.once,
+                          fresh=args.fresh, checkpoint=settings.checkpoint)
+    loop = asyncio.get_running_loop()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)
+    summary = TourSummary(site) if args.once else None
+    if summary is not None:
+        summary.attach(executive.taps)
+    status = None if args.quiet else StatusLine(source=executive.status_text)
+    refresher = None
+    if status is not None:
+        executive.taps.tick.append(status.update)
+        # The tree does not tick while rosbridge is unreachable (or before /clock):
+        # the line must still say what the executive is waiting for.
+        refresher = asyncio.create_task(_refresh(status))
+    observers = attach_observers(executive, record=settings.record, rerun=settings.rerun)
     try:
-        return asyncio.run(main())
-    except OSError as exc:  # e.g. the listen port is taken
-        print(f"frog-bt: {exc}", file=sys.stderr)
-        return 1
+        outcome = await executive.run()
+    finally:
+        if refresher is not None:
+            refresher.cancel()
+        for observer in observers:
+            observer.close()
+        if status is not None:
+            status.close()
+    if summary is not None and executive.core.ticks:
+        print("\n".join("  " + line for line in summary.lines(executive.link.stats)))
+    if outcome.code:
+        print(f"frog-bt: {outcome.reason}", file=sys.stderr)
+    return outcome.code
+
+
+async def _refresh(status: Any, interval: float = 0.5) -> None:
+    """Redraw the status line every ``interval`` wall seconds (display only, not tour time)."""
+    while True:
+        await asyncio.sleep(interval)
+        status.update()

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import errno
 import ipaddress
 import logging
 import socket
@@ -69,6 +70,17 @@ class WarningLimiter:
         log.warning("%s", message)
         self._last[kind] = now
         return True
+
+
+class AddressError(OSError):
+    """The link cannot use an address: ``which`` is ``"listen"`` (cannot bind) or
+    ``"peer"`` (cannot resolve the front end's host); the message says why."""
+
+    def __init__(self, which: str, address: Address, reason: str) -> None:
+        super().__init__(f"{address[0]}:{address[1]}: {reason}")
+        self.which = which
+        self.address = address
+        self.reason = reason
 
 
 class _DatagramProtocol(asyncio.DatagramProtocol):
@@ -133,6 +145,7 @@ class FrontendLink:
         self._closed = asyncio.Event()
         self._closing = False
         self._warnings = WarningLimiter()
+        self._settled = asyncio.Event()  # an ack arrived or a command was given up on
 
     # ------------------------------------------------------------ lifecycle
 
@@ -141,14 +154,19 @@ class FrontendLink:
         if self._transport is not None or self._closing:
             raise RuntimeError("FrontendLink already started or closed")
         loop = asyncio.get_running_loop()
-        transport, _ = await loop.create_datagram_endpoint(
-            lambda: _DatagramProtocol(self), local_addr=self.listen)
+        try:
+            transport, _ = await loop.create_datagram_endpoint(
+                lambda: _DatagramProtocol(self), local_addr=self.listen)
+        except OSError as exc:
+            raise AddressError("listen", self.listen, "cannot listen there: " + _why(exc)
+                               ) from exc
         self._transport = transport
         try:
             host = await _resolve(loop, self.peer, transport.get_extra_info("socket").family)
-        except OSError:
+        except OSError as exc:
             self.close()
-            raise
+            raise AddressError("peer", self.peer, "cannot resolve the host: " + _why(exc)
+                               ) from exc
         # Compare and send by IP: datagram sources are reported as IPs, never names.
         self._endpoint.peer_host = host
         self._peer_addr = (host, self.peer[1])
@@ -168,6 +186,22 @@ class FrontendLink:
             self._transport.close()
         else:
             self._closed.set()
+
+    async def drain(self, timeout: float) -> bool:
+        """Wait, at most ``timeout`` wall seconds, until every command sent has been acked
+        or given up on (resends go on meanwhile); True when none is left.
+
+        Called before :meth:`close` on shutdown, so that the last commands (``tour
+        ended``, ``projector`` off, ``finish_poi``) reach the front end despite loss.
+        """
+        if self._transport is None or self._closing:
+            return self._endpoint.pending == 0
+        with contextlib.suppress(TimeoutError):
+            async with asyncio.timeout(timeout):
+                while self._endpoint.pending:
+                    self._settled.clear()
+                    await self._settled.wait()
+        return self._endpoint.pending == 0
 
     async def wait_closed(self) -> None:
         """Return once :meth:`close` has released the socket and the resend task."""
@@ -236,8 +270,11 @@ class FrontendLink:
                 continue  # an earlier deadline arrived: recompute
             self._sleeping_until = None
             now = self.clock.now()
+            pending = self._endpoint.pending
             for data in self._endpoint.poll(now):
                 self._sendto(data, self._peer_addr, now)
+            if self._endpoint.pending != pending:
+                self._settled.set()  # given up on
 
     async def _sleep_or_wake(self, deadline: float) -> bool:
         """True once the clock reaches ``deadline``; False if woken earlier by :meth:`send`."""
@@ -258,6 +295,8 @@ class FrontendLink:
             self.on_datagram("in", data, now)
         foreign = self._endpoint.stats.foreign
         received = self._endpoint.receive(data, addr[0], now)
+        if received.acked is not None:
+            self._settled.set()
         if received.reply is not None and not self._closing:
             self._sendto(received.reply, addr, now)
         if self._endpoint.stats.foreign != foreign:
@@ -287,6 +326,13 @@ async def _resolve(loop: asyncio.AbstractEventLoop, addr: Address, family: int) 
             raise OSError(f"cannot resolve front-end host {host!r}") from None
         return str(infos[0][4][0])
     return host
+
+
+def _why(exc: OSError) -> str:
+    text = exc.strerror or str(exc)
+    if exc.errno == errno.EADDRINUSE:
+        text += " (is another frog-bt or front end using it?)"
+    return text
 
 
 def _report_crash(task: asyncio.Task[None]) -> None:

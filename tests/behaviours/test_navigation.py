@@ -111,4 +111,4 @@ def test_retry_resends_then_skip_stop(tmp_path):
     bench.ros("response", 4)
     assert bench.tick() == SUCCESS  # skipped: no content
     assert bench.take_sent() == []
-    assert "skip POI3: navigation kept failing" in bench.core.last_note
+    assert "skipped POI3: navigation kept failing" in bench.core.last_note

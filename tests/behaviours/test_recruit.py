@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+import itertools
+
 import py_trees
+import pytest
 from bench import Bench, write_tree
 
+from frog_bt.errors import TreeError
 from frog_bt.frontend.messages import (
     AskTour,
+    Engagement,
     FinishIntroduction,
     StartIntroduction,
     UserNegative,
@@ -64,20 +69,39 @@ def recruit_tree(tmp_path):
                   memory: true
                   children:
                     - {type: StartIntroduction}
-                    - {type: WaitEvent, event: finish_introduction}
+                    - {type: WaitEvent, event: finish_introduction, timeout: introduction,
+                       on_timeout: success}
                     - {type: AskTour}
                     - {type: WaitAnswer}
         """)
 
 
-def test_rejected_approach_seeks_again_and_declined_visitor_is_skipped(tmp_path):
+def test_rejected_approach_seeks_someone_else_and_declined_visitor_is_skipped(tmp_path):
     bench = Bench(recruit_tree(tmp_path))
     bench.pose(0.0, 0.0)
     bench.persons((7, 2.0, 0.0, 180.0), (8, 4.0, 0.0, 170.0))
     bench.tick()
     assert bench.take_published() == [("/ApproachPeopleFar", {"data": 7})]
-    bench.ros("response", 4)  # rejected: seek again, same nearest visitor
+    bench.ros("response", 4)  # rejected: seek again, someone else (7 cools down)
     bench.tick()
+    bench.tick()
+    assert bench.take_published() == []  # not before recruit.approach_interval (5 s)
+    bench.advance(4.9)
+    bench.persons((7, 2.0, 0.0, 180.0), (8, 4.0, 0.0, 170.0))
+    bench.tick()
+    assert bench.take_published() == []
+    bench.advance(0.1)
+    bench.persons((7, 2.0, 0.0, 180.0), (8, 4.0, 0.0, 170.0))
+    bench.tick()
+    assert bench.take_published() == [("/ApproachPeopleFar", {"data": 8})]
+    bench.ros("response", 3)  # 8 fails too: 7 is still cooling down, nobody to approach
+    bench.tick()
+    bench.advance(30)
+    bench.persons((7, 2.0, 0.0, 180.0), (8, 4.0, 0.0, 170.0))
+    bench.tick()
+    assert bench.take_published() == []
+    bench.advance(30)  # 60 s (recruit.retry_after) since 7 failed: 7 again
+    bench.persons((7, 2.0, 0.0, 180.0), (8, 4.0, 0.0, 170.0))
     bench.tick()
     assert bench.take_published() == [("/ApproachPeopleFar", {"data": 7})]
     bench.ros("response", 2)
@@ -90,6 +114,7 @@ def test_rejected_approach_seeks_again_and_declined_visitor_is_skipped(tmp_path)
     bench.event(UserNegative())
     bench.tick()  # declined: face stream stopped, 7 excluded
     assert bench.take_published() == [("/ICL_command", {"data": "stop"})]
+    bench.advance(5)  # the approach interval since the approach of 7
     bench.persons((7, 2.0, 0.0, 180.0), (8, 4.0, 0.0, 170.0))
     bench.tick()
     assert bench.take_published() == [("/ApproachPeopleFar", {"data": 8})]
@@ -114,6 +139,51 @@ def test_face_stream_is_stopped_when_the_scope_is_interrupted(tmp_path):
     assert bench.take_published() == [("/ICL_command", {"data": "stop"})]
     bench.core.halt()  # a second halt sends nothing more
     assert bench.take_published() == []
+
+
+def test_a_person_whose_approach_always_fails_is_approached_once_a_minute(tmp_path):
+    bench = Bench(recruit_tree(tmp_path))
+    bench.pose(0.0, 0.0)
+    sent = []
+    t0 = bench.clock.now()
+    for _ in range(3000):  # 5 minutes at 10 Hz
+        bench.persons((7, 2.0, 0.0, 180.0))
+        bench.tick()
+        for topic, msg in bench.take_published():
+            sent.append((round(bench.clock.now() - t0, 1), topic, msg["data"]))
+            bench.ros("response", 4)
+        bench.advance(0.1)
+    # the failure is seen a tick or two after the approach; 60 s from then on
+    times = [t for t, *_ in sent]
+    assert len(times) == 5
+    assert all(60 < b - a <= 60.3 for a, b in itertools.pairwise(times))
+    assert {(topic, data) for _, topic, data in sent} == {("/ApproachPeopleFar", 7)}
+    assert "approach of visitor 7 aborted: seek again (not them for 60 s)" in [
+        text for _, text in bench.core.ctx.notes]
+
+
+def test_lost_finish_introduction_asks_the_visitor_after_the_timeout(tmp_path):
+    bench = Bench(recruit_tree(tmp_path))
+    bench.pose(0.0, 0.0)
+    bench.persons((7, 2.0, 0.0, 180.0))
+    bench.tick()
+    bench.ros("response", 2)
+    bench.tick()
+    assert bench.take_sent() == [StartIntroduction(icl=True)]
+    bench.advance(299.9)  # site timeouts.introduction is 300 s
+    bench.tick()
+    assert [m for m in bench.take_sent() if not isinstance(m, Engagement)] == []
+    bench.advance(0.1)
+    bench.tick()
+    assert [m for m in bench.take_sent() if not isinstance(m, Engagement)] == [
+        AskTour(engaged=None)]
+    kinds = [i.kind for i in bench.core.ctx.incidents]
+    assert kinds == ["event missing"]
+
+
+def test_a_wait_without_a_bound_is_a_load_error(tmp_path):
+    with pytest.raises(TreeError, match=r"root\.timeout: missing required key"):
+        Bench(write_tree(tmp_path, "root: {type: WaitEvent, event: finish_introduction}"))
 
 
 def test_finish_introduction_that_came_before_the_wait_does_not_count(tmp_path):

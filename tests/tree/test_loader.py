@@ -54,12 +54,12 @@ def test_the_shipped_tour_loads_and_has_every_stop(site):
     ("root: {type: Sequence, memory: true, children: [{type: WaitAnswer}]}",
      "t.yaml: root.children[0]: WaitAnswer reads /visitor, which nothing writes"),
     ("root: {type: Sequence, memory: true, children: [{include: missing.yaml}]}",
-     "missing.yaml: <top>: cannot read"),
+     "missing.yaml: cannot read"),
     ("root: {type: FinishPoi, poi: '{place}'}", "t.yaml: root.poi: unknown variable 'place'"),
     ("root: {type: FinishPoi, poi: POI1, when: sunny}", "t.yaml: root.when: unknown variable"),
     ("rot: {type: FinishPoi, poi: POI1}", "t.yaml: rot: unknown key"),
     ("root: [1, 2]", "t.yaml: root: expected a node (a mapping), got [1, 2]"),
-    ("root: {type: Sequence, memory: true\n", "t.yaml: <top>: not valid YAML: line"),
+    ("root: {type: Sequence, memory: true\n", "t.yaml: not valid YAML: line"),
 ])
 def test_errors_name_file_path_and_expectation(tmp_path, site, text, expected):
     assert expected in error_of(tmp_path, text, site)
