@@ -5,7 +5,10 @@ from __future__ import annotations
 import json
 import time
 
-from frog_bt.checkpoint import Progress, load, save
+import pytest
+
+from frog_bt.checkpoint import Progress, Resume, claim, default_path, load, save
+from frog_bt.errors import UsageError
 
 
 def test_progress_round_trips_and_an_empty_one_removes_the_file(tmp_path):
@@ -41,3 +44,34 @@ def test_old_unreadable_or_foreign_checkpoints_are_not_resumed(tmp_path):
         path.write_text(text)
         assert load(path) is None
     assert load(tmp_path / "missing.json") is None
+
+
+def test_default_checkpoints_are_per_site_config_and_listen_address(tmp_path):
+    site_a, site_b = tmp_path / "a.yaml", tmp_path / "b.yaml"
+    paths = {default_path(site, listen, tmp_path)
+             for site in (site_a, site_b)
+             for listen in (("127.0.0.1", 5006), ("127.0.0.1", 5016))}
+    assert len(paths) == 4
+    assert default_path(site_a, ("127.0.0.1", 5006), tmp_path) == default_path(
+        tmp_path / "." / "a.yaml", ("127.0.0.1", 5006), tmp_path)
+
+
+def test_a_claimed_checkpoint_cannot_be_claimed_again_until_released(tmp_path):
+    path = tmp_path / "state" / "cp.json"
+    first = claim(path)
+    with pytest.raises(UsageError, match="in use by another running executive"):
+        claim(path)
+    first.close()
+    claim(path).close()
+
+
+def test_resume_is_announced_where_the_tour_picks_up_and_how_old_it_is():
+    stops = ["POI1", "POI2", "POI3"]
+    resume = Resume({"start", "recruit", "stop 0"}, 7, ["start", "recruit", "stop 0"], 1000.0)
+    assert resume.announce(stops, now=1180.0) == (
+        "resuming the tour at POI2: checkpoint 3 min old")
+    assert Resume(set(), None, ["start", "recruit"], 1000.0).announce(stops, 1010.0) == (
+        "resuming the tour at POI1: checkpoint 10 s old")
+    assert Resume(set(), None, ["start"], 0.0).where(stops) == "at the recruitment"
+    assert Resume(set(), None, ["start", "recruit", "stop 2"], 0.0).where(stops) == (
+        "on the way back to the dock")

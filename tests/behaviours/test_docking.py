@@ -47,3 +47,15 @@ def test_already_undocked_sends_nothing(tmp_path):
     bench.ros("docking_state", "undocked")
     assert bench.tick() == SUCCESS
     assert bench.take_published() == []
+
+
+def test_dock_gives_up_after_the_site_timeout_without_a_docked_state(tmp_path):
+    bench = Bench(write_tree(tmp_path, "root: {type: Docking, action: dock}"))
+    bench.ros("docking_state", "undocked")
+    assert bench.tick() == RUNNING
+    bench.ros("docking_state", "docking")
+    bench.advance(119.9)  # site timeouts.dock is 120 s
+    assert bench.tick() == RUNNING
+    bench.advance(0.1)
+    assert bench.tick() == FAILURE
+    assert [i.text for i in bench.core.ctx.incidents] == ["dock: no docked within 120 s"]

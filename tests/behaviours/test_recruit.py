@@ -193,3 +193,32 @@ def test_finish_introduction_that_came_before_the_wait_does_not_count(tmp_path):
     bench.tick()  # the event arrived before the leaf started: not this one
     bench.advance(5)
     assert bench.tick() == FAILURE
+
+
+def test_no_answer_within_the_site_timeout_declines_and_seeks_again(tmp_path):
+    bench = Bench(write_tree(tmp_path, "root: {type: Sequence, memory: true, children: ["
+                             "{type: SeekVisitor}, {type: WaitAnswer}]}"))
+    bench.pose(0.0, 0.0)
+    bench.persons((7, 2.0, 0.0, 180.0))
+    assert bench.tick() == RUNNING
+    bench.advance(119.9)  # site timeouts.answer is 120 s
+    assert bench.tick() == RUNNING
+    bench.advance(0.1)
+    assert bench.tick() == FAILURE
+    assert py_trees.blackboard.Blackboard.storage["/declined"] == frozenset({7})
+    assert bench.core.ctx.incidents[-1].text == (
+        "visitor 7 gave no answer within 120 s: seek again")
+
+
+def test_an_unanswered_approach_fails_after_the_site_timeout(tmp_path):
+    bench = Bench(write_tree(tmp_path, "root: {type: Sequence, memory: true, children: ["
+                             "{type: SeekVisitor}, {type: ApproachVisitor}]}"))
+    bench.pose(0.0, 0.0)
+    bench.persons((7, 2.0, 0.0, 180.0))
+    bench.tick()
+    assert bench.take_published() == [("/ApproachPeopleFar", {"data": 7})]
+    bench.advance(119.9)  # site timeouts.approach is 120 s
+    assert bench.tick() == RUNNING
+    bench.advance(0.1)
+    assert bench.tick() == FAILURE
+    assert bench.core.ctx.incidents[-1].kind == "approach failed"

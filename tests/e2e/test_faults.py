@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import re
 import time
 
 from tour import Running, describe, fast
@@ -104,7 +105,7 @@ def test_docking_failure_is_retried_then_stops_with_a_reason():
     assert (code, reason) == (1, "dock failed")
 
 
-async def _crash_and_resume(tmp_path) -> tuple[list[str], list[str], int]:
+async def _crash_and_resume(tmp_path) -> tuple[list[str], list[str], int, list[str]]:
     checkpoint = tmp_path / "checkpoint.json"
     async with Running({}, checkpoint=checkpoint) as first:
         sim, listen = first.sim, first.listen
@@ -118,13 +119,18 @@ async def _crash_and_resume(tmp_path) -> tuple[list[str], list[str], int]:
     async with Running({}, sim=sim, listen=listen, checkpoint=checkpoint, once=True) as second:
         outcome = await second.finish()
         resumed = commands_after(second, restart_t)
+        announced = second.summary.lines()
     await sim.stop()
-    return resumed, [describe(r, second.summary) for r in sim.received("tour")], outcome.code
+    return resumed, [describe(r, second.summary) for r in sim.received("tour")], outcome.code, \
+        announced
 
 
 def test_a_restarted_executive_resumes_the_tour_at_the_current_stop(tmp_path):
-    resumed, tours, code = asyncio.run(_crash_and_resume(tmp_path))
+    resumed, tours, code, summary = asyncio.run(_crash_and_resume(tmp_path))
     assert code == 0
+    resumed_line = next(line for line in summary if line.startswith("resumed:"))
+    assert re.fullmatch(r"resumed:   resuming the tour at POI2: checkpoint \d s old",
+                        resumed_line)
     gotos = [c for c in resumed if c.startswith("/GotoWayPoint")]
     assert gotos[0] == "/GotoWayPoint POI2a"  # re-navigates to the current stop
     assert "/docking/dock undock" not in resumed and not any(

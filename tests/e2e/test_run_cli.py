@@ -3,15 +3,30 @@
 from __future__ import annotations
 
 import asyncio
+import contextlib
+import os
+import socket
 import subprocess
 import sys
 
+import pytest
 from tour import fast, free_udp_port
 
+from frog_bt.checkpoint import claim
+from frog_bt.config import DEFAULT_CONFIG as CONFIG
 from frog_bt.sim import Simulator
 
 
-async def _run_once() -> tuple[int, bytes, list[str]]:
+@contextlib.contextmanager
+def checkpoint_claim(path):
+    handle = claim(path)
+    try:
+        yield handle
+    finally:
+        handle.close()
+
+
+async def _run_once() -> tuple[int, bytes, list[str], str]:
     scenario = fast()
     listen = free_udp_port()
     sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=("127.0.0.1", listen))
@@ -22,18 +37,23 @@ async def _run_once() -> tuple[int, bytes, list[str]]:
             "--checkpoint", "none",
             "--rosbridge", f"ws://127.0.0.1:{sim.rosbridge_port}",
             "--frontend", f"127.0.0.1:{sim.frontend_port}", "--listen", f"127.0.0.1:{listen}",
-            stderr=asyncio.subprocess.PIPE)
-        _, stderr = await asyncio.wait_for(proc.communicate(), 90)
+            stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE)
+        stdout, stderr = await asyncio.wait_for(proc.communicate(), 90)
         tours = [r.payload["state"] for r in sim.received("tour")]
-        return proc.returncode or 0, stderr, tours
+        return proc.returncode or 0, stderr, tours, stdout.decode()
     finally:
         await sim.stop()
 
 
 def test_run_once_exits_0_after_one_tour_ends_docked():
-    code, stderr, tours = asyncio.run(_run_once())
+    code, stderr, tours, stdout = asyncio.run(_run_once())
     assert code == 0, stderr.decode()
     assert tours == ["started", "ended"]
+    banner = stdout.splitlines()[:3]
+    assert banner[0].startswith("frog-bt 0.1.0: tree ") and "tour.yaml, config " in banner[0]
+    assert banner[1].startswith("  clock sim time (/clock); rosbridge ws://127.0.0.1:")
+    assert banner[2] == "  checkpoint off; recording off; telemetry off"
+    assert "  outcome:   tour ended docked, every stop visited" in stdout.splitlines()
 
 
 def test_bad_config_is_one_line_and_exit_2(tmp_path):
@@ -44,3 +64,80 @@ def test_bad_config_is_one_line_and_exit_2(tmp_path):
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == [
         f"frog-bt: {bad}: tour.dock: unknown POI 'SHOP' (no POIs are defined)"]
+
+
+def _run(*argv: str, cwd=None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "frog_bt", "run", "--quiet", "--once", *argv],
+                          capture_output=True, text=True, timeout=30, cwd=cwd)
+
+
+@pytest.mark.parametrize(("argv", "line"), [
+    (["--rosbridge", "127.0.0.1:9090"],
+     "--rosbridge 127.0.0.1:9090: expected ws://HOST:PORT, e.g. ws://127.0.0.1:9090"),
+    (["--rosbridge", "http://127.0.0.1:9090"],
+     "--rosbridge http://127.0.0.1:9090: expected ws://HOST:PORT, e.g. ws://127.0.0.1:9090 "
+     "(not http://)"),
+    (["--rosbridge", "ws://127.0.0.1:90900"],
+     "--rosbridge ws://127.0.0.1:90900: expected ws://HOST:PORT, e.g. ws://127.0.0.1:9090 "
+     "(Port out of range 0-65535)"),
+    (["--frontend", "127.0.0.1"], "--frontend 127.0.0.1: expected HOST:PORT (e.g. 127.0.0.1:5005)"),
+    (["--listen", "127.0.0.1:http"],
+     "--listen 127.0.0.1:http: expected HOST:PORT with a port from 0 to 65535, got port 'http'"),
+    (["--listen", "no-such-host.invalid:5006"],
+     "--listen no-such-host.invalid:5006: cannot listen there: "),
+    (["--frontend", "no-such-host.invalid:5005"],
+     "--frontend no-such-host.invalid:5005: cannot resolve the host: "),
+    (["--checkpoint", "/dev/null/checkpoint.json"],
+     "--checkpoint /dev/null/checkpoint.json: cannot write there: /dev/null is not a directory"),
+    (["--record", "/no/such/dir/tour.mcap"],
+     "--record /no/such/dir/tour.mcap: cannot write there: /no/such/dir does not exist"),
+    (["--rerun", "save:/no/such/dir/t.rrd"],
+     "--rerun save:/no/such/dir/t.rrd: cannot write there: /no/such/dir does not exist"),
+    (["--rerun", "bogus"],
+     "--rerun bogus: expected spawn, save:FILE.rrd, connect[:URL], serve or off"),
+    (["--config", "/no/such/site.yaml"],
+     "/no/such/site.yaml: cannot read: No such file or directory"),
+    (["--tree", "/no/such/tour.yaml"],
+     "/no/such/tour.yaml: cannot read: No such file or directory"),
+])
+def test_user_errors_are_one_line_naming_the_option_and_exit_2(tmp_path, argv, line):
+    # no free port is needed: each error is found before anything connects or binds,
+    # except the listen/frontend host ones, which fail resolving a name that cannot exist
+    if "--checkpoint" not in argv:
+        argv = ["--checkpoint", "none", *argv]
+    result = _run(*argv, cwd=tmp_path)
+    lines = result.stderr.strip().splitlines()
+    assert result.returncode == 2, result.stderr
+    assert len(lines) == 1 and lines[0].startswith(f"frog-bt: {line}"), result.stderr
+    assert "Traceback" not in result.stdout + result.stderr
+
+
+def test_a_listen_port_in_use_is_one_line_and_exit_2(tmp_path):
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as taken:
+        taken.bind(("127.0.0.1", 0))
+        port = taken.getsockname()[1]
+        result = _run("--checkpoint", "none", "--listen", f"127.0.0.1:{port}", cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == [
+        f"frog-bt: --listen 127.0.0.1:{port}: cannot listen there: Address already in use "
+        "(is another frog-bt or front end using it?)"]
+
+
+def test_a_bad_rosbridge_url_in_the_site_config_names_its_path(tmp_path):
+    site = tmp_path / "site.yaml"
+    site.write_text(CONFIG.read_text().replace("rosbridge: ws://127.0.0.1:9090",
+                                               "rosbridge: 127.0.0.1:9090"))
+    result = _run("--config", str(site), "--checkpoint", "none", cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == [
+        f"frog-bt: {site}: links.rosbridge: expected ws://HOST:PORT, e.g. ws://127.0.0.1:9090"]
+
+
+def test_two_executives_never_share_a_checkpoint(tmp_path):
+    checkpoint = tmp_path / "cp.json"
+    with checkpoint_claim(checkpoint):
+        result = _run("--checkpoint", str(checkpoint), cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == [
+        f"frog-bt: --checkpoint {checkpoint}: in use by another running executive "
+        f"(pid {os.getpid()}); give each executive its own --checkpoint"]

@@ -1,0 +1,20 @@
+"""The status line says what the executive waits for while the tree cannot tick."""
+
+from __future__ import annotations
+
+from frog_bt.rosbridge.link import LinkState
+from frog_bt.status import link_line
+
+
+def test_unreachable_rosbridge_is_named_with_attempt_delay_and_plain_reason():
+    down = LinkState(connected=False, since=0.0, last_error="ConnectionRefusedError: [Errno 111] "
+                     "Connect call failed ('127.0.0.1', 9090)")
+    line = link_line("ws://frog:9090", down)
+    assert line == "rosbridge: connecting to ws://frog:9090: connection refused"
+
+
+def test_connected_link_leaves_the_line_to_the_tree_unless_waiting_for_clock():
+    up = LinkState(connected=True, since=0.0)
+    assert link_line("ws://frog:9090", up) is None
+    assert link_line("ws://frog:9090", up, clock_ready=False) == (
+        "rosbridge: connected to ws://frog:9090, waiting for /clock")
