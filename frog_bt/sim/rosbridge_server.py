@@ -63,7 +63,9 @@ class RosbridgeServer:
         """Listen (again: on the port bound the first time)."""
         if self._server is not None:
             return
-        self._server = await serve(self._handle, self.host, self.port, max_size=MAX_FRAME_BYTES)
+        # No permessage-deflate: loopback needs no compression, and it costs per frame.
+        self._server = await serve(self._handle, self.host, self.port, max_size=MAX_FRAME_BYTES,
+                                   compression=None)
         self.port = next(iter(self._server.sockets)).getsockname()[1]
         log.info("rosbridge listening on ws://%s:%d", self.host, self.port)
 
