@@ -45,6 +45,8 @@ class Context:
     incidents: list[Incident] = field(default_factory=list)
     incident_total: int = 0  # incidents ever recorded (the list keeps the latest)
     gave_up: str | None = None  # why the tree gave up (GiveUp): the executive's exit reason
+    tour_state: str | None = None  # the latest ``tour`` state sent: started, ended, aborted
+    tour_reason: str = ""  # and its reason
     note_limit: int = 1000
 
     def note(self, text: str, incident: IncidentKind | None = None, subject: str = "") -> None:

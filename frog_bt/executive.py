@@ -206,9 +206,9 @@ class Executive:
                     "checkpoint", f"cannot write the checkpoint {self.checkpoint}: "
                                   f"{exc.strerror or exc}")
         if status == Status.SUCCESS:
-            storage = py_trees.blackboard.Blackboard.storage
-            if storage.get("/tour_state") == "aborted":
-                reason = f"tour aborted: {storage.get('/abort_reason_last') or self.core.last_note}"
+            ctx = self.core.ctx
+            if ctx.tour_state == "aborted":
+                reason = f"tour aborted: {ctx.tour_reason or self.core.last_note}"
                 log.warning("%s", reason)
                 if self.once:
                     self.stop(reason, 1)

@@ -71,6 +71,7 @@ class TourStatus(Leaf):
             self.ctx.progress.clear()
         self.set("/frontend_ready", False)
         self.set("/tour_state", p.state)
+        self.ctx.tour_state, self.ctx.tour_reason = p.state, reason
         if p.state == "started":
             self.set("/declined", frozenset())
             self.set("/special_done", frozenset())
