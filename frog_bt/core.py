@@ -9,7 +9,6 @@ so the same tick code runs everywhere.
 
 from __future__ import annotations
 
-import functools
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -24,6 +23,7 @@ from frog_bt.config import Site
 from frog_bt.context import Context
 from frog_bt.frontend.messages import FrontendMessage
 from frog_bt.topics import INPUTS
+from frog_bt.tree import observed, ticking
 from frog_bt.tree.loader import LoadedTree
 
 log = logging.getLogger(__name__)
@@ -33,12 +33,6 @@ Status = py_trees.common.Status
 NO_TICK_ROLES = frozenset({"pose", "faces", "people"})
 Tap = Callable[[float, str, Any], None]  # (project-clock time, channel, payload)
 Behaviour = py_trees.behaviour.Behaviour
-
-
-def _stop_noting(stop: Callable[..., None], node: Behaviour, touched: list[Behaviour],
-                 *args: Any, **kwargs: Any) -> None:
-    touched.append(node)
-    stop(node, *args, **kwargs)
 
 
 @dataclass(slots=True)
@@ -81,9 +75,7 @@ class Core:
         # changed is among them (a status changes only in its node's tick or in stop()),
         # so observers can follow the tree in O(active path) rather than O(tree).
         self.touched: list[Behaviour] = []
-        for node in tree.root.iterate():
-            # the class's own stop, so that a tree reused by a later Core is not wrapped twice
-            node.stop = functools.partial(_stop_noting, type(node).stop, node, self.touched)
+        observed.attach(tree.root, self.touched)
 
     def _publish(self, role: str, msg: dict[str, Any]) -> None:
         topic = self.site.topic(role)
@@ -139,21 +131,8 @@ class Core:
     def tick(self) -> Status:
         """Snapshot the inputs, tick the tree once, run the tick taps; the root's status."""
         self.setup()
-        bt, touched = self.bt, self.touched
-        if bt.visitors:
-            bt.tick()
-            touched.extend(bt.root.iterate())
-        else:
-            # BehaviourTree.tick walks the *whole* tree after every tick for its "full"
-            # visitors, even when there are none: a cost that grows with the tour, not with
-            # the active path. Without visitors, tick the root directly (same order:
-            # pre-tick handlers, the tick, post-tick handlers).
-            for handler in bt.pre_tick_handlers:
-                handler(bt)
-            touched.extend(bt.root.tick())  # every node ticked is yielded
-            for handler in bt.post_tick_handlers:
-                handler(bt)
-            bt.count += 1
+        touched = self.touched
+        touched.extend(ticking.tick(self.bt))  # stopped nodes are already in it
         self.ticks += 1
         for tap in self.taps.tick:
             tap(self)

@@ -23,9 +23,10 @@ import py_trees
 from pydantic import BaseModel, Field
 
 from frog_bt.tree.node import FAILURE, RUNNING, SUCCESS, Declared, Params, Status
+from frog_bt.tree.observed import Observed
 
 
-class FrogDecorator(Declared, py_trees.decorators.Decorator):
+class FrogDecorator(Observed, Declared, py_trees.decorators.Decorator):
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour,
                  params: BaseModel | None = None) -> None:
         super().__init__(name=name, child=child)

@@ -28,12 +28,13 @@ from frog_bt.tree.node import (
     Params,
     Status,
 )
+from frog_bt.tree.observed import Observed
 
 __all__ = ["FAILURE", "INVALID", "LEAVES", "RUNNING", "SUCCESS", "Leaf", "Params", "Status",
            "register"]
 
 
-class Leaf(Declared, py_trees.behaviour.Behaviour):
+class Leaf(Observed, Declared, py_trees.behaviour.Behaviour):
     def __init__(self, name: str, params: BaseModel | None = None) -> None:
         super().__init__(name)
         self._declare(params)

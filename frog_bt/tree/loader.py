@@ -45,6 +45,7 @@ from frog_bt.config import Site
 from frog_bt.errors import TreeError
 from frog_bt.tree.decorators import DECORATORS
 from frog_bt.tree.leaf import LEAVES
+from frog_bt.tree.observed import Parallel, Selector, Sequence
 from frog_bt.yamlfile import load_yaml, validate
 
 DEFAULT_TREE_DIR = Path(__file__).resolve().parent.parent.parent / "trees"
@@ -170,7 +171,7 @@ class _Builder:
             pol = (py_trees.common.ParallelPolicy.SuccessOnAll(synchronise=sync)
                    if policy == "all" else
                    py_trees.common.ParallelPolicy.SuccessOnOne())
-            return py_trees.composites.Parallel(name, policy=pol, children=children)
+            return Parallel(name, policy=pol, children=children)
         if "memory" not in data:
             raise TreeError(file, (*path, "memory"),
                             f"missing required key: a {type_} must say memory: true or false")
@@ -178,7 +179,7 @@ class _Builder:
         if not isinstance(memory, bool):
             raise TreeError(file, (*path, "memory"),
                             f"expected true or false, got {_short(memory)}")
-        cls = py_trees.composites.Sequence if type_ == "Sequence" else py_trees.composites.Selector
+        cls = Sequence if type_ == "Sequence" else Selector
         return cls(name, memory=memory, children=children)
 
     def _decorator(self, type_: str, data: dict[str, Any], file: str, path: Path_,
