@@ -108,10 +108,15 @@ def _int_any(obj: Mapping[str, Any], key: str, path: Path) -> int:
 
 
 def encode_time(t: float) -> dict[str, int]:
-    """ROS 1 time shape, which CONTRACT §1 says the executive sends."""
+    """ROS 1 time shape ``{secs, nsecs}``, which CONTRACT §1 says the executive sends,
+    to the microsecond: an epoch time as a float is only good to about 0.2 µs, so
+    10:30:00.1 would otherwise read 10:30:00.099999905. The one time encoder (the
+    simulator uses it too)."""
     secs = math.floor(t)
-    nsecs = min(round((t - secs) * 1e9), 999_999_999)
-    return {"secs": int(secs), "nsecs": int(nsecs)}
+    usecs = round((t - secs) * 1e6)
+    if usecs >= 1_000_000:
+        secs, usecs = secs + 1, 0
+    return {"secs": int(secs), "nsecs": int(usecs) * 1000}
 
 
 def _header(obj: Mapping[str, Any], path: Path) -> tuple[float, str]:

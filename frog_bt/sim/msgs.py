@@ -14,12 +14,11 @@ that ``decode_x(x(stamp, items))`` gives the items back.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from frog_bt.messages import encode_pose
+from frog_bt.messages import encode_pose, encode_time
 
 __all__ = [
     "DiagnosticStatus",
@@ -29,7 +28,6 @@ __all__ = [
     "header",
     "person_detections",
     "pose_stamped",
-    "ros_time",
     "tracked_people",
 ]
 
@@ -45,22 +43,9 @@ class DiagnosticStatus:
     values: tuple[tuple[str, str], ...] = ()
 
 
-def ros_time(t: float) -> dict[str, int]:
-    """ROS 1 time ``{secs, nsecs}``, to the microsecond.
-
-    An epoch time as a float is only good to about 0.2 us, so 10:30:00.1
-    would otherwise read 10:30:00.099999905.
-    """
-    secs = math.floor(t)
-    usecs = round((t - secs) * 1e6)
-    if usecs >= 1_000_000:
-        secs, usecs = secs + 1, 0
-    return {"secs": int(secs), "nsecs": int(usecs) * 1000}
-
-
 def header(t: float, frame_id: str = "", seq: int = 0) -> dict[str, Any]:
     """``std_msgs/Header`` (ROS 1 time shape)."""
-    return {"seq": int(seq), "stamp": ros_time(t), "frame_id": frame_id}
+    return {"seq": int(seq), "stamp": encode_time(t), "frame_id": frame_id}
 
 
 def _get(item: Any, name: str) -> Any:
@@ -132,4 +117,4 @@ def pose_stamped(x: float, y: float, qz: float, qw: float, t: float) -> dict[str
 
 def clock(t: float) -> dict[str, Any]:
     """``rosgraph_msgs/Clock``: ``{clock: {secs, nsecs}}``."""
-    return {"clock": ros_time(t)}
+    return {"clock": encode_time(t)}
