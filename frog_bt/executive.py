@@ -111,7 +111,7 @@ class Executive:
         actions = self.core.actions
         if not state.connected:
             self._pending_at_loss = actions.pending
-            self._refusals = self._refusals + 1 if "1008" in (state.last_error or "") else 0
+            self._refusals = self._refusals + 1 if state.refused else 0
             if self._refusals >= 3 and self.once:
                 self.stop("rosbridge refused authentication (check the secret)", 1)
         elif (state.reconnects > 0 and actions.pending is not None

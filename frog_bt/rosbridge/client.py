@@ -101,6 +101,7 @@ class RosbridgeClient:
         queue_limit: int = 1000,
         backoff_initial: float = 0.25,
         backoff_max: float = 5.0,
+        stable_after: float = 5.0,
         on_message: Callable[[str, Any], None] | None = None,
         on_link: Callable[[LinkState], None] | None = None,
         on_raw: Callable[[str, Any], None] | None = None,
@@ -117,6 +118,9 @@ class RosbridgeClient:
         self.url = url
         self.backoff_initial = backoff_initial
         self.backoff_max = backoff_max
+        # A connection that ends sooner, with nothing received on it, was not a success (a
+        # refused auth is a close right after the handshake): the backoff goes on growing.
+        self.stable_after = stable_after
         self.on_message = on_message
         self.on_link = on_link
         self.on_raw = on_raw  # (topic, msg JSON) of every publish on a subscribed topic
@@ -133,6 +137,7 @@ class RosbridgeClient:
         self._loop_task: asyncio.Task[None] | None = None
         self._run_task: asyncio.Task[None] | None = None
         self._ws: ClientConnection | None = None  # the current connection
+        self._heard = 0
 
     # ------------------------------------------------------------ program side
 
@@ -246,13 +251,16 @@ class RosbridgeClient:
         # Clock: under --sim-time the link IS the source of /clock, so a sim
         # clock would stand still exactly while the link is down.
         delays = backoff_delays(self.backoff_initial, self.backoff_max)
+        attempt = 1
         while True:
             error: str | None = None
+            up_at: float | None = None
+            delay = 0.0
             try:
                 async with connect(self.url, proxy=None, max_size=_MAX_WS_MESSAGE,
                                    open_timeout=10, close_timeout=2) as ws:
+                    up_at = time.monotonic()
                     self._on_up(ws)
-                    delays = backoff_delays(self.backoff_initial, self.backoff_max)  # reset
                     error = await self._serve(ws)
                     if self._closing:
                         error = None  # close(): not an error
@@ -266,10 +274,22 @@ class RosbridgeClient:
                 log.exception("rosbridge %s: unexpected error", self.url)
             finally:
                 self._ws = None
-                self._on_down(error)
+                # A connection worked if the server said anything on it, or if it stayed up.
+                stable = up_at is not None and (
+                    self._heard > 0 or time.monotonic() - up_at >= self.stable_after)
+                if stable:
+                    delays = backoff_delays(self.backoff_initial, self.backoff_max)  # reset
+                    attempt = 1
+                else:
+                    attempt += 1
+                delay = next(delays)
+                # A server refuses an auth by closing at once, having sent nothing.
+                refused = (up_at is not None and not stable and not self._closing
+                           and self.session.secret is not None)
+                self._on_down(error, attempt, time.monotonic() + delay, refused)
             if self._closing:
                 return
-            await asyncio.sleep(next(delays))
+            await asyncio.sleep(delay)
 
     async def _serve(self, ws: ClientConnection) -> str:
         """Run reader and writer until the connection ends; say why it ended."""
@@ -316,6 +336,7 @@ class RosbridgeClient:
             self.session.client_addr = str(ws.local_address[0])
             self.session.dest_addr = str(ws.remote_address[0])
         self._ws = ws
+        self._heard = 0  # frames received on this connection
         self._outbox.clear()
         self._enqueue(self.session.on_connected(time.time()))
         if self._ever_connected:
@@ -325,7 +346,8 @@ class RosbridgeClient:
         log.info("rosbridge %s: connected", self.url)
         self._set_link(True, None)
 
-    def _on_down(self, error: str | None) -> None:
+    def _on_down(self, error: str | None, attempt: int = 0, retry_at: float | None = None,
+                 refused: bool = False) -> None:
         pending = list(self._outbox)
         self._outbox.clear()
         self.session.on_disconnected()
@@ -334,15 +356,20 @@ class RosbridgeClient:
         for text in pending:  # publishes that never made it: back into the Session's queue
             self._requeue(text)
         self._note_dropped(dropped)
+        if self._closing:
+            retry_at = None
+        if refused:
+            error = f"{error or 'closed'}, right after connecting: authentication refused?"
         if self._link.connected:
             if error is None:
                 log.info("rosbridge %s: closed", self.url)
             else:
                 log.warning("rosbridge %s: link lost: %s", self.url, error)
-            self._set_link(False, error)
+            self._set_link(False, error, attempt, retry_at, refused)
         elif error is not None:
             self.stats.connect_failures += 1
-            self._link = replace(self._link, last_error=error)
+            self._link = replace(self._link, last_error=error, attempt=attempt,
+                                 retry_at=retry_at, refused=False)
             self._warn("connect", "rosbridge %s: cannot connect: %s", self.url, error)
 
     def _requeue(self, text: str) -> None:
@@ -352,8 +379,10 @@ class RosbridgeClient:
         with contextlib.suppress(ValueError):  # unadvertised meanwhile: drop it
             self.session.publish(frame["topic"], frame["msg"])
 
-    def _set_link(self, connected: bool, error: str | None) -> None:
-        self._link = LinkState(connected, time.monotonic(), self.stats.reconnects, error)
+    def _set_link(self, connected: bool, error: str | None, attempt: int = 0,
+                  retry_at: float | None = None, refused: bool = False) -> None:
+        self._link = LinkState(connected, time.monotonic(), self.stats.reconnects, error,
+                               attempt, retry_at, refused)
         if self.on_link is not None:
             try:
                 self.on_link(self._link)
@@ -364,6 +393,7 @@ class RosbridgeClient:
 
     def _on_frame(self, frame: str | bytes) -> None:
         self.stats.received += 1
+        self._heard += 1
         try:
             event = decode_frame(frame)
         except DecodeError as exc:

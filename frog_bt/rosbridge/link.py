@@ -8,6 +8,7 @@ the network adapter.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 
@@ -21,12 +22,27 @@ class LinkState:
     first. ``last_error`` says why the link is down or why the latest attempt
     to connect failed; it is ``None`` while connected and after a deliberate
     ``close()``.
+
+    While down: ``attempt`` is the number of the next attempt since the last
+    connection that stayed up (1 after a first failure), ``retry_at`` the
+    ``time.monotonic()`` it is due, and ``refused`` whether the latest
+    connection was closed by the server right after it opened while an auth
+    secret was set: how a rosbridge server refuses an ``auth`` (it sends no
+    status frame, and need not use close code 1008).
     """
 
     connected: bool
     since: float
     reconnects: int = 0
     last_error: str | None = None
+    attempt: int = 0
+    retry_at: float | None = None
+    refused: bool = False
+
+    @property
+    def retry_in(self) -> float | None:
+        """Seconds until the next attempt (None while connected or closed)."""
+        return None if self.retry_at is None else max(0.0, self.retry_at - time.monotonic())
 
 
 @dataclass(slots=True)

@@ -15,13 +15,13 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import math
 import secrets
 from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
 from frog_bt.errors import DecodeError
-from frog_bt.messages import encode_time
 
 MAX_FRAME_BYTES = 1 << 20  # rosbridge's own default max message size is larger; ours is a guard
 
@@ -89,13 +89,24 @@ def dumps(obj: dict[str, Any]) -> str:
 
 def auth_frame(secret: str, client: str, dest: str, t: float, ttl: float = 60.0,
                level: str = "admin", rand: str | None = None) -> dict[str, Any]:
-    """The rosauth ``auth`` op (rosbridge v2): a SHA-512 MAC over the shared secret."""
+    """The rosauth ``auth`` op (rosbridge v2): a SHA-512 MAC over the shared secret.
+
+    ``t`` and ``end`` go out as plain numbers of seconds: rosbridge builds
+    ``rospy.Time(msg["t"])`` from them and refuses ``{secs, nsecs}`` objects.
+    rosauth's MAC is over their whole seconds (``req.t.sec``).
+    """
     rand = rand if rand is not None else secrets.token_hex(8)
-    start, end = encode_time(t), encode_time(t + ttl)
-    digest_input = (f"{secret}{client}{dest}{rand}{start['secs']}{level}{end['secs']}")
-    mac = hashlib.sha512(digest_input.encode()).hexdigest()
-    return {"op": "auth", "mac": mac, "client": client, "dest": dest, "rand": rand,
-            "t": start, "level": level, "end": end}
+    end = t + ttl
+    return {"op": "auth", "mac": auth_mac(secret, client, dest, rand, t, level, end),
+            "client": client, "dest": dest, "rand": rand, "t": t, "level": level, "end": end}
+
+
+def auth_mac(secret: str, client: str, dest: str, rand: str, t: float, level: str,
+             end: float) -> str:
+    """rosauth's MAC: hex SHA-512 of secret + client + dest + rand + whole seconds of ``t``
+    + level + whole seconds of ``end``."""
+    text = f"{secret}{client}{dest}{rand}{math.floor(t)}{level}{math.floor(end)}"
+    return hashlib.sha512(text.encode()).hexdigest()
 
 
 @dataclass(slots=True)

@@ -10,10 +10,18 @@ It behaves like rosbridge_suite's server where the executive and roslibpy can
 tell: ``publish`` frames carry no ``id``; no ``status`` frame is sent unless the
 client asked for them with ``set_level``; ``publish`` works with or without
 ``advertise``; a publish is also forwarded to every client subscribed to the
-topic; unknown ops are ignored; malformed frames are logged and counted. With
-a shared secret, the first frame must be an ``auth`` whose MAC matches
-:func:`frog_bt.rosbridge.protocol.auth_frame`, or the client is closed (as
-rosbridge does). ``call_service`` answers ``/rosapi/get_time``,
+topic; unknown ops are ignored; malformed frames are logged and counted.
+
+With a shared secret it checks ``auth`` as rosbridge 0.11.17 with rosauth does
+(``real-rosbridge/README.md``): until a client has authenticated, any frame but
+``auth`` closes it; an ``auth`` whose ``t`` or ``end`` is not a number (the
+``{secs, nsecs}`` object form) is not understood ("Unknown operation: auth" in
+the real server's log) and leaves the client unauthenticated, so its next frame
+closes it; an ``auth`` with a wrong MAC, a ``t`` whole seconds off the server's
+time by ``allowed_time_delta`` (5 s) or more, or an ``end`` already past closes
+it at once. A close never comes with a status frame. rosauth compares with ROS
+time, which is the wall clock on a robot without sim time: ``auth_time``
+(injected, default ``time.time``). ``call_service`` answers ``/rosapi/get_time``,
 ``/rosapi/topics`` and ``/rosapi/topic_type``; other services fail.
 """
 
@@ -24,13 +32,14 @@ import itertools
 import json
 import logging
 import math
-from collections.abc import Mapping
+import time
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 from frog_bt.errors import DecodeError
-from frog_bt.messages import decode_time, encode_time
-from frog_bt.rosbridge.protocol import MAX_FRAME_BYTES, auth_frame, dumps
+from frog_bt.messages import encode_time
+from frog_bt.rosbridge.protocol import MAX_FRAME_BYTES, auth_mac, dumps
 
 log = logging.getLogger(__name__)
 
@@ -97,8 +106,12 @@ class BridgeServer:
     """All clients of one rosbridge server; ``topic_types`` are the server's own topics."""
 
     def __init__(self, secret: str | None = None,
-                 topic_types: Mapping[str, str] | None = None) -> None:
+                 topic_types: Mapping[str, str] | None = None, *,
+                 auth_time: Callable[[], float] = time.time,
+                 allowed_time_delta: float = 5.0) -> None:
         self.secret = secret
+        self.auth_time = auth_time
+        self.allowed_time_delta = allowed_time_delta
         self.topic_types = dict(topic_types or {})
         self.clients: dict[int, Client] = {}
         self.stats = ServerStats()
@@ -150,14 +163,38 @@ class BridgeServer:
 
     def _authenticate(self, state: Client, frame: dict[str, Any]) -> list[Action]:
         assert self.secret is not None
-        if frame["op"] == "auth" and _mac_ok(self.secret, frame):
-            state.authenticated = True
-            log.info("client %d authenticated", state.id)
-            return []
+        if frame["op"] == "auth":
+            t, end = frame.get("t"), frame.get("end")
+            if not (_is_number(t) and _is_number(end)):
+                # rospy.Time(msg["t"]) raises: the real server logs "Unknown operation:
+                # auth" and waits for the next frame, which then closes the connection.
+                self.stats.auth_failures += 1
+                log.warning("client %d: auth with t/end not numbers of seconds: "
+                            "Unknown operation: auth", state.id)
+                return []
+            if self._auth_ok(frame, float(t), float(end)):  # type: ignore[arg-type]
+                state.authenticated = True
+                log.info("client %d authenticated", state.id)
+                return []
         self.stats.auth_failures += 1
         log.warning("client %d did not authenticate (%s); closing", state.id, frame["op"])
         self.clients.pop(state.id, None)
         return [Close(state.id, "authentication failed")]
+
+    def _auth_ok(self, frame: dict[str, Any], t: float, end: float) -> bool:
+        """rosauth's check: the time within the allowed delta (whole seconds), ``end`` still
+        ahead, and the MAC."""
+        assert self.secret is not None
+        now = self.auth_time()
+        if not (math.floor(abs(t - now)) < self.allowed_time_delta and end > now):
+            return False
+        try:
+            client, dest, rand, level = (str(frame[k]) for k in ("client", "dest", "rand", "level"))
+            mac = str(frame["mac"])
+        except KeyError:
+            return False
+        expected = auth_mac(self.secret, client, dest, rand, t, level, end)
+        return hmac.compare_digest(mac, expected)
 
     def _advertise(self, state: Client, frame: dict[str, Any], now: float) -> list[Action]:
         state.advertised[_topic(frame)] = _text(frame, "type")
@@ -298,14 +335,5 @@ def _count(frame: dict[str, Any], key: str) -> int:
     return int(value)
 
 
-def _mac_ok(secret: str, frame: dict[str, Any]) -> bool:
-    """Whether an ``auth`` frame's MAC is the one ``auth_frame`` builds for ``secret``."""
-    try:
-        client, dest, rand, level = (str(frame[k]) for k in ("client", "dest", "rand", "level"))
-        start = math.floor(decode_time(frame["t"]))
-        end = math.floor(decode_time(frame["end"]))
-        mac = str(frame["mac"])
-    except (KeyError, DecodeError):
-        return False
-    expected = auth_frame(secret, client, dest, start, end - start, level, rand)["mac"]
-    return hmac.compare_digest(mac, expected)
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import asyncio
 import hashlib
+import itertools
 import json
 import logging
 from collections.abc import AsyncIterator
@@ -15,6 +16,7 @@ from contextlib import asynccontextmanager
 from typing import Any
 
 import pytest
+from websockets.asyncio.server import serve
 
 from frog_bt.messages import Pose, encode_int32, encode_pose, encode_string
 from frog_bt.rosbridge.client import (
@@ -349,8 +351,8 @@ def test_auth_frame_is_sent_first_when_a_secret_is_configured() -> None:
                                        ("subscribe", "/docking/state")]
             assert auth["op"] == "auth"
             assert auth["client"] == "127.0.0.1" and auth["dest"] == "127.0.0.1"
-            text = (f"s3cret{auth['client']}{auth['dest']}{auth['rand']}{auth['t']['secs']}"
-                    f"{auth['level']}{auth['end']['secs']}")
+            text = (f"s3cret{auth['client']}{auth['dest']}{auth['rand']}{int(auth['t'])}"
+                    f"{auth['level']}{int(auth['end'])}")
             assert auth["mac"] == hashlib.sha512(text.encode()).hexdigest()
 
     run(main())
@@ -432,5 +434,54 @@ def test_close_right_after_start() -> None:
         assert client.start() is task  # idempotent
         await client.close()
         assert task.done() and task.exception() is None
+
+    run(main())
+
+
+def test_a_server_that_closes_at_once_is_backed_off_and_reported_as_refused() -> None:
+    """A refused auth is a close right after the handshake: the client must back off as
+    for a refused connection, not reconnect at once for ever."""
+
+    async def main() -> None:
+        opened: list[float] = []
+        enough = asyncio.Event()
+
+        async def slam(ws) -> None:
+            opened.append(asyncio.get_running_loop().time())
+            if len(opened) >= 5:
+                enough.set()
+            await ws.close()
+
+        async with serve(slam, "127.0.0.1", 0) as server:
+            port = server.sockets[0].getsockname()[1]
+            client = RosbridgeClient(f"ws://127.0.0.1:{port}", secret="s3cret",
+                                     backoff_initial=0.05, backoff_max=0.4)
+            client.start()
+            await asyncio.wait_for(enough.wait(), 5)
+            link = client.link
+            await client.close()
+        gaps = [b - a for a, b in itertools.pairwise(opened)]
+        # 0.05, 0.1, 0.2, 0.4 s: doubling, never a tight loop
+        assert [round(g, 2) >= d * 0.9 for g, d in zip(gaps, (0.05, 0.1, 0.2, 0.4),
+                                                        strict=False)] == [True] * 4
+        assert link.refused and not link.connected
+        assert link.attempt >= 5 and "authentication refused?" in (link.last_error or "")
+
+    run(main())
+
+
+def test_a_connection_that_stays_up_restarts_the_backoff() -> None:
+    async def main() -> None:
+        rec = Recorder()
+        server = await FakeRosbridge().start()
+        client = RosbridgeClient(server.url, on_link=rec.on_link, stable_after=0.0, **FAST)
+        client.start()
+        await rec.link(True)
+        await server.stop()
+        await rec.link(False)
+        down = client.link
+        await client.close()
+        assert down.attempt == 1 and not down.refused  # no secret, and a stable connection
+        assert down.retry_in is not None and down.retry_in <= FAST["backoff_initial"]
 
     run(main())

@@ -159,8 +159,9 @@ def test_unsubscribe_while_down_is_not_restored() -> None:
 
 
 def _mac(secret: str, f: dict[str, Any]) -> str:
-    text = (f"{secret}{f['client']}{f['dest']}{f['rand']}{f['t']['secs']}{f['level']}"
-            f"{f['end']['secs']}")
+    # rosauth: secret + client + dest + rand + t.sec + level + end.sec (whole seconds)
+    text = (f"{secret}{f['client']}{f['dest']}{f['rand']}{int(f['t'])}{f['level']}"
+            f"{int(f['end'])}")
     return hashlib.sha512(text.encode()).hexdigest()
 
 
@@ -175,8 +176,9 @@ def test_auth_frame_first_only_with_a_secret_and_mac_verifies() -> None:
     assert adv["op"] == "advertise"
     assert auth["op"] == "auth"
     assert auth["client"] == "10.0.0.2" and auth["dest"] == "10.0.0.1"
-    assert auth["t"] == {"secs": 1_700_000_000, "nsecs": 250_000_000}
-    assert auth["end"]["secs"] > auth["t"]["secs"]
+    # numbers of seconds, as rosbridge's rospy.Time(msg["t"]) needs (not {secs, nsecs})
+    assert auth["t"] == 1_700_000_000.25 and type(auth["end"]) is float
+    assert auth["end"] == 1_700_000_060.25
     assert auth["mac"] == _mac("s3cret", auth)
     assert auth["mac"] != _mac("wrong", auth)
 

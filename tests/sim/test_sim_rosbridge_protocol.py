@@ -127,7 +127,7 @@ def test_rosapi_services(server: BridgeServer) -> None:
 
 
 def test_auth_with_a_secret() -> None:
-    server = BridgeServer(secret="s3cret")
+    server = BridgeServer(secret="s3cret", auth_time=lambda: NOW)
     good = server.connect()
     assert server.receive(good, json.dumps(auth_frame("s3cret", "10.0.0.2", "10.0.0.1",
                                                       NOW + 0.7)), NOW) == []
@@ -143,6 +143,50 @@ def test_auth_with_a_secret() -> None:
     out = server.receive(bad_mac, json.dumps(auth_frame("guess", "a", "b", NOW)), NOW)
     assert out == [Close(bad_mac, "authentication failed")]
     assert server.stats.auth_failures == 2
+
+
+def _authenticated_server() -> BridgeServer:
+    return BridgeServer(secret="s3cret", auth_time=lambda: NOW)
+
+
+def test_auth_in_the_number_form_is_accepted() -> None:
+    server = _authenticated_server()
+    c = server.connect()
+    auth = auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW + 0.25)
+    assert isinstance(auth["t"], float)
+    assert server.receive(c, json.dumps(auth), NOW) == []
+    assert server.clients[c].authenticated
+
+
+def test_auth_in_the_object_form_is_not_understood_and_the_next_frame_closes() -> None:
+    # rosbridge 0.11.17: rospy.Time({...}) raises, "Unknown operation: auth" is logged,
+    # nothing is sent; the next frame of the unauthenticated client closes it.
+    server = _authenticated_server()
+    c = server.connect()
+    auth = auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW)
+    auth["t"], auth["end"] = {"secs": int(NOW), "nsecs": 0}, {"secs": int(NOW) + 60, "nsecs": 0}
+    assert server.receive(c, json.dumps(auth), NOW) == []
+    assert not server.clients[c].authenticated
+    assert server.receive(c, frame(op="subscribe", topic="/t", type="std_msgs/String"),
+                          NOW) == [Close(c, "authentication failed")]
+
+
+@pytest.mark.parametrize(("what", "auth"), [
+    ("wrong secret", auth_frame("guess", "10.0.0.2", "10.0.0.1", NOW)),
+    ("t 5 s behind", auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW - 5.0)),
+    ("t 6 s ahead", auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW + 6.0)),
+    ("end already past", auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW - 2.0, ttl=1.0)),
+    ("a bool for t", {**auth_frame("s3cret", "a", "b", NOW), "t": True}),
+])
+def test_a_bad_auth_closes_the_connection_without_a_status_frame(what: str, auth: Any) -> None:
+    server = _authenticated_server()
+    c = server.connect()
+    out = server.receive(c, json.dumps(auth), NOW)
+    if what == "a bool for t":  # not a number: not understood, closed by the next frame
+        assert out == []
+        out = server.receive(c, frame(op="advertise", topic="/t", type="std_msgs/String"), NOW)
+    assert out == [Close(c, "authentication failed")], what
+    assert c not in server.clients
 
 
 def test_auth_without_a_secret_is_accepted_and_ignored(server: BridgeServer) -> None:
