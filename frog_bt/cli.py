@@ -17,6 +17,7 @@ COMMANDS = {
     "demo": ("frog_bt.commands.demo", "simulator and executive together for one full tour"),
     "render": ("frog_bt.commands.render", "draw a tour tree"),
     "replay": ("frog_bt.commands.replay", "re-run a recorded tour offline"),
+    "init": ("frog_bt.commands.init", "write an editable copy of the tour and the site config"),
 }
 
 

@@ -16,11 +16,12 @@ from urllib.parse import urlsplit
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from frog_bt import resources
 from frog_bt.errors import ConfigError, UsageError
 from frog_bt.topics import DEFAULT_FRONTEND, DEFAULT_LISTEN, DEFAULT_ROSBRIDGE_URL, INPUTS, OUTPUTS
 from frog_bt.yamlfile import PathError, load_yaml, validate
 
-DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config" / "site.yaml"
+DEFAULT_CONFIG = resources.site_dir() / resources.SITE_FILE
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]

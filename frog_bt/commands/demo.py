@@ -18,6 +18,7 @@ import sys
 import time
 from pathlib import Path
 
+from frog_bt.commands.options import add_tree_and_config
 from frog_bt.config import load_site
 from frog_bt.errors import DefinitionError
 from frog_bt.tree.loader import load_tree
@@ -27,8 +28,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scenario", default="default", metavar="NAME|FILE",
                    help="simulator scenario (default: default)")
     p.add_argument("--speed", type=float, help="sim-time speed factor (default: the scenario's)")
-    p.add_argument("--config", type=Path, help="site configuration (default: config/site.yaml)")
-    p.add_argument("--tree", type=Path, help="tour tree (default: trees/tour.yaml)")
+    add_tree_and_config(p)
     p.add_argument("--timeout", type=float, default=300.0,
                    help="give up after this many wall seconds (default: 300)")
     p.add_argument("--record", type=Path, default=Path("frog-demo.mcap"), metavar="FILE.mcap",

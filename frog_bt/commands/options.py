@@ -7,11 +7,24 @@ deployer never meets a traceback for a typo.
 
 from __future__ import annotations
 
+import argparse
 import os
 from pathlib import Path
 
 from frog_bt.config import Site
 from frog_bt.errors import UsageError
+
+TREE_HELP = ("tour tree (default: the packaged tour, trees/tour.yaml; "
+             "'frog-bt init DIR' copies it to edit)")
+CONFIG_HELP = ("site configuration (default: the packaged config/site.yaml; "
+               "'frog-bt init DIR' copies it to edit)")
+
+
+def add_tree_and_config(p: argparse.ArgumentParser, *, tree: bool = True) -> None:
+    """``--tree FILE`` and ``--config FILE``, with the same defaults in every command."""
+    if tree:
+        p.add_argument("--tree", type=Path, metavar="FILE", help=TREE_HELP)
+    p.add_argument("--config", type=Path, metavar="FILE", help=CONFIG_HELP)
 
 
 def writable_file(path: Path, option: str) -> Path:

@@ -24,22 +24,23 @@ import sys
 from pathlib import Path
 
 from frog_bt import render
+from frog_bt.commands.options import CONFIG_HELP, TREE_HELP
 from frog_bt.config import load_site
 from frog_bt.errors import DefinitionError
-from frog_bt.tree.loader import DEFAULT_TREE, load_tree
+from frog_bt.tree.loader import load_tree
 
 FORMATS = ("ascii", "unicode", "dot", "svg", "png", "mermaid")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("tree", nargs="?", type=Path, metavar="TREE",
-                   help=f"tree file (default: trees/{DEFAULT_TREE.name})")
+    p.add_argument("tree", nargs="?", type=Path, metavar="TREE", help=TREE_HELP)
+    p.add_argument("--tree", dest="tree_option", type=Path, metavar="FILE",
+                   help="the same as TREE, as the other commands take it")
     p.add_argument("-f", "--format", choices=FORMATS, default="ascii",
                    help="output format (default: ascii)")
     p.add_argument("-o", "--output", type=Path, metavar="FILE",
                    help="write to FILE instead of stdout")
-    p.add_argument("--config", type=Path, metavar="FILE",
-                   help="site configuration (default: config/site.yaml)")
+    p.add_argument("--config", type=Path, metavar="FILE", help=CONFIG_HELP)
     p.add_argument("--keys", action="store_true",
                    help="show each node's blackboard keys (reads, optional reads?, writes)")
     p.add_argument("--rankdir", choices=("TB", "LR"), default="TB",
@@ -58,10 +59,14 @@ def draw(root: render.Node, fmt: str, *, keys: bool = False, rankdir: str = "TB"
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.tree and args.tree_option:
+        print("frog-bt: give the tree once: TREE or --tree FILE", file=sys.stderr)
+        return 2
+    path = args.tree or args.tree_option
     try:
         site = load_site(args.config)
         # absolute: load_tree resolves a relative path against the tree's own folder
-        tree = load_tree(args.tree.absolute() if args.tree else None, site)
+        tree = load_tree(path.absolute() if path else None, site)
     except DefinitionError as exc:
         print(f"frog-bt: {exc}", file=sys.stderr)
         return 2

@@ -23,9 +23,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TextIO
 
+from frog_bt.commands.options import add_tree_and_config
 from frog_bt.config import load_site
 from frog_bt.errors import DefinitionError
-from frog_bt.tree.loader import DEFAULT_TREE, load_tree
+from frog_bt.tree.loader import load_tree
 
 REDRAW = 0.1  # wall seconds between progress-bar redraws
 BAR = 30
@@ -33,8 +34,7 @@ BAR = 30
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", type=Path, metavar="FILE.mcap", help="recording to replay")
-    p.add_argument("--tree", type=Path, help=f"tour tree (default: {DEFAULT_TREE.name})")
-    p.add_argument("--config", type=Path, help="site configuration (default: config/site.yaml)")
+    add_tree_and_config(p)
     p.add_argument("--rerun", metavar="SPEC",
                    help="rerun telemetry of the replay: spawn | save:FILE.rrd | connect:URL | "
                    "serve (default: off)")

@@ -26,7 +26,7 @@ from frog_bt.checkpoint import STATE_DIR
 from frog_bt.checkpoint import claim as claim_checkpoint
 from frog_bt.checkpoint import default_path as default_checkpoint
 from frog_bt.clock import SimClock, WallClock
-from frog_bt.commands.options import read_secret, rerun_spec, writable_file
+from frog_bt.commands.options import add_tree_and_config, read_secret, rerun_spec, writable_file
 from frog_bt.config import DEFAULT_CONFIG, Site, check_ws_url, load_site, parse_hostport
 from frog_bt.errors import FrogError, UsageError
 from frog_bt.frontend.link import AddressError
@@ -34,8 +34,7 @@ from frog_bt.tree.loader import DEFAULT_TREE, load_tree
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--config", type=Path, help="site configuration (default: config/site.yaml)")
-    p.add_argument("--tree", type=Path, help=f"tour tree (default: {DEFAULT_TREE.name})")
+    add_tree_and_config(p)
     p.add_argument("--rosbridge", metavar="URL", help="rosbridge URL (default: from config, "
                    "ws://127.0.0.1:9090)")
     p.add_argument("--frontend", metavar="HOST:PORT",

@@ -130,7 +130,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="where the executive listens for the front end "
                              "(default 127.0.0.1:5006)")
     parser.add_argument("--config", type=Path, default=None, metavar="FILE",
-                        help="site configuration with the POI table (default config/site.yaml)")
+                        help="site configuration with the POI table (default: the packaged "
+                        "config/site.yaml; 'frog-bt init DIR' copies it to edit)")
     parser.add_argument("--secret", default=None,
                         help="require rosbridge clients to authenticate with this secret")
     parser.add_argument("--log", action="store_true",

@@ -40,6 +40,7 @@ import py_trees
 from pydantic import BaseModel
 
 import frog_bt.behaviours  # noqa: F401 - registers the leaf types
+from frog_bt import resources
 from frog_bt.blackboard import INPUT_KEYS
 from frog_bt.config import Site
 from frog_bt.errors import TreeError
@@ -48,8 +49,8 @@ from frog_bt.tree.leaf import LEAVES
 from frog_bt.tree.observed import Parallel, Selector, Sequence
 from frog_bt.yamlfile import load_yaml, validate
 
-DEFAULT_TREE_DIR = Path(__file__).resolve().parent.parent.parent / "trees"
-DEFAULT_TREE = DEFAULT_TREE_DIR / "tour.yaml"
+DEFAULT_TREE_DIR = resources.tree_dir()
+DEFAULT_TREE = DEFAULT_TREE_DIR / resources.TREE_FILE
 COMPOSITES = ("Sequence", "Selector", "Parallel")
 STRUCTURE = {"type", "name", "when"}
 _VAR = re.compile(r"\{(\w+)\}")
