@@ -2,15 +2,24 @@
 
 from __future__ import annotations
 
+import time
+
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.status import link_line
 
 
 def test_unreachable_rosbridge_is_named_with_attempt_delay_and_plain_reason():
     down = LinkState(connected=False, since=0.0, last_error="ConnectionRefusedError: [Errno 111] "
-                     "Connect call failed ('127.0.0.1', 9090)")
+                     "Connect call failed ('127.0.0.1', 9090)", attempt=4,
+                     retry_at=time.monotonic() + 2.04)
     line = link_line("ws://frog:9090", down)
-    assert line == "rosbridge: connecting to ws://frog:9090: connection refused"
+    assert line == ("rosbridge: connecting to ws://frog:9090 (attempt 4, next in 2.0 s): "
+                    "connection refused")
+
+
+def test_before_the_first_attempt_fails_the_line_says_only_where():
+    assert link_line("ws://frog:9090", LinkState(connected=False, since=0.0)) == (
+        "rosbridge: connecting to ws://frog:9090")
 
 
 def test_connected_link_leaves_the_line_to_the_tree_unless_waiting_for_clock():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import os
+import signal
 import socket
 import subprocess
 import sys
@@ -141,3 +142,28 @@ def test_two_executives_never_share_a_checkpoint(tmp_path):
     assert result.stderr.strip().splitlines() == [
         f"frog-bt: --checkpoint {checkpoint}: in use by another running executive "
         f"(pid {os.getpid()}); give each executive its own --checkpoint"]
+
+
+def test_status_line_says_rosbridge_is_unreachable_and_sigint_exits_0(tmp_path):
+    port = free_udp_port()  # nothing listens on this TCP port either
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "frog_bt", "run", "--checkpoint", "none",
+         "--rosbridge", f"ws://127.0.0.1:{port}", "--listen", f"127.0.0.1:{free_udp_port()}"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        assert proc.stderr is not None
+        seen = []
+        for line in proc.stderr:
+            seen.append(line)
+            if "(attempt 2, next in" in line:
+                break
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=10)
+    finally:
+        proc.kill()
+    status = [s for s in seen if s.startswith("rosbridge:")]
+    assert status and status[-1].startswith(
+        f"rosbridge: connecting to ws://127.0.0.1:{port} (attempt 2, next in ")
+    assert status[-1].rstrip().endswith("connection refused")
+    assert not any("Wait for the front end" in s for s in seen)
+    assert proc.returncode == 0
