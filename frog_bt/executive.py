@@ -26,13 +26,14 @@ from frog_bt.checkpoint import save as save_checkpoint
 from frog_bt.clock import Clock, ManualClock
 from frog_bt.config import Site
 from frog_bt.core import Core
-from frog_bt.frontend.link import FrontendLink, WarningLimiter
+from frog_bt.frontend.link import FrontendLink
 from frog_bt.frontend.messages import EVENTS, FrontendMessage
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.status import link_line, status_line
 from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
 from frog_bt.tree.loader import LoadedTree
+from frog_bt.warning_limit import WarningLimiter
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
@@ -89,7 +90,7 @@ class Executive:
         self._pending_at_loss: object = None
         self._refusals = 0  # consecutive connections refused (auth)
         self._peer_restarts = 0
-        self._checkpoint_warnings = WarningLimiter(60.0)
+        self._checkpoint_warnings = WarningLimiter(60.0, logger=log)
 
     # ------------------------------------------------------------ I/O callbacks (cache only)
 

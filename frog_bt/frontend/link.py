@@ -26,51 +26,18 @@ import errno
 import ipaddress
 import logging
 import socket
-import time
 from collections.abc import Callable
 
 from frog_bt.clock import Clock
 from frog_bt.frontend.messages import EVENTS, FrontendMessage
 from frog_bt.frontend.protocol import MAX_DATAGRAM, Endpoint, LinkStats
+from frog_bt.warning_limit import WarningLimiter
 
 log = logging.getLogger(__name__)
 
 Address = tuple[str, int]
 # (direction "in" | "out", datagram, clock time): a tap for recordings (CONTRACT §6).
 DatagramTap = Callable[[str, bytes, float], None]
-
-WARN_INTERVAL = 5.0  # wall seconds between two warnings of one kind
-
-
-class WarningLimiter:
-    """At most one warning per kind per ``interval`` wall seconds.
-
-    Warnings suppressed in between are counted and reported with the next one
-    that gets through, so a flood of bad datagrams costs one log line per
-    interval, not one per datagram.
-    """
-
-    def __init__(self, interval: float = WARN_INTERVAL,
-                 wall: Callable[[], float] = time.monotonic) -> None:
-        self.interval = interval
-        self._wall = wall
-        self._last: dict[str, float] = {}
-        self._suppressed: dict[str, int] = {}
-
-    def warn(self, kind: str, message: str) -> bool:
-        """Log ``message`` unless ``kind`` was logged within the interval; True if logged."""
-        now = self._wall()
-        last = self._last.get(kind)
-        if last is not None and now - last < self.interval:
-            self._suppressed[kind] = self._suppressed.get(kind, 0) + 1
-            return False
-        suppressed = self._suppressed.pop(kind, 0)
-        if suppressed:
-            message = f"{message} ({suppressed} more {kind} suppressed)"
-        log.warning("%s", message)
-        self._last[kind] = now
-        return True
-
 
 class AddressError(OSError):
     """The link cannot use an address: ``which`` is ``"listen"`` (cannot bind) or
@@ -144,7 +111,7 @@ class FrontendLink:
         self._sleeping_until: float | None = None
         self._closed = asyncio.Event()
         self._closing = False
-        self._warnings = WarningLimiter()
+        self._warnings = WarningLimiter(logger=log)
         self._settled = asyncio.Event()  # an ack arrived or a command was given up on
 
     # ------------------------------------------------------------ lifecycle

@@ -15,7 +15,7 @@ into typed values with :data:`frog_bt.messages.DECODERS`.
   advertise, subscribe, queued publishes).
 * Bad input never stops the receive loop: malformed frames and messages are
   counted per topic in :attr:`RosbridgeClient.stats` and logged at most once
-  per topic per :data:`WARN_INTERVAL` seconds.
+  per topic per :data:`frog_bt.warning_limit.WARN_INTERVAL` seconds.
 
 Not thread-safe: call every method from the event loop's thread.
 """
@@ -47,38 +47,16 @@ from frog_bt.rosbridge.protocol import (
     Status,
     decode_frame,
 )
+from frog_bt.warning_limit import WarningLimiter
 
-__all__ = ["FRAME_TOPIC", "WARN_INTERVAL", "ClientStats", "LinkState", "RosbridgeClient",
-           "WarningThrottle", "backoff_delays"]
+__all__ = ["FRAME_TOPIC", "ClientStats", "LinkState", "RosbridgeClient", "backoff_delays"]
 
 log = logging.getLogger(__name__)
 
-WARN_INTERVAL = 5.0  # seconds of wall time between two warnings about one topic
 FRAME_TOPIC = "<frame>"  # stats/warning key for frames too broken to name a topic
 # A frame above decode_frame's guard is counted as malformed; only far larger
 # ones make websockets drop the connection (which would then loop on reconnect).
 _MAX_WS_MESSAGE = 4 * MAX_FRAME_BYTES
-
-
-class WarningThrottle:
-    """At most one warning per key per ``interval``; counts the ones held back.
-
-    Sans-clock: the caller passes ``now`` (monotonic seconds).
-    """
-
-    def __init__(self, interval: float = WARN_INTERVAL) -> None:
-        self.interval = interval
-        self._last: dict[str, float] = {}
-        self._held: dict[str, int] = {}
-
-    def allow(self, key: str, now: float) -> int | None:
-        """``None``: stay quiet. Otherwise log, noting this many suppressed since the last."""
-        last = self._last.get(key)
-        if last is not None and now - last < self.interval:
-            self._held[key] = self._held.get(key, 0) + 1
-            return None
-        self._last[key] = now
-        return self._held.pop(key, 0)
 
 
 class RosbridgeClient:
@@ -127,7 +105,7 @@ class RosbridgeClient:
         self.session = Session(queue_limit=queue_limit, secret=secret)
         self.stats = ClientStats()
         self._link = LinkState(connected=False, since=time.monotonic())
-        self._throttle = WarningThrottle()
+        self._throttle = WarningLimiter(logger=log)
         self._outbox: deque[str] = deque()  # frames for the current connection, in order
         self._wake = asyncio.Event()  # outbox became non-empty
         self._drained = asyncio.Event()  # the writer found the outbox empty
@@ -424,7 +402,7 @@ class RosbridgeClient:
         try:
             self.on_message(event.topic, value)
         except Exception:
-            held = self._throttle.allow(f"on_message {event.topic}", time.monotonic())
+            held = self._throttle.allow(f"on_message {event.topic}")
             if held is not None:
                 log.exception("rosbridge: on_message(%s) failed%s", event.topic, _held(held))
 
@@ -442,7 +420,7 @@ class RosbridgeClient:
                        self.session.dropped)
 
     def _warn(self, key: str, fmt: str, *args: Any) -> None:
-        held = self._throttle.allow(key, time.monotonic())
+        held = self._throttle.allow(key)
         if held is not None:
             log.warning(fmt + "%s", *args, _held(held))
 

@@ -18,7 +18,7 @@ from typing import Any, TypeVar
 import pytest
 
 from frog_bt.clock import ManualClock
-from frog_bt.frontend.link import FrontendLink, WarningLimiter
+from frog_bt.frontend.link import FrontendLink, log
 from frog_bt.frontend.messages import (
     COMMANDS,
     ContentDone,
@@ -28,6 +28,7 @@ from frog_bt.frontend.messages import (
     Volume,
 )
 from frog_bt.frontend.protocol import MAX_DATAGRAM
+from frog_bt.warning_limit import WarningLimiter
 
 HOST = "127.0.0.1"
 T0 = 1_700_000_000.0
@@ -447,7 +448,7 @@ def test_invalid_settings(kwargs: dict[str, Any]) -> None:
 
 def test_warning_limiter(caplog: pytest.LogCaptureFixture) -> None:
     wall = [100.0]
-    limiter = WarningLimiter(5.0, wall=lambda: wall[0])
+    limiter = WarningLimiter(5.0, wall=lambda: wall[0], logger=log)
     with caplog.at_level(logging.WARNING, logger="frog_bt.frontend.link"):
         assert limiter.warn("malformed", "bad 1")
         assert not limiter.warn("malformed", "bad 2")

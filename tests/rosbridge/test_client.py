@@ -23,9 +23,9 @@ from frog_bt.rosbridge.client import (
     FRAME_TOPIC,
     LinkState,
     RosbridgeClient,
-    WarningThrottle,
     backoff_delays,
 )
+from frog_bt.warning_limit import WarningLimiter
 
 from .conftest import FakeRosbridge, free_port, run
 
@@ -212,7 +212,7 @@ def test_on_message_exceptions_are_logged_not_fatal(caplog: pytest.LogCaptureFix
 
 
 def test_warning_throttle() -> None:
-    throttle = WarningThrottle(interval=5.0)
+    throttle = WarningLimiter(interval=5.0)
     assert throttle.allow("/a", 100.0) == 0
     assert throttle.allow("/a", 101.0) is None
     assert throttle.allow("/a", 104.9) is None
