@@ -54,7 +54,9 @@ def link_line(url: str, link: Any, clock_ready: bool = True) -> str | None:
 def _plain_error(error: str) -> str:
     """``ConnectionRefusedError: [Errno 111] Connect call failed ...`` -> ``connection refused``."""
     lowered = error.lower()
-    for needle, words in (("refused", "connection refused"), ("timed out", "timed out"),
+    for needle, words in (("authentication refused", "closed at once: authentication refused? "
+                           "(check the secret)"),
+                          ("refused", "connection refused"), ("timed out", "timed out"),
                           ("name or service not known", "unknown host"),
                           ("no route", "no route to host"), ("unreachable", "unreachable")):
         if needle in lowered:

@@ -17,6 +17,14 @@ def test_unreachable_rosbridge_is_named_with_attempt_delay_and_plain_reason():
                     "connection refused")
 
 
+def test_a_refused_auth_is_not_called_a_refused_connection():
+    down = LinkState(connected=False, since=0.0, refused=True, attempt=2,
+                     last_error="connection closed (code 1000), right after connecting: "
+                                "authentication refused?")
+    assert link_line("ws://frog:9090", down).endswith(
+        ": closed at once: authentication refused? (check the secret)")
+
+
 def test_before_the_first_attempt_fails_the_line_says_only_where():
     assert link_line("ws://frog:9090", LinkState(connected=False, since=0.0)) == (
         "rosbridge: connecting to ws://frog:9090")
