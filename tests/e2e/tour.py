@@ -39,6 +39,7 @@ class Tour:
     summary: TourSummary
     site: Site
     sent: list[tuple[float, Any]] = field(default_factory=list)  # (executive time, message)
+    published: list[tuple[float, str]] = field(default_factory=list)  # (executive time, topic)
 
     def commands(self) -> list[str]:
         """What the executive sent, as the simulator received it, compactly."""
@@ -74,6 +75,7 @@ class Running(Rehearsal):
         site = site or load_site()
         self.summary = TourSummary(site)
         self.sent: list[tuple[float, Any]] = []
+        self.published: list[tuple[float, str]] = []
         executive_kwargs.setdefault("once", False)
         super().__init__(None if sim is not None else fast(scenario_data), site=site,
                          tree=tree, sim=sim, listen=listen, prepare=self._prepare,
@@ -82,10 +84,15 @@ class Running(Rehearsal):
     def _prepare(self, executive: Executive) -> None:
         self.summary.attach(executive.taps)
         executive.taps.frontend_out.append(lambda t, _type, m: self.sent.append((t, m)))
+        executive.taps.ros_out.append(lambda t, topic, _m: self.published.append((t, topic)))
 
     def tour(self) -> Tour:
         return Tour(self.sim, self.executive, self.executive.outcome, self.summary, self.site,
-                    self.sent)
+                    self.sent, self.published)
+
+    def published_at(self, topic: str) -> list[float]:
+        """When (by the executive's clock) the executive published on ``topic``."""
+        return [t for t, name in self.published if name == topic]
 
 
 async def run_tour(scenario_data: dict[str, Any], *, site: Site | None = None,
