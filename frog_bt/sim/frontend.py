@@ -27,7 +27,6 @@ channel, fields)`` (resends and duplicates are not).
 
 from __future__ import annotations
 
-import json
 import logging
 import sys
 from collections.abc import Callable
@@ -96,13 +95,13 @@ class FrontendModel:
         if received.error is not None:
             log.warning("malformed datagram from %s: %s", host, received.error)
         if received.acked is not None:
-            seq = json.loads(data)["seq"]
+            seq = fm.decode_envelope(data).seq
             self._notify("in", "ack", {"seq": seq, "type": received.acked.type})
         out: list[bytes] = []
         silent = self.silent(now)
         if received.reply is not None and self.spec.ack and not silent:
             out.append(received.reply)
-            self._notify("out", "ack", {"seq": json.loads(received.reply)["seq"]})
+            self._notify("out", "ack", {"seq": fm.decode_envelope(received.reply).seq})
         message = received.message
         if message is not None:
             self._notify("in", message.type, fm.message_fields(message))

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any
 
 import pytest
@@ -94,7 +93,8 @@ def test_extra_fields_are_ignored() -> None:
 
 @pytest.mark.parametrize(
     ("cls", "name"),
-    [(cls, name) for cls in [*COMMANDS.values(), *EVENTS.values()] for name in cls.spec],
+    [(cls, name) for cls in [*COMMANDS.values(), *EVENTS.values()]
+     for name in cls.__struct_fields__],
     ids=lambda v: getattr(v, "type", v),
 )
 def test_missing_field(cls: type[FrontendMessage], name: str) -> None:
@@ -146,7 +146,7 @@ WRONG: list[tuple[str, str, Any]] = [
 def test_wrong_type_or_range(type_: str, name: str, value: Any) -> None:
     message, fields = next((m, f) for m, f in VALID if m.type == type_)
     obj = {**wire(message, fields), name: value}
-    with pytest.raises(DecodeError, match="expected") as info:
+    with pytest.raises(DecodeError, match=r"expected|out of range|invalid enum value") as info:
         decode_message(obj, table_of(type(message)))
     assert info.value.path == (name,)
 
@@ -184,7 +184,7 @@ def test_unknown_type(obj: dict[str, Any], table: dict[str, type[FrontendMessage
 
 
 def test_messages_are_frozen_values() -> None:
-    with pytest.raises(dataclasses.FrozenInstanceError):
+    with pytest.raises(AttributeError):
         FollowMe(on=True).on = False  # type: ignore[misc]
     assert FrontendIdle() != FinishIntroduction()
     assert StartPoi("POI1", "POI1a", "a") == StartPoi("POI1", "POI1a", "a")

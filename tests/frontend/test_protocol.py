@@ -374,10 +374,10 @@ json_objects = st.fixed_dictionaries(
 @given(st.binary(max_size=300))
 def test_decode_datagram_on_any_bytes(data: bytes) -> None:
     try:
-        obj = decode_datagram(data)
+        envelope = decode_datagram(data)
     except DecodeError:
         return
-    assert isinstance(obj["type"], str) and isinstance(obj["seq"], int)
+    assert isinstance(envelope.type, str) and isinstance(envelope.seq, int)
 
 
 @given(json_objects)
@@ -387,10 +387,10 @@ def test_decode_datagram_on_any_json_object(obj: dict[str, Any]) -> None:
         decoded = decode_datagram(data)
     except DecodeError:
         return
-    assert decoded == obj
+    assert (decoded.type, decoded.seq) == (obj["type"], obj["seq"])
     for table in (COMMANDS, EVENTS):
         with contextlib.suppress(DecodeError):
-            decode_message(decoded, table)
+            decode_message(data, table)
 
 
 @given(st.binary(max_size=300) | json_objects.map(lambda o: json.dumps(o).encode()),
@@ -419,7 +419,7 @@ messages = st.one_of(
     st.builds(COMMANDS["projector"], on=st.booleans()),
     st.builds(COMMANDS["tour"], state=st.sampled_from(["started", "ended", "aborted"]),
               reason=texts),
-    *(st.just(cls()) for cls in EVENTS.values() if not cls.spec),
+    *(st.just(cls()) for cls in EVENTS.values() if not cls.__struct_fields__),
     st.builds(EVENTS["content_done"], poi=texts, part=parts),
 )
 

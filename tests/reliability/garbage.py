@@ -223,13 +223,13 @@ def classify_frame(frame: str | bytes, subscribed: dict[str, str]) -> str:
 def classify_datagram(data: bytes, inbound: dict[str, type[fm.FrontendMessage]]) -> str:
     """``malformed`` (not a datagram, or a message that does not decode), ``ack`` or ``valid``."""
     try:
-        obj = decode_datagram(data)
+        envelope = decode_datagram(data)
     except DecodeError:
         return "malformed"
-    if obj["type"] == "ack":
+    if envelope.type == "ack":
         return "ack"
     try:
-        fm.decode_message(obj, inbound)
+        fm.decode_message(data, inbound)
     except DecodeError:
         return "malformed"
     return "valid"
