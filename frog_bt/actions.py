@@ -19,8 +19,8 @@ from typing import Any
 
 from frog_bt.clock import Clock
 from frog_bt.config import Poi
-from frog_bt.messages import encode_int32, encode_pose, encode_string
-from frog_bt.topics import ABORTED, ACTIVE, FAILED, SUCCEEDED
+from frog_bt.rosbridge.msgs import Pose
+from frog_bt.wire import ABORTED, ACTIVE, FAILED, SUCCEEDED
 
 log = logging.getLogger(__name__)
 TERMINAL = (SUCCEEDED, FAILED, ABORTED)
@@ -35,7 +35,7 @@ class Request:
     kind: str  # "goto" | "approach"
     target: str
     sent_at: float
-    msg: dict[str, Any] | None = None  # as published, for a re-send
+    value: Any = None  # as published, for a re-send
     code: int = 0
     answered_at: float | None = None
 
@@ -44,7 +44,7 @@ class Request:
         return self.code in TERMINAL
 
 
-Publish = Callable[[str, dict[str, Any]], None]  # (role, msg)
+Publish = Callable[[str, Any], None]  # (output role, value: the wire table encodes it)
 
 
 class Actions:
@@ -61,22 +61,22 @@ class Actions:
 
     def goto(self, waypoint: str, poi: Poi) -> Request:
         now = self._clock.now()
-        msg = encode_pose(poi.x, poi.y, poi.z, poi.w, now)
-        self._publish("goto", msg)
-        return self._replace(Request(next(self._ids), "goto", waypoint, now, msg))
+        goal = Pose(now, "map", poi.x, poi.y, poi.z, poi.w)
+        self._publish("goto", goal)
+        return self._replace(Request(next(self._ids), "goto", waypoint, now, goal))
 
     def approach(self, person_id: int) -> Request:
-        msg = encode_int32(person_id)
-        self._publish("approach", msg)
+        self._publish("approach", person_id)
         self.last_approach_at = now = self._clock.now()
-        return self._replace(Request(next(self._ids), "approach", str(person_id), now, msg))
+        return self._replace(Request(next(self._ids), "approach", str(person_id), now,
+                                     person_id))
 
     def resend_pending(self) -> Request | None:
         """Publish the pending goal or approach again (after a reconnect its answer may
         have been lost while the link was down). The request keeps waiting as before."""
         request = self.pending
-        if request is not None and request.msg is not None:
-            self._publish(request.kind, request.msg)  # the kind is the output role
+        if request is not None and request.value is not None:
+            self._publish(request.kind, request.value)  # the kind is the output role
             log.info("re-sent %s %s after a reconnect", request.kind, request.target)
         return request
 
@@ -102,8 +102,8 @@ class Actions:
         return request
 
     def dock(self, action: str) -> None:
-        self._publish("dock", encode_string(action))
+        self._publish("dock", action)
 
     def icl(self, on: bool) -> None:
         self.face_stream = on
-        self._publish("icl", encode_string("start" if on else "stop"))
+        self._publish("icl", "start" if on else "stop")

@@ -4,16 +4,19 @@ Subscriber callbacks only *cache* (:class:`Inputs`); once per tick,
 :meth:`Snapshot.write` copies one consistent view onto the blackboard, so no
 input can change half-way through a tick (the py_trees_ros pattern).
 
-Blackboard keys written here (the *input keys*; leaves declare what they read):
+Blackboard keys written here (the *input keys*; leaves declare what they read).
+Each ROS input of the wire table (:data:`frog_bt.wire.INPUTS`) writes its key as
+its :class:`~frog_bt.wire.Keep` says; with the default table:
 
 ============================  ===========================================================
 ``/now``                      project-clock time of this tick (s)
-``/pose``                     :class:`Reading` of :class:`~frog_bt.messages.Pose`, or None
+``/pose``                     :class:`Reading` of :class:`~frog_bt.rosbridge.msgs.Pose`, or None
 ``/persons``                  :class:`Reading` of PersonDetections (camera), or None
 ``/people``                   :class:`Reading` of TrackedPeople (laser), or None
 ``/faces``                    face samples received since the last tick: ``(t, Face)``
 ``/docking``                  :class:`Reading` of the docking state string, or None
 ``/diagnostics``              :class:`Reading` of Diagnostics, or None
+``/responses``                ``/FROG_response`` codes since the last tick: ``(code, t)``
 ``/events``                   :class:`EventLog` of front-end events
 ``/frontend_ready``           a ``frontend_idle`` arrived since the last tour started/ended
 ``/link``                     rosbridge link state (anything with ``.connected``), or None
@@ -24,20 +27,23 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
 import py_trees
 
-from frog_bt.actions import Actions
 from frog_bt.clock import Clock
 from frog_bt.frontend.messages import FrontendIdle, FrontendMessage
-from frog_bt.messages import Diagnostics, Face, FaceData, PersonDetections, Pose, TrackedPeople
+from frog_bt.wire import INPUTS, Input, Keep
 
 T = TypeVar("T")
 
-INPUT_KEYS = ("/now", "/pose", "/persons", "/people", "/faces", "/docking", "/diagnostics",
-              "/events", "/frontend_ready", "/link")
+FIXED_KEYS = ("/now", "/events", "/frontend_ready", "/link")
+
+
+def input_keys() -> tuple[str, ...]:
+    """Every key the snapshot writes (the fixed ones and the wire table's inputs)."""
+    return (*FIXED_KEYS, *(inp.key for inp in INPUTS.values()))
 
 
 @dataclass(frozen=True, slots=True)
@@ -87,66 +93,58 @@ class EventLog:
         return None
 
 
-@dataclass(slots=True)
 class Inputs:
-    """Latest inputs as the callbacks leave them; touched only by callbacks and snapshot."""
+    """Latest inputs as the callbacks leave them; touched only by callbacks and snapshot.
 
-    pose: Reading[Pose] | None = None
-    persons: Reading[PersonDetections] | None = None
-    people: Reading[TrackedPeople] | None = None
-    docking: Reading[str] | None = None
-    diagnostics: Reading[Diagnostics] | None = None
-    link: Any = None
-    faces: list[tuple[float, Face]] = field(default_factory=list)
-    responses: list[tuple[int, float]] = field(default_factory=list)
-    events: list[tuple[FrontendMessage, float]] = field(default_factory=list)
-    face_limit: int = 10_000
+    ``table`` maps each topic name to its :class:`~frog_bt.wire.Input`."""
 
-    def add_faces(self, data: FaceData, at: float) -> None:
-        if len(self.faces) + len(data.faces) > self.face_limit:
-            del self.faces[: len(data.faces)]  # a stalled tick must not grow memory
-        self.faces.extend((at, f) for f in data.faces)
+    def __init__(self, table: dict[str, Input]) -> None:
+        self.table = table
+        self.latest: dict[str, Reading[Any] | None] = {
+            i.key: None for i in table.values() if i.keep is Keep.LATEST}
+        self.pending: dict[str, list[tuple[Any, Any]]] = {
+            i.key: [] for i in table.values() if i.keep is not Keep.LATEST}
+        self.link: Any = None
+        self.events: list[tuple[FrontendMessage, float]] = []
+
+    def add(self, inp: Input, value: Any, at: float) -> None:
+        """Cache one decoded message of ``inp``."""
+        if inp.keep is Keep.LATEST:
+            self.latest[inp.key] = Reading(value, at)
+            return
+        pending = self.pending[inp.key]
+        if inp.keep is Keep.SAMPLES:
+            assert inp.items is not None
+            pending.extend((at, item) for item in inp.items(value))
+        else:
+            pending.append((value, at))
+        if len(pending) > inp.limit:
+            del pending[: len(pending) - inp.limit]  # a stalled tick must not grow memory
 
 
 class Snapshot:
     """Writes the input keys once per tick (the tree's pre-tick handler)."""
 
-    def __init__(self, inputs: Inputs, clock: Clock, actions: Actions) -> None:
+    def __init__(self, inputs: Inputs, clock: Clock) -> None:
         self.inputs = inputs
         self.clock = clock
-        self.actions = actions
         self.events = EventLog()
         self.bb = py_trees.blackboard.Client(name="snapshot")
-        for key in INPUT_KEYS:
+        for key in (*FIXED_KEYS, *inputs.latest, *inputs.pending):
             self.bb.register_key(key, access=py_trees.common.Access.WRITE)
         self.bb.set("/frontend_ready", False)
-        self.bb.set("/faces", ())
         self.write()
 
     def write(self) -> None:
         inp = self.inputs
-        if py_trees.blackboard.Blackboard.activity_stream is not None:
-            set_ = self.bb.set  # py_trees' own path, so that the stream sees every write
-        else:
-            # The keys were registered for writing in __init__; a client's set() would
-            # check that again, ten times a tick (~3 µs each).
-            set_ = py_trees.blackboard.Blackboard.storage.__setitem__
+        set_ = self.bb.set
         set_("/now", self.clock.now())
-        set_("/pose", inp.pose)
-        set_("/persons", inp.persons)
-        set_("/people", inp.people)
-        set_("/docking", inp.docking)
-        set_("/diagnostics", inp.diagnostics)
+        for key, reading in inp.latest.items():
+            set_(key, reading)
+        for key, pending in inp.pending.items():
+            set_(key, tuple(pending))
+            pending.clear()
         set_("/link", inp.link)
-        if inp.faces:
-            set_("/faces", tuple(inp.faces))
-            inp.faces.clear()
-        else:
-            set_("/faces", ())
-        if inp.responses:
-            for code, at in inp.responses:
-                self.actions.on_response(code, at)
-            inp.responses.clear()
         if inp.events:
             for message, at in inp.events:
                 self.events.append(message, at)
@@ -154,3 +152,6 @@ class Snapshot:
                     set_("/frontend_ready", True)
             inp.events.clear()
         set_("/events", self.events)
+
+    def get(self, key: str) -> Any:
+        return self.bb.get(key)

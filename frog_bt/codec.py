@@ -41,7 +41,7 @@ def decode_error(exc: msgspec.MsgspecError) -> DecodeError:
     match = _AT.match(str(exc))
     assert match is not None  # the pattern matches any text
     path: list[str | int] = [
-        name if name is not None else int(index)
+        name if name else int(index)
         for name, index in _STEP.findall(match["path"] or "")]
     text = match["text"]
     missing = _MISSING.match(text)
@@ -59,7 +59,7 @@ def decoder(type_: type[T]) -> Callable[[bytes | str], T]:
             return decode(data)
         except msgspec.MsgspecError as exc:
             raise decode_error(exc) from None
-        except UnicodeDecodeError as exc:
+        except UnicodeError as exc:
             raise DecodeError(f"not UTF-8: {exc}"[:200]) from None
         except RecursionError:
             raise DecodeError("nested too deeply") from None
@@ -73,6 +73,8 @@ def convert(obj: Any, type_: type[T]) -> T:
         return msgspec.convert(obj, type_)
     except msgspec.MsgspecError as exc:
         raise decode_error(exc) from None
+    except UnicodeError as exc:  # a lone surrogate in a str
+        raise DecodeError(f"not valid text: {exc}"[:200]) from None
     except RecursionError:
         raise DecodeError("nested too deeply") from None
 

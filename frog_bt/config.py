@@ -18,7 +18,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from frog_bt import resources
 from frog_bt.errors import ConfigError, UsageError
-from frog_bt.topics import DEFAULT_FRONTEND, DEFAULT_LISTEN, DEFAULT_ROSBRIDGE_URL, INPUTS, OUTPUTS
+from frog_bt.wire import DEFAULT_FRONTEND, DEFAULT_LISTEN, DEFAULT_ROSBRIDGE_URL, INPUTS, OUTPUTS
 from frog_bt.yamlfile import PathError, load_yaml, validate
 
 DEFAULT_CONFIG = resources.site_dir() / resources.SITE_FILE

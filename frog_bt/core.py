@@ -17,20 +17,18 @@ from typing import Any
 import py_trees
 
 from frog_bt.actions import Actions
-from frog_bt.blackboard import Inputs, Reading, Snapshot
+from frog_bt.blackboard import Inputs, Snapshot
 from frog_bt.clock import Clock
 from frog_bt.config import Site
 from frog_bt.context import Context
 from frog_bt.frontend.messages import FrontendMessage
-from frog_bt.topics import INPUTS
 from frog_bt.tree import observed, ticking
 from frog_bt.tree.loader import LoadedTree
+from frog_bt.wire import INPUTS, OUTPUTS
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
 
-# High-rate inputs do not each call for a tick; the periodic tick covers them.
-NO_TICK_ROLES = frozenset({"pose", "faces", "people"})
 Tap = Callable[[float, str, Any], None]  # (project-clock time, channel, payload)
 Behaviour = py_trees.behaviour.Behaviour
 
@@ -61,14 +59,14 @@ class Core:
         self._publish_topic = publish
         self._send = send
         self.taps = Taps()
-        self.inputs = Inputs()
-        self.roles = {site.topic(role): role for role in INPUTS}
+        self.table = {site.topic(role): inp for role, inp in INPUTS.items()}
+        self.inputs = Inputs(self.table)
         self.actions = Actions(self._publish, clock)
         py_trees.blackboard.Blackboard.clear()  # one tree per process at a time
         self.ctx = Context(clock, site, self.actions, self._send_message)
-        self.snapshot = Snapshot(self.inputs, clock, self.actions)
+        self.snapshot = Snapshot(self.inputs, clock)
         self.bt = py_trees.trees.BehaviourTree(tree.root)
-        self.bt.add_pre_tick_handler(lambda _: self.snapshot.write())
+        self.bt.add_pre_tick_handler(self._pre_tick)
         self.ticks = 0
         self._setup = False
         # Nodes ticked or stopped since the last tick's taps ran: every node whose status
@@ -77,8 +75,9 @@ class Core:
         self.touched: list[Behaviour] = []
         observed.attach(tree.root, self.touched)
 
-    def _publish(self, role: str, msg: dict[str, Any]) -> None:
+    def _publish(self, role: str, value: Any) -> None:
         topic = self.site.topic(role)
+        msg = OUTPUTS[role].codec.encode(value)
         self._publish_topic(topic, msg)
         for tap in self.taps.ros_out:
             tap(self.clock.now(), topic, msg)
@@ -100,25 +99,11 @@ class Core:
         now = self.clock.now()
         for tap in self.taps.ros_in:
             tap(now, topic, value)
-        role = self.roles.get(topic)
-        inp = self.inputs
-        if role == "pose":
-            inp.pose = Reading(value, now)
-        elif role == "response":
-            inp.responses.append((value, now))
-        elif role == "docking_state":
-            inp.docking = Reading(value, now)
-        elif role == "diagnostic":
-            inp.diagnostics = Reading(value, now)
-        elif role == "persons":
-            inp.persons = Reading(value, now)
-        elif role == "people":
-            inp.people = Reading(value, now)
-        elif role == "faces":
-            inp.add_faces(value, now)
-        else:
+        inp = self.table.get(topic)
+        if inp is None:
             return False
-        return role not in NO_TICK_ROLES
+        self.inputs.add(inp, value, now)
+        return inp.tick
 
     def on_event(self, message: FrontendMessage) -> None:
         now = self.clock.now()
@@ -127,6 +112,11 @@ class Core:
         self.inputs.events.append((message, now))
 
     # ------------------------------------------------------------ ticking
+
+    def _pre_tick(self, _tree: py_trees.trees.BehaviourTree) -> None:
+        self.snapshot.write()
+        for code, at in self.snapshot.get(INPUTS["response"].key):
+            self.actions.on_response(code, at)
 
     def tick(self) -> Status:
         """Snapshot the inputs, tick the tree once, run the tick taps; the root's status."""

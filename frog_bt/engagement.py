@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from frog_bt.messages import Face
+from frog_bt.rosbridge.msgs import Face
 
 
 def qualifies(face: Face, near: float) -> bool:

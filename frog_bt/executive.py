@@ -31,9 +31,9 @@ from frog_bt.frontend.messages import EVENTS, FrontendMessage
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.status import link_line, status_line
-from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.warning_limit import WarningLimiter
+from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
@@ -134,14 +134,19 @@ class Executive:
 
     # ------------------------------------------------------------ lifecycle
 
-    async def run(self) -> Outcome:
-        """Connect, tick until stopped (or one tour done with ``once``), then halt cleanly."""
+    def setup_wire(self) -> None:
+        """Advertise every output and subscribe to every input of the wire table (sent
+        once connected, and again after each reconnect)."""
         for role, topic in OUTPUTS.items():
             self.client.advertise(self.site.topic(role), topic.type)
         for role, topic in INPUTS.items():
             self.client.subscribe(self.site.topic(role), topic.type)
         if self.sim_time:
             self.client.subscribe(CLOCK.name, CLOCK.type)
+
+    async def run(self) -> Outcome:
+        """Connect, tick until stopped (or one tour done with ``once``), then halt cleanly."""
+        self.setup_wire()
         await self.link.start()
         self.client.start()
         try:

@@ -41,12 +41,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any
 
+import msgspec
 from mcap.writer import CompressionType, Writer
 
 from frog_bt import __version__
 from frog_bt.errors import DecodeError
-from frog_bt.messages import decode_clock
-from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
+from frog_bt.frontend.messages import COMMANDS, EVENTS
+from frog_bt.rosbridge.msgs import ROS_TYPES
+from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 log = logging.getLogger(__name__)
 
@@ -60,67 +62,42 @@ FLUSH_EVERY = 2.0  # wall seconds between forced chunk flushes
 HELD_LIMIT = 10_000  # messages held before the first /clock
 
 # ------------------------------------------------------------------ JSON Schemas
-
-_INT = {"type": "integer"}
-_NUM = {"type": "number"}
-_STR = {"type": "string"}
-_BOOL = {"type": "boolean"}
+# From the wire table's Structs (refs inlined: one self-contained schema per channel).
 
 
-def _obj(title: str | None = None, **props: Any) -> dict[str, Any]:
-    schema: dict[str, Any] = {"type": "object", "properties": props}
-    if title:
-        schema["title"] = title
-    return schema
+def _inline(node: Any, defs: dict[str, Any]) -> Any:
+    if isinstance(node, dict):
+        if "$ref" in node:
+            return _inline(defs[node["$ref"].rsplit("/", 1)[1]], defs)
+        return {k: _inline(v, defs) for k, v in node.items() if k != "$defs"}
+    if isinstance(node, list):
+        return [_inline(v, defs) for v in node]
+    return node
 
 
-def _array(items: dict[str, Any]) -> dict[str, Any]:
-    return {"type": "array", "items": items}
+def struct_schema(types: Any, title: str) -> dict[str, Any]:
+    """The JSON schema of a Struct type (or a union of them), refs inlined."""
+    schema = msgspec.json.decode(msgspec.json.encode(msgspec.json.schema(types)))  # as JSON
+    return {**_inline(schema, schema.get("$defs", {})), "title": title}
 
 
-_TIME = {**_obj(secs=_INT, nsecs=_INT, sec=_INT, nanosec=_INT),
-         "description": "ROS 1 {secs, nsecs} or ROS 2 {sec, nanosec}"}
-_HEADER = _obj("std_msgs/Header", seq=_INT, stamp=_TIME, frame_id=_STR)
-_POINT = _obj("geometry_msgs/Point", x=_NUM, y=_NUM, z=_NUM)
-_QUATERNION = _obj("geometry_msgs/Quaternion", x=_NUM, y=_NUM, z=_NUM, w=_NUM)
+def _datagram_schema() -> dict[str, Any]:
+    """Every front-end message's fields in one object: a datagram is one of them."""
+    props: dict[str, Any] = {
+        "type": {"type": "string", "description": "command, event or ack (CONTRACT §2)"},
+        "seq": {"type": "integer", "minimum": 0}}
+    for cls in (*COMMANDS.values(), *EVENTS.values()):
+        props.update(struct_schema(cls, cls.type).get("properties", {}))
+    return {"type": "object", "title": DATAGRAM_TYPE, "properties": props,
+            "required": ["type", "seq"]}
+
 
 SCHEMAS: dict[str, dict[str, Any]] = {
-    "geometry_msgs/PoseStamped": _obj(
-        "geometry_msgs/PoseStamped", header=_HEADER,
-        pose=_obj("geometry_msgs/Pose", position=_POINT, orientation=_QUATERNION)),
-    "std_msgs/Int32": _obj("std_msgs/Int32", data=_INT),
-    "std_msgs/String": _obj("std_msgs/String", data=_STR),
-    "diagnostic_msgs/DiagnosticArray": _obj(
-        "diagnostic_msgs/DiagnosticArray", header=_HEADER, status=_array(_obj(
-            "diagnostic_msgs/DiagnosticStatus",
-            level={"type": "integer", "minimum": 0, "maximum": 3,
-                   "description": "0 OK, 1 WARN, 2 ERROR, 3 STALE"},
-            name=_STR, message=_STR, hardware_id=_STR,
-            values=_array(_obj("diagnostic_msgs/KeyValue", key=_STR, value=_STR))))),
-    "frog_msgs/PersonDetections": _obj(
-        "frog_msgs/PersonDetections", header=_HEADER, persons=_array(_obj(
-            "frog_msgs/PersonDetection", id=_INT, position=_POINT,
-            orientation={**_NUM, "description": "degrees 0..360 relative to the robot, "
-                                                "180 = facing it"}))),
-    "frog_msgs/FaceData": _obj(
-        "frog_msgs/FaceData", header=_HEADER, faces=_array(_obj(
-            "frog_msgs/Face", id=_INT,
-            engagement={"type": "number", "minimum": -1, "maximum": 1},
-            distance={**_NUM, "description": "metres"}, facing=_BOOL))),
-    "frog_msgs/TrackedPeople": _obj(
-        "frog_msgs/TrackedPeople", header=_HEADER,
-        people=_array(_obj("frog_msgs/TrackedPerson", id=_INT, position=_POINT))),
-    "rosgraph_msgs/Clock": _obj("rosgraph_msgs/Clock", clock=_TIME),
-    DATAGRAM_TYPE: {
-        **_obj("frog_bt/FrontendDatagram",
-               type={**_STR, "description": "command, event or ack (CONTRACT §2)"},
-               seq={"type": "integer", "minimum": 0}, icl=_BOOL,
-               engaged={"type": ["boolean", "null"]}, poi=_STR, waypoint=_STR,
-               part={"enum": ["a", "b"]}, level={"type": ["number", "null"]}, on=_BOOL,
-               percent=_INT, spot=_STR, state=_STR, reason=_STR),
-        "required": ["type", "seq"]},
-    TICK_TYPE: _obj("frog_bt/Tick", tick=_INT,
-                    status={"enum": ["INVALID", "RUNNING", "SUCCESS", "FAILURE"]}),
+    **{name: struct_schema(codec.wire, name) for name, codec in ROS_TYPES.items()},
+    DATAGRAM_TYPE: _datagram_schema(),
+    TICK_TYPE: {"type": "object", "title": TICK_TYPE, "properties": {
+        "tick": {"type": "integer"},
+        "status": {"enum": ["INVALID", "RUNNING", "SUCCESS", "FAILURE"]}}},
 }
 
 
@@ -139,6 +116,11 @@ def from_ns(ns: int) -> float:
 
 def _dumps(msg: Any) -> bytes:
     return json.dumps(msg, separators=(",", ":")).encode()
+
+
+def _raw(msg: Any) -> bytes:
+    """A received ``msg`` as JSON bytes: as it came (raw) when it is raw JSON."""
+    return bytes(msg) if isinstance(msg, bytes | msgspec.Raw) else _dumps(msg)
 
 
 Queued = tuple[int, int, bytes, int]  # channel id, log time (ns), data, sequence
@@ -243,15 +225,16 @@ class Recorder:
         cid = self._channels.get(topic)
         if cid is None:
             cid = self.channel(topic, "unknown")
+        data = _raw(msg)
         if topic == self._clock_topic:
             try:  # /clock is seen before the clock takes it: stamp it with its own time
-                t = max(t, decode_clock(msg)) if self._ready() else decode_clock(msg)
+                clock = CLOCK.codec.decode(data)
             except DecodeError:
                 pass
             else:
-                self._write(cid, t, _dumps(msg))
+                self._write(cid, max(t, clock) if self._ready() else clock, data)
                 return
-        self._write(cid, t if self._ready() else None, _dumps(msg))
+        self._write(cid, t if self._ready() else None, data)
 
     def on_ros_out(self, t: float, topic: str, msg: Any) -> None:
         self._write(self._channels.get(topic) or self.channel(topic, "unknown"), t, _dumps(msg))

@@ -3,7 +3,7 @@
 :class:`Replay` reads an MCAP recording (:mod:`frog_bt.recording`) in log-time
 order and feeds a fresh :class:`~frog_bt.core.Core` on a
 :class:`~frog_bt.clock.ManualClock` that takes the recorded times: ROS inputs
-go through :data:`~frog_bt.messages.DECODERS` (by the channel's schema name) to
+go through :data:`~frog_bt.rosbridge.msgs.ROS_TYPES` (by the channel's schema name) to
 ``Core.on_ros``; ``/frontend/in`` datagrams go through a fresh
 :class:`~frog_bt.frontend.protocol.Endpoint`, so duplicates are suppressed exactly
 as live, to ``Core.on_event``; ``/clock`` moves the clock (under sim time what
@@ -47,10 +47,10 @@ from frog_bt.core import Core
 from frog_bt.errors import DecodeError, FrogError
 from frog_bt.frontend.messages import EVENTS, FrontendMessage, message_fields
 from frog_bt.frontend.protocol import Endpoint
-from frog_bt.messages import DECODERS, decode_clock
 from frog_bt.recording import FRONTEND_IN, FRONTEND_OUT, TICK, from_ns
-from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
+from frog_bt.rosbridge.msgs import ROS_TYPES
 from frog_bt.tree.loader import LoadedTree
+from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 
@@ -227,8 +227,8 @@ class Replay:
     def _on_message(self, topic: str, t: float, data: bytes) -> None:
         if topic == CLOCK.name and self.sim_time:
             try:
-                t = decode_clock(json.loads(data))
-            except (ValueError, DecodeError):
+                t = CLOCK.codec.decode(data)
+            except DecodeError:
                 return  # live, a malformed /clock does not move the clock either
             self._advance(t)
             return
@@ -249,10 +249,10 @@ class Replay:
             self._compare()
 
     def _on_ros(self, topic: str, data: bytes) -> None:
-        decoder = DECODERS.get(self.types.get(topic, "")) or DECODERS[self.inputs[topic]]
+        codec = ROS_TYPES.get(self.types.get(topic, "")) or ROS_TYPES[self.inputs[topic]]
         try:
-            value = decoder(json.loads(data))
-        except (ValueError, DecodeError):
+            value = codec.decode(data)
+        except DecodeError:
             return  # live, the client drops a malformed message before the core
         self.result.inputs += 1
         if self.core.on_ros(topic, value) and not self.exact and self.clock.ready:

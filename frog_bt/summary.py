@@ -17,8 +17,8 @@ from frog_bt.config import Site
 from frog_bt.context import Incident
 from frog_bt.engagement import Decision
 from frog_bt.frontend.messages import StartPoi, Tour, UserPositive
-from frog_bt.messages import decode_pose
-from frog_bt.topics import SUCCEEDED
+from frog_bt.rosbridge.msgs import POSE
+from frog_bt.wire import SUCCEEDED
 
 
 @dataclass
@@ -38,7 +38,7 @@ class TourSummary:
     _seen_incidents: int = 0
 
     def waypoint_of(self, msg: dict[str, Any]) -> str:
-        pose = decode_pose(msg)
+        pose = POSE.convert(msg)
         for name, poi in self.site.pois.items():
             if (abs(poi.x - pose.x) < 1e-6 and abs(poi.y - pose.y) < 1e-6
                     and abs(poi.z - pose.qz) < 1e-6 and abs(poi.w - pose.qw) < 1e-6):

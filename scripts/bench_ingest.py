@@ -122,7 +122,7 @@ async def one_flood(server: FakeRosbridge, child: Child, kind: str,
 
 async def measure(seconds: float, kinds: list[str]) -> dict[str, Any]:
     from frog_bt.frontend.messages import FrontendIdle
-    from frog_bt.topics import INPUTS
+    from frog_bt.wire import INPUTS
 
     result: dict[str, Any] = {"seconds": seconds}
 

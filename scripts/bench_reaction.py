@@ -172,7 +172,7 @@ class Director:
 
 async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]:
     from frog_bt.config import load_site
-    from frog_bt.topics import INPUTS
+    from frog_bt.wire import INPUTS
 
     plain = {"content": True, "face_stream": False, "projector": False, "check_follower": True}
     site_path = synthetic_site(7, workdir, flags=plain, over={"follow": {"grace": 0.0}})

@@ -25,7 +25,7 @@ def main() -> None:
     args = p.parse_args()
     import roslibpy
 
-    from frog_bt.topics import INPUTS
+    from frog_bt.wire import INPUTS
 
     received = 0
     lock = threading.Lock()

@@ -35,7 +35,7 @@ from bench_support import (
 
 
 async def startup_runs(runs: int, extra: list[str]) -> dict[str, Any]:
-    from frog_bt.topics import INPUTS
+    from frog_bt.wire import INPUTS
 
     server = FakeRosbridge(expect_subscriptions=len(INPUTS))
     await server.start()

@@ -12,7 +12,7 @@ from frog_bt.clock import ManualClock
 from frog_bt.config import Site, load_site
 from frog_bt.core import Core
 from frog_bt.frontend.messages import FrontendMessage
-from frog_bt.messages import (
+from frog_bt.rosbridge.msgs import (
     PersonDetection,
     PersonDetections,
     Point,

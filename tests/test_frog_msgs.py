@@ -7,7 +7,7 @@ arrays) and checks, field by field, that
 * they are CONTRACT's definitions, comments included;
 * the simulator's JSON (:mod:`frog_bt.sim.msgs`) has every field, no other
   field, and JSON types matching the ROS types;
-* the executive's decoders (:mod:`frog_bt.messages`) accept a message built from
+* the executive's decoders (:mod:`frog_bt.rosbridge.msgs`) accept a message built from
   the definition and read every field;
 * ``package.xml`` and ``CMakeLists.txt`` build the package with catkin.
 """
@@ -24,9 +24,10 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import rosmsgs
 
-from frog_bt import messages
 from frog_bt.errors import DecodeError
+from frog_bt.rosbridge import msgs as messages
 
 PACKAGE = Path(__file__).resolve().parents[1] / "ros" / "frog_msgs"
 MSG_DIR = PACKAGE / "msg"
@@ -60,9 +61,9 @@ geometry_msgs/Point position     # map frame
 
 # Top-level message -> the executive's decoder for it.
 TOP_LEVEL = {
-    "PersonDetections": messages.decode_person_detections,
-    "FaceData": messages.decode_face_data,
-    "TrackedPeople": messages.decode_tracked_people,
+    "PersonDetections": rosmsgs.decode_person_detections,
+    "FaceData": rosmsgs.decode_face_data,
+    "TrackedPeople": rosmsgs.decode_tracked_people,
 }
 
 
@@ -187,9 +188,16 @@ def test_cmakelists() -> None:
     assert order == sorted(order)
 
 
-def test_decoders_are_registered_by_ros_type() -> None:
-    for name, decoder in TOP_LEVEL.items():
-        assert messages.DECODERS[f"frog_msgs/{name}"] is decoder
+def test_wire_structs_have_the_msg_fields() -> None:
+    """Each frog_msgs type has a codec whose wire Struct has exactly the .msg's fields."""
+    wires = {"Face": messages.Face, "PersonDetection": messages.PersonDetection,
+             "TrackedPerson": messages.TrackedPerson}
+    for name in TOP_LEVEL:
+        codec = messages.ROS_TYPES[f"frog_msgs/{name}"]
+        assert codec.name == f"frog_msgs/{name}"
+        wires[name] = codec.wire
+    for name, wire in wires.items():
+        assert set(wire.__struct_fields__) == {f.name for f in DEFS[name]}, name
 
 
 # ------------------------------------------------------------------ JSON schema check

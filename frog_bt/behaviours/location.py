@@ -20,7 +20,7 @@ from frog_bt.behaviours.navigation import PoiParams
 from frog_bt.blackboard import Reading
 from frog_bt.config import ZoneShape
 from frog_bt.frontend.messages import FollowMe, SpecialContent, Volume
-from frog_bt.messages import Pose
+from frog_bt.rosbridge.msgs import Pose
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import Status
 from frog_bt.zones import Membership, Shape

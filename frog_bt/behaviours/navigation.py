@@ -5,8 +5,8 @@ from __future__ import annotations
 from pydantic import Field, ValidationInfo, field_validator
 
 from frog_bt.actions import CODE_NAMES, Request
-from frog_bt.topics import SUCCEEDED
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
+from frog_bt.wire import SUCCEEDED
 
 
 class PoiParams(Params):

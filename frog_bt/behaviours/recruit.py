@@ -11,9 +11,9 @@ from frog_bt.blackboard import EventLog, Reading
 from frog_bt.frontend.messages import AskTour as AskTourCommand
 from frog_bt.frontend.messages import StartIntroduction as StartIntroductionCommand
 from frog_bt.frontend.messages import UserNegative, UserPositive
-from frog_bt.messages import PersonDetection, PersonDetections, Pose
-from frog_bt.topics import SUCCEEDED
+from frog_bt.rosbridge.msgs import PersonDetection, PersonDetections, Pose
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
+from frog_bt.wire import SUCCEEDED
 
 Timeout = Field(None, gt=0, allow_inf_nan=False)
 

@@ -10,7 +10,7 @@ from pydantic import Field
 
 from frog_bt.blackboard import Reading
 from frog_bt.frontend.messages import Tour
-from frog_bt.messages import Diagnostics
+from frog_bt.rosbridge.msgs import Diagnostics
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
 

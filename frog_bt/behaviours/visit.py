@@ -11,7 +11,7 @@ from frog_bt.behaviours.navigation import PoiParams
 from frog_bt.blackboard import EventLog, Reading
 from frog_bt.frontend.messages import ContentDone, FrontendIdle, StartPoi
 from frog_bt.frontend.messages import FinishPoi as FinishPoiCommand
-from frog_bt.messages import Pose, TrackedPeople
+from frog_bt.rosbridge.msgs import Pose, TrackedPeople
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
 
 

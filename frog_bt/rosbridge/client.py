@@ -3,7 +3,7 @@
 The :class:`~frog_bt.rosbridge.protocol.Session` decides what to send and
 when; this module only moves frames between it and a WebSocket
 (``websockets.asyncio.client``), reconnects, and turns inbound ``publish`` ops
-into typed values with :data:`frog_bt.messages.DECODERS`.
+into typed values with :data:`frog_bt.rosbridge.msgs.ROS_TYPES`.
 
 * ``advertise``/``subscribe``/``publish``/... are plain synchronous calls, O(1)
   and never blocking, so behaviour-tree leaves may call them inside a tick.
@@ -37,8 +37,8 @@ from websockets.exceptions import ConnectionClosed, InvalidURI, WebSocketExcepti
 from websockets.uri import parse_uri
 
 from frog_bt.errors import DecodeError
-from frog_bt.messages import DECODERS
 from frog_bt.rosbridge.link import ClientStats, LinkState
+from frog_bt.rosbridge.msgs import ROS_TYPES
 from frog_bt.rosbridge.protocol import (
     MAX_FRAME_BYTES,
     OtherOp,
@@ -136,11 +136,11 @@ class RosbridgeClient:
 
     def subscribe(self, topic: str, type: str, throttle_rate: int = 0,
                   queue_length: int = 0) -> None:
-        """Subscribe; messages arrive decoded by ``DECODERS[type]``.
+        """Subscribe; messages arrive decoded by ``ROS_TYPES[type]``.
 
         Raises ValueError for a type with no decoder (a programming error).
         """
-        if type not in DECODERS:
+        if type not in ROS_TYPES:
             raise ValueError(f"subscribe {topic!r}: no decoder for type {type!r}")
         self._enqueue(self.session.subscribe(topic, type, throttle_rate, queue_length))
 
@@ -393,7 +393,7 @@ class RosbridgeClient:
         if self.on_raw is not None:
             self.on_raw(event.topic, event.msg)
         try:
-            value = DECODERS[sub.type](event.msg)
+            value = ROS_TYPES[sub.type].decode(event.msg)
         except DecodeError as exc:
             self._malformed(event.topic, f"malformed {sub.type} on {event.topic}: msg.{exc}")
             return

@@ -21,6 +21,9 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
+import msgspec
+
+from frog_bt.codec import decoder
 from frog_bt.errors import DecodeError
 
 MAX_FRAME_BYTES = 1 << 20  # rosbridge's own default max message size is larger; ours is a guard
@@ -29,7 +32,7 @@ MAX_FRAME_BYTES = 1 << 20  # rosbridge's own default max message size is larger;
 @dataclass(frozen=True, slots=True)
 class Publish:
     topic: str
-    msg: Any
+    msg: msgspec.Raw  # the ``msg`` JSON as received, decoded by the topic's ROS type
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,39 +50,37 @@ class OtherOp:
 Inbound = Publish | Status | OtherOp
 
 
+class Frame(msgspec.Struct):
+    """What a client reads of any inbound frame; ``msg`` stays raw JSON until the topic's
+    type decodes it (a ``publish``), or is the text of a ``status``."""
+
+    op: str
+    topic: str | None = None
+    msg: msgspec.Raw = msgspec.Raw()  # empty: no msg
+    level: Any = ""
+    id: Any = None
+
+
+_decode_frame = decoder(Frame)
+_decode_any = decoder(Any)  # type: ignore[arg-type]
+
+
 def decode_frame(text: str | bytes) -> Inbound:
     """Decode one inbound frame; raises DecodeError when malformed."""
     if len(text) > MAX_FRAME_BYTES:
         raise DecodeError(f"frame of {len(text)} bytes exceeds {MAX_FRAME_BYTES}")
-    try:
-        # One decoder for every frame: json.loads with an argument builds a new one each call.
-        obj = (_DECODER.decode(text) if isinstance(text, str)
-               else json.loads(text, parse_constant=_reject_constant))
-    except (ValueError, UnicodeDecodeError, RecursionError) as exc:
-        raise DecodeError(f"not JSON: {exc}") from None
-    if not isinstance(obj, dict):
-        raise DecodeError(f"expected a JSON object, got {type(obj).__name__}")
-    op = obj.get("op")
-    if not isinstance(op, str):
-        raise DecodeError("expected a string", ("op",))
-    if op == "publish":
-        topic = obj.get("topic")
-        if not isinstance(topic, str) or not topic:
+    frame = _decode_frame(text)
+    if frame.op == "publish":
+        if not frame.topic:
             raise DecodeError("expected a topic name", ("topic",))
-        if "msg" not in obj:
+        if not frame.msg:
             raise DecodeError("missing field", ("msg",))
-        return Publish(topic, obj["msg"])
-    if op == "status":
-        level, msg, ident = obj.get("level", ""), obj.get("msg", ""), obj.get("id")
-        return Status(str(level), str(msg), None if ident is None else str(ident))
-    return OtherOp(op)
-
-
-def _reject_constant(name: str) -> Any:
-    raise ValueError(f"{name} is not valid JSON")
-
-
-_DECODER = json.JSONDecoder(parse_constant=_reject_constant)
+        return Publish(frame.topic, frame.msg)
+    if frame.op == "status":
+        msg = _decode_any(frame.msg) if frame.msg else ""
+        ident = frame.id
+        return Status(str(frame.level), str(msg), None if ident is None else str(ident))
+    return OtherOp(frame.op)
 
 
 def dumps(obj: dict[str, Any]) -> str:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from frog_bt.sim.msgs import DiagnosticStatus
+from frog_bt.rosbridge.msgs import DiagnosticStatus, KeyValue
 from frog_bt.sim.scenario import BatterySpec, FaultSpec
 
 
@@ -27,7 +27,7 @@ class Battery:
 
     def status(self) -> DiagnosticStatus:
         return DiagnosticStatus(0, "battery", "", "frog",
-                                (("percentage", f"{self.percentage:.1f}"),))
+                                (KeyValue("percentage", f"{self.percentage:.1f}"),))
 
 
 def active_faults(faults: Iterable[FaultSpec], elapsed: float) -> list[DiagnosticStatus]:

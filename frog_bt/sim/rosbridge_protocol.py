@@ -37,8 +37,10 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+import msgspec
+
 from frog_bt.errors import DecodeError
-from frog_bt.messages import encode_time
+from frog_bt.rosbridge.msgs import encode_time
 from frog_bt.rosbridge.protocol import MAX_FRAME_BYTES, auth_mac, dumps
 
 log = logging.getLogger(__name__)
@@ -236,7 +238,7 @@ class BridgeServer:
         values: Any
         result = True
         if service == "/rosapi/get_time":
-            values = {"time": encode_time(now)}
+            values = {"time": msgspec.to_builtins(encode_time(now))}
         elif service == "/rosapi/topics":
             types = self._all_topic_types()
             values = {"topics": list(types), "types": list(types.values())}

@@ -31,7 +31,7 @@ from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.site import PoiPose, load_pois
 from frog_bt.sim.traffic import MessageLog, Predicate, Record
 from frog_bt.sim.world import World
-from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
+from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 log = logging.getLogger(__name__)
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from frog_bt.errors import ConfigError, DecodeError
-from frog_bt.messages import decode_int32, decode_pose, decode_string, encode_int32, encode_string
+from frog_bt.rosbridge import msgs as ros
 from frog_bt.sim import msgs
 from frog_bt.sim.diagnostics import Battery, active_faults
 from frog_bt.sim.docking import Docking
@@ -36,7 +36,7 @@ from frog_bt.sim.navigation import Navigator, RobotPose
 from frog_bt.sim.people import Crowd, Visitor
 from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.site import PoiPose, poi_matches, pois_at
-from frog_bt.topics import ABORTED, ACTIVE, FAILED, INPUTS, OUTPUTS, SUCCEEDED
+from frog_bt.wire import ABORTED, ACTIVE, FAILED, INPUTS, OUTPUTS, SUCCEEDED
 
 log = logging.getLogger(__name__)
 
@@ -158,7 +158,7 @@ class World:
             return []
 
     def _response(self, code: int) -> Out:
-        return RESPONSE, encode_int32(code)
+        return RESPONSE, ros.INT32.encode(code)
 
     def _held(self, what: str) -> bool:
         if self.docking.docked or self.docking.busy:
@@ -167,7 +167,7 @@ class World:
         return False
 
     def _on_goto(self, msg: Any) -> list[Out]:
-        goal = decode_pose(msg)
+        goal = ros.POSE.convert(msg)
         self.approach = None
         if self._held("goal"):
             self.navigator.cancel()
@@ -179,7 +179,7 @@ class World:
         return [self._response(ACTIVE)]
 
     def _on_approach(self, msg: Any) -> list[Out]:
-        vid = decode_int32(msg)
+        vid = ros.INT32.convert(msg)
         self.navigator.cancel()
         self.approach = None
         if self._held("approach"):
@@ -192,7 +192,7 @@ class World:
         return [self._response(ACTIVE)]
 
     def _on_icl(self, msg: Any) -> list[Out]:
-        command = decode_string(msg)
+        command = ros.STRING.convert(msg)
         if command in ("start", "stop"):
             self.faces_on = command == "start"
         else:
@@ -200,14 +200,14 @@ class World:
         return []
 
     def _on_dock(self, msg: Any) -> list[Out]:
-        command = decode_string(msg)
+        command = ros.STRING.convert(msg)
         near = self.pose.distance_to(self.dock_pose.x, self.dock_pose.y) \
             <= self.scenario.docking.dock_range
         if command in ("dock", "undock"):
             self.navigator.cancel()
             self.approach = None
         state = self.docking.command(command, near)
-        return [] if state is None else [(DOCKING_STATE, encode_string(state))]
+        return [] if state is None else [(DOCKING_STATE, ros.STRING.encode(state))]
 
     def on_frontend(self, direction: str, channel: str, payload: Mapping[str, Any]) -> None:
         """Front-end traffic that matters to visitors: the answer, and tour start / end."""
@@ -237,7 +237,7 @@ class World:
             if state == "docked":
                 d = self.dock_pose
                 self.pose = RobotPose(d.x, d.y, d.yaw, d.exact)
-            out.append((DOCKING_STATE, encode_string(state)))
+            out.append((DOCKING_STATE, ros.STRING.encode(state)))
         self.battery.step(dt, self.docking.docked)
         moved = (self.pose.x - before[0], self.pose.y - before[1])
         self.crowd.step(self.elapsed, dt, self.pose, moved)
@@ -272,5 +272,5 @@ class World:
             statuses = [self.battery.status(), *active_faults(self.scenario.faults, elapsed)]
             out.append((DIAGNOSTIC, msgs.diagnostic_array(now, statuses)))
         if rates[DOCKING_STATE].due(elapsed):
-            out.append((DOCKING_STATE, encode_string(self.docking.state)))
+            out.append((DOCKING_STATE, ros.STRING.encode(self.docking.state)))
         return out

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import py_trees
 
 from frog_bt.telemetry.layout import TreeIndex
-from frog_bt.topics import INPUTS
+from frog_bt.wire import INPUTS
 
 if TYPE_CHECKING:
     from frog_bt.config import Site

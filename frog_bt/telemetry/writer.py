@@ -21,11 +21,11 @@ import rerun as rr
 
 from frog_bt.config import Site
 from frog_bt.frontend.messages import message_fields
-from frog_bt.messages import decode_pose
+from frog_bt.rosbridge.msgs import POSE
 from frog_bt.telemetry.layout import TreeIndex, tidy_layout
 from frog_bt.telemetry.rows import Batch
 from frog_bt.telemetry.site_map import poi_marks, tour_routes, zone_outlines
-from frog_bt.topics import ABORTED, FAILED, SUCCEEDED
+from frog_bt.wire import ABORTED, FAILED, SUCCEEDED
 
 Status = py_trees.common.Status
 TICK, TIME = "tick", "time"  # the timelines: tick number, project-clock time
@@ -325,7 +325,7 @@ class Writer:
             if role == "icl":  # stray samples after a stop must not bridge two sessions
                 self._end_face_session(tick, t)
             if role == "goto":
-                pose = decode_pose(payload)
+                pose = POSE.convert(payload)
                 name = self._waypoint(pose.x, pose.y, pose.qz, pose.qw)
                 text = f"{channel} {name} ({pose.x:.1f}, {pose.y:.1f})"
                 goals.append((tick, 1, t, (name, pose.x, pose.y, pose.yaw)))

@@ -41,7 +41,7 @@ from pydantic import BaseModel
 
 import frog_bt.behaviours  # noqa: F401 - registers the leaf types
 from frog_bt import resources
-from frog_bt.blackboard import INPUT_KEYS
+from frog_bt.blackboard import input_keys
 from frog_bt.config import Site
 from frog_bt.errors import TreeError
 from frog_bt.tree.decorators import DECORATORS
@@ -289,7 +289,7 @@ def _short(value: Any) -> str:
 
 def check_keys(tree: LoadedTree) -> None:
     """Every key a node reads must be written by some node or by the input snapshot."""
-    written = set(INPUT_KEYS)
+    written = set(input_keys())
     for node in tree.nodes():
         written.update(getattr(node, "writes", ()))
     for node in tree.nodes():

@@ -7,7 +7,7 @@ import pytest
 from bench import Bench, write_tree
 
 from frog_bt.frontend.messages import ContentDone, Engagement, FinishPoi, StartPoi
-from frog_bt.messages import Face, FaceData
+from frog_bt.rosbridge.msgs import Face, FaceData
 
 TREE = """
 root:

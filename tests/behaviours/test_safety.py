@@ -6,7 +6,7 @@ import py_trees
 from bench import Bench, write_tree
 
 from frog_bt.frontend.messages import ContentDone, FrontendIdle, Tour, Volume
-from frog_bt.messages import Diagnostics
+from frog_bt.rosbridge.msgs import Diagnostics
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS
 
 GUARD = """

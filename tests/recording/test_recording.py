@@ -16,12 +16,12 @@ from hypothesis import given
 from hypothesis import strategies as st
 from mcap.reader import make_reader
 from recorded_tour import RecordedTour, scenario
+from rosmsgs import encode_clock
 
 from frog_bt.clock import SimClock
 from frog_bt.config import load_site
 from frog_bt.core import Taps
 from frog_bt.executive import WireTaps
-from frog_bt.messages import encode_clock
 from frog_bt.recording import (
     DATAGRAM_TYPE,
     FRONTEND_IN,
@@ -34,7 +34,7 @@ from frog_bt.recording import (
 )
 from frog_bt.rehearsal import free_udp_port
 from frog_bt.sim import Simulator
-from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
+from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 ROOT = Path(__file__).resolve().parents[2]
 JSON_TYPES: dict[str, Any] = {"object": dict, "array": list, "string": str, "boolean": bool,
@@ -42,8 +42,15 @@ JSON_TYPES: dict[str, Any] = {"object": dict, "array": list, "string": str, "boo
 
 
 def conforms(value: Any, schema: dict[str, Any]) -> bool:
-    """The subset of JSON Schema the recorder writes: type, properties, items, enum, required."""
+    """The subset of JSON Schema the recorder writes: type, properties, items, enum,
+    required, anyOf, minimum/maximum."""
+    if "anyOf" in schema and not any(conforms(value, s) for s in schema["anyOf"]):
+        return False
     if "enum" in schema and value not in schema["enum"]:
+        return False
+    if "minimum" in schema and isinstance(value, int | float) and value < schema["minimum"]:
+        return False
+    if "maximum" in schema and isinstance(value, int | float) and value > schema["maximum"]:
         return False
     types = schema.get("type")
     if types is not None:

@@ -36,6 +36,7 @@ from garbage import (
 )
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from rosmsgs import DECODERS, encode_clock
 from websockets.asyncio.server import ServerConnection, serve
 
 from frog_bt.clock import SimClock
@@ -44,7 +45,6 @@ from frog_bt.errors import DecodeError
 from frog_bt.executive import Executive
 from frog_bt.frontend import messages as fm
 from frog_bt.frontend.protocol import Endpoint, decode_datagram, encode_datagram
-from frog_bt.messages import DECODERS, encode_clock
 from frog_bt.rehearsal import free_udp_port
 from frog_bt.rosbridge.protocol import Publish, decode_frame
 from frog_bt.tree.loader import load_tree

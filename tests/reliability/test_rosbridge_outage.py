@@ -16,13 +16,13 @@ import re
 
 import pytest
 from harness import TourRun, arrived, received
+from rosmsgs import encode_pose, encode_string
 
-from frog_bt.messages import encode_pose, encode_string
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.sim.scenario import parse_scenario
 from frog_bt.sim.site import load_pois
 from frog_bt.sim.world import World
-from frog_bt.topics import CLOCK, INPUTS, OUTPUTS
+from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 GOTO, DOCK = "/GotoWayPoint", "/docking/dock"
 # what the leaves note when they time out, fail, skip, abort or give up

@@ -16,15 +16,16 @@ from contextlib import asynccontextmanager
 from typing import Any
 
 import pytest
+from rosmsgs import encode_int32, encode_pose, encode_string
 from websockets.asyncio.server import serve
 
-from frog_bt.messages import Pose, encode_int32, encode_pose, encode_string
 from frog_bt.rosbridge.client import (
     FRAME_TOPIC,
     LinkState,
     RosbridgeClient,
     backoff_delays,
 )
+from frog_bt.rosbridge.msgs import Pose
 from frog_bt.warning_limit import WarningLimiter
 
 from .conftest import FakeRosbridge, free_port, run
@@ -183,7 +184,7 @@ def test_malformed_inbound_frames_are_counted_and_the_client_keeps_working(
     # rate limited: one warning per topic within the interval
     assert len([w for w in warnings if "malformed frame" in w]) == 1
     assert any("engagement" in w for w in warnings)
-    assert any("msg.data: expected an integer" in w for w in warnings)
+    assert any("msg.data: expected `int`" in w for w in warnings)
 
 
 def test_on_message_exceptions_are_logged_not_fatal(caplog: pytest.LogCaptureFixture) -> None:

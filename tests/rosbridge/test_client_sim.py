@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import asyncio
 
-from frog_bt.messages import Pose, encode_pose
+from rosmsgs import encode_pose
+
 from frog_bt.rosbridge.client import RosbridgeClient
+from frog_bt.rosbridge.msgs import Pose
 from frog_bt.sim import Simulator, parse_scenario
 
 

@@ -9,8 +9,8 @@ from frog_bt.clock import WallClock
 from frog_bt.config import load_site
 from frog_bt.executive import Executive
 from frog_bt.rehearsal import free_udp_port
-from frog_bt.topics import INPUTS, OUTPUTS
 from frog_bt.tree.loader import load_tree
+from frog_bt.wire import INPUTS, OUTPUTS
 
 from .conftest import FakeRosbridge
 

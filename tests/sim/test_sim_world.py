@@ -7,8 +7,7 @@ from collections.abc import Callable
 from typing import Any
 
 import pytest
-
-from frog_bt.messages import (
+from rosmsgs import (
     decode_diagnostics,
     decode_face_data,
     decode_person_detections,
@@ -18,6 +17,7 @@ from frog_bt.messages import (
     encode_pose,
     encode_string,
 )
+
 from frog_bt.sim.faces import EngagementScript
 from frog_bt.sim.navigation import drive
 from frog_bt.sim.world import World
