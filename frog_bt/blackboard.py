@@ -41,6 +41,15 @@ T = TypeVar("T")
 FIXED_KEYS = ("/now", "/events", "/frontend_ready", "/link")
 
 
+def peek(key: str) -> Any:
+    """The value of ``key``, or None: py_trees' introspection read, for observers (status
+    line, telemetry, summaries) that hold no blackboard client."""
+    try:
+        return py_trees.blackboard.Blackboard.get(key)
+    except KeyError:
+        return None
+
+
 def input_keys() -> tuple[str, ...]:
     """Every key the snapshot writes (the fixed ones and the wire table's inputs)."""
     return (*FIXED_KEYS, *(inp.key for inp in INPUTS.values()))

@@ -18,6 +18,7 @@ from typing import Any, TextIO
 
 import py_trees
 
+from frog_bt.blackboard import peek
 from frog_bt.core import Core
 
 
@@ -65,15 +66,14 @@ def _plain_error(error: str) -> str:
 
 
 def status_line(core: Core) -> str:
-    storage = py_trees.blackboard.Blackboard.storage
     tip = core.bt.root.tip()
-    diagnostics = storage.get("/diagnostics")
+    diagnostics = peek("/diagnostics")
     battery = diagnostics.value.battery if diagnostics is not None else None
     parts = [
         phase(core),
-        f"poi {storage.get('/waypoint') or '-'}",
+        f"poi {peek('/waypoint') or '-'}",
         f"tip {tip.name if tip else '-'}",
-        f"visitor {storage.get('/visitor') if storage.get('/visitor') is not None else '-'}",
+        f"visitor {peek('/visitor') if peek('/visitor') is not None else '-'}",
         f"battery {battery:.0f}%" if battery is not None else "battery -",
     ]
     if core.ctx.resumed:

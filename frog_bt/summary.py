@@ -11,8 +11,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
-import py_trees
-
+from frog_bt.blackboard import peek
 from frog_bt.config import Site
 from frog_bt.context import Incident
 from frog_bt.engagement import Decision
@@ -73,7 +72,7 @@ class TourSummary:
             self.recruited.append(self.approached[-1])
 
     def tick(self, core: Any) -> None:
-        decision = py_trees.blackboard.Blackboard.storage.get("/engagement_decision")
+        decision = peek("/engagement_decision")
         if decision is not None and decision is not self._last_decision:
             self._last_decision = decision
             self.decisions.append(decision)

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import py_trees
 
+from frog_bt.blackboard import peek
 from frog_bt.telemetry.layout import TreeIndex
 from frog_bt.wire import INPUTS
 
@@ -179,9 +180,8 @@ class Rows:
                 i -= 1
             batch.notes.extend((tick, at, text) for at, text in notes[i + 1:])
             self._last_note = notes[-1]
-        storage = py_trees.blackboard.Blackboard.storage
         for key in ENGAGEMENT_KEYS:
-            value = storage.get(key)
+            value = peek(key)
             if value is not self._blackboard.get(key):
                 self._blackboard[key] = value
                 batch.blackboard.append((tick, t, key, value))

@@ -17,20 +17,29 @@ behaviours in :mod:`frog_bt.behaviours`.
 
 from __future__ import annotations
 
+import math
 from typing import Any, TypeVar
 
 import py_trees
 from pydantic import BaseModel, Field
 
-from frog_bt.tree.node import FAILURE, RUNNING, SUCCESS, Declared, Params, Status
+from frog_bt.tree.node import FAILURE, RUNNING, Declared, Params, Status
 from frog_bt.tree.observed import Observed
 
 
 class FrogDecorator(Observed, Declared, py_trees.decorators.Decorator):
+    """A decorator a tree file can name. One that is a py_trees decorator with our
+    parameters lists that class among its bases and maps the parameters to its
+    constructor's in :meth:`base_kwargs`."""
+
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour,
                  params: BaseModel | None = None) -> None:
-        super().__init__(name=name, child=child)
+        params = params if params is not None else type(self).Params()
+        super().__init__(name=name, child=child, **self.base_kwargs(params))
         self._declare(params)
+
+    def base_kwargs(self, params: Any) -> dict[str, Any]:
+        return {}
 
 
 D = TypeVar("D", bound=type[FrogDecorator])
@@ -45,8 +54,9 @@ def register_decorator(cls: D) -> D:
 
 
 @register_decorator
-class Retry(FrogDecorator):
-    """Run the child again after FAILURE, up to ``attempts`` runs in all (None: forever).
+class Retry(FrogDecorator, py_trees.decorators.Retry):
+    """Run the child again after FAILURE, up to ``attempts`` runs in all (None: forever):
+    py_trees' ``Retry``.
 
     Returns the child's SUCCESS; RUNNING while retrying (the child restarts on
     the next tick); FAILURE once the last attempt failed. Reads and writes nothing.
@@ -55,22 +65,11 @@ class Retry(FrogDecorator):
     class Params(Params):
         attempts: int | None = Field(None, ge=1)
 
+    def base_kwargs(self, params: Any) -> dict[str, Any]:
+        return {"num_failures": params.attempts or math.inf}
+
     def describe(self) -> dict[str, Any]:
         return {"attempts": self.params.attempts or "until success"}
-
-    def initialise(self) -> None:
-        self.failures = 0
-
-    def update(self) -> Status:
-        status = self.decorated.status
-        if status != FAILURE:
-            return status
-        self.failures += 1
-        if self.params.attempts is not None and self.failures >= self.params.attempts:
-            self.feedback_message = f"failed {self.failures} times"
-            return FAILURE
-        self.feedback_message = f"attempt {self.failures + 1}"
-        return RUNNING
 
 
 @register_decorator
@@ -96,9 +95,6 @@ class Timeout(FrogDecorator):
 
 
 @register_decorator
-class FailureIsSuccess(FrogDecorator):
-    """An optional part: SUCCESS when the child fails, else the child's status."""
-
-    def update(self) -> Status:
-        status = self.decorated.status
-        return SUCCESS if status == FAILURE else status
+class FailureIsSuccess(FrogDecorator, py_trees.decorators.FailureIsSuccess):
+    """An optional part: SUCCESS when the child fails, else the child's status
+    (py_trees' ``FailureIsSuccess``)."""

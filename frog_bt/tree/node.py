@@ -20,24 +20,12 @@ from frog_bt.context import Context
 
 Status = py_trees.common.Status
 SUCCESS, FAILURE, RUNNING, INVALID = Status.SUCCESS, Status.FAILURE, Status.RUNNING, Status.INVALID
-_BB = py_trees.blackboard.Blackboard
 
 
 class Params(BaseModel):
     """Base of every node's parameter model: unknown keys are errors."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-def direct_keys(client: py_trees.blackboard.Client, keys: tuple[str, ...]) -> frozenset[str]:
-    """The keys of ``client`` that a plain dict access can serve: absolute and not remapped.
-
-    py_trees' ``Client.get``/``set`` resolve the name and check access on every call
-    (about 3 µs each, a large share of a tick). Access was checked when the key was
-    registered, so while no activity stream is on a read or write of one of these keys
-    is just ``Blackboard.storage[key]``; any other key takes py_trees' own path.
-    """
-    return frozenset(k for k in keys if client.remappings.get(k) == k)
 
 
 class Declared:
@@ -53,17 +41,12 @@ class Declared:
         """Call from ``__init__`` once the py_trees base is initialised."""
         self.params: Any = params if params is not None else type(self).Params()
         self._ctx: Context | None = None
-        self._direct_reads: frozenset[str] = frozenset()
-        self._direct_writes: frozenset[str] = frozenset()
         if self.reads or self.optional_reads or self.writes:
             self.bb = self.attach_blackboard_client(name=self.name)  # type: ignore[attr-defined]
             for key in (*self.reads, *self.optional_reads):
                 self.bb.register_key(key, access=py_trees.common.Access.READ)
             for key in self.writes:
                 self.bb.register_key(key, access=py_trees.common.Access.WRITE)
-            self._direct_reads = direct_keys(self.bb, (*self.reads, *self.optional_reads,
-                                                       *self.writes))
-            self._direct_writes = direct_keys(self.bb, self.writes)
 
     def setup(self, **kwargs: Any) -> None:
         self._ctx = kwargs["ctx"]
@@ -76,18 +59,13 @@ class Declared:
 
     def get(self, key: str, default: Any = None) -> Any:
         """The blackboard value of ``key``, or ``default`` while nothing has written it."""
-        if key in self._direct_reads and _BB.activity_stream is None:
-            return _BB.storage.get(key, default)
         try:
             return self.bb.get(key)
         except KeyError:
             return default
 
     def set(self, key: str, value: Any) -> None:
-        if key in self._direct_writes and _BB.activity_stream is None:
-            _BB.storage[key] = value
-        else:
-            self.bb.set(key, value, overwrite=True)
+        self.bb.set(key, value, overwrite=True)
 
     def describe(self) -> dict[str, Any]:
         """Parameters as shown by ``render`` (unset ones omitted)."""
