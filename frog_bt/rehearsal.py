@@ -74,8 +74,16 @@ class Rehearsal:
                                    sim_time=True, **self.executive_kwargs)
         if self.prepare is not None:
             self.prepare(self.executive)
+        self.sim.follow(self._executive_time)
         self.task = asyncio.create_task(self.executive.run())
         return self
+
+    def _executive_time(self) -> float | None:
+        """The executive's clock while it runs and is connected (the simulator follows it)."""
+        exe = self.executive
+        if self.task is None or self.task.done() or not exe.client.link.connected:
+            return None
+        return exe.clock.now() if exe.clock.ready else None
 
     async def finish(self, timeout: float = 60.0) -> Outcome:
         """The executive's outcome (with ``once``: after one tour); TimeoutError after
@@ -89,5 +97,6 @@ class Rehearsal:
                 self.executive.stop("rehearsal over")
                 await asyncio.wait_for(self.task, 10)
         finally:
+            self.sim.follow(None)
             if self.own_sim:
                 await self.sim.stop()

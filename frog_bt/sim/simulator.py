@@ -8,6 +8,13 @@ due. The time loop paces steps to the wall clock by the speed factor
 (``speed: 50`` = 50x real time); when the process cannot keep up, simulated
 time simply runs slower (it never jumps to catch up).
 
+A simulator can *follow* its executive (:meth:`Simulator.follow`): it then
+runs at most ``lead`` simulated seconds ahead of the executive's clock, and
+waits (re-publishing ``/clock``) until the executive catches up. A loaded
+machine then slows the whole rehearsal down instead of changing what the
+executive sees: the same tour at any load. :meth:`pause` holds the world
+still (a test reconnecting its executive, say).
+
 Tests can also skip the time loop (``await sim.start(run_clock=False)``) and
 move the world by hand with :meth:`Simulator.step` / :meth:`Simulator.advance`.
 """
@@ -18,7 +25,7 @@ import asyncio
 import contextlib
 import logging
 import random
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from frog_bt.clock import ManualClock
@@ -36,6 +43,8 @@ from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 log = logging.getLogger(__name__)
 
 MAX_LAG = 0.05  # wall seconds behind schedule before the loop stops trying to catch up
+FOLLOW_POLL = 0.001  # wall seconds between looks at a lagging executive
+REPUBLISH_AFTER = 0.05  # wall seconds waiting before /clock is published again
 
 
 class Simulator:
@@ -48,6 +57,9 @@ class Simulator:
                  secret: str | None = None, frontend_host: str | None = None) -> None:
         self.scenario = scenario
         self.speed = scenario.speed
+        self._follow: Callable[[], float | None] | None = None
+        self._lead = 1.0
+        self._paused = False
         self.pois = dict(pois) if pois is not None else load_pois()
         self.world = World(scenario, self.pois)
         self.clock = ManualClock(self.world.now)
@@ -134,10 +146,37 @@ class Simulator:
 
     # ------------------------------------------------------------ time
 
+    def follow(self, executive_time: Callable[[], float | None] | None,
+               lead: float = 1.0) -> None:
+        """Run at most ``lead`` simulated seconds ahead of ``executive_time()`` (the
+        executive's clock; None while it does not follow, e.g. disconnected)."""
+        self._follow = executive_time
+        self._lead = lead
+
+    def pause(self, paused: bool = True) -> None:
+        """Hold simulated time still (False: let it run again)."""
+        self._paused = paused
+
+    def _waiting(self) -> bool:
+        if self._paused:
+            return True
+        t = self._follow() if self._follow is not None else None
+        return t is not None and self.world.now - t > self._lead
+
     async def _run(self) -> None:
         loop = asyncio.get_running_loop()
         deadline = loop.time()
         while True:
+            if self._waiting():
+                waited = 0.0
+                while self._waiting():
+                    await asyncio.sleep(FOLLOW_POLL)
+                    waited += FOLLOW_POLL
+                    if waited >= REPUBLISH_AFTER and not self._paused:
+                        # the executive may have missed it (it was reconnecting, say)
+                        self._publish(CLOCK.name, msgs.clock(self.world.now), logged=False)
+                        waited = 0.0
+                deadline = loop.time()
             try:
                 self.step()
             except Exception:

@@ -116,9 +116,12 @@ class TourRun(Rehearsal):
         sim_down = self.sim.world.now
         result = await until
         assert self.executive.clock.now() == frozen, "the executive's clock moved while down"
+        self.sim.pause()  # the reconnect takes wall time, which must not change the tour
+        sim_up = self.sim.world.now
         await self.sim.start_rosbridge()
         await self.link(True)
-        return Outage(sim_down, self.sim.world.now, frozen, result)
+        self.sim.pause(False)
+        return Outage(sim_down, sim_up, frozen, result)
 
     # ------------------------------------------------------------ what the simulator saw
 
