@@ -29,10 +29,10 @@ def say(event: str, **fields: Any) -> None:
 
 
 async def serve(args: argparse.Namespace) -> None:
-    from frog_bt.clock import SimClock, WallClock
     from frog_bt.commands.run import attach_observers
     from frog_bt.config import load_site, parse_hostport
-    from frog_bt.executive import Executive
+    from frog_bt.runtime.clock import SimClock, WallClock
+    from frog_bt.runtime.executive import Executive
     from frog_bt.tree.loader import load_tree
 
     site = load_site(args.config)

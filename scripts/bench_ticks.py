@@ -68,9 +68,9 @@ def phase_of(node: Any, dock: str, recruit_at: str) -> str:
 
 
 async def one_tour(stops: int, telemetry: bool, workdir: Path) -> dict[str, Any]:
-    from frog_bt.clock import SimClock
     from frog_bt.config import load_site
-    from frog_bt.executive import Executive
+    from frog_bt.runtime.clock import SimClock
+    from frog_bt.runtime.executive import Executive
     from frog_bt.sim import Simulator
     from frog_bt.sim.site import load_pois
     from frog_bt.tree.loader import load_tree
@@ -90,8 +90,8 @@ async def one_tour(stops: int, telemetry: bool, workdir: Path) -> dict[str, Any]
     observers: list[Any] = []
     writes: list[int] = []
     if telemetry:
-        from frog_bt.recording import Recorder
         from frog_bt.telemetry import Telemetry
+        from frog_bt.tools.recording import Recorder
 
         tel = Telemetry.open(f"save:{workdir / 'ticks.rrd'}", site, tree)
         tel.attach(executive.core)

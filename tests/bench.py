@@ -8,9 +8,7 @@ from typing import Any
 
 import py_trees
 
-from frog_bt.clock import ManualClock
 from frog_bt.config import Site, load_site
-from frog_bt.core import Core
 from frog_bt.frontend.messages import FrontendMessage
 from frog_bt.rosbridge.msgs import (
     PersonDetection,
@@ -20,6 +18,8 @@ from frog_bt.rosbridge.msgs import (
     TrackedPeople,
     TrackedPerson,
 )
+from frog_bt.runtime.clock import ManualClock
+from frog_bt.runtime.core import Core
 from frog_bt.tree.loader import LoadedTree, load_tree
 
 MORNING = 1780302600.0  # 2026-06-01 10:30 Europe/Madrid

@@ -7,8 +7,8 @@ import time
 
 import pytest
 
-from frog_bt.checkpoint import Progress, Resume, claim, default_path, load, save
 from frog_bt.errors import UsageError
+from frog_bt.runtime.checkpoint import Progress, Resume, claim, default_path, load, save
 
 
 def test_progress_round_trips_and_an_empty_one_removes_the_file(tmp_path):

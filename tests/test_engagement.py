@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from frog_bt.engagement import Samples, decide, edge_indices, meter, qualifies
+from frog_bt.maths.engagement import Samples, decide, edge_indices, meter, qualifies
 from frog_bt.rosbridge.msgs import Face
 
 

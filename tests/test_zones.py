@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from frog_bt.zones import Membership, Shape, point_in_polygon
+from frog_bt.maths.zones import Membership, Shape, point_in_polygon
 
 SQUARE = ((0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0))
 

@@ -4,7 +4,7 @@
 when left for any reason; while it runs it stores the qualifying face samples
 and sends the engagement meter every ``engagement.window`` seconds.
 :class:`DecideEngagement` takes the decision over the samples stored so far;
-:class:`Engaged` tests it. The maths is in :mod:`frog_bt.engagement`.
+:class:`Engaged` tests it. The maths is in :mod:`frog_bt.maths.engagement`.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from collections.abc import Iterator
 
 import py_trees
 
-from frog_bt.engagement import Decision, Samples, decide, meter, qualifies
 from frog_bt.frontend.messages import Engagement
+from frog_bt.maths.engagement import Decision, Samples, decide, meter, qualifies
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
 
@@ -28,7 +28,7 @@ class FaceStream(FrogDecorator):
     (``engagement.near``) and facing, and every ``engagement.window`` seconds
     sends ``engagement`` with the meter level (null for an empty window).
     Reads ``/faces``, ``/now``; writes ``/icl`` (True while on),
-    ``/engagement`` (the session's :class:`~frog_bt.engagement.Samples`) and
+    ``/engagement`` (the session's :class:`~frog_bt.maths.engagement.Samples`) and
     ``/engagement_meter``. With ``enabled: false`` it only runs its child.
     Returns the child's status.
     """
@@ -98,7 +98,7 @@ class DecideEngagement(Leaf):
 
     Reads ``/engagement`` (optional: no session means no data). Writes
     ``/engaged`` (True, False, or None without face data) and
-    ``/engagement_decision`` (the :class:`~frog_bt.engagement.Decision`, with
+    ``/engagement_decision`` (the :class:`~frog_bt.maths.engagement.Decision`, with
     ``about`` for whom it was taken). SUCCESS.
     """
 

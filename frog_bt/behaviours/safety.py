@@ -8,9 +8,9 @@ from collections.abc import Iterator
 import py_trees
 from pydantic import Field
 
-from frog_bt.blackboard import Reading
 from frog_bt.frontend.messages import Tour
 from frog_bt.rosbridge.msgs import Diagnostics
+from frog_bt.runtime.blackboard import Reading
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
 

@@ -23,10 +23,10 @@ import os
 import sys
 from pathlib import Path
 
-from frog_bt import render
 from frog_bt.commands.options import CONFIG_HELP, TREE_HELP
 from frog_bt.config import load_site
 from frog_bt.errors import DefinitionError
+from frog_bt.tools import render
 from frog_bt.tree.loader import load_tree
 
 FORMATS = ("ascii", "unicode", "dot", "svg", "png", "mermaid")

@@ -71,7 +71,7 @@ class Progress:
 
 
 def run(args: argparse.Namespace) -> int:
-    from frog_bt.replay import Replay, ReplayError, local_time
+    from frog_bt.tools.replay import Replay, ReplayError, local_time
 
     try:
         site = load_site(args.config)

@@ -22,14 +22,14 @@ from pathlib import Path
 from typing import Any
 
 from frog_bt import __version__
-from frog_bt.checkpoint import STATE_DIR
-from frog_bt.checkpoint import claim as claim_checkpoint
-from frog_bt.checkpoint import default_path as default_checkpoint
-from frog_bt.clock import SimClock, WallClock
 from frog_bt.commands.options import add_tree_and_config, read_secret, rerun_spec, writable_file
 from frog_bt.config import DEFAULT_CONFIG, Site, check_ws_url, load_site, parse_hostport
 from frog_bt.errors import FrogError, UsageError
 from frog_bt.frontend.link import AddressError
+from frog_bt.runtime.checkpoint import STATE_DIR
+from frog_bt.runtime.checkpoint import claim as claim_checkpoint
+from frog_bt.runtime.checkpoint import default_path as default_checkpoint
+from frog_bt.runtime.clock import SimClock, WallClock
 from frog_bt.tree.loader import DEFAULT_TREE, load_tree
 
 
@@ -115,7 +115,7 @@ def attach_observers(executive: Any, *, record: Path | None, rerun: str | None) 
     """Recorder and telemetry, each imported only when asked for; closed by the caller."""
     observers: list[Any] = []
     if record is not None:
-        from frog_bt.recording import Recorder
+        from frog_bt.tools.recording import Recorder
 
         recorder = Recorder(record)
         recorder.attach(executive)
@@ -153,9 +153,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Settings) -> int:
-    from frog_bt.executive import Executive  # the network stack only when running
-    from frog_bt.status import StatusLine
-    from frog_bt.summary import TourSummary
+    from frog_bt.runtime.executive import Executive  # the network stack only when running
+    from frog_bt.runtime.status import StatusLine
+    from frog_bt.tools.summary import TourSummary
 
     clock = SimClock() if args.sim_time else WallClock()
     executive = Executive(site, tree, clock, rosbridge_url=settings.url,

@@ -28,7 +28,7 @@ from frog_bt.telemetry.spec import Sink, parse_spec
 
 if TYPE_CHECKING:
     from frog_bt.config import Site
-    from frog_bt.core import Core
+    from frog_bt.runtime.core import Core
     from frog_bt.tree.loader import LoadedTree
 
 __all__ = ["Sink", "Telemetry", "TreeIndex", "parse_spec", "tidy_layout"]

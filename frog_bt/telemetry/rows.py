@@ -1,6 +1,6 @@
 """The taps of telemetry: cheap appends of plain values on the tick path (no rerun here).
 
-:class:`Rows` is attached to a :class:`~frog_bt.core.Core`'s taps. Each tap
+:class:`Rows` is attached to a :class:`~frog_bt.runtime.core.Core`'s taps. Each tap
 only appends a tuple stamped with the tick it belongs to and the project-clock
 time; the tick tap also records the tree's statuses when they changed, the new
 decision notes and the engagement meter/decision from the blackboard. The
@@ -24,13 +24,13 @@ from typing import TYPE_CHECKING, Any
 
 import py_trees
 
-from frog_bt.blackboard import peek
+from frog_bt.runtime.blackboard import peek
 from frog_bt.telemetry.layout import TreeIndex
 from frog_bt.wire import INPUTS
 
 if TYPE_CHECKING:
     from frog_bt.config import Site
-    from frog_bt.core import Core
+    from frog_bt.runtime.core import Core
 
 Status = py_trees.common.Status
 ENGAGEMENT_KEYS = ("/engagement_meter", "/engagement_decision")  # guarded: may not exist

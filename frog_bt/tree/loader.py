@@ -41,9 +41,9 @@ from pydantic import BaseModel
 
 import frog_bt.behaviours  # noqa: F401 - registers the leaf types
 from frog_bt import resources
-from frog_bt.blackboard import input_keys
 from frog_bt.config import Site
 from frog_bt.errors import TreeError
+from frog_bt.runtime.blackboard import input_keys
 from frog_bt.tree.decorators import DECORATORS
 from frog_bt.tree.leaf import LEAVES
 from frog_bt.tree.observed import Parallel, Selector, Sequence

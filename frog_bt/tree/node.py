@@ -5,7 +5,7 @@ are errors), the blackboard keys it reads (``reads``: something must write them;
 ``optional_reads``: a default applies while nothing has) and the keys it writes.
 The loader checks a whole tree against these declarations before anything
 connects. At run time ``setup`` hands the node the
-:class:`~frog_bt.context.Context`; :meth:`Declared.get` and :meth:`Declared.set`
+:class:`~frog_bt.runtime.context.Context`; :meth:`Declared.get` and :meth:`Declared.set`
 reach the blackboard.
 """
 
@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 import py_trees
 from pydantic import BaseModel, ConfigDict
 
-from frog_bt.context import Context
+from frog_bt.runtime.context import Context
 
 Status = py_trees.common.Status
 SUCCESS, FAILURE, RUNNING, INVALID = Status.SUCCESS, Status.FAILURE, Status.RUNNING, Status.INVALID

@@ -4,7 +4,7 @@ py_trees changes a node's status in two places: in its ``tick`` (the tick
 yields every node it reaches) and in its ``stop`` (which yields nothing). Every
 node a tree file can build is one of our classes — leaves, decorators and the
 composites below — and their ``stop`` reports the node to ``stop_log`` when one
-is attached (:class:`~frog_bt.core.Core` attaches its own). Observers such as
+is attached (:class:`~frog_bt.runtime.core.Core` attaches its own). Observers such as
 telemetry then follow the tree in O(active path), not O(tree).
 """
 

@@ -13,8 +13,8 @@ import sys
 import pytest
 from tour import fast, free_udp_port
 
-from frog_bt.checkpoint import claim
 from frog_bt.config import DEFAULT_CONFIG as CONFIG
+from frog_bt.runtime.checkpoint import claim
 from frog_bt.sim import Simulator
 
 

@@ -17,7 +17,6 @@ from typing import Any, TypeVar
 
 import pytest
 
-from frog_bt.clock import ManualClock
 from frog_bt.frontend.link import FrontendLink, log
 from frog_bt.frontend.messages import (
     COMMANDS,
@@ -28,6 +27,7 @@ from frog_bt.frontend.messages import (
     Volume,
 )
 from frog_bt.frontend.protocol import MAX_DATAGRAM
+from frog_bt.runtime.clock import ManualClock
 from frog_bt.warning_limit import WarningLimiter
 
 HOST = "127.0.0.1"

@@ -18,11 +18,13 @@ from mcap.reader import make_reader
 from recorded_tour import RecordedTour, scenario
 from rosmsgs import encode_clock
 
-from frog_bt.clock import SimClock
 from frog_bt.config import load_site
-from frog_bt.core import Taps
-from frog_bt.executive import WireTaps
-from frog_bt.recording import (
+from frog_bt.runtime.clock import SimClock
+from frog_bt.runtime.core import Taps
+from frog_bt.runtime.executive import WireTaps
+from frog_bt.runtime.rehearsal import free_udp_port
+from frog_bt.sim import Simulator
+from frog_bt.tools.recording import (
     DATAGRAM_TYPE,
     FRONTEND_IN,
     FRONTEND_OUT,
@@ -32,8 +34,6 @@ from frog_bt.recording import (
     from_ns,
     to_ns,
 )
-from frog_bt.rehearsal import free_udp_port
-from frog_bt.sim import Simulator
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -148,7 +148,7 @@ def test_nanosecond_stamps_give_the_clock_time_back(t: float) -> None:
 
 def test_a_crash_still_leaves_valid_mcap(tmp_path: Path) -> None:
     path = tmp_path / "crash.mcap"
-    code = ("import sys; from pathlib import Path; from frog_bt.recording import Recorder\n"
+    code = ("import sys; from pathlib import Path; from frog_bt.tools.recording import Recorder\n"
             "r = Recorder(Path(sys.argv[1]))\n"
             "r.on_datagram('out', b'{\"type\":\"tour\",\"seq\":1}', 1.0)\n"
             "raise RuntimeError('boom')\n")

@@ -14,7 +14,7 @@ from recorded_tour import RecordedTour
 from frog_bt.cli import main
 from frog_bt.commands.replay import Progress
 from frog_bt.config import DEFAULT_CONFIG, load_site
-from frog_bt.replay import Replay, local_time
+from frog_bt.tools.replay import Replay, local_time
 from frog_bt.tree.loader import load_tree
 
 

@@ -1,7 +1,7 @@
 """A simulated tour run in this event loop, for tests that break things mid-tour.
 
 :class:`TourRun` starts the built-in simulator and the real
-:class:`~frog_bt.executive.Executive` (sim time, ``once``) and records, beside
+:class:`~frog_bt.runtime.executive.Executive` (sim time, ``once``) and records, beside
 the simulator's own message log, what the executive published on rosbridge
 (with whether its link was up at that moment) and each change of its link.
 Tests wait on those records and on the simulator's log, never on sleeps::
@@ -20,12 +20,12 @@ from dataclasses import dataclass
 from typing import Any
 
 from frog_bt.config import Site, load_site
-from frog_bt.executive import Executive
-from frog_bt.rehearsal import Rehearsal
 from frog_bt.rosbridge.link import LinkState
+from frog_bt.runtime.executive import Executive
+from frog_bt.runtime.rehearsal import Rehearsal
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.sim.traffic import Record
-from frog_bt.summary import TourSummary
+from frog_bt.tools.summary import TourSummary
 
 FAST = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
 WAIT = 30.0  # wall seconds: a safety net for every wait, never a pace

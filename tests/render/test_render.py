@@ -22,8 +22,8 @@ from pathlib import Path
 
 import pytest
 
-from frog_bt import render
 from frog_bt.cli import main
+from frog_bt.tools import render
 from frog_bt.tree.loader import load_tree
 
 HERE = Path(__file__).resolve().parent
@@ -136,7 +136,7 @@ def test_render_loads_neither_websockets_nor_rerun(tmp_path):
         import sys
         from frog_bt.commands import render
         from frog_bt.cli import main
-        from frog_bt.render import outline
+        from frog_bt.tools.render import outline
         from frog_bt.tree.loader import load_tree
         root = outline(load_tree().root)
         for fmt in ("ascii", "unicode", "dot", "mermaid"):

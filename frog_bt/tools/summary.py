@@ -1,6 +1,6 @@
 """What happened on a tour, from the executive's own traffic (``frog-bt demo`` prints it).
 
-:class:`TourSummary` is a set of taps for :class:`~frog_bt.executive.Taps`: it
+:class:`TourSummary` is a set of taps for :class:`~frog_bt.runtime.executive.Taps`: it
 watches the goals sent and answered, the content started, the visitors
 approached and recruited.
 """
@@ -11,12 +11,12 @@ from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
-from frog_bt.blackboard import peek
 from frog_bt.config import Site
-from frog_bt.context import Incident
-from frog_bt.engagement import Decision
 from frog_bt.frontend.messages import StartPoi, Tour, UserPositive
+from frog_bt.maths.engagement import Decision
 from frog_bt.rosbridge.msgs import POSE
+from frog_bt.runtime.blackboard import peek
+from frog_bt.runtime.context import Incident
 from frog_bt.wire import SUCCEEDED
 
 

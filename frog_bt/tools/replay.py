@@ -1,15 +1,15 @@
 """Re-run the tree offline on a recording's inputs, on the recording's clock.
 
-:class:`Replay` reads an MCAP recording (:mod:`frog_bt.recording`) in log-time
-order and feeds a fresh :class:`~frog_bt.core.Core` on a
-:class:`~frog_bt.clock.ManualClock` that takes the recorded times: ROS inputs
+:class:`Replay` reads an MCAP recording (:mod:`frog_bt.tools.recording`) in log-time
+order and feeds a fresh :class:`~frog_bt.runtime.core.Core` on a
+:class:`~frog_bt.runtime.clock.ManualClock` that takes the recorded times: ROS inputs
 go through :data:`~frog_bt.rosbridge.msgs.ROS_TYPES` (by the channel's schema name) to
 ``Core.on_ros``; ``/frontend/in`` datagrams go through a fresh
 :class:`~frog_bt.frontend.protocol.Endpoint`, so duplicates are suppressed exactly
 as live, to ``Core.on_event``; ``/clock`` moves the clock (under sim time what
 arrived before the first ``/clock`` is fed with the clock not yet ready, as live).
 
-Ticks: a recording made by :class:`~frog_bt.recording.Recorder` has the live
+Ticks: a recording made by :class:`~frog_bt.tools.recording.Recorder` has the live
 ticks (``/frog_bt/tick``), and replay ticks exactly there, in the same place
 among the inputs. Live ticks coalesce bursts of inputs and land wherever the
 event loop gets to them, so no rule can recompute them; with the recorded ones,
@@ -41,14 +41,14 @@ from typing import Any
 from mcap.exceptions import InvalidMagic, McapError
 from mcap.reader import make_reader
 
-from frog_bt.clock import SITE_TZ, ManualClock
 from frog_bt.config import Site, parse_hostport
-from frog_bt.core import Core
 from frog_bt.errors import DecodeError, FrogError
 from frog_bt.frontend.messages import EVENTS, FrontendMessage, message_fields
 from frog_bt.frontend.protocol import Endpoint
-from frog_bt.recording import FRONTEND_IN, FRONTEND_OUT, TICK, from_ns
 from frog_bt.rosbridge.msgs import ROS_TYPES
+from frog_bt.runtime.clock import SITE_TZ, ManualClock
+from frog_bt.runtime.core import Core
+from frog_bt.tools.recording import FRONTEND_IN, FRONTEND_OUT, TICK, from_ns
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 

@@ -18,8 +18,8 @@ from typing import Any, TextIO
 
 import py_trees
 
-from frog_bt.blackboard import peek
-from frog_bt.core import Core
+from frog_bt.runtime.blackboard import peek
+from frog_bt.runtime.core import Core
 
 
 def phase(core: Core) -> str:

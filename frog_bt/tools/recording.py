@@ -12,7 +12,7 @@
 * ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``).
   Live ticks coalesce bursts of inputs and fall wherever the event loop gets to
   them, so replay ticks exactly where the live executive did
-  (:mod:`frog_bt.replay`).
+  (:mod:`frog_bt.tools.replay`).
 
 Every message is stamped (``log_time`` = ``publish_time``, ns) with the
 project-clock time it was received or sent; ``/clock`` with the time it carries
@@ -147,7 +147,7 @@ class Recorder:
     """Writes an MCAP recording of one executive run; see the module docstring.
 
     ``Recorder(path)`` creates the file (``OSError`` when it cannot);
-    :meth:`attach` hooks it to an :class:`~frog_bt.executive.Executive`;
+    :meth:`attach` hooks it to an :class:`~frog_bt.runtime.executive.Executive`;
     :meth:`close` finishes it. A write error is logged once and stops the
     recording; it never reaches the tick path.
     """

@@ -17,9 +17,9 @@ import socket
 from collections.abc import Callable
 from typing import Any
 
-from frog_bt.clock import SimClock
 from frog_bt.config import Site
-from frog_bt.executive import Executive, Outcome
+from frog_bt.runtime.clock import SimClock
+from frog_bt.runtime.executive import Executive, Outcome
 from frog_bt.sim import Simulator
 from frog_bt.sim.scenario import Scenario
 from frog_bt.tree.loader import LoadedTree, load_tree

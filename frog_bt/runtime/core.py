@@ -16,12 +16,12 @@ from typing import Any
 
 import py_trees
 
-from frog_bt.actions import Actions
-from frog_bt.blackboard import Inputs, Snapshot
-from frog_bt.clock import Clock
 from frog_bt.config import Site
-from frog_bt.context import Context
 from frog_bt.frontend.messages import FrontendMessage
+from frog_bt.runtime.actions import Actions
+from frog_bt.runtime.blackboard import Inputs, Snapshot
+from frog_bt.runtime.clock import Clock
+from frog_bt.runtime.context import Context
 from frog_bt.tree import observed, ticking
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.wire import INPUTS, OUTPUTS

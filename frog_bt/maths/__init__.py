@@ -1,0 +1,1 @@
+"""Sans-I/O maths of the tour: the engagement meter and zone geometry."""

@@ -1,0 +1,1 @@
+"""Tools around the tour: render a tree, record and replay a tour, summarise it."""
