@@ -175,7 +175,8 @@ async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]
     from frog_bt.wire import INPUTS
 
     plain = {"content": True, "face_stream": False, "projector": False, "check_follower": True}
-    site_path = synthetic_site(7, workdir, flags=plain, over={"follow": {"grace": 0.0}})
+    site_path = synthetic_site(7, workdir, flags=plain, over={"follow": {"grace": 0.0},
+                                                           "recruit": {"approach_interval": 0.0}})
     site = load_site(site_path)
     director = Director(site, trials)
     director.server.expect = len(INPUTS)
