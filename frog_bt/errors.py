@@ -55,6 +55,19 @@ class TreeError(DefinitionError):
     """A tree file is invalid."""
 
 
+class TreeErrors(TreeError):
+    """Several errors of one tree, found in one pass: one line each, in tree order."""
+
+    def __init__(self, errors: Sequence[TreeError]) -> None:
+        self.errors = list(errors)
+        first = self.errors[0]
+        DefinitionError.__init__(self, first.file, first.path, first.detail)
+        self.args = ("\n".join(str(e) for e in self.errors),)
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
 class UsageError(FrogError, ValueError):
     """A command-line value cannot be used: ``OPTION VALUE: what was expected``.
 

@@ -71,5 +71,5 @@ def test_a_leaf_reading_a_key_no_input_writes_is_refused(tmp_path: Path,
                                                          monkeypatch: pytest.MonkeyPatch
                                                          ) -> None:
     monkeypatch.setitem(LEAVES, "CorridorClear", CorridorClear)
-    with pytest.raises(Exception, match="reads /corridor, which nothing writes"):
+    with pytest.raises(Exception, match="reads /corridor: nothing writes it"):
         load_tree(write_tree(tmp_path, "root: {type: CorridorClear}"), load_site())

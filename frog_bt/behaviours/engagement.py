@@ -39,6 +39,10 @@ class FaceStream(FrogDecorator):
     reads = ("/faces", "/now")
     writes = ("/icl", "/engagement", "/engagement_meter")
 
+    def provides(self) -> tuple[str, ...]:
+        """What the child may read while the stream is on (the data-flow check)."""
+        return self.writes if self.params.enabled else ()
+
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour,
                  params: Params | None = None) -> None:
         super().__init__(name, child, params)

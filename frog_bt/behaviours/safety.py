@@ -148,6 +148,7 @@ class Checkpointed(FrogDecorator):
 
     optional_reads = ("/visitor",)
     writes = ("/visitor",)
+    skips_child = True  # resumed: SUCCESS without the child (the data-flow check)
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
         if self.status != RUNNING and self._resumed_past():

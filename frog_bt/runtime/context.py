@@ -20,7 +20,7 @@ from frog_bt.runtime.clock import Clock
 IncidentKind = Literal[
     "docking failed", "navigation failed", "stop skipped", "approach failed", "visitor declined",
     "visitor lost", "event missing", "content timeout", "front end restarted",
-    "tour aborted", "gave up", "resumed",
+    "tour aborted", "gave up", "resumed", "missing value",
 ]
 
 

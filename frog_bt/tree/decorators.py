@@ -98,3 +98,5 @@ class Timeout(FrogDecorator):
 class FailureIsSuccess(FrogDecorator, py_trees.decorators.FailureIsSuccess):
     """An optional part: SUCCESS when the child fails, else the child's status
     (py_trees' ``FailureIsSuccess``)."""
+
+    child_may_fail = True  # nothing the child writes is sure after it (the data-flow check)

@@ -42,9 +42,9 @@ from pydantic import BaseModel
 import frog_bt.behaviours  # noqa: F401 - registers the leaf types
 from frog_bt import resources
 from frog_bt.config import Site
-from frog_bt.errors import TreeError
-from frog_bt.runtime.blackboard import input_keys
+from frog_bt.errors import TreeError, TreeErrors, format_path
 from frog_bt.tree.decorators import DECORATORS
+from frog_bt.tree.flow import Gap, gaps
 from frog_bt.tree.leaf import LEAVES
 from frog_bt.tree.observed import Parallel, Selector, Sequence
 from frog_bt.yamlfile import load_yaml, validate
@@ -73,6 +73,7 @@ class LoadedTree:
     file: str
     description: str = ""
     where: dict[int, Where] = field(default_factory=dict)  # id(node) -> file and path
+    scopes: dict[int, str] = field(default_factory=dict)  # id(node) -> scope it starts
 
     def nodes(self) -> Iterator[Behaviour]:
         yield from self.root.iterate()
@@ -89,6 +90,7 @@ class _Builder:
     def __init__(self, site: Site | None) -> None:
         self.site = site
         self.where: dict[int, Where] = {}
+        self.scopes: dict[int, str] = {}  # id(node) -> the scope it starts ("stop")
         self.stack: list[Path] = []
 
     # ------------------------------------------------------------ files
@@ -235,8 +237,10 @@ class _Builder:
             {**s.model_dump(), "index": i} for i, s in enumerate(self.site.tour.stops)]
         out: list[Behaviour] = []
         for stop in stops:
-            out += self._include({k: v for k, v in data.items() if k != "foreach"}, file, path,
-                                 {**variables, **stop})
+            nodes = self._include({k: v for k, v in data.items() if k != "foreach"}, file, path,
+                                  {**variables, **stop})
+            self.scopes.update((id(n), "stop") for n in nodes)
+            out += nodes
         return out
 
     # ------------------------------------------------------------ helpers
@@ -288,16 +292,36 @@ def _short(value: Any) -> str:
 
 
 def check_keys(tree: LoadedTree) -> None:
-    """Every key a node reads must be written by some node or by the input snapshot."""
-    written = set(input_keys())
-    for node in tree.nodes():
-        written.update(getattr(node, "writes", ()))
-    for node in tree.nodes():
-        for key in getattr(node, "reads", ()):
-            if key not in written:
-                where = tree.where.get(id(node), Where(tree.file, ()))
-                raise TreeError(where.file, where.path,
-                                f"{type(node).__name__} reads {key}, which nothing writes")
+    """Every key a node reads is written before it on every path (:mod:`.flow`)."""
+    errors: list[TreeError] = []
+    for gap in gaps(tree.root, tree.scopes):
+        error = _gap_error(tree, gap)
+        if str(error) not in (str(e) for e in errors):  # one per place, not per stop
+            errors.append(error)
+    if errors:
+        raise errors[0] if len(errors) == 1 else TreeErrors(errors)
+
+
+def _gap_error(tree: LoadedTree, gap: Gap) -> TreeError:
+    where = tree.where.get(id(gap.node), Where(tree.file, ()))
+    reader = f"{type(gap.node).__name__} {gap.node.name!r}"
+    if gap.scope is not None:
+        why = (f"a {gap.scope} starts without it: the value from before this {gap.scope} "
+               f"is not this {gap.scope}'s; write it in this {gap.scope}, before the reader")
+    elif gap.writers:
+        at = [_at(tree, w) for w in gap.writers[:3]]
+        why = (f"{', '.join(at)} write{'s' if len(at) == 1 else ''} it, but not before it on "
+               "every path (a later node, another selector alternative, a sibling in "
+               "parallel, or a part that may fail or be skipped)")
+    else:
+        why = "nothing writes it"
+    return TreeError(where.file, where.path, f"{reader} reads {gap.key}: {why}")
+
+
+def _at(tree: LoadedTree, node: Behaviour) -> str:
+    where = tree.where.get(id(node))
+    place = f" ({Path(where.file).name}: {format_path(where.path)})" if where else ""
+    return f"{type(node).__name__} {node.name!r}{place}"
 
 
 def load_tree(path: str | Path | None = None, site: Site | None = None) -> LoadedTree:
@@ -307,6 +331,6 @@ def load_tree(path: str | Path | None = None, site: Site | None = None) -> Loade
     root, description = builder.file(path, site_variables(site))
     if root is None:
         raise TreeError(str(path), ("root",), "the whole tree was left out by 'when'")
-    tree = LoadedTree(root, str(path), description, builder.where)
+    tree = LoadedTree(root, str(path), description, builder.where, builder.scopes)
     check_keys(tree)
     return tree

@@ -11,6 +11,7 @@ reach the blackboard.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any, ClassVar
 
 import py_trees
@@ -20,6 +21,15 @@ from frog_bt.runtime.context import Context
 
 Status = py_trees.common.Status
 SUCCESS, FAILURE, RUNNING, INVALID = Status.SUCCESS, Status.FAILURE, Status.RUNNING, Status.INVALID
+
+
+class MissingValue(Exception):
+    """A required key a tree node writes has no value yet (the tree was built wrong
+    past the load-time check): the reading node fails with this reason."""
+
+    def __init__(self, key: str) -> None:
+        super().__init__(key)
+        self.key = key
 
 
 class Params(BaseModel):
@@ -58,11 +68,28 @@ class Declared:
         return self._ctx
 
     def get(self, key: str, default: Any = None) -> Any:
-        """The blackboard value of ``key``, or ``default`` while nothing has written it."""
+        """The blackboard value of ``key``, or ``default`` while nothing has written it.
+
+        A required read (``reads``) of a key that tree nodes write never returns None:
+        the node then FAILs with the reason in its feedback (inputs may be None: no
+        data yet, which the leaves handle)."""
         try:
-            return self.bb.get(key)
+            value = self.bb.get(key)
         except KeyError:
-            return default
+            value = default
+        if value is None and key in self.reads and key not in _input_keys():
+            raise MissingValue(key)
+        return value
+
+    def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
+        try:
+            yield from super().tick()  # type: ignore[misc]
+        except MissingValue as missing:
+            self.feedback_message = f"no value for {missing.key}"  # type: ignore[attr-defined]
+            self.ctx.note(f"{self.name}: no value for {missing.key}; failing",
+                          incident="missing value", subject=missing.key)
+            self.stop(FAILURE)  # type: ignore[attr-defined]
+            yield self  # type: ignore[misc]
 
     def set(self, key: str, value: Any) -> None:
         self.bb.set(key, value, overwrite=True)
@@ -70,3 +97,9 @@ class Declared:
     def describe(self) -> dict[str, Any]:
         """Parameters as shown by ``render`` (unset ones omitted)."""
         return self.params.model_dump(exclude_none=True)
+
+
+def _input_keys() -> frozenset[str]:
+    from frog_bt.runtime.blackboard import input_keys  # the runtime imports the tree
+
+    return frozenset(input_keys())

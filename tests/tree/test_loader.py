@@ -52,7 +52,7 @@ def test_the_shipped_tour_loads_and_has_every_stop(site):
     ("root: {type: Retry, attempts: 0, child: {type: FinishPoi, poi: POI1}}",
      "t.yaml: root.attempts: Input should be greater than or equal to 1"),
     ("root: {type: Sequence, memory: true, children: [{type: WaitAnswer}]}",
-     "t.yaml: root.children[0]: WaitAnswer reads /visitor, which nothing writes"),
+     "t.yaml: root.children[0]: WaitAnswer 'WaitAnswer' reads /visitor: nothing writes it"),
     ("root: {type: Sequence, memory: true, children: [{include: missing.yaml}]}",
      "missing.yaml: cannot read"),
     ("root: {type: FinishPoi, poi: '{place}'}", "t.yaml: root.poi: unknown variable 'place'"),
