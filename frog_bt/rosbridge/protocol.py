@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-import json
 import math
 import secrets
 from collections import deque
@@ -23,7 +22,7 @@ from typing import Any
 
 import msgspec
 
-from frog_bt.codec import decoder
+from frog_bt.codec import decoder, encode
 from frog_bt.errors import DecodeError
 
 MAX_FRAME_BYTES = 1 << 20  # rosbridge's own default max message size is larger; ours is a guard
@@ -84,8 +83,9 @@ def decode_frame(text: str | bytes) -> Inbound:
 
 
 def dumps(obj: dict[str, Any]) -> str:
-    """Compact JSON; NaN and Infinity are refused rather than sent."""
-    return json.dumps(obj, separators=(",", ":"), allow_nan=False)
+    """Compact JSON text (msgspec); NaN and Infinity are refused (ValueError) rather
+    than sent."""
+    return encode(obj).decode()
 
 
 def auth_frame(secret: str, client: str, dest: str, t: float, ttl: float = 60.0,
