@@ -16,6 +16,7 @@ COMMANDS = {
     "sim": ("frog_bt.sim.command", "start the built-in robot and front-end simulator"),
     "demo": ("frog_bt.commands.demo", "simulator and executive together for one full tour"),
     "render": ("frog_bt.commands.render", "draw a tour tree"),
+    "check": ("frog_bt.commands.check", "check a tour tree and the site config; draw nothing"),
     "replay": ("frog_bt.commands.replay", "re-run a recorded tour offline"),
     "init": ("frog_bt.commands.init", "write an editable copy of the tour and the site config"),
 }

@@ -43,8 +43,12 @@ class DefinitionError(FrogError):
         self.file = str(file)
         self.path = tuple(path)
         self.detail = message
+        from frog_bt.yamlfile import line_of  # errors.py imports nothing of ours at load
+
+        self.line = line_of(self.file, self.path) if self.path else None
+        at = f"{self.file}:{self.line[0]}:{self.line[1]}" if self.line else self.file
         where = f"{format_path(self.path)}: " if self.path else ""
-        super().__init__(f"{self.file}: {where}{message}")
+        super().__init__(f"{at}: {where}{message}")
 
 
 class ConfigError(DefinitionError):

@@ -27,12 +27,46 @@ def load_yaml(path: str | Path, error: type[DefinitionError]) -> Any:
     except OSError as exc:
         raise error(str(path), (), f"cannot read: {exc.strerror or exc}") from exc
     try:
-        return yaml.safe_load(text)
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        data = yaml.safe_load(text) if node is not None else None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
         problem = getattr(exc, "problem", None) or str(exc)
         raise error(str(path), (), f"not valid YAML: {where}{problem}") from exc
+    marks: dict[tuple[str | int, ...], tuple[int, int]] = {}
+    if node is not None:
+        _marks(node, (), marks)
+    MARKS[str(path)] = marks
+    return data
+
+
+# file (as given to load_yaml) -> path in it -> (line, column), both from 1
+MARKS: dict[str, dict[tuple[str | int, ...], tuple[int, int]]] = {}
+
+
+def _marks(node: yaml.Node, path: tuple[str | int, ...],
+           out: dict[tuple[str | int, ...], tuple[int, int]]) -> None:
+    out[path] = (node.start_mark.line + 1, node.start_mark.column + 1)
+    if isinstance(node, yaml.MappingNode):
+        for key, value in node.value:
+            if isinstance(key, yaml.ScalarNode):
+                _marks(value, (*path, key.value), out)
+    elif isinstance(node, yaml.SequenceNode):
+        for i, item in enumerate(node.value):
+            _marks(item, (*path, i), out)
+
+
+def line_of(file: str, path: tuple[str | int, ...]) -> tuple[int, int] | None:
+    """(line, column) of ``path`` in a loaded ``file``, or of its nearest ancestor there."""
+    marks = MARKS.get(str(file))
+    if not marks:
+        return None
+    for n in range(len(path), -1, -1):
+        found = marks.get(tuple(path[:n]))
+        if found is not None:
+            return found
+    return None
 
 
 class PathError(ValueError):

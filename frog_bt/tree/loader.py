@@ -47,7 +47,7 @@ from frog_bt.tree.decorators import DECORATORS
 from frog_bt.tree.flow import Gap, gaps
 from frog_bt.tree.leaf import LEAVES
 from frog_bt.tree.observed import Parallel, Selector, Sequence
-from frog_bt.yamlfile import load_yaml, validate
+from frog_bt.yamlfile import line_of, load_yaml, validate
 
 DEFAULT_TREE_DIR = resources.tree_dir()
 DEFAULT_TREE = DEFAULT_TREE_DIR / resources.TREE_FILE
@@ -298,6 +298,7 @@ def check_keys(tree: LoadedTree) -> None:
         error = _gap_error(tree, gap)
         if str(error) not in (str(e) for e in errors):  # one per place, not per stop
             errors.append(error)
+    errors.sort(key=lambda e: (e.file, e.line or (0, 0)))
     if errors:
         raise errors[0] if len(errors) == 1 else TreeErrors(errors)
 
@@ -320,8 +321,12 @@ def _gap_error(tree: LoadedTree, gap: Gap) -> TreeError:
 
 def _at(tree: LoadedTree, node: Behaviour) -> str:
     where = tree.where.get(id(node))
-    place = f" ({Path(where.file).name}: {format_path(where.path)})" if where else ""
-    return f"{type(node).__name__} {node.name!r}{place}"
+    if where is None:
+        return f"{type(node).__name__} {node.name!r}"
+    line = line_of(where.file, where.path)
+    place = f"{Path(where.file).name}:{line[0]}" if line else (
+        f"{Path(where.file).name}: {format_path(where.path)}")
+    return f"{type(node).__name__} {node.name!r} ({place})"
 
 
 def load_tree(path: str | Path | None = None, site: Site | None = None) -> LoadedTree:

@@ -3,6 +3,7 @@ designer makes: each is refused at load time naming the reader, the key and why.
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -33,7 +34,7 @@ def edit(path: Path, old: str, new: str) -> None:
 def refused(trees: Path) -> str:
     with pytest.raises(TreeError) as info:
         load_tree(trees / "tour.yaml", load_site())
-    return str(info.value)
+    return re.sub(r"\.yaml:\d+:\d+:", ".yaml:", str(info.value))
 
 
 def test_the_shipped_tour_passes() -> None:
@@ -53,7 +54,7 @@ def test_seek_visitor_after_approach_visitor_is_refused(trees: Path) -> None:
          "      - {type: ApproachVisitor}\n      - {type: SeekVisitor}\n")
     message = refused(trees)
     assert "ApproachVisitor 'ApproachVisitor' reads /visitor" in message
-    assert "SeekVisitor 'SeekVisitor' (recruit.yaml: root.child.children[1])" in message
+    assert "SeekVisitor 'SeekVisitor' (recruit.yaml:16)" in message
 
 
 def test_removing_decide_engagement_at_the_stops_is_refused(trees: Path) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 from bench import write_tree
 
@@ -19,7 +21,21 @@ def error_of(tmp_path, text, site, name="t.yaml"):
     path = write_tree(tmp_path, text, name)
     with pytest.raises(TreeError) as info:
         load_tree(path, site)
-    return str(info.value).replace(str(tmp_path) + "/", "")
+    return without_lines(str(info.value).replace(str(tmp_path) + "/", ""))
+
+
+def without_lines(message: str) -> str:
+    """``t.yaml:3:7: root...`` as ``t.yaml: root...`` (the line is checked on its own)."""
+    return re.sub(r"\.yaml:\d+:\d+:", ".yaml:", message)
+
+
+def test_an_error_names_the_line_and_column_of_its_node(tmp_path, site):
+    path = write_tree(tmp_path, "root:\n  type: Sequence\n  memory: true\n  children:\n"
+                      "    - {type: Navigate, poi: POI1, speed: 3}\n")
+    with pytest.raises(TreeError) as info:
+        load_tree(path, site)
+    assert str(info.value) == f"{path}:5:42: root.children[0].speed: unknown key"
+    assert info.value.line == (5, 42)  # the value of the key
 
 
 def test_the_shipped_tour_loads_and_has_every_stop(site):

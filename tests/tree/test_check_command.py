@@ -1,0 +1,44 @@
+"""``frog-bt check``: every error of a tree in one pass, one ``file:line:column`` line
+each, exit 2; the shipped tour and site pass with exit 0."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from frog_bt import resources
+from frog_bt.cli import main
+
+
+def test_the_shipped_tour_and_site_pass(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["check"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("ok: ") and "tour.yaml (" in out and "site.yaml" in out
+
+
+def test_every_error_with_file_line_and_column(tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    trees = tmp_path / "trees"
+    shutil.copytree(resources.tree_dir(), trees)
+    recruit = trees / "recruit.yaml"
+    recruit.write_text(recruit.read_text().replace("      - {type: SeekVisitor}\n", ""))
+    assert main(["check", str(trees / "tour.yaml")]) == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[-1] == "frog-bt: 2 errors"
+    found = [re.match(r"(.+):(\d+):(\d+): (\S+): (\w+) '", line) for line in lines[:-1]]
+    assert all(found), lines
+    assert [(Path(m[1]).name, int(m[2]), m[5]) for m in found if m] == [
+        ("recruit.yaml", 15, "ApproachVisitor"), ("recruit.yaml", 28, "WaitAnswer")]
+
+
+def test_a_bad_config_is_one_line_and_exit_2(tmp_path: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    site = tmp_path / "site.yaml"
+    site.write_text((resources.site_dir() / "site.yaml").read_text().replace(
+        "tick_hz:", "tick_hz: -1\n  old_tick_hz:", 1))
+    assert main(["check", "--config", str(site)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(site) in err
