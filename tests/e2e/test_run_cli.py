@@ -64,7 +64,8 @@ def test_bad_config_is_one_line_and_exit_2(tmp_path):
                             capture_output=True, text=True, timeout=30)
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == [
-        f"frog-bt: {bad}: tour.dock: unknown POI 'SHOP' (no POIs are defined)"]
+        # tour.dock is not in the file: the line is its nearest ancestor's, tour
+        f"frog-bt: {bad}:2:7: tour.dock: unknown POI 'SHOP' (no POIs are defined)"]
 
 
 def _run(*argv: str, cwd=None) -> subprocess.CompletedProcess[str]:
@@ -131,7 +132,8 @@ def test_a_bad_rosbridge_url_in_the_site_config_names_its_path(tmp_path):
     result = _run("--config", str(site), "--checkpoint", "none", cwd=tmp_path)
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == [
-        f"frog-bt: {site}: links.rosbridge: expected ws://HOST:PORT, e.g. ws://127.0.0.1:9090"]
+        f"frog-bt: {site}:60:14: links.rosbridge: expected ws://HOST:PORT, "
+        "e.g. ws://127.0.0.1:9090"]
 
 
 def test_two_executives_never_share_a_checkpoint(tmp_path):

@@ -119,7 +119,7 @@ def test_an_invalid_tree_exits_2_naming_file_and_path(capsys, tmp_path):
     bad.write_text("root: {type: Sequence, children: [{type: FinishPoi, poi: POI1}]}\n")
     code, out, err = cli(capsys, str(bad), "-f", "dot")
     assert (code, out) == (2, "")
-    assert err == (f"frog-bt: {bad}: root.memory: missing required key: "
+    assert err == (f"frog-bt: {bad}:1:7: root.memory: missing required key: "
                    "a Sequence must say memory: true or false\n")
 
 
@@ -128,7 +128,7 @@ def test_an_invalid_config_exits_2(capsys, tmp_path):
     bad.write_text("pois: []\n")
     code, out, err = cli(capsys, "--config", str(bad))
     assert (code, out) == (2, "")
-    assert err.startswith(f"frog-bt: {bad}: ") and err.count("\n") == 1
+    assert err.startswith(f"frog-bt: {bad}:1:7: pois: ") and err.count("\n") == 1
 
 
 def test_render_loads_neither_websockets_nor_rerun(tmp_path):

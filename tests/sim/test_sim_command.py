@@ -38,7 +38,7 @@ def test_a_bad_scenario_is_a_one_line_error(tmp_path: Path,
     bad.write_text("visitors: [{id: 1, position: [0, 0], faces: happy}]\n")
     assert main(["sim", "--scenario", str(bad)]) == 2
     err = capsys.readouterr().err
-    assert f"{bad}: visitors[0].faces: expected one of engaged" in err
+    assert f"{bad}:1:45: visitors[0].faces: expected one of engaged" in err
 
 
 def read_line(proc: subprocess.Popen[str], timeout: float) -> str:

@@ -136,7 +136,8 @@ def test_errors_name_file_path_and_expectation(tmp_path: Path, text: str,
     error = error_of(tmp_path, text)
     assert error.path == path, str(error)
     assert expected in error.detail, str(error)
-    assert str(error).startswith(f"{error.file}: ")
+    assert error.line is not None  # the node's line and column in the file
+    assert str(error).startswith(f"{error.file}:{error.line[0]}:{error.line[1]}: ")
 
 
 def test_not_yaml(tmp_path: Path) -> None:
