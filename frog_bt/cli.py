@@ -17,6 +17,7 @@ COMMANDS = {
     "demo": ("frog_bt.commands.demo", "simulator and executive together for one full tour"),
     "render": ("frog_bt.commands.render", "draw a tour tree"),
     "check": ("frog_bt.commands.check", "check a tour tree and the site config; draw nothing"),
+    "leaves": ("frog_bt.commands.leaves", "list every node type: parameters, keys, docs"),
     "replay": ("frog_bt.commands.replay", "re-run a recorded tour offline"),
     "init": ("frog_bt.commands.init", "write an editable copy of the tour and the site config"),
 }

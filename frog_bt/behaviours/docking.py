@@ -28,8 +28,9 @@ class Docking(Leaf):
     """
 
     class Params(Params):
-        action: Literal["dock", "undock"]
-        timeout: float | None = Field(None, gt=0, allow_inf_nan=False)
+        action: Literal["dock", "undock"] = Field(description="what to ask of the robot")
+        timeout: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
+            "seconds before it fails (default: site timeouts.dock / timeouts.undock)"))
 
     reads = ("/docking", "/now")
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 import py_trees
+from pydantic import Field
 
 from frog_bt.frontend.messages import Engagement
 from frog_bt.maths.engagement import Decision, Samples, decide, meter, qualifies
@@ -34,7 +35,7 @@ class FaceStream(FrogDecorator):
     """
 
     class Params(Params):
-        enabled: bool = True
+        enabled: bool = Field(True, description="false: only run the child (no stream)")
 
     reads = ("/faces", "/now")
     writes = ("/icl", "/engagement", "/engagement_meter")
@@ -107,7 +108,8 @@ class DecideEngagement(Leaf):
     """
 
     class Params(Params):
-        about: str = ""
+        about: str = Field("", description="what the decision is about, for notes and "
+                           "telemetry (the POI, or introduction)")
 
     optional_reads = ("/engagement",)
     writes = ("/engaged", "/engagement_decision")

@@ -10,7 +10,7 @@ from frog_bt.wire import SUCCEEDED
 
 
 class PoiParams(Params):
-    poi: str
+    poi: str = Field(description="a POI or time-of-day variant of the site (config pois)")
 
     @field_validator("poi")
     @classmethod
@@ -34,7 +34,8 @@ class Navigate(Leaf):
     """
 
     class Params(PoiParams):
-        timeout: float | None = Field(None, gt=0, allow_inf_nan=False)
+        timeout: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
+            "seconds before it fails (default: site timeouts.navigation)"))
 
     reads = ("/now",)
     writes = ("/target", "/waypoint", "/skipped")

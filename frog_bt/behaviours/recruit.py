@@ -15,7 +15,8 @@ from frog_bt.runtime.blackboard import EventLog, Reading
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
 from frog_bt.wire import SUCCEEDED
 
-Timeout = Field(None, gt=0, allow_inf_nan=False)
+Timeout = Field(None, gt=0, allow_inf_nan=False,
+                description="seconds before it fails (default: the site's timeouts entry)")
 
 
 def facing_visitor(persons: tuple[PersonDetection, ...], pose: Pose, lo: float, hi: float,

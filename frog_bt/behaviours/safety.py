@@ -144,7 +144,8 @@ class Checkpointed(FrogDecorator):
     """
 
     class Params(Params):
-        checkpoint: str = Field(min_length=1)
+        checkpoint: str = Field(min_length=1, description=(
+            "the part's name in the checkpoint (unique in the tree)"))
 
     optional_reads = ("/visitor",)
     writes = ("/visitor",)

@@ -56,8 +56,9 @@ class TourStatus(Leaf):
     """
 
     class Params(Params):
-        state: Literal["started", "ended", "aborted"]
-        reason: str = ""
+        state: Literal["started", "ended", "aborted"] = Field(
+            description="the tour state sent to the front end")
+        reason: str = Field("", description="why (with aborted; default: the abort reason)")
 
     optional_reads = ("/abort_reason",)
     writes = ("/frontend_ready", "/declined", "/special_done", "/tour_state")
@@ -93,9 +94,12 @@ class WaitEvent(Leaf):
     """
 
     class Params(Params):
-        event: Literal[tuple(EVENTS)]  # type: ignore[valid-type]
-        timeout: Annotated[float, Field(gt=0, allow_inf_nan=False)] | TimeoutName
-        on_timeout: Literal["failure", "success"] = "failure"
+        event: Literal[tuple(EVENTS)] = Field(  # type: ignore[valid-type]
+            description="the front-end event waited for")
+        timeout: Annotated[float, Field(gt=0, allow_inf_nan=False)] | TimeoutName = Field(
+            description="seconds, or the name of a site timeouts entry")
+        on_timeout: Literal["failure", "success"] = Field(
+            "failure", description="what a wait that ran out returns")
 
     reads = ("/events", "/now")
 

@@ -34,8 +34,11 @@ class VisitorFollows(Leaf):
     """
 
     class Params(Params):
-        radius: float | None = Field(None, gt=0, allow_inf_nan=False)
-        grace: float | None = Field(None, ge=0, allow_inf_nan=False)
+        radius: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
+            "metres around the robot a follower is looked for (default: site follow.radius)"))
+        grace: float | None = Field(None, ge=0, allow_inf_nan=False, description=(
+            "seconds nobody may be seen before the visitor counts as lost "
+            "(default: site follow.grace)"))
 
     reads = ("/people", "/pose", "/now")
 
@@ -78,8 +81,9 @@ class PlayContent(Leaf):
     """
 
     class Params(PoiParams):
-        part: Literal["a", "b"] = "a"
-        timeout: float | None = Field(None, gt=0, allow_inf_nan=False)
+        part: Literal["a", "b"] = Field("a", description="a: the content; b: its extension")
+        timeout: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
+            "seconds before going on without content_done (default: site timeouts.content)"))
 
     reads = ("/events", "/now")
     optional_reads = ("/waypoint",)

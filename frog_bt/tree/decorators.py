@@ -63,7 +63,8 @@ class Retry(FrogDecorator, py_trees.decorators.Retry):
     """
 
     class Params(Params):
-        attempts: int | None = Field(None, ge=1)
+        attempts: int | None = Field(None, ge=1, description=(
+            "runs in all (null: until it succeeds)"))
 
     def base_kwargs(self, params: Any) -> dict[str, Any]:
         return {"num_failures": params.attempts or math.inf}
@@ -80,7 +81,8 @@ class Timeout(FrogDecorator):
     """
 
     class Params(Params):
-        seconds: float = Field(gt=0, allow_inf_nan=False)
+        seconds: float = Field(gt=0, allow_inf_nan=False, description=(
+            "project-clock seconds the child may run"))
 
     def initialise(self) -> None:
         self.deadline = self.ctx.clock.now() + self.params.seconds

@@ -1,0 +1,141 @@
+"""The catalogue of every node type a tree file can name: parameters, keys, docstring.
+
+Built from the registries (:data:`~frog_bt.tree.leaf.LEAVES`,
+:data:`~frog_bt.tree.decorators.DECORATORS`) and the composites' structural keys,
+so it cannot drift from the code. ``frog-bt leaves`` prints it as Markdown or
+JSON; the node reference in ``docs/TREES.md`` is its Markdown (a test compares).
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+import types
+import typing
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+from pydantic import BaseModel
+from pydantic_core import PydanticUndefined
+
+import frog_bt.behaviours  # noqa: F401 - registers the leaf types
+from frog_bt.tree.decorators import DECORATORS
+from frog_bt.tree.leaf import LEAVES
+
+
+@dataclass(frozen=True, slots=True)
+class Param:
+    name: str
+    type: str
+    default: Any  # "required" when it has none
+    meaning: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class NodeType:
+    name: str
+    kind: str  # composite | decorator | leaf
+    params: tuple[Param, ...]
+    reads: tuple[str, ...] = ()
+    optional_reads: tuple[str, ...] = ()
+    writes: tuple[str, ...] = ()
+    doc: str = ""
+    children: str = field(default="")  # "children" | "child" | ""
+
+
+COMPOSITES = (
+    NodeType("Sequence", "composite", (
+        Param("memory", "bool", "required",
+              "true: resume at the running child; false: re-check every child each tick"),),
+        doc="Runs its children in order; SUCCESS when all succeed, FAILURE at the first "
+            "that fails.", children="children"),
+    NodeType("Selector", "composite", (
+        Param("memory", "bool", "required",
+              "true: resume at the running child; false: try from the first each tick"),),
+        doc="Tries its children in order; SUCCESS at the first that succeeds, FAILURE when "
+            "all fail.", children="children"),
+    NodeType("Parallel", "composite", (
+        Param("policy", "all | one", "all", "SUCCESS when all children / one child succeed"),
+        Param("synchronise", "bool", True, "with policy all: a succeeded child is not "
+              "ticked again")),
+        doc="Ticks all its children every tick; FAILURE as soon as one fails.",
+        children="children"),
+)
+
+
+def _type_name(annotation: Any) -> str:
+    if annotation is None or annotation is type(None):
+        return "null"
+    origin = typing.get_origin(annotation)
+    if origin is typing.Literal:
+        return " | ".join(str(a) for a in typing.get_args(annotation))
+    if origin in (typing.Union, types.UnionType):
+        return " | ".join(_type_name(a) for a in typing.get_args(annotation))
+    if origin is typing.Annotated:
+        return _type_name(typing.get_args(annotation)[0])
+    return getattr(annotation, "__name__", str(annotation))
+
+
+def _params(model: type[BaseModel]) -> tuple[Param, ...]:
+    out = []
+    for name, info in model.model_fields.items():
+        default = "required" if info.is_required() else info.get_default(
+            call_default_factory=True)
+        if default is PydanticUndefined:
+            default = "required"
+        out.append(Param(name, _type_name(info.annotation), default, info.description or ""))
+    return tuple(out)
+
+
+def _node(cls: Any, kind: str) -> NodeType:
+    return NodeType(cls.__name__, kind, _params(cls.Params), tuple(cls.reads),
+                    tuple(cls.optional_reads), tuple(cls.writes),
+                    inspect.cleandoc(cls.__doc__ or ""), "child" if kind == "decorator" else "")
+
+
+def catalogue() -> list[NodeType]:
+    """Every node type, composites first, then decorators and leaves by name."""
+    return [*COMPOSITES,
+            *(_node(DECORATORS[n], "decorator") for n in sorted(DECORATORS)),
+            *(_node(LEAVES[n], "leaf") for n in sorted(LEAVES))]
+
+
+def as_json(nodes: list[NodeType]) -> str:
+    return json.dumps([asdict(n) for n in nodes], indent=2, default=str) + "\n"
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def as_markdown(nodes: list[NodeType]) -> str:
+    """One section per node type: its docstring, a parameter table and its keys."""
+    out: list[str] = []
+    for kind, title in (("composite", "Composites"), ("decorator", "Decorators and scopes"),
+                        ("leaf", "Leaves")):
+        out.append(f"### {title}\n")
+        for node in (n for n in nodes if n.kind == kind):
+            out.append(f"#### `{node.name}`\n")
+            if node.doc:
+                out.append(node.doc + "\n")
+            if node.params:
+                out.append("| parameter | type | default | meaning |")
+                out.append("|---|---|---|---|")
+                for p in node.params:
+                    default = "required" if p.default == "required" else f"`{p.default!r}`"
+                    out.append(f"| `{p.name}` | {_cell(p.type)} | {_cell(default)} | "
+                               f"{_cell(p.meaning)} |")
+                out.append("")
+            keys = []
+            if node.children:
+                keys.append(f"takes `{node.children}`")
+            if node.reads:
+                keys.append("reads " + ", ".join(f"`{k}`" for k in node.reads))
+            if node.optional_reads:
+                keys.append("reads if set " + ", ".join(f"`{k}`" for k in node.optional_reads))
+            if node.writes:
+                keys.append("writes " + ", ".join(f"`{k}`" for k in node.writes))
+            if keys:
+                line = "; ".join(keys)
+                out.append(line[0].upper() + line[1:] + ".\n")
+    return "\n".join(out).rstrip() + "\n"
