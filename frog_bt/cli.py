@@ -18,6 +18,7 @@ COMMANDS = {
     "render": ("frog_bt.commands.render", "draw a tour tree"),
     "check": ("frog_bt.commands.check", "check a tour tree and the site config; draw nothing"),
     "leaves": ("frog_bt.commands.leaves", "list every node type: parameters, keys, docs"),
+    "schema": ("frog_bt.commands.schema", "print the JSON Schema of tree files or the site"),
     "replay": ("frog_bt.commands.replay", "re-run a recorded tour offline"),
     "init": ("frog_bt.commands.init", "write an editable copy of the tour and the site config"),
 }

@@ -27,9 +27,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def copies(target: Path) -> list[tuple[Path, Path]]:
     """(packaged file, where it goes) for every file ``init`` writes."""
     out = [(src, target / "trees" / src.name)
-           for src in sorted(resources.tree_dir().glob("*.yaml"))]
-    out.append((resources.site_dir() / resources.SITE_FILE,
-                target / "config" / resources.SITE_FILE))
+           for src in sorted([*resources.tree_dir().glob("*.yaml"),
+                              *resources.tree_dir().glob("*.schema.json")])]
+    for src in (resources.site_dir() / resources.SITE_FILE,
+                *resources.site_dir().glob("*.schema.json")):
+        out.append((src, target / "config" / src.name))
     return out
 
 

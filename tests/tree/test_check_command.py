@@ -31,7 +31,7 @@ def test_every_error_with_file_line_and_column(tmp_path: Path,
     found = [re.match(r"(.+):(\d+):(\d+): (\S+): (\w+) '", line) for line in lines[:-1]]
     assert all(found), lines
     assert [(Path(m[1]).name, int(m[2]), m[5]) for m in found if m] == [
-        ("recruit.yaml", 15, "ApproachVisitor"), ("recruit.yaml", 28, "WaitAnswer")]
+        ("recruit.yaml", 16, "ApproachVisitor"), ("recruit.yaml", 29, "WaitAnswer")]
 
 
 def test_a_bad_config_is_one_line_and_exit_2(tmp_path: Path,

@@ -54,7 +54,7 @@ def test_seek_visitor_after_approach_visitor_is_refused(trees: Path) -> None:
          "      - {type: ApproachVisitor}\n      - {type: SeekVisitor}\n")
     message = refused(trees)
     assert "ApproachVisitor 'ApproachVisitor' reads /visitor" in message
-    assert "SeekVisitor 'SeekVisitor' (recruit.yaml:16)" in message
+    assert "SeekVisitor 'SeekVisitor' (recruit.yaml:17)" in message
 
 
 def test_removing_decide_engagement_at_the_stops_is_refused(trees: Path) -> None:
