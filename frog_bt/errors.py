@@ -98,3 +98,8 @@ class DecodeError(FrogError):
         self.detail = message
         where = format_path(self.path) if self.path else ""
         super().__init__(f"{where}: {message}" if where else message)
+
+
+def error_lines(exc: BaseException) -> list[str]:
+    """One line per error (several for :class:`TreeErrors`), for a command to print."""
+    return [str(e) for e in exc.errors] if isinstance(exc, TreeErrors) else [str(exc)]

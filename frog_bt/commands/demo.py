@@ -20,7 +20,7 @@ from pathlib import Path
 
 from frog_bt.commands.options import add_tree_and_config
 from frog_bt.config import load_site
-from frog_bt.errors import DefinitionError
+from frog_bt.errors import DefinitionError, error_lines
 from frog_bt.tree.loader import load_tree
 
 
@@ -48,7 +48,8 @@ def run(args: argparse.Namespace) -> int:
         tree = load_tree(args.tree, site)
         scenario = load_scenario(args.scenario)
     except DefinitionError as exc:
-        print(f"frog-bt: {exc}", file=sys.stderr)
+        for line in error_lines(exc):
+            print(f"frog-bt: {line}", file=sys.stderr)
         return 2
     if args.speed:
         scenario = scenario.model_copy(update={"speed": args.speed})

@@ -25,7 +25,7 @@ from pathlib import Path
 
 from frog_bt.commands.options import CONFIG_HELP, TREE_HELP
 from frog_bt.config import load_site
-from frog_bt.errors import DefinitionError
+from frog_bt.errors import DefinitionError, error_lines
 from frog_bt.tools import render
 from frog_bt.tree.loader import load_tree
 
@@ -68,7 +68,8 @@ def run(args: argparse.Namespace) -> int:
         # absolute: load_tree resolves a relative path against the tree's own folder
         tree = load_tree(path.absolute() if path else None, site)
     except DefinitionError as exc:
-        print(f"frog-bt: {exc}", file=sys.stderr)
+        for line in error_lines(exc):
+            print(f"frog-bt: {line}", file=sys.stderr)
         return 2
     if args.format == "png" and args.output is None and sys.stdout.isatty():
         print("frog-bt: png is binary: give -o FILE (or redirect stdout)", file=sys.stderr)

@@ -24,7 +24,7 @@ from typing import Any
 from frog_bt import __version__
 from frog_bt.commands.options import add_tree_and_config, read_secret, rerun_spec, writable_file
 from frog_bt.config import DEFAULT_CONFIG, Site, check_ws_url, load_site, parse_hostport
-from frog_bt.errors import FrogError, UsageError
+from frog_bt.errors import FrogError, UsageError, error_lines
 from frog_bt.frontend.link import AddressError
 from frog_bt.runtime.checkpoint import STATE_DIR
 from frog_bt.runtime.checkpoint import claim as claim_checkpoint
@@ -138,7 +138,8 @@ def run(args: argparse.Namespace) -> int:
         settings = resolve(args, site)
         lock = claim_checkpoint(settings.checkpoint) if settings.checkpoint else None
     except FrogError as exc:
-        print(f"frog-bt: {exc}", file=sys.stderr)
+        for line in error_lines(exc):
+            print(f"frog-bt: {line}", file=sys.stderr)
         return 2
     print("\n".join(banner(args, settings)), flush=True)
     try:

@@ -91,6 +91,7 @@ class _Builder:
         self.site = site
         self.where: dict[int, Where] = {}
         self.scopes: dict[int, str] = {}  # id(node) -> the scope it starts ("stop")
+        self.errors: list[TreeError] = []  # found so far; the build goes on past each
         self.stack: list[Path] = []
 
     # ------------------------------------------------------------ files
@@ -117,6 +118,20 @@ class _Builder:
         return (nodes[0] if nodes else None), str(data.get("description", ""))
 
     # ------------------------------------------------------------ nodes
+
+    def _collect(self, data: Any, file: str, path: Path_, variables: dict[str, Any]
+                 ) -> list[Behaviour]:
+        """:meth:`node`, with its errors noted and the build going on (all in one pass)."""
+        try:
+            return self.node(data, file, path, variables)
+        except TreeError as exc:
+            self.note(exc)
+            return []
+
+    def note(self, exc: TreeError) -> None:
+        for error in exc.errors if isinstance(exc, TreeErrors) else [exc]:
+            if str(error) not in (str(e) for e in self.errors):  # an include, once per stop
+                self.errors.append(error)
 
     def node(self, data: Any, file: str, path: Path_, variables: dict[str, Any]
              ) -> list[Behaviour]:
@@ -162,7 +177,7 @@ class _Builder:
         # (after `when`, a composite may keep no children: it then succeeds at once)
         children: list[Behaviour] = []
         for i, child in enumerate(children_data):
-            children += self.node(child, file, (*path, "children", i), variables)
+            children += self._collect(child, file, (*path, "children", i), variables)
         name = name or type_
         if type_ == "Parallel":
             policy = data.get("policy", "all")
@@ -192,7 +207,7 @@ class _Builder:
         params = self._params(cls.Params, raw, file, path, variables)
         if "child" not in data:
             raise TreeError(file, (*path, "child"), f"missing required key: a {type_} has a child")
-        child = self.node(data["child"], file, (*path, "child"), variables)
+        child = self._collect(data["child"], file, (*path, "child"), variables)
         if len(child) != 1:
             if not child:
                 return None  # its child was left out by `when`
@@ -298,9 +313,14 @@ def check_keys(tree: LoadedTree) -> None:
         error = _gap_error(tree, gap)
         if str(error) not in (str(e) for e in errors):  # one per place, not per stop
             errors.append(error)
-    errors.sort(key=lambda e: (e.file, e.line or (0, 0)))
     if errors:
-        raise errors[0] if len(errors) == 1 else TreeErrors(errors)
+        raise_all(errors)
+
+
+def raise_all(errors: list[TreeError]) -> None:
+    """Raise every error at once, sorted by file and line (one: as it is)."""
+    errors = sorted(errors, key=lambda e: (e.file, e.line or (0, 0)))
+    raise errors[0] if len(errors) == 1 else TreeErrors(errors)
 
 
 def _gap_error(tree: LoadedTree, gap: Gap) -> TreeError:
@@ -333,7 +353,12 @@ def load_tree(path: str | Path | None = None, site: Site | None = None) -> Loade
     """Load, expand, build and check a tree file (default ``trees/tour.yaml``)."""
     path = Path(path) if path is not None else DEFAULT_TREE
     builder = _Builder(site)
-    root, description = builder.file(path, site_variables(site))
+    try:
+        root, description = builder.file(path, site_variables(site))
+    except TreeError as exc:
+        builder.note(exc)
+    if builder.errors:  # the structure first: a data-flow check of a broken tree misleads
+        raise_all(builder.errors)
     if root is None:
         raise TreeError(str(path), ("root",), "the whole tree was left out by 'when'")
     tree = LoadedTree(root, str(path), description, builder.where, builder.scopes)

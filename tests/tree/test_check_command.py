@@ -42,3 +42,24 @@ def test_a_bad_config_is_one_line_and_exit_2(tmp_path: Path,
     assert main(["check", "--config", str(site)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and str(site) in err
+
+
+def test_structural_errors_all_at_once_sorted_by_line(tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("root:\n  type: Sequence\n  memory: true\n  children:\n"
+                   "    - {type: Navigat, poi: POI1}\n"
+                   "    - {type: Navigate, poi: POI9}\n"
+                   "    - {type: Retry, attempts: 0, child: {type: GiveUp}}\n"
+                   "    - {type: Sequence, children: [{type: GiveUp}]}\n")
+    assert main(["check", str(bad)]) == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert lines == [
+        f"{bad}:5:14: root.children[0].type: unknown type 'Navigat'; did you mean 'Navigate'?",
+        f"{bad}:6:29: root.children[1].poi: unknown POI 'POI9' (known: END, POI0, POI1, POI1a, "
+        "POI1b, POI2, POI2a, POI2b, POI3, POI4, POI5, SHOP, TEMP)",
+        f"{bad}:7:31: root.children[2].attempts: Input should be greater than or equal to 1, "
+        "got 0",
+        f"{bad}:8:7: root.children[3].memory: missing required key: a Sequence must say "
+        "memory: true or false",
+        "frog-bt: 4 errors"]
