@@ -93,6 +93,10 @@ class Navigation(_Model):
     attempts: int = Field(3, ge=1)
 
 
+class DockingCfg(_Model):
+    attempts: int = Field(3, ge=1)  # tries of a dock or an undock before giving up
+
+
 class Recruit(_Model):
     facing_min: Finite = 135.0
     facing_max: Finite = 225.0
@@ -215,6 +219,7 @@ class Site(_Model):
     tour: Tour
     timeouts: Timeouts = Timeouts()
     navigation: Navigation = Navigation()
+    docking: DockingCfg = DockingCfg()
     recruit: Recruit = Recruit()
     follow: Follow = Follow()
     links: Links = Links()

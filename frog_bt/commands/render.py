@@ -43,12 +43,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--config", type=Path, metavar="FILE", help=CONFIG_HELP)
     p.add_argument("--keys", action="store_true",
                    help="show each node's blackboard keys (reads, optional reads?, writes)")
-    p.add_argument("--rankdir", choices=("TB", "LR"), default="TB",
-                   help="graph direction for dot, svg, png and mermaid: TB top-down "
-                   "(default) or LR left-to-right")
+    p.add_argument("--rankdir", choices=("TB", "LR"), default="LR",
+                   help="graph direction for dot, svg, png and mermaid: LR left-to-right "
+                   "(default: a whole tour stays legible) or TB top-down")
 
 
-def draw(root: render.Node, fmt: str, *, keys: bool = False, rankdir: str = "TB") -> bytes:
+def draw(root: render.Node, fmt: str, *, keys: bool = False, rankdir: str = "LR") -> bytes:
     """The tree in ``fmt`` as bytes (text formats UTF-8); raises GraphvizError for svg/png."""
     if fmt in ("ascii", "unicode"):
         return render.text(root, unicode=fmt == "unicode", keys=keys).encode("utf-8")

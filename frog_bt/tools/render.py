@@ -180,7 +180,16 @@ def text(root: Node, *, unicode: bool = False, keys: bool = False) -> str:
         unicode_lines(root, "", "")
     else:
         ascii_lines(root, 0)
+    lines.append("")
+    lines.append(UNICODE_LEGEND if unicode else ASCII_LEGEND)
+    if keys:
+        lines.append("keys: reads /key, reads if set /key?, writes /key")
     return "\n".join(lines) + "\n"
+
+
+ASCII_LEGEND = ("legend: {-} sequence with memory, [-] without; {o} selector with memory, "
+                "[o] without; /_/ parallel; -^- decorator; --> leaf")
+UNICODE_LEGEND = "legend: → sequence, ? selector, ⇉ parallel, ◇ decorator, • leaf"
 
 
 # ------------------------------------------------------------------ graphs
@@ -196,8 +205,9 @@ def _dot_quote(text: str) -> str:
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
-def dot(root: Node, *, keys: bool = False, rankdir: str = "TB") -> str:
-    """Graphviz DOT for the tree (``rankdir``: ``TB`` top-down or ``LR`` left-to-right)."""
+def dot(root: Node, *, keys: bool = False, rankdir: str = "LR") -> str:
+    """Graphviz DOT for the tree (``rankdir``: ``LR`` left-to-right, the default, or
+    ``TB`` top-down)."""
     out = [
         "digraph tree {",
         f"    graph [rankdir={rankdir}, ordering=out, nodesep=0.2, ranksep=0.35, "
@@ -223,8 +233,8 @@ def _mermaid_escape(text: str) -> str:
     return text
 
 
-def mermaid(root: Node, *, keys: bool = False, rankdir: str = "TB") -> str:
-    """A Mermaid ``flowchart TD`` (``LR`` with ``rankdir="LR"``) of the tree."""
+def mermaid(root: Node, *, keys: bool = False, rankdir: str = "LR") -> str:
+    """A Mermaid flowchart of the tree (``LR`` by default, ``TD`` with ``rankdir="TB"``)."""
     out = [f"flowchart {'LR' if rankdir == 'LR' else 'TD'}"]
     for node in root.walk():
         _, _, opening, closing, _ = LOOK[node.kind]

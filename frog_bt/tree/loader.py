@@ -18,7 +18,7 @@ per tour stop of the site configuration, with that stop's variables.
 
 Strings may use ``{VAR}``; a string that is exactly ``"{VAR}"`` takes the
 variable's value and type. Variables: ``dock``, ``recruit_at``,
-``nav_attempts`` from the site, and per stop ``index`` (from 0), ``poi``,
+``nav_attempts``, ``dock_attempts`` from the site, and per stop ``index`` (from 0), ``poi``,
 ``content``, ``face_stream``, ``projector``, ``check_follower``,
 ``content_timeout``.
 
@@ -81,9 +81,9 @@ class LoadedTree:
 
 def site_variables(site: Site | None) -> dict[str, Any]:
     if site is None:
-        return {"dock": "SHOP", "recruit_at": "POI0", "nav_attempts": 3}
+        return {"dock": "SHOP", "recruit_at": "POI0", "nav_attempts": 3, "dock_attempts": 3}
     return {"dock": site.tour.dock, "recruit_at": site.tour.recruit_at,
-            "nav_attempts": site.navigation.attempts}
+            "nav_attempts": site.navigation.attempts, "dock_attempts": site.docking.attempts}
 
 
 class _Builder:

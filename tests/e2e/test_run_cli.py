@@ -131,8 +131,10 @@ def test_a_bad_rosbridge_url_in_the_site_config_names_its_path(tmp_path):
                                                "rosbridge: 127.0.0.1:9090"))
     result = _run("--config", str(site), "--checkpoint", "none", cwd=tmp_path)
     assert result.returncode == 2
+    line = next(i for i, text in enumerate(site.read_text().splitlines(), 1)
+                if "rosbridge: 127.0.0.1:9090" in text)
     assert result.stderr.strip().splitlines() == [
-        f"frog-bt: {site}:61:14: links.rosbridge: expected ws://HOST:PORT, "
+        f"frog-bt: {site}:{line}:14: links.rosbridge: expected ws://HOST:PORT, "
         "e.g. ws://127.0.0.1:9090"]
 
 
