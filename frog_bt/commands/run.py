@@ -55,6 +55,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    f"per site config and listen address in {STATE_DIR}); 'none' disables it")
     p.add_argument("--fresh", action="store_true",
                    help="ignore the checkpoint: start a fresh tour")
+    p.add_argument("--watch", action="store_true",
+                   help="re-check the tree and config files when they change; a valid change "
+                   "takes over when the robot is docked and idle, a bad one is reported and "
+                   "the running tree stays")
     p.add_argument("--quiet", action="store_true", help="no live status line")
     p.add_argument("-v", "--verbose", action="store_true", help="log at debug level")
 
@@ -136,6 +140,9 @@ def run(args: argparse.Namespace) -> int:
         site = load_site(args.config)
         tree = load_tree(args.tree, site)
         settings = resolve(args, site)
+        if args.watch and settings.rerun:
+            raise UsageError("--watch", "", "cannot be combined with --rerun (the viewer's "
+                             "tree layout is fixed when it starts)")
         lock = claim_checkpoint(settings.checkpoint) if settings.checkpoint else None
     except FrogError as exc:
         for line in error_lines(exc):
@@ -177,9 +184,17 @@ async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Setti
         # the line must still say what the executive is waiting for.
         refresher = asyncio.create_task(_refresh(status))
     observers = attach_observers(executive, record=settings.record, rerun=settings.rerun)
+    watcher = None
+    if args.watch:
+        from frog_bt.runtime.watch import Watch
+
+        watch = Watch(args.tree, args.config, tree, executive.offer)
+        watcher = asyncio.create_task(watch.run())
     try:
         outcome = await executive.run()
     finally:
+        if watcher is not None:
+            watcher.cancel()
         if refresher is not None:
             refresher.cancel()
         for observer in observers:

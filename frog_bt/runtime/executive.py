@@ -91,6 +91,8 @@ class Executive:
         self._refusals = 0  # consecutive connections refused (auth)
         self._peer_restarts = 0
         self._checkpoint_warnings = WarningLimiter(60.0, logger=log)
+        self._swap: tuple[Site, LoadedTree] | None = None  # a checked tree, for the next idle
+        self.swaps = 0
 
     # ------------------------------------------------------------ I/O callbacks (cache only)
 
@@ -196,7 +198,44 @@ class Executive:
             await self.clock.sleep_until(next_at)
             self._wake.set()
 
+    # ------------------------------------------------------------ hot reload
+
+    def offer(self, site: Site, tree: LoadedTree) -> None:
+        """A checked tree (and site) to swap in at the next safe point: docked, no tour
+        running. A later offer replaces an earlier one not yet swapped in."""
+        if site.links != self.site.links or site.topics != self.site.topics:
+            log.warning("tree change refused: links and topics take a restart")
+            return
+        self._swap = (site, tree)
+        log.info("tree change checked; it takes over when the robot is docked and idle")
+
+    def idle(self) -> bool:
+        """Docked, and no tour running: a safe point to swap the tree."""
+        docking = self.core.inputs.latest.get(INPUTS["docking_state"].key)
+        return (self.core.ctx.tour_state != "started" and docking is not None
+                and docking.value == "docked")
+
+    def _swap_tree(self) -> None:
+        assert self._swap is not None
+        site, tree = self._swap
+        self._swap = None
+        old = self.core
+        ready = old.snapshot.get("/frontend_ready")
+        old.halt()
+        core = Core(site, tree, self.clock, self.client.publish, self.link.send)
+        core.taps = old.taps  # the observers (status, recording, summary) carry on
+        core.inputs.latest.update(old.inputs.latest)  # what the robot last said still holds
+        core.inputs.link = old.inputs.link
+        core.snapshot.bb.set("/frontend_ready", ready)
+        core.setup()
+        self.core, self.site, self.swaps = core, site, self.swaps + 1
+        nodes = sum(1 for _ in tree.nodes())
+        log.warning("tree reloaded at an idle point: %s (%d nodes)", tree.file, nodes)
+        core.ctx.note(f"tree reloaded: {tree.file}")
+
     def tick(self) -> None:
+        if self._swap is not None and self.idle():
+            self._swap_tree()
         restarts = self.link.stats.peer_restarts
         if restarts != self._peer_restarts:
             self._peer_restarts = restarts

@@ -97,6 +97,9 @@ def _run(*argv: str, cwd=None) -> subprocess.CompletedProcess[str]:
      "--rerun save:/no/such/dir/t.rrd: cannot write there: /no/such/dir does not exist"),
     (["--rerun", "bogus"],
      "--rerun bogus: expected spawn, save:FILE.rrd, connect[:URL], serve or off"),
+    (["--watch", "--rerun", "save:t.rrd"],
+     "--watch: cannot be combined with --rerun (the viewer's tree layout is fixed when it "
+     "starts)"),
     (["--config", "/no/such/site.yaml"],
      "/no/such/site.yaml: cannot read: No such file or directory"),
     (["--tree", "/no/such/tour.yaml"],

@@ -1,0 +1,95 @@
+"""``frog-bt run --watch``: a valid change to the tree takes over at the next idle point
+(docked, no tour running); a bad one is reported and the running tree stays."""
+
+from __future__ import annotations
+
+import asyncio
+import shutil
+from pathlib import Path
+
+from tour import Running
+
+from frog_bt import resources
+from frog_bt.config import load_site
+from frog_bt.runtime.watch import Watch
+from frog_bt.tree.loader import load_tree
+
+WAIT = "Wait for the front end"
+
+
+def copy_trees(tmp_path: Path) -> Path:
+    shutil.copytree(resources.tree_dir(), tmp_path / "trees")
+    return tmp_path / "trees" / "tour.yaml"
+
+
+def names(tree) -> set[str]:
+    return {n.name for n in tree.nodes()}
+
+
+def test_a_valid_change_takes_over_when_idle_and_a_bad_one_is_refused(tmp_path: Path) -> None:
+    tour_file = copy_trees(tmp_path)
+    site = load_site()
+    tree = load_tree(tour_file, site)
+
+    async def main() -> None:
+        # The front end never says it is idle: the robot stays docked, no tour starts.
+        async with Running({"frontend": {"idle_at": 10_000}}, site=site, tree=tree) as run:
+            exe = run.executive
+            refused: list[list[str]] = []
+            watch = Watch(tour_file, None, tree, exe.offer, refuse=refused.append)
+            assert await watch.check() is None  # nothing changed
+
+            await run.sim.wait_for(lambda r: r.channel == "/docking/state", 30)
+            for _ in range(300):  # until the executive has ticked, docked and idle
+                if exe.core.ticks and exe.idle():
+                    break
+                await asyncio.sleep(0.01)
+            assert exe.idle()
+
+            # A bad save: reported (file and line), the running tree stays.
+            recruit = tour_file.parent / "recruit.yaml"
+            good = recruit.read_text()
+            recruit.write_text(good.replace("      - {type: SeekVisitor}\n", ""))
+            assert await watch.check() is False
+            assert len(refused) == 1 and "recruit.yaml:16:9:" in refused[0][0]
+            assert await watch.check() is None  # reported once, not at every poll
+            assert exe.core.tree is tree
+
+            # A valid save: checked, then swapped in at the next tick (docked and idle).
+            recruit.write_text(good)
+            text = tour_file.read_text()
+            tour_file.write_text(text.replace(f"name: {WAIT}", f"name: {WAIT} again"))
+            assert await watch.check() is True
+            ticks = exe.core.ticks
+            for _ in range(300):
+                if exe.swaps:
+                    break
+                await asyncio.sleep(0.01)
+            assert exe.swaps == 1 and ticks >= 1
+            assert f"{WAIT} again" in names(exe.core.tree) and exe.core.tree is not tree
+            for _ in range(300):  # and the new tree runs: it waits for the front end
+                if exe.core.ticks:
+                    break
+                await asyncio.sleep(0.01)
+            tip = exe.core.bt.root.tip()
+            assert tip is not None and tip.name == f"{WAIT} again"
+
+    asyncio.run(main())
+
+
+def test_no_swap_while_a_tour_runs(tmp_path: Path) -> None:
+    tour_file = copy_trees(tmp_path)
+    site = load_site()
+    tree = load_tree(tour_file, site)
+
+    async def main() -> None:
+        async with Running({}, site=site, tree=tree) as run:
+            exe = run.executive
+            await run.sim.wait_for(lambda r: r.channel == "tour"
+                                   and r.payload.get("state") == "started", 30)
+            exe.offer(site, load_tree(tour_file, site))
+            await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 30)
+            assert exe.core.ctx.tour_state == "started" and not exe.idle()
+            assert exe.swaps == 0 and exe.core.tree is tree
+
+    asyncio.run(main())
