@@ -16,29 +16,25 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
-from frog_bt.commands.options import CONFIG_HELP, TREE_HELP
+from frog_bt.commands.options import add_tree_argument, tree_argument
 from frog_bt.config import DEFAULT_CONFIG, load_site
-from frog_bt.errors import DefinitionError, TreeErrors
+from frog_bt.errors import DefinitionError, TreeErrors, UsageError
 from frog_bt.tree.loader import load_tree
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("tree", nargs="?", type=Path, metavar="TREE", help=TREE_HELP)
-    p.add_argument("--tree", dest="tree_option", type=Path, metavar="FILE",
-                   help="the same as TREE, as the other commands take it")
-    p.add_argument("--config", type=Path, metavar="FILE", help=CONFIG_HELP)
+    add_tree_argument(p)
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.tree and args.tree_option:
-        print("frog-bt: give the tree once: TREE or --tree FILE", file=sys.stderr)
-        return 2
-    path = args.tree or args.tree_option
     try:
+        path = tree_argument(args)
         site = load_site(args.config)
-        tree = load_tree(path.absolute() if path else None, site)
+        tree = load_tree(path, site)
+    except UsageError as exc:
+        print(f"frog-bt: {exc}", file=sys.stderr)
+        return 2
     except TreeErrors as exc:
         for error in exc.errors:
             print(error, file=sys.stderr)

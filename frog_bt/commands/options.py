@@ -27,6 +27,23 @@ def add_tree_and_config(p: argparse.ArgumentParser, *, tree: bool = True) -> Non
     p.add_argument("--config", type=Path, metavar="FILE", help=CONFIG_HELP)
 
 
+def add_tree_argument(p: argparse.ArgumentParser) -> None:
+    """``[TREE]`` or ``--tree FILE``, and ``--config FILE`` (render, check)."""
+    p.add_argument("tree", nargs="?", type=Path, metavar="TREE", help=TREE_HELP)
+    p.add_argument("--tree", dest="tree_option", type=Path, metavar="FILE",
+                   help="the same as TREE, as the other commands take it")
+    p.add_argument("--config", type=Path, metavar="FILE", help=CONFIG_HELP)
+
+
+def tree_argument(args: argparse.Namespace) -> Path | None:
+    """The tree given as TREE or --tree (absolute: the loader resolves includes against
+    the tree's own folder); UsageError when both are given."""
+    if args.tree and args.tree_option:
+        raise UsageError("TREE", "", "give the tree once: TREE or --tree FILE")
+    path = args.tree or args.tree_option
+    return path.absolute() if path else None
+
+
 def writable_file(path: Path, option: str) -> Path:
     """``path`` if a file can be written there (its folder exists and is writable)."""
     if path.is_dir():

@@ -23,9 +23,9 @@ import os
 import sys
 from pathlib import Path
 
-from frog_bt.commands.options import CONFIG_HELP, TREE_HELP
+from frog_bt.commands.options import add_tree_argument, tree_argument
 from frog_bt.config import load_site
-from frog_bt.errors import DefinitionError, error_lines
+from frog_bt.errors import DefinitionError, UsageError, error_lines
 from frog_bt.tools import render
 from frog_bt.tree.loader import load_tree
 
@@ -33,14 +33,11 @@ FORMATS = ("ascii", "unicode", "dot", "svg", "png", "mermaid")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("tree", nargs="?", type=Path, metavar="TREE", help=TREE_HELP)
-    p.add_argument("--tree", dest="tree_option", type=Path, metavar="FILE",
-                   help="the same as TREE, as the other commands take it")
+    add_tree_argument(p)
     p.add_argument("-f", "--format", choices=FORMATS, default="ascii",
                    help="output format (default: ascii)")
     p.add_argument("-o", "--output", type=Path, metavar="FILE",
                    help="write to FILE instead of stdout")
-    p.add_argument("--config", type=Path, metavar="FILE", help=CONFIG_HELP)
     p.add_argument("--keys", action="store_true",
                    help="show each node's blackboard keys (reads, optional reads?, writes)")
     p.add_argument("--rankdir", choices=("TB", "LR"), default="LR",
@@ -59,14 +56,13 @@ def draw(root: render.Node, fmt: str, *, keys: bool = False, rankdir: str = "LR"
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.tree and args.tree_option:
-        print("frog-bt: give the tree once: TREE or --tree FILE", file=sys.stderr)
-        return 2
-    path = args.tree or args.tree_option
     try:
+        path = tree_argument(args)
         site = load_site(args.config)
-        # absolute: load_tree resolves a relative path against the tree's own folder
-        tree = load_tree(path.absolute() if path else None, site)
+        tree = load_tree(path, site)
+    except UsageError as exc:
+        print(f"frog-bt: {exc}", file=sys.stderr)
+        return 2
     except DefinitionError as exc:
         for line in error_lines(exc):
             print(f"frog-bt: {line}", file=sys.stderr)
