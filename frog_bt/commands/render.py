@@ -1,4 +1,5 @@
-"""Draw a tour tree as text, Graphviz DOT, Mermaid, or an SVG/PNG image.
+"""Draw a tour tree as text, Graphviz DOT, Mermaid, an SVG/PNG image, or BehaviorTree.CPP
+v4 XML (btcpp: Groot2 opens and edits it; `--tree FILE.xml` reads it back).
 
 Loads and checks the site configuration and the tree as `frog-bt run` does (a bad
 file: one line naming the file and the path in it, exit 2). Needs no robot and no
@@ -13,7 +14,8 @@ Examples:
   frog-bt render                                 the tour as an indented tree
   frog-bt render --format unicode --keys         with guide lines and blackboard keys
   frog-bt render trees/recruit.yaml --format mermaid
-  frog-bt render --format svg --rankdir LR -o docs/tour-tree.svg
+  frog-bt render --format svg -o docs/tour-tree.svg
+  frog-bt render --format btcpp -o tour.xml      for Groot2; frog-bt check tour.xml
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import argparse
 import os
 import sys
 from pathlib import Path
+from typing import Any
 
 from frog_bt.commands.options import add_tree_argument, tree_argument
 from frog_bt.config import load_site
@@ -29,7 +32,7 @@ from frog_bt.errors import DefinitionError, UsageError, error_lines
 from frog_bt.tools import render
 from frog_bt.tree.loader import load_tree
 
-FORMATS = ("ascii", "unicode", "dot", "svg", "png", "mermaid")
+FORMATS = ("ascii", "unicode", "dot", "svg", "png", "mermaid", "btcpp")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -43,6 +46,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--rankdir", choices=("TB", "LR"), default="LR",
                    help="graph direction for dot, svg, png and mermaid: LR left-to-right "
                    "(default: a whole tour stays legible) or TB top-down")
+
+
+def btcpp_xml(path: Path | None, site: Any) -> str:
+    """The tree as BehaviorTree.CPP v4 XML (Groot2): from its YAML files, or re-exported
+    from an imported XML file."""
+    from frog_bt.tools.btcpp import read_xml, to_xml
+    from frog_bt.tree.loader import DEFAULT_TREE
+
+    path = path or DEFAULT_TREE
+    if path.suffix.lower() == ".xml":
+        documents, main = read_xml(path)
+        return to_xml(path.parent / f"{main}.yaml", site, documents)
+    return to_xml(path, site)
 
 
 def draw(root: render.Node, fmt: str, *, keys: bool = False, rankdir: str = "LR") -> bytes:
@@ -70,9 +86,11 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "png" and args.output is None and sys.stdout.isatty():
         print("frog-bt: png is binary: give -o FILE (or redirect stdout)", file=sys.stderr)
         return 2
+    data = btcpp_xml(path, site).encode("utf-8") if args.format == "btcpp" else None
     try:
-        data = draw(render.outline(tree.root), args.format, keys=args.keys,
-                    rankdir=args.rankdir)
+        if data is None:
+            data = draw(render.outline(tree.root), args.format, keys=args.keys,
+                        rankdir=args.rankdir)
     except render.GraphvizError as exc:
         print(f"frog-bt: {exc}", file=sys.stderr)
         return 1

@@ -92,14 +92,24 @@ class _Builder:
         self.where: dict[int, Where] = {}
         self.scopes: dict[int, str] = {}  # id(node) -> the scope it starts ("stop")
         self.errors: list[TreeError] = []  # found so far; the build goes on past each
+        self.documents: dict[str, Any] | None = None  # name -> document (imported XML)
         self.stack: list[Path] = []
 
     # ------------------------------------------------------------ files
 
+    def read(self, path: Path) -> Any:
+        """A tree document: the YAML file, or (a tree imported from BT.CPP XML) the
+        document of that name."""
+        if self.documents is not None:
+            if path.name not in self.documents:
+                raise TreeError(str(path), (), "no such BehaviorTree in the XML file")
+            return self.documents[path.name]
+        return load_yaml(path, TreeError)
+
     def file(self, path: Path, variables: dict[str, Any]) -> tuple[Behaviour | None, str]:
         if path.resolve() in (p.resolve() for p in self.stack):
             raise TreeError(str(path), (), "includes itself (directly or through others)")
-        data = load_yaml(path, TreeError)
+        data = self.read(path)
         if not isinstance(data, dict):
             raise TreeError(str(path), (), "expected a mapping with a 'root' node")
         unknown = set(data) - {"root", "description"}
@@ -353,6 +363,13 @@ def load_tree(path: str | Path | None = None, site: Site | None = None) -> Loade
     """Load, expand, build and check a tree file (default ``trees/tour.yaml``)."""
     path = Path(path) if path is not None else DEFAULT_TREE
     builder = _Builder(site)
+    source = path
+    if path.suffix.lower() == ".xml":  # BehaviorTree.CPP v4 (Groot2): its trees as documents
+        from frog_bt.tools.btcpp import read_xml
+
+        builder.documents, main = read_xml(path)
+        path = path.parent / main
+    root, description = None, ""
     try:
         root, description = builder.file(path, site_variables(site))
     except TreeError as exc:
@@ -361,6 +378,6 @@ def load_tree(path: str | Path | None = None, site: Site | None = None) -> Loade
         raise_all(builder.errors)
     if root is None:
         raise TreeError(str(path), ("root",), "the whole tree was left out by 'when'")
-    tree = LoadedTree(root, str(path), description, builder.where, builder.scopes)
+    tree = LoadedTree(root, str(source), description, builder.where, builder.scopes)
     check_keys(tree)
     return tree
