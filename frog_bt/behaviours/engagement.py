@@ -113,6 +113,7 @@ class DecideEngagement(Leaf):
 
     optional_reads = ("/engagement",)
     writes = ("/engaged", "/engagement_decision")
+    key_types = {"/engaged": bool | None, "/engagement_decision": tuple[str, Decision]}
 
     def update(self) -> Status:
         cfg = self.ctx.site.engagement
@@ -134,6 +135,7 @@ class Engaged(Leaf):
     """
 
     reads = ("/engaged",)
+    key_types = {"/engaged": bool | None}
 
     def update(self) -> Status:
         engaged = self.get("/engaged")

@@ -51,6 +51,7 @@ class SeekVisitor(Leaf):
     reads = ("/persons", "/pose", "/now")
     optional_reads = ("/declined", "/approach_failed")
     writes = ("/visitor",)
+    key_types = {"/visitor": int}
 
     def update(self) -> Status:
         cfg = self.ctx.site.recruit
@@ -97,6 +98,7 @@ class ApproachVisitor(Leaf):
     reads = ("/visitor", "/now")
     optional_reads = ("/approach_failed",)
     writes = ("/approach_failed",)
+    key_types = {"/visitor": int, "/approach_failed": dict}
 
     def initialise(self) -> None:
         self.visitor = self.get("/visitor")
@@ -189,6 +191,7 @@ class WaitAnswer(Leaf):
     reads = ("/events", "/visitor", "/now")
     optional_reads = ("/declined",)
     writes = ("/declined",)
+    key_types = {"/visitor": int, "/declined": frozenset}
 
     def initialise(self) -> None:
         events: EventLog = self.get("/events")

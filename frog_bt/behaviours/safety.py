@@ -149,6 +149,7 @@ class Checkpointed(FrogDecorator):
 
     optional_reads = ("/visitor",)
     writes = ("/visitor",)
+    key_types = {"/visitor": int}
     skips_child = True  # resumed: SUCCESS without the child (the data-flow check)
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:

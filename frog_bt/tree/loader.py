@@ -45,6 +45,7 @@ from frog_bt.config import Site
 from frog_bt.errors import TreeError, TreeErrors, format_path
 from frog_bt.tree.decorators import DECORATORS
 from frog_bt.tree.flow import Gap, gaps
+from frog_bt.tree.keys import key_types, type_name
 from frog_bt.tree.leaf import LEAVES
 from frog_bt.tree.observed import Parallel, Selector, Sequence
 from frog_bt.yamlfile import line_of, load_yaml, validate
@@ -317,8 +318,10 @@ def _short(value: Any) -> str:
 
 
 def check_keys(tree: LoadedTree) -> None:
-    """Every key a node reads is written before it on every path (:mod:`.flow`)."""
-    errors: list[TreeError] = []
+    """Every key a node reads or writes is known and of the type the node takes it as
+    (:mod:`.keys`), and every key it reads is written before it on every path
+    (:mod:`.flow`)."""
+    errors: list[TreeError] = list(_type_errors(tree))
     for gap in gaps(tree.root, tree.scopes):
         error = _gap_error(tree, gap)
         if str(error) not in (str(e) for e in errors):  # one per place, not per stop
@@ -331,6 +334,24 @@ def raise_all(errors: list[TreeError]) -> None:
     """Raise every error at once, sorted by file and line (one: as it is)."""
     errors = sorted(errors, key=lambda e: (e.file, e.line or (0, 0)))
     raise errors[0] if len(errors) == 1 else TreeErrors(errors)
+
+
+def _type_errors(tree: LoadedTree) -> Iterator[TreeError]:
+    types = key_types()
+    for node in tree.nodes():
+        where = tree.where.get(id(node), Where(tree.file, ()))
+        who = f"{type(node).__name__} {node.name!r}"
+        declared: dict[str, Any] = getattr(node, "key_types", {})
+        for key in (*getattr(node, "reads", ()), *getattr(node, "optional_reads", ()),
+                    *getattr(node, "writes", ())):
+            if key not in types:
+                yield TreeError(where.file, where.path,
+                                f"{who} uses {key}, which no key declaration knows "
+                                "(frog_bt/tree/keys.py)")
+            elif key in declared and declared[key] != types[key]:
+                yield TreeError(where.file, where.path,
+                                f"{who} takes {key} as {type_name(declared[key])}, but "
+                                f"{key} holds {type_name(types[key])}")
 
 
 def _gap_error(tree: LoadedTree, gap: Gap) -> TreeError:

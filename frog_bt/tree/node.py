@@ -45,6 +45,7 @@ class Declared:
     reads: ClassVar[tuple[str, ...]] = ()
     optional_reads: ClassVar[tuple[str, ...]] = ()
     writes: ClassVar[tuple[str, ...]] = ()
+    key_types: ClassVar[dict[str, Any]] = {}  # key -> the type this node takes it as
     name: str
 
     def _declare(self, params: BaseModel | None) -> None:

@@ -14,7 +14,7 @@ from frog_bt import resources
 from frog_bt.config import load_site
 from frog_bt.errors import TreeError
 from frog_bt.tree import loader
-from frog_bt.tree.leaf import FAILURE
+from frog_bt.tree.leaf import FAILURE, LEAVES, SUCCESS, Leaf, Status
 from frog_bt.tree.loader import load_tree
 
 
@@ -121,3 +121,41 @@ def test_a_missing_value_at_run_time_fails_the_leaf_with_a_reason(
     node = bench.node("ApproachVisitor")
     assert node.feedback_message == "no value for /visitor"
     assert [i.kind for i in bench.core.ctx.incidents] == ["missing value"]
+
+
+class VisitorName(Leaf):
+    """Reads ``/visitor`` as a name (wrongly: it holds the tracked id)."""
+
+    reads = ("/visitor",)
+    key_types = {"/visitor": str}
+
+    def update(self) -> Status:
+        return SUCCESS
+
+
+class Mood(Leaf):
+    """Reads ``/mood``, which no key declaration knows."""
+
+    reads = ("/mood",)
+
+    def update(self) -> Status:
+        return SUCCESS
+
+
+@pytest.mark.parametrize(("leaf", "message"), [
+    (VisitorName, "VisitorName 'VisitorName' takes /visitor as str, but /visitor holds int"),
+    (Mood, "Mood 'Mood' uses /mood, which no key declaration knows"),
+])
+def test_keys_have_types(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                         leaf: type[Leaf], message: str) -> None:
+    monkeypatch.setitem(LEAVES, leaf.__name__, leaf)
+    path = write_tree(tmp_path, f"""
+        root:
+          type: Sequence
+          memory: true
+          children:
+            - {{type: SeekVisitor}}
+            - {{type: {leaf.__name__}}}
+    """)
+    with pytest.raises(TreeError, match=re.escape(message)):
+        load_tree(path, load_site())
