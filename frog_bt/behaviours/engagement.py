@@ -30,19 +30,16 @@ class FaceStream(FrogDecorator):
     sends ``engagement`` with the meter level (null for an empty window).
     Reads ``/faces``, ``/now``; writes ``/icl`` (True while on),
     ``/engagement`` (the session's :class:`~frog_bt.maths.engagement.Samples`) and
-    ``/engagement_meter``. With ``enabled: false`` it only runs its child.
+    ``/engagement_meter``.
     Returns the child's status.
     """
-
-    class Params(Params):
-        enabled: bool = Field(True, description="false: only run the child (no stream)")
 
     reads = ("/faces", "/now")
     writes = ("/icl", "/engagement", "/engagement_meter")
 
     def provides(self) -> tuple[str, ...]:
         """What the child may read while the stream is on (the data-flow check)."""
-        return self.writes if self.params.enabled else ()
+        return self.writes
 
     def __init__(self, name: str, child: py_trees.behaviour.Behaviour,
                  params: Params | None = None) -> None:
@@ -50,8 +47,6 @@ class FaceStream(FrogDecorator):
         self._on = False
 
     def initialise(self) -> None:
-        if not self.params.enabled:
-            return
         self.ctx.actions.icl(True)
         self._on = True
         self.samples = Samples()

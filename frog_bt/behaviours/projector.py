@@ -37,11 +37,11 @@ class Projector(FrogDecorator):
     driven to). Sends ``projector`` on once ETA < ``projector.warmup`` +
     ``projector.margin`` or the
     robot is within ``projector.radius``; sends off when the scope ends, if on.
-    With ``enabled: false`` it only runs its child. Returns the child's status.
+    Returns the child's status.
     """
 
     class Params(PoiParams):
-        enabled: bool = True
+        pass
 
     reads = ("/pose", "/now")
     optional_reads = ("/waypoint",)
@@ -54,7 +54,7 @@ class Projector(FrogDecorator):
         self.history: deque[tuple[float, float, float]] = deque()
 
     def update(self) -> Status:
-        if self.params.enabled and not self._on:
+        if not self._on:
             self._consider()
         return self.decorated.status
 

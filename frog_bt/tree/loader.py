@@ -11,7 +11,9 @@ mapping with a ``type``:
 * leaves (:mod:`frog_bt.behaviours`), their parameters given inline.
 
 Any node may have a ``name``, and ``when: VAR`` / ``when: not VAR`` to keep it
-only where a variable is true. Two constructs are expanded at load time:
+only where a variable is true: a composite or a leaf is then left out with all
+it holds; a decorator (a scope, a retry, a checkpoint) is left out alone, and its
+child runs as it is. Two constructs are expanded at load time:
 ``{include: FILE, with: {VAR: VALUE}}`` inserts another file's root, and
 ``{foreach: stops, include: FILE}`` (in a ``children`` list) inserts FILE once
 per tour stop of the site configuration, with that stop's variables.
@@ -150,6 +152,9 @@ class _Builder:
         if not isinstance(data, dict):
             raise TreeError(file, path, f"expected a node (a mapping), got {_short(data)}")
         if "when" in data and not self._when(data["when"], file, (*path, "when"), variables):
+            if data.get("type") in DECORATORS and "child" in data:
+                # a decorator is its own effect: without it, its child runs as it is
+                return self._collect(data["child"], file, (*path, "child"), variables)
             return []
         if "foreach" in data:
             return self._foreach(data, file, path, variables)

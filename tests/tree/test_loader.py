@@ -118,3 +118,23 @@ def test_whole_string_variable_keeps_its_type(tmp_path, site):
                       "child: {type: FinishPoi, poi: POI1}}")
     tree = load_tree(path, site)
     assert tree.root.params.attempts == site.navigation.attempts
+
+
+def test_when_on_a_decorator_leaves_out_that_decorator_only(tmp_path, site):
+    """One switch, `when`: a decorator left out leaves its child in place; a composite or
+    a leaf left out goes with all it holds."""
+    path = write_tree(tmp_path, """
+        root:
+          type: Sequence
+          memory: true
+          children:
+            - type: FaceStream
+              when: not dock_attempts
+              child: {type: FinishPoi, poi: POI1}
+            - type: Retry
+              attempts: 2
+              child: {type: FinishPoi, poi: POI2, when: not dock_attempts}
+    """)
+    tree = load_tree(path, site)
+    assert [type(n).__name__ for n in tree.root.iterate()] == ["FinishPoi", "Sequence"]
+    assert [n.name for n in tree.root.children] == ["FinishPoi POI1"]
