@@ -63,3 +63,24 @@ def test_structural_errors_all_at_once_sorted_by_line(tmp_path: Path,
         f"{bad}:8:7: root.children[3].memory: missing required key: a Sequence must say "
         "memory: true or false",
         "frog-bt: 4 errors"]
+
+
+@pytest.mark.parametrize(("file", "old", "new", "where"), [
+    ("recruit.yaml", "      - {type: SeekVisitor}\n", "", "recruit.yaml:16:9:"),
+    ("recruit.yaml", "      - {type: SeekVisitor}\n      - {type: ApproachVisitor}\n",
+     "      - {type: ApproachVisitor}\n      - {type: SeekVisitor}\n", "recruit.yaml:16:9:"),
+    ("visit_poi.yaml",
+     '                      - {type: DecideEngagement, about: "{poi}", when: face_stream}\n',
+     "", "visit_poi.yaml:59:31:"),
+], ids=["no SeekVisitor", "SeekVisitor after ApproachVisitor", "no DecideEngagement at stops"])
+def test_the_designers_mistakes_are_refused_with_file_and_line(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], file: str, old: str, new: str,
+        where: str) -> None:
+    trees = tmp_path / "trees"
+    shutil.copytree(resources.tree_dir(), trees)
+    path = trees / file
+    assert old in path.read_text()
+    path.write_text(path.read_text().replace(old, new))
+    assert main(["check", str(trees / "tour.yaml")]) == 2
+    first = capsys.readouterr().err.splitlines()[0]
+    assert first.startswith(str(trees / where)), first
