@@ -71,7 +71,7 @@ class Progress:
 
 
 def run(args: argparse.Namespace) -> int:
-    from frog_bt.tools.replay import Replay, ReplayError, local_time
+    from frog_bt.tools.replay import Replay, ReplayError, differences, local_time
 
     try:
         site = load_site(args.config)
@@ -114,6 +114,10 @@ def run(args: argparse.Namespace) -> int:
             text = "nothing" if command is None else (
                 f"{command}  (at +{command.t - result.start:.1f} s)")
             print(f"  {label + ':':9} {text}")
+        print(f"  {'differs:':9} {differences(div.expected, div.got, site)}")
+        for label, command in (("recorded", div.expected), ("replayed", div.got)):
+            if command is not None:
+                print(f"  {label + ':':9} sent by {command.node or '? (no blame recorded)'}")
     simulated = result.covered - result.start
     wall = result.wall
     print(f"replayed {simulated:.1f} of {result.end - result.start:.1f} s recorded in "

@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import py_trees
@@ -24,7 +25,9 @@ from frog_bt.runtime.clock import Clock
 from frog_bt.runtime.context import Context
 from frog_bt.tree import observed, ticking
 from frog_bt.tree.loader import LoadedTree
+from frog_bt.tree.observed import acting
 from frog_bt.wire import INPUTS, OUTPUTS
+from frog_bt.yamlfile import line_of
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
@@ -47,6 +50,7 @@ class Taps:
     frontend_in: list[Tap] = field(default_factory=list)
     frontend_out: list[Tap] = field(default_factory=list)
     tick: list[Callable[[Core], None]] = field(default_factory=list)
+    blame: list[Tap] = field(default_factory=list)  # (t, channel, node) after each command
 
 
 class Core:
@@ -59,6 +63,8 @@ class Core:
         self._publish_topic = publish
         self._send = send
         self.taps = Taps()
+        self.blamed = "-"  # the node that sent the latest command (see who())
+        self._labels: dict[int, str] = {}
         self.table = {site.topic(role): inp for role, inp in INPUTS.items()}
         self.inputs = Inputs(self.table)
         self.actions = Actions(self._publish, clock)
@@ -75,17 +81,40 @@ class Core:
         self.touched: list[Behaviour] = []
         observed.attach(tree.root, self.touched)
 
+    def who(self, node: Behaviour | None) -> str:
+        """The node that sent a command, as people find it: its name and where it is
+        written (``Navigate POI1 (goto.yaml:5)``); ``-`` for none (the executive)."""
+        if node is None:
+            return "-"
+        label = self._labels.get(id(node))
+        if label is None:
+            where = self.tree.where.get(id(node))
+            line = line_of(where.file, where.path) if where else None
+            place = f" ({Path(where.file).name}:{line[0]})" if where and line else ""
+            label = self._labels[id(node)] = f"{node.name}{place}"
+        return label
+
+    def _blame(self, channel: str) -> None:
+        if self.taps.blame:
+            now = self.clock.now()
+            for tap in self.taps.blame:
+                tap(now, channel, self.blamed)
+
     def _publish(self, role: str, value: Any) -> None:
         topic = self.site.topic(role)
+        self.blamed = self.who(acting())
         msg = OUTPUTS[role].codec.encode(value)
         self._publish_topic(topic, msg)
         for tap in self.taps.ros_out:
             tap(self.clock.now(), topic, msg)
+        self._blame(topic)
 
     def _send_message(self, message: FrontendMessage) -> None:
+        self.blamed = self.who(acting())
         self._send(message)
         for tap in self.taps.frontend_out:
             tap(self.clock.now(), message.type, message)
+        self._blame(message.type)
 
     def setup(self) -> None:
         if not self._setup:

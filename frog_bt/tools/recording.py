@@ -9,6 +9,8 @@
 * ``/frontend/in`` and ``/frontend/out``: every UDP datagram from the front-end
   host and to the front end (acks and resends included), data = the datagram's
   bytes;
+* ``/frog_bt/blame``: after each command, the tree node that sent it
+  (``{"channel", "node"}``), for replay's divergence report;
 * ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``).
   Live ticks coalesce bursts of inputs and fall wherever the event loop gets to
   them, so replay ticks exactly where the live executive did
@@ -55,6 +57,8 @@ log = logging.getLogger(__name__)
 FRONTEND_IN = "/frontend/in"
 FRONTEND_OUT = "/frontend/out"
 TICK = "/frog_bt/tick"
+BLAME = "/frog_bt/blame"  # the tree node that sent each command, right after it
+BLAME_TYPE = "frog_bt/Blame"
 DATAGRAM_TYPE = "frog_bt/FrontendDatagram"
 TICK_TYPE = "frog_bt/Tick"
 CHUNK_SIZE = 256 * 1024  # bytes of uncompressed messages per chunk
@@ -95,6 +99,9 @@ def _datagram_schema() -> dict[str, Any]:
 SCHEMAS: dict[str, dict[str, Any]] = {
     **{name: struct_schema(codec.wire, name) for name, codec in ROS_TYPES.items()},
     DATAGRAM_TYPE: _datagram_schema(),
+    BLAME_TYPE: {"type": "object", "title": BLAME_TYPE, "properties": {
+        "channel": {"type": "string", "description": "ROS topic or front-end message type"},
+        "node": {"type": "string", "description": "the tree node that sent it"}}},
     TICK_TYPE: {"type": "object", "title": TICK_TYPE, "properties": {
         "tick": {"type": "integer"},
         "status": {"enum": ["INVALID", "RUNNING", "SUCCESS", "FAILURE"]}}},
@@ -199,12 +206,14 @@ class Recorder:
         self.channel(FRONTEND_IN, DATAGRAM_TYPE)
         self.channel(FRONTEND_OUT, DATAGRAM_TYPE)
         self.channel(TICK, TICK_TYPE)
+        self.channel(BLAME, BLAME_TYPE)
         clock = executive.clock
         self._ready = lambda: bool(clock.ready)
         executive.wire.ros_in.append(self.on_ros_in)
         executive.taps.ros_out.append(self.on_ros_out)
         executive.wire.datagram.append(self.on_datagram)
         executive.taps.tick.append(self.on_tick)
+        executive.taps.blame.append(self.on_blame)
 
     def channel(self, topic: str, type_: str) -> int:
         """The channel id of ``topic``, registering it (and its schema) on first use."""
@@ -243,6 +252,10 @@ class Recorder:
         topic = FRONTEND_IN if direction == "in" else FRONTEND_OUT
         cid = self._channels.get(topic) or self.channel(topic, DATAGRAM_TYPE)
         self._write(cid, t if self._ready() else None, bytes(data))
+
+    def on_blame(self, t: float, channel: str, node: str) -> None:
+        self._write(self._channels.get(BLAME) or self.channel(BLAME, BLAME_TYPE), t,
+                    _dumps({"channel": channel, "node": node}))
 
     def on_tick(self, core: Any) -> None:
         status = core.bt.root.status.name

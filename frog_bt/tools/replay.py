@@ -48,7 +48,7 @@ from frog_bt.frontend.protocol import Endpoint
 from frog_bt.rosbridge.msgs import ROS_TYPES
 from frog_bt.runtime.clock import SITE_TZ, ManualClock
 from frog_bt.runtime.core import Core
-from frog_bt.tools.recording import FRONTEND_IN, FRONTEND_OUT, TICK, from_ns
+from frog_bt.tools.recording import BLAME, FRONTEND_IN, FRONTEND_OUT, TICK, from_ns
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
@@ -59,13 +59,15 @@ class ReplayError(FrogError):
     """The recording cannot be replayed (not a file, not MCAP, channels missing)."""
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Command:
-    """One command sent: when, on which channel (ROS topic or ``/frontend/out``), what."""
+    """One command sent: when, on which channel (ROS topic or ``/frontend/out``), what,
+    and the tree node that sent it (``node``: blame; empty when the recording has none)."""
 
     t: float
     channel: str
     payload: dict[str, Any]
+    node: str = ""
 
     def __str__(self) -> str:
         return f"{self.channel} {json.dumps(self.payload, sort_keys=True)}"
@@ -171,6 +173,7 @@ class Replay:
         self.endpoint = Endpoint(self._peer, EVENTS)  # the same dedup as the live link
         self._expected: deque[Command] = deque()
         self._got: deque[Command] = deque()
+        self._last_expected: Command | None = None
         self._seqs: set[int] = set()
         self._compared = 0
         self._next_tick = 0.0
@@ -182,12 +185,13 @@ class Replay:
     # ------------------------------------------------------------ outputs of the replayed tree
 
     def _publish(self, topic: str, msg: dict[str, Any]) -> None:
-        self._got.append(Command(self.clock.now(), topic, _without_stamp(_plain(msg))))
+        self._got.append(Command(self.clock.now(), topic, _without_stamp(_plain(msg)),
+                                 self.core.blamed))
         self._compare()
 
     def _send(self, message: FrontendMessage) -> None:
         payload = _plain({"type": message.type, **message_fields(message)})
-        self._got.append(Command(self.clock.now(), FRONTEND_OUT, payload))
+        self._got.append(Command(self.clock.now(), FRONTEND_OUT, payload, self.core.blamed))
         self._compare()
 
     def _compare(self) -> None:
@@ -204,14 +208,18 @@ class Replay:
         wall0 = time.monotonic()
         result = self.result
         try:
+            parted = False
             for _schema, channel, message in self._reader.iter_messages(log_time_order=True):
+                if parted and channel.topic != BLAME:
+                    break  # the blame of the diverging command, recorded after it, is read
                 t = from_ns(message.log_time)
                 self._on_message(channel.topic, t, message.data)
+                if parted:
+                    break
                 result.covered = t
                 if progress is not None:
                     progress(t)
-                if result.divergence is not None:
-                    break
+                parted = result.divergence is not None
             else:
                 self.core.halt()  # as the executive does when it stops (face stream off, ...)
                 if result.divergence is None and (self._expected or self._got):
@@ -243,9 +251,12 @@ class Replay:
                 self._tick()
         elif topic == FRONTEND_OUT:
             self._expect_datagram(t, data)
+        elif topic == BLAME:
+            self._blame(data)
         elif topic in self.outputs:
             self.result.ros_commands += 1
-            self._expected.append(Command(t, topic, _without_stamp(json.loads(data))))
+            self._last_expected = Command(t, topic, _without_stamp(json.loads(data)))
+            self._expected.append(self._last_expected)
             self._compare()
 
     def _on_ros(self, topic: str, data: bytes) -> None:
@@ -278,8 +289,23 @@ class Replay:
             return  # a resend
         self._seqs.add(seq)
         self.result.frontend_commands += 1
-        self._expected.append(Command(t, FRONTEND_OUT, obj))
+        self._last_expected = Command(t, FRONTEND_OUT, obj)
+        self._expected.append(self._last_expected)
         self._compare()
+
+    def _blame(self, data: bytes) -> None:
+        """A recorded ``/frog_bt/blame``: the node that sent the command just recorded."""
+        try:
+            obj = json.loads(data)
+        except ValueError:
+            return
+        last = self._last_expected
+        if last is None or not isinstance(obj, dict):
+            return
+        channel = obj.get("channel")
+        if channel == last.channel or (last.channel == FRONTEND_OUT
+                                       and last.payload.get("type") == channel):
+            last.node = str(obj.get("node", ""))
 
     # ------------------------------------------------------------ time and ticks
 
@@ -317,3 +343,46 @@ class Replay:
     def _tick(self) -> None:
         if self.result.divergence is None:
             self.core.tick()
+
+
+# ------------------------------------------------------------------ the report, in domain terms
+
+
+def _fields(command: Command, site: Site) -> tuple[str, dict[str, Any]]:
+    """What a command is (``/GotoWayPoint``, ``start_poi``) and its fields in domain
+    terms: a goal's waypoint by name, a front-end message's fields."""
+    if command.channel == site.topic("goto"):
+        from frog_bt.tools.summary import TourSummary  # the one waypoint matcher
+
+        return command.channel, {"waypoint": TourSummary(site).waypoint_of(command.payload)}
+    if command.channel == FRONTEND_OUT:
+        fields = dict(command.payload)
+        return str(fields.pop("type", "?")), fields
+    payload = command.payload
+    return command.channel, dict(payload) if isinstance(payload, dict) else {"msg": payload}
+
+
+def describe(command: Command | None, site: Site) -> str:
+    """``/GotoWayPoint waypoint POI1a``, ``start_poi poi POI2 part b``; ``nothing``."""
+    if command is None:
+        return "nothing"
+    what, fields = _fields(command, site)
+    return " ".join([what, *(f"{k} {_short_value(v)}" for k, v in fields.items())])
+
+
+def differences(expected: Command | None, got: Command | None, site: Site) -> str:
+    """The difference in domain terms: ``waypoint POI1a → POI1b``, or ``start_poi part b
+    → finish_poi`` when the commands are of different kinds."""
+    if expected is None or got is None:
+        return f"{describe(expected, site)} → {describe(got, site)}"
+    (a, fa), (b, fb) = _fields(expected, site), _fields(got, site)
+    if a != b:
+        return f"{describe(expected, site)} → {describe(got, site)}"
+    changed = [f"{k} {_short_value(fa.get(k))} → {_short_value(fb.get(k))}"
+               for k in sorted(set(fa) | set(fb)) if fa.get(k) != fb.get(k)]
+    return "; ".join(changed) or "the same fields (at another time)"
+
+
+def _short_value(value: Any) -> str:
+    text = value if isinstance(value, str) else json.dumps(value, sort_keys=True)
+    return text if len(text) <= 60 else text[:57] + "..."

@@ -18,6 +18,7 @@ import py_trees
 from pydantic import BaseModel, ConfigDict
 
 from frog_bt.runtime.context import Context
+from frog_bt.tree.observed import ACTING
 
 Status = py_trees.common.Status
 SUCCESS, FAILURE, RUNNING, INVALID = Status.SUCCESS, Status.FAILURE, Status.RUNNING, Status.INVALID
@@ -83,6 +84,7 @@ class Declared:
         return value
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
+        ACTING.append(self)  # type: ignore[arg-type]
         try:
             yield from super().tick()  # type: ignore[misc]
         except MissingValue as missing:
@@ -91,6 +93,8 @@ class Declared:
                           incident="missing value", subject=missing.key)
             self.stop(FAILURE)  # type: ignore[attr-defined]
             yield self  # type: ignore[misc]
+        finally:
+            ACTING.pop()
 
     def set(self, key: str, value: Any) -> None:
         self.bb.set(key, value, overwrite=True)

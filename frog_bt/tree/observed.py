@@ -14,6 +14,16 @@ import py_trees
 
 Behaviour = py_trees.behaviour.Behaviour
 
+# The frog-bt nodes whose tick (or stop) is running, innermost last: a command sent now
+# is the last one's doing (blame, in recordings and replay). A tick runs to its end
+# synchronously, so the stack is balanced between ticks.
+ACTING: list[Behaviour] = []
+
+
+def acting() -> Behaviour | None:
+    """The innermost frog-bt node ticking or stopping now, if any."""
+    return ACTING[-1] if ACTING else None
+
 
 class Observed:
     """Mixin (before the py_trees base): ``stop`` appends the node to ``stop_log``."""
@@ -22,7 +32,11 @@ class Observed:
 
     def stop(self, new_status: py_trees.common.Status = py_trees.common.Status.INVALID
              ) -> None:
-        super().stop(new_status)  # type: ignore[misc]
+        ACTING.append(self)  # type: ignore[arg-type]
+        try:
+            super().stop(new_status)  # type: ignore[misc]
+        finally:
+            ACTING.pop()
         log = self.stop_log
         if log is not None:
             log.append(self)  # type: ignore[arg-type]

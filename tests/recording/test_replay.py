@@ -4,17 +4,20 @@ from __future__ import annotations
 
 import io
 import json
+import shutil
 from pathlib import Path
+from typing import Any
 
 import pytest
 import yaml
 from mcap.writer import Writer
-from recorded_tour import RecordedTour
+from recorded_tour import RecordedTour, record_tour
 
+from frog_bt import resources
 from frog_bt.cli import main
 from frog_bt.commands.replay import Progress
 from frog_bt.config import DEFAULT_CONFIG, load_site
-from frog_bt.tools.replay import Replay, local_time
+from frog_bt.tools.replay import Replay, differences, local_time
 from frog_bt.tree.loader import load_tree
 
 
@@ -56,7 +59,12 @@ def test_c_a_changed_stop_order_diverges_at_the_first_different_goal(
                         f"the recording), command {div.number}:")
     assert lines[1].startswith("  expected: /GotoWayPoint {") and "51.7105" in lines[1]
     assert lines[2].startswith("  got:      /GotoWayPoint {") and "52.08933" in lines[2]
-    assert lines[3].startswith("replayed ")
+    assert lines[3] == "  differs:  waypoint POI4 → POI5"  # in domain terms
+    assert lines[4].startswith("  recorded: sent by Navigate POI4 (goto.yaml:")
+    assert lines[5].startswith("  replayed: sent by Navigate POI5 (goto.yaml:")
+    assert div.expected.node.startswith("Navigate POI4") and div.got.node.startswith(
+        "Navigate POI5")  # blame: the node that sent each command, on both sides
+    assert lines[6].startswith("replayed ")
 
 
 def test_not_a_file_not_mcap_and_missing_channels_exit_2(
@@ -89,3 +97,63 @@ def test_progress_bar_redraws_at_most_ten_times_a_second() -> None:
     draws = out.getvalue().split("\r")[1:]
     assert len(draws) == 3  # two draws and the final erase
     assert " 10% " in draws[0] and " 50% " in draws[1] and draws[2] == "\033[K"
+
+
+def changed_config(tmp_path: Path, change: Any) -> Path:
+    data = yaml.safe_load(DEFAULT_CONFIG.read_text(encoding="utf-8"))
+    change(data)
+    path = tmp_path / "site.yaml"
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    return path
+
+
+def test_a_moved_variant_cut_off_is_blamed_on_the_variant_choice(
+        tour: RecordedTour, tmp_path: Path) -> None:
+    """The tour was recorded at 10:30; with POI1's variant a only until 10:00 the replay
+    drives to POI1b: the report says so in waypoint names, and which node sent each."""
+    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(
+        until="10:00"))
+    site = load_site(config)
+    div = Replay(tour.path, site, load_tree(site=site)).run().divergence
+    assert div is not None
+    assert differences(div.expected, div.got, site) == "waypoint POI1a → POI1b"
+    assert div.expected.node.startswith("Navigate POI1 (goto.yaml:")
+    assert div.got.node == div.expected.node  # the same node chose another variant
+
+
+def test_a_removed_extension_is_blamed_on_the_content_node(
+        tour: RecordedTour, tmp_path: Path) -> None:
+    """Without the engagement-gated part b, the replay finishes the POI where the
+    recording played part b: `start_poi … part b → finish_poi`, both nodes named."""
+    trees = tmp_path / "trees"
+    shutil.copytree(resources.tree_dir(), trees)
+    visit = trees / "visit_poi.yaml"
+    text = visit.read_text()
+    start = text.index("                      - type: FailureIsSuccess")
+    end = text.index("                      - {type: FinishPoi")
+    visit.write_text(text[:start] + text[end:])
+    site = load_site()
+    div = Replay(tour.path, site, load_tree(trees / "tour.yaml", site)).run().divergence
+    assert div is not None and div.expected is not None and div.got is not None
+    assert differences(div.expected, div.got, site).startswith("start_poi poi POI1")
+    assert "part b" in differences(div.expected, div.got, site)
+    assert div.got.payload["type"] == "finish_poi"
+    assert div.expected.node.startswith("PlayContent POI1 b")
+    assert div.got.node.startswith("FinishPoi POI1")
+
+
+def test_a_skipped_stop_is_reported_with_the_nodes_on_both_sides(tmp_path: Path) -> None:
+    """Recorded: navigation to POI2 failed once and the retry got there. With one
+    navigation attempt only, the replay gives up on POI2: where the recording sent the
+    goal again, the replay's guided drive ends (follow-me off) on its way to skip it."""
+    recorded = record_tour(tmp_path / "retry.mcap",
+                           {"navigation": {"failures": [{"poi": "POI2", "times": 1}]}})
+    assert recorded.outcome.code == 0
+    config = changed_config(tmp_path, lambda d: d["navigation"].update(attempts=1))
+    site = load_site(config)
+    div = Replay(recorded.path, site, load_tree(site=site)).run().divergence
+    assert div is not None and div.expected is not None and div.got is not None
+    assert differences(div.expected, div.got, site) == (
+        "/GotoWayPoint waypoint POI2a → follow_me on false")
+    assert div.expected.node.startswith("Navigate POI2 (goto.yaml:")  # the retry
+    assert div.got.node.startswith("Guide to POI2 (visit_poi.yaml:")  # giving up on it
