@@ -12,6 +12,14 @@ differently on the same inputs:
 
   frog-bt replay frog-demo.mcap
   frog-bt replay frog-demo.mcap --tree my-trees/tour.yaml
+
+Batch what-if over a corpus (several files, or directories of *.mcap): one line
+per tour (identical, diverged with its first divergence, or unreadable and
+skipped), then a summary grouping the divergences by node and what differs;
+--jobs N replays N files at a time (processes), --report FILE writes it as JSON.
+Exit 0 only when every tour replays identically.
+
+  frog-bt replay recordings/ --config what-if/site.yaml --jobs 2 --report out.json
 """
 
 from __future__ import annotations
@@ -25,7 +33,7 @@ from typing import Any, TextIO
 
 from frog_bt.commands.options import add_tree_and_config
 from frog_bt.config import load_site
-from frog_bt.errors import DefinitionError
+from frog_bt.errors import DefinitionError, error_lines
 from frog_bt.tree.loader import load_tree
 
 REDRAW = 0.1  # wall seconds between progress-bar redraws
@@ -33,12 +41,17 @@ BAR = 30
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("file", type=Path, metavar="FILE.mcap", help="recording to replay")
+    p.add_argument("files", type=Path, nargs="+", metavar="FILE_OR_DIR",
+                   help="recording(s) to replay: MCAP files, or directories of them")
     add_tree_and_config(p)
     p.add_argument("--rerun", metavar="SPEC",
                    help="rerun telemetry of the replay: spawn | save:FILE.rrd | connect:URL | "
                    "serve (default: off)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="corpus: recordings replayed at a time, in processes (default 1)")
+    p.add_argument("--report", type=Path, metavar="FILE.json",
+                   help="corpus: write every tour's row and the summary as JSON")
 
 
 class Progress:
@@ -71,6 +84,70 @@ class Progress:
 
 
 def run(args: argparse.Namespace) -> int:
+    if len(args.files) > 1 or args.files[0].is_dir() or args.report or args.jobs != 1:
+        return run_corpus(args)
+    args.file = args.files[0]
+    return run_one(args)
+
+
+def run_corpus(args: argparse.Namespace) -> int:
+    import json
+    from concurrent.futures import ProcessPoolExecutor
+
+    from frog_bt.tools.corpus import recordings, replay_corpus, summary, summary_line
+
+    if args.rerun:
+        print("frog-bt replay: --rerun takes one recording", file=sys.stderr)
+        return 2
+    if args.jobs < 1:
+        print(f"frog-bt replay: --jobs {args.jobs}: expected 1 or more", file=sys.stderr)
+        return 2
+    try:
+        site = load_site(args.config)  # checked once, up front
+        load_tree(args.tree, site)
+    except DefinitionError as exc:
+        for line in error_lines(exc):
+            print(f"frog-bt replay: {line}", file=sys.stderr)
+        return 2
+    files = recordings(args.files)
+    if not files:
+        print("frog-bt replay: no recordings (*.mcap) found", file=sys.stderr)
+        return 2
+    bar = None if args.quiet or not sys.stderr.isatty() else CountBar(sys.stderr)
+    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        rows = []
+        for row in replay_corpus(files, args.tree, args.config, pool, bar):
+            rows.append(row)
+            if bar is not None:
+                bar.clear()
+            print(row.line(), flush=True)
+    if bar is not None:
+        bar.clear()
+    totals = summary(rows)
+    print(summary_line(totals))
+    if args.report is not None:
+        args.report.write_text(json.dumps(
+            {"tours": [r.as_dict() for r in rows], "summary": totals}, indent=1) + "\n")
+    return 0 if totals["identical"] == totals["tours"] else 1
+
+
+class CountBar:
+    """A one-line progress bar over the corpus, on a terminal."""
+
+    def __init__(self, out: TextIO) -> None:
+        self.out = out
+
+    def __call__(self, done: int, total: int) -> None:
+        filled = round(done / max(total, 1) * BAR)
+        self.out.write(f"\rreplay [{'#' * filled}{'-' * (BAR - filled)}] {done}/{total} tours")
+        self.out.flush()
+
+    def clear(self) -> None:
+        self.out.write("\r\033[K")
+        self.out.flush()
+
+
+def run_one(args: argparse.Namespace) -> int:
     from frog_bt.tools.replay import Replay, ReplayError, differences, local_time
 
     try:

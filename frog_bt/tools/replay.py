@@ -383,6 +383,21 @@ def differences(expected: Command | None, got: Command | None, site: Site) -> st
     return "; ".join(changed) or "the same fields (at another time)"
 
 
+def what_differs(expected: Command | None, got: Command | None, site: Site) -> str:
+    """What a divergence is about, for grouping: the first field that differs
+    (``waypoint``), or the two kinds (``start_poi → finish_poi``, ``/GotoWayPoint →
+    nothing``)."""
+    if expected is None or got is None:
+        a = _fields(expected, site)[0] if expected else "nothing"
+        b = _fields(got, site)[0] if got else "nothing"
+        return f"{a} → {b}"
+    (a, fa), (b, fb) = _fields(expected, site), _fields(got, site)
+    if a != b:
+        return f"{a} → {b}"
+    changed = sorted(k for k in set(fa) | set(fb) if fa.get(k) != fb.get(k))
+    return changed[0] if changed else "time"
+
+
 def _short_value(value: Any) -> str:
     text = value if isinstance(value, str) else json.dumps(value, sort_keys=True)
     return text if len(text) <= 60 else text[:57] + "..."

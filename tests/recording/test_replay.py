@@ -80,7 +80,9 @@ def test_not_a_file_not_mcap_and_missing_channels_exit_2(
         writer.add_message(channel, log_time=1, data=json.dumps({"data": "hi"}).encode(),
                            publish_time=1)
         writer.finish()
-    for path, reason in ((tmp_path, "not a file"), (text, "not an MCAP file"),
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    for path, reason in ((empty, "no recordings (*.mcap) found"), (text, "not an MCAP file"),
                          (other, "no channel /ApproachPeopleFar")):
         assert main(["replay", str(path)]) == 2
         err = capsys.readouterr().err
@@ -157,3 +159,36 @@ def test_a_skipped_stop_is_reported_with_the_nodes_on_both_sides(tmp_path: Path)
         "/GotoWayPoint waypoint POI2a → follow_me on false")
     assert div.expected.node.startswith("Navigate POI2 (goto.yaml:")  # the retry
     assert div.got.node.startswith("Guide to POI2 (visit_poi.yaml:")  # giving up on it
+
+
+def test_a_corpus_is_replayed_in_parallel_and_summarised(
+        tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Two morning tours (the same recording twice), an afternoon tour and a truncated
+    file, with POI1's variant a moved to end at 10:00: the morning tours diverge at the
+    variant choice, the afternoon one does not, the truncated one is reported and
+    skipped; the summary groups the divergences and the JSON report has every row."""
+    corpus = tmp_path / "corpus"
+    corpus.mkdir()
+    shutil.copy(tour.path, corpus / "a-morning.mcap")
+    shutil.copy(tour.path, corpus / "b-morning.mcap")
+    record_tour(corpus / "c-afternoon.mcap", {"start_time": "2026-06-01T15:10:00+02:00"})
+    data = tour.path.read_bytes()
+    (corpus / "d-truncated.mcap").write_bytes(data[: len(data) // 2])
+    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(
+        until="10:00"))
+    report = tmp_path / "report.json"
+    code = main(["replay", str(corpus), "--config", str(config), "--jobs", "2",
+                 "--report", str(report), "--quiet"])
+    assert code == 1
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith(f"{corpus / 'a-morning.mcap'}: diverged at +")
+    assert lines[1].startswith(f"{corpus / 'b-morning.mcap'}: diverged at +")
+    assert lines[2] == f"{corpus / 'c-afternoon.mcap'}: identical"
+    assert lines[3].startswith(f"{corpus / 'd-truncated.mcap'}: unreadable: ")
+    assert "waypoint POI1a → POI1b" in lines[0] and "replayed: Navigate POI1" in lines[0]
+    assert lines[4] == ("2 of 4 tours diverge: 2 at Navigate POI1: waypoint; 1 unreadable")
+    rows = json.loads(report.read_text())
+    assert [r["status"] for r in rows["tours"]] == [
+        "diverged", "diverged", "identical", "unreadable"]
+    assert rows["summary"]["by_signature"] == {"Navigate POI1: waypoint": 2}
+    assert rows["tours"][3]["reason"]  # why it could not be read
