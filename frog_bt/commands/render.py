@@ -49,16 +49,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def btcpp_xml(path: Path | None, site: Any) -> str:
-    """The tree as BehaviorTree.CPP v4 XML (Groot2): from its YAML files, or re-exported
-    from an imported XML file."""
-    from frog_bt.tools.btcpp import read_xml, to_xml
+    """The tree as BehaviorTree.CPP v4 XML (:func:`frog_bt.tools.btcpp.tree_xml`)."""
+    from frog_bt.tools.btcpp import tree_xml
     from frog_bt.tree.loader import DEFAULT_TREE
 
-    path = path or DEFAULT_TREE
-    if path.suffix.lower() == ".xml":
-        documents, main = read_xml(path)
-        return to_xml(path.parent / f"{main}.yaml", site, documents)
-    return to_xml(path, site)
+    return tree_xml(path or DEFAULT_TREE, site)
 
 
 def draw(root: render.Node, fmt: str, *, keys: bool = False, rankdir: str = "LR") -> bytes:

@@ -25,6 +25,7 @@ Exit 0 only when every tour replays identically.
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from collections.abc import Callable
@@ -48,6 +49,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="rerun telemetry of the replay: spawn | save:FILE.rrd | connect:URL | "
                    "serve (default: off)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--format", choices=("text", "json"), default="text",
+                   help="one recording's report: text for people, json for scripts")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
                    help="corpus: recordings replayed at a time, in processes (default 1)")
     p.add_argument("--report", type=Path, metavar="FILE.json",
@@ -91,7 +94,6 @@ def run(args: argparse.Namespace) -> int:
 
 
 def run_corpus(args: argparse.Namespace) -> int:
-    import json
     from concurrent.futures import ProcessPoolExecutor
 
     from frog_bt.tools.corpus import recordings, replay_corpus, summary, summary_line
@@ -129,6 +131,32 @@ def run_corpus(args: argparse.Namespace) -> int:
         args.report.write_text(json.dumps(
             {"tours": [r.as_dict() for r in rows], "summary": totals}, indent=1) + "\n")
     return 0 if totals["identical"] == totals["tours"] else 1
+
+
+def report(result: Any, site: Any) -> dict[str, Any]:
+    """One replay as JSON: identical or the first divergence, in domain terms."""
+    from frog_bt.tools.replay import differences, what_differs
+
+    div = result.divergence
+    out: dict[str, Any] = {
+        "identical": div is None, "start": result.start, "end": result.end,
+        "inputs": result.inputs, "ticks": result.ticks,
+        "ros_commands": result.ros_commands, "frontend_commands": result.frontend_commands,
+        "exact_ticks": result.exact}
+    if div is not None:
+        def side(command: Any) -> dict[str, Any] | None:
+            if command is None:
+                return None
+            return {"at": command.t - result.start, "channel": command.channel,
+                    "payload": command.payload, "node": command.node,
+                    "reads": command.reads}
+
+        out["divergence"] = {
+            "number": div.number, "at": div.t - result.start,
+            "differs": differences(div.expected, div.got, site),
+            "what": what_differs(div.expected, div.got, site),
+            "recorded": side(div.expected), "replayed": side(div.got)}
+    return out
 
 
 class CountBar:
@@ -179,6 +207,9 @@ def run_one(args: argparse.Namespace) -> int:
         if telemetry is not None:
             telemetry.close()
     commands = f"{result.ros_commands} ROS and {result.frontend_commands} front-end commands"
+    if args.format == "json":
+        print(json.dumps(report(result, site), indent=1))
+        return 0 if result.divergence is None else 1
     if not result.exact:
         print("note: the recording has no /frog_bt/tick channel; ticks follow the live rules")
     div = result.divergence
@@ -195,6 +226,8 @@ def run_one(args: argparse.Namespace) -> int:
         for label, command in (("recorded", div.expected), ("replayed", div.got)):
             if command is not None:
                 print(f"  {label + ':':9} sent by {command.node or '? (no blame recorded)'}")
+        if div.got is not None and div.got.reads:
+            print(f"  {'read:':9} " + "; ".join(f"{k} {v}" for k, v in div.got.reads.items()))
     simulated = result.covered - result.start
     wall = result.wall
     print(f"replayed {simulated:.1f} of {result.end - result.start:.1f} s recorded in "

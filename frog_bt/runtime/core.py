@@ -20,7 +20,7 @@ import py_trees
 from frog_bt.config import Site
 from frog_bt.frontend.messages import FrontendMessage
 from frog_bt.runtime.actions import Actions
-from frog_bt.runtime.blackboard import Inputs, Snapshot
+from frog_bt.runtime.blackboard import Inputs, Reading, Snapshot, peek
 from frog_bt.runtime.clock import Clock
 from frog_bt.runtime.context import Context
 from frog_bt.tree import observed, ticking
@@ -64,6 +64,7 @@ class Core:
         self._send = send
         self.taps = Taps()
         self.blamed = "-"  # the node that sent the latest command (see who())
+        self.blamed_reads: dict[str, str] = {}  # what that node read, as short text
         self._labels: dict[int, str] = {}
         self.table = {site.topic(role): inp for role, inp in INPUTS.items()}
         self.inputs = Inputs(self.table)
@@ -94,6 +95,12 @@ class Core:
             label = self._labels[id(node)] = f"{node.name}{place}"
         return label
 
+    def _note_sender(self) -> None:
+        node = acting()
+        self.blamed = self.who(node)
+        keys = (*getattr(node, "reads", ()), *getattr(node, "optional_reads", ()))
+        self.blamed_reads = {k: _short(peek(k)) for k in keys if k != "/now"}
+
     def _blame(self, channel: str) -> None:
         if self.taps.blame:
             now = self.clock.now()
@@ -102,7 +109,7 @@ class Core:
 
     def _publish(self, role: str, value: Any) -> None:
         topic = self.site.topic(role)
-        self.blamed = self.who(acting())
+        self._note_sender()
         msg = OUTPUTS[role].codec.encode(value)
         self._publish_topic(topic, msg)
         for tap in self.taps.ros_out:
@@ -110,7 +117,7 @@ class Core:
         self._blame(topic)
 
     def _send_message(self, message: FrontendMessage) -> None:
-        self.blamed = self.who(acting())
+        self._note_sender()
         self._send(message)
         for tap in self.taps.frontend_out:
             tap(self.clock.now(), message.type, message)
@@ -166,3 +173,11 @@ class Core:
     @property
     def last_note(self) -> str:
         return self.ctx.notes[-1][1] if self.ctx.notes else ""
+
+
+def _short(value: Any) -> str:
+    """A blackboard value as a short line of text (for a divergence report)."""
+    if isinstance(value, Reading):
+        value = value.value
+    text = repr(value)
+    return text if len(text) <= 120 else text[:117] + "..."

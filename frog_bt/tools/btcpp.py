@@ -246,3 +246,12 @@ def read_xml(path: Path) -> tuple[dict[str, Any], str]:
     if main not in documents:
         raise TreeError(str(path), (), f"no BehaviorTree {main!r} to execute")
     return documents, main
+
+
+def tree_xml(path: Path, site: Site | None) -> str:
+    """The tree file at ``path`` as BT.CPP v4 XML: exported from its YAML files, or
+    re-exported from an XML file (the same XML)."""
+    if path.suffix.lower() == ".xml":
+        documents, main = read_xml(path)
+        return to_xml(path.parent / f"{main}.yaml", site, documents)
+    return to_xml(path, site)

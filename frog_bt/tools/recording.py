@@ -9,6 +9,8 @@
 * ``/frontend/in`` and ``/frontend/out``: every UDP datagram from the front-end
   host and to the front end (acks and resends included), data = the datagram's
   bytes;
+* ``/frog_bt/tree``: once, the tree that ran as BehaviorTree.CPP v4 XML
+  (``{"format", "file", "xml"}``: Groot2 opens the XML);
 * ``/frog_bt/blame``: after each command, the tree node that sent it
   (``{"channel", "node"}``), for replay's divergence report;
 * ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``).
@@ -59,6 +61,8 @@ FRONTEND_OUT = "/frontend/out"
 TICK = "/frog_bt/tick"
 BLAME = "/frog_bt/blame"  # the tree node that sent each command, right after it
 BLAME_TYPE = "frog_bt/Blame"
+TREE = "/frog_bt/tree"  # the tree that ran, as BehaviorTree.CPP v4 XML, once at the start
+TREE_TYPE = "frog_bt/Tree"
 DATAGRAM_TYPE = "frog_bt/FrontendDatagram"
 TICK_TYPE = "frog_bt/Tick"
 CHUNK_SIZE = 256 * 1024  # bytes of uncompressed messages per chunk
@@ -99,6 +103,9 @@ def _datagram_schema() -> dict[str, Any]:
 SCHEMAS: dict[str, dict[str, Any]] = {
     **{name: struct_schema(codec.wire, name) for name, codec in ROS_TYPES.items()},
     DATAGRAM_TYPE: _datagram_schema(),
+    TREE_TYPE: {"type": "object", "title": TREE_TYPE, "properties": {
+        "format": {"type": "string"}, "file": {"type": "string"},
+        "xml": {"type": "string", "description": "the tree (Groot2 opens it)"}}},
     BLAME_TYPE: {"type": "object", "title": BLAME_TYPE, "properties": {
         "channel": {"type": "string", "description": "ROS topic or front-end message type"},
         "node": {"type": "string", "description": "the tree node that sent it"}}},
@@ -209,6 +216,7 @@ class Recorder:
         self.channel(BLAME, BLAME_TYPE)
         clock = executive.clock
         self._ready = lambda: bool(clock.ready)
+        self._write_tree(executive)
         executive.wire.ros_in.append(self.on_ros_in)
         executive.taps.ros_out.append(self.on_ros_out)
         executive.wire.datagram.append(self.on_datagram)
@@ -252,6 +260,22 @@ class Recorder:
         topic = FRONTEND_IN if direction == "in" else FRONTEND_OUT
         cid = self._channels.get(topic) or self.channel(topic, DATAGRAM_TYPE)
         self._write(cid, t if self._ready() else None, bytes(data))
+
+    def _write_tree(self, executive: Any) -> None:
+        """The tree that runs, so that a recording explains itself without the files."""
+        from frog_bt.tools.btcpp import tree_xml
+
+        tree = getattr(getattr(executive, "core", None), "tree", None)
+        if tree is None:
+            return
+        tree_file = Path(tree.file)
+        try:
+            xml = tree_xml(tree_file, executive.site)
+        except Exception as exc:
+            log.info("recording without the tree's XML: %s", exc)
+            return
+        self._write(self.channel(TREE, TREE_TYPE), None, _dumps(
+            {"format": "BehaviorTree.CPP v4", "file": str(tree_file), "xml": xml}))
 
     def on_blame(self, t: float, channel: str, node: str) -> None:
         self._write(self._channels.get(BLAME) or self.channel(BLAME, BLAME_TYPE), t,

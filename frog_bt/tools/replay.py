@@ -33,7 +33,7 @@ import struct
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
 from typing import Any
@@ -68,6 +68,7 @@ class Command:
     channel: str
     payload: dict[str, Any]
     node: str = ""
+    reads: dict[str, str] = field(default_factory=dict)  # replayed: what the node read
 
     def __str__(self) -> str:
         return f"{self.channel} {json.dumps(self.payload, sort_keys=True)}"
@@ -186,12 +187,13 @@ class Replay:
 
     def _publish(self, topic: str, msg: dict[str, Any]) -> None:
         self._got.append(Command(self.clock.now(), topic, _without_stamp(_plain(msg)),
-                                 self.core.blamed))
+                                 self.core.blamed, self.core.blamed_reads))
         self._compare()
 
     def _send(self, message: FrontendMessage) -> None:
         payload = _plain({"type": message.type, **message_fields(message)})
-        self._got.append(Command(self.clock.now(), FRONTEND_OUT, payload, self.core.blamed))
+        self._got.append(Command(self.clock.now(), FRONTEND_OUT, payload, self.core.blamed,
+                                 self.core.blamed_reads))
         self._compare()
 
     def _compare(self) -> None:

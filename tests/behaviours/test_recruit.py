@@ -222,3 +222,20 @@ def test_an_unanswered_approach_fails_after_the_site_timeout(tmp_path):
     bench.advance(0.1)
     assert bench.tick() == FAILURE
     assert bench.core.ctx.incidents[-1].kind == "approach failed"
+
+
+def test_a_command_is_blamed_on_its_node_with_what_it_read(tmp_path):
+    bench = Bench(write_tree(tmp_path, """
+        root:
+          type: Sequence
+          memory: true
+          children:
+            - {type: SeekVisitor}
+            - {type: ApproachVisitor}
+    """))
+    bench.pose(100.0, 30.0)
+    bench.persons((2, 103.0, 30.0, 200.0))
+    bench.tick()
+    assert bench.take_published() == [("/ApproachPeopleFar", {"data": 2})]
+    assert bench.core.blamed.startswith("ApproachVisitor (t.yaml:")
+    assert bench.core.blamed_reads["/visitor"] == "2"  # what the deciding node read

@@ -192,3 +192,33 @@ def test_a_corpus_is_replayed_in_parallel_and_summarised(
         "diverged", "diverged", "identical", "unreadable"]
     assert rows["summary"]["by_signature"] == {"Navigate POI1: waypoint": 2}
     assert rows["tours"][3]["reason"]  # why it could not be read
+
+
+def test_json_report_names_nodes_reads_and_the_domain_diff(
+        tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(
+        until="10:00"))
+    assert main(["replay", str(tour.path), "--config", str(config), "--format", "json",
+                 "--quiet"]) == 1
+    out = json.loads(capsys.readouterr().out)
+    div = out["divergence"]
+    assert out["identical"] is False and div["differs"] == "waypoint POI1a → POI1b"
+    assert div["what"] == "waypoint"
+    assert div["recorded"]["node"].startswith("Navigate POI1 (goto.yaml:")
+    assert div["replayed"]["node"] == div["recorded"]["node"]
+    assert div["replayed"]["channel"] == "/GotoWayPoint"
+    assert "/waypoint" not in div["replayed"]["reads"]  # Navigate reads only the clock
+
+
+def test_a_recording_carries_the_tree_that_ran(tour: RecordedTour) -> None:
+    """The tree's BT.CPP XML is on /frog_bt/tree: the recording explains itself."""
+    from mcap.reader import make_reader
+
+    from frog_bt.tools.btcpp import tree_xml
+    from frog_bt.tree.loader import DEFAULT_TREE
+
+    with open(tour.path, "rb") as f:
+        trees = [json.loads(m.data) for _, c, m in make_reader(f).iter_messages()
+                 if c.topic == "/frog_bt/tree"]
+    assert len(trees) == 1 and trees[0]["format"] == "BehaviorTree.CPP v4"
+    assert trees[0]["xml"] == tree_xml(DEFAULT_TREE, tour.site)
