@@ -175,6 +175,9 @@ class Replay:
         self._expected: deque[Command] = deque()
         self._got: deque[Command] = deque()
         self._last_expected: Command | None = None
+        # observers: ("recorded" | "replayed", command) and the divergence (the viewer)
+        self.on_command: list[Callable[[str, Command], None]] = []
+        self.on_divergence: list[Callable[[Divergence], None]] = []
         self._seqs: set[int] = set()
         self._compared = 0
         self._next_tick = 0.0
@@ -200,8 +203,13 @@ class Replay:
         while self._expected and self._got and self.result.divergence is None:
             expected, got = self._expected.popleft(), self._got.popleft()
             self._compared += 1
+            for observe in self.on_command:
+                observe("recorded", expected)
+                observe("replayed", got)
             if (expected.channel, expected.payload) != (got.channel, got.payload):
                 self.result.divergence = Divergence(self._compared, expected, got)
+                for seen in self.on_divergence:
+                    seen(self.result.divergence)
 
     # ------------------------------------------------------------ the run
 

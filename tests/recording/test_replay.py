@@ -222,3 +222,27 @@ def test_a_recording_carries_the_tree_that_ran(tour: RecordedTour) -> None:
                  if c.topic == "/frog_bt/tree"]
     assert len(trees) == 1 and trees[0]["format"] == "BehaviorTree.CPP v4"
     assert trees[0]["xml"] == tree_xml(DEFAULT_TREE, tour.site)
+
+
+def test_the_viewer_shows_recorded_and_replayed_commands_and_the_divergence(
+        tour: RecordedTour, tmp_path: Path) -> None:
+    from rerun.chunk import RrdReader
+
+    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(
+        until="10:00"))
+    rrd = tmp_path / "what-if.rrd"
+    assert main(["replay", str(tour.path), "--config", str(config), "--quiet",
+                 "--rerun", f"save:{rrd}"]) == 1
+    texts: dict[str, list[str]] = {}
+    for chunk in RrdReader(rrd).stream():
+        if chunk.entity_path.startswith("/log/replay/") and not chunk.is_static:
+            batch = chunk.to_record_batch()
+            if "TextLog:text" in batch.schema.names:
+                texts.setdefault(chunk.entity_path, []).extend(
+                    t for row in batch.column("TextLog:text").to_pylist() for t in row)
+    recorded, replayed = texts["/log/replay/recorded"], texts["/log/replay/replayed"]
+    assert len(recorded) == len(replayed) > 1  # two lanes, command for command
+    assert recorded[-1].startswith("/GotoWayPoint waypoint POI1a  [Navigate POI1")
+    assert replayed[-1].startswith("/GotoWayPoint waypoint POI1b  [Navigate POI1")
+    assert texts["/log/replay/divergence"] == [
+        f"divergence, command {len(recorded)}: waypoint POI1a → POI1b"]
