@@ -74,7 +74,7 @@ class Rehearsal:
                                    sim_time=True, **self.executive_kwargs)
         if self.prepare is not None:
             self.prepare(self.executive)
-        self.sim.follow(self._executive_time)
+        self.sim.follow(self._executive_time, self.executive.clock.sleep_until)
         self.task = asyncio.create_task(self.executive.run())
         return self
 

@@ -25,7 +25,7 @@ import asyncio
 import contextlib
 import logging
 import random
-from collections.abc import Callable, Mapping
+from collections.abc import Awaitable, Callable, Mapping
 from typing import Any
 
 from frog_bt.runtime.clock import ManualClock
@@ -58,7 +58,8 @@ class Simulator:
         self.scenario = scenario
         self.speed = scenario.speed
         self._follow: Callable[[], float | None] | None = None
-        self._lead = 1.0
+        self._lead = 0.5
+        self._wait_until: Callable[[float], Awaitable[Any]] | None = None
         self._paused = False
         self.pois = dict(pois) if pois is not None else load_pois()
         self.world = World(scenario, self.pois)
@@ -147,10 +148,14 @@ class Simulator:
     # ------------------------------------------------------------ time
 
     def follow(self, executive_time: Callable[[], float | None] | None,
-               lead: float = 1.0) -> None:
+               wait_until: Callable[[float], Awaitable[Any]] | None = None,
+               lead: float = 0.5) -> None:
         """Run at most ``lead`` simulated seconds ahead of ``executive_time()`` (the
-        executive's clock; None while it does not follow, e.g. disconnected)."""
+        executive's clock; None while it does not follow, e.g. disconnected).
+        ``wait_until(t)`` resolves once the executive's clock reaches ``t`` (without it
+        the simulator looks every millisecond)."""
         self._follow = executive_time
+        self._wait_until = wait_until
         self._lead = lead
 
     def pause(self, paused: bool = True) -> None:
@@ -170,8 +175,15 @@ class Simulator:
             if self._waiting():
                 waited = 0.0
                 while self._waiting():
-                    await asyncio.sleep(FOLLOW_POLL)
-                    waited += FOLLOW_POLL
+                    if self._wait_until is not None and not self._paused:
+                        target = self.world.now - self._lead
+                        try:
+                            await asyncio.wait_for(self._wait_until(target), REPUBLISH_AFTER)
+                        except TimeoutError:
+                            waited = REPUBLISH_AFTER
+                    else:
+                        await asyncio.sleep(FOLLOW_POLL)
+                        waited += FOLLOW_POLL
                     if waited >= REPUBLISH_AFTER and not self._paused:
                         # the executive may have missed it (it was reconnecting, say)
                         self._publish(CLOCK.name, msgs.clock(self.world.now), logged=False)
