@@ -96,6 +96,8 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--minutes", type=float, default=60.0, help="simulated minutes to record")
     p.add_argument("--speed", type=float, default=600.0, help="sim speed while recording")
+    p.add_argument("--copies", type=int, default=6,
+                   help="recordings in the batch corpus (copies of the recorded one)")
     p.add_argument("--out")
     args = p.parse_args()
     with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
@@ -106,7 +108,36 @@ def main() -> None:
         result["rrd"] = replay(mcap, ["--rerun", f"save:{Path(tmp) / 'replay.rrd'}"])
         result["rrd"]["rrd_bytes"] = (Path(tmp) / "replay.rrd").stat().st_size \
             if (Path(tmp) / "replay.rrd").exists() else 0
+        result["batch"] = batch(mcap, Path(tmp) / "corpus", args.copies)
     emit(result, args.out)
+
+
+def batch(mcap: Path, corpus: Path, copies: int) -> dict[str, Any]:
+    """The corpus (``copies`` of the recording) with --jobs 1 and --jobs N (N = CPUs):
+    recorded seconds replayed per wall second, and the ratio of the two."""
+    import os
+    import shutil
+
+    corpus.mkdir()
+    for i in range(copies):
+        shutil.copy(mcap, corpus / f"tour-{i:02d}.mcap")
+    recorded = 0.0
+    match = REPLAYED.search(subprocess.run([str(FROG_BT), "replay", str(mcap), "--quiet"],
+                                           capture_output=True, text=True).stdout)
+    if match:
+        recorded = float(match.group(2))
+    jobs_n = os.cpu_count() or 1
+    out: dict[str, Any] = {"copies": copies, "recorded_s_each": recorded, "cpus": jobs_n}
+    for jobs in sorted({1, jobs_n}):
+        t0 = time.perf_counter()
+        done = subprocess.run([str(FROG_BT), "replay", str(corpus), "--quiet",
+                               "--jobs", str(jobs)], capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+        out[f"jobs_{jobs}"] = {"exit": done.returncode, "wall_s": wall,
+                               "speed_x": copies * recorded / max(wall, 1e-9)}
+    if jobs_n > 1:
+        out["scaling"] = out[f"jobs_{jobs_n}"]["speed_x"] / max(out["jobs_1"]["speed_x"], 1e-9)
+    return out
 
 
 if __name__ == "__main__":
