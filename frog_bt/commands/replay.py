@@ -149,7 +149,7 @@ def compare_lanes(rec: Any, replay: Any, site: Any) -> None:
     def command(side: str, c: Any) -> None:
         at(c.t)
         rec.log(f"/log/replay/{side}",
-                rr.TextLog(f"{describe(c, site)}  [{c.node or '?'}]", level="INFO"))
+                rr.TextLog(f"{side}: {describe(c, site)}  [{c.node or '?'}]", level="INFO"))
 
     def divergence(d: Any) -> None:
         at(d.t)

@@ -242,7 +242,7 @@ def test_the_viewer_shows_recorded_and_replayed_commands_and_the_divergence(
                     t for row in batch.column("TextLog:text").to_pylist() for t in row)
     recorded, replayed = texts["/log/replay/recorded"], texts["/log/replay/replayed"]
     assert len(recorded) == len(replayed) > 1  # two lanes, command for command
-    assert recorded[-1].startswith("/GotoWayPoint waypoint POI1a  [Navigate POI1")
-    assert replayed[-1].startswith("/GotoWayPoint waypoint POI1b  [Navigate POI1")
+    assert recorded[-1].startswith("recorded: /GotoWayPoint waypoint POI1a  [Navigate POI1")
+    assert replayed[-1].startswith("replayed: /GotoWayPoint waypoint POI1b  [Navigate POI1")
     assert texts["/log/replay/divergence"] == [
         f"divergence, command {len(recorded)}: waypoint POI1a → POI1b"]
