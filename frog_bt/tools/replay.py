@@ -409,5 +409,7 @@ def what_differs(expected: Command | None, got: Command | None, site: Site) -> s
 
 
 def _short_value(value: Any) -> str:
+    if isinstance(value, float):
+        value = round(value, 3)
     text = value if isinstance(value, str) else json.dumps(value, sort_keys=True)
     return text if len(text) <= 60 else text[:57] + "..."
