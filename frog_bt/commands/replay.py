@@ -133,34 +133,6 @@ def run_corpus(args: argparse.Namespace) -> int:
     return 0 if totals["identical"] == totals["tours"] else 1
 
 
-def compare_lanes(rec: Any, replay: Any, site: Any) -> None:
-    """In the viewer: the recorded and the replayed commands on two lanes of the same
-    timeline (``/log/replay/recorded``, ``/log/replay/replayed``, each with the node
-    that sent it), and a marker at the divergence (``/log/replay/divergence``)."""
-    import rerun as rr
-
-    from frog_bt.telemetry.writer import TICK, TIME
-    from frog_bt.tools.replay import describe, differences
-
-    def at(t: float) -> None:
-        rec.set_time(TICK, sequence=replay.core.ticks)
-        rec.set_time(TIME, timestamp=t)
-
-    def command(side: str, c: Any) -> None:
-        at(c.t)
-        rec.log(f"/log/replay/{side}",
-                rr.TextLog(f"{side}: {describe(c, site)}  [{c.node or '?'}]", level="INFO"))
-
-    def divergence(d: Any) -> None:
-        at(d.t)
-        rec.log("/log/replay/divergence", rr.TextLog(
-            f"divergence, command {d.number}: {differences(d.expected, d.got, site)}",
-            level="ERROR"))
-
-    replay.on_command.append(command)
-    replay.on_divergence.append(divergence)
-
-
 def report(result: Any, site: Any) -> dict[str, Any]:
     """One replay as JSON: identical or the first divergence, in domain terms."""
     from frog_bt.tools.replay import differences, what_differs
@@ -224,6 +196,8 @@ def run_one(args: argparse.Namespace) -> int:
             print(f"frog-bt replay: {exc}", file=sys.stderr)
             return 2
         telemetry.attach(replay.core)
+        from frog_bt.telemetry.compare import compare_lanes
+
         compare_lanes(telemetry.rec, replay, site)
     progress = None
     if not args.quiet and sys.stderr.isatty():
