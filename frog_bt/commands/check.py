@@ -17,10 +17,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from frog_bt.commands.options import add_tree_argument, tree_argument
-from frog_bt.config import DEFAULT_CONFIG, load_site
+from frog_bt.commands.options import add_tree_argument, load_tree_argument
+from frog_bt.config import DEFAULT_CONFIG
 from frog_bt.errors import DefinitionError, TreeErrors, UsageError
-from frog_bt.tree.loader import load_tree
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -29,9 +28,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        path = tree_argument(args)
-        site = load_site(args.config)
-        tree = load_tree(path, site)
+        _, _, tree = load_tree_argument(args)
     except UsageError as exc:
         print(f"frog-bt: {exc}", file=sys.stderr)
         return 2

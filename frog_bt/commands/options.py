@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+from typing import Any
 
 from frog_bt.config import Site
 from frog_bt.errors import UsageError
@@ -42,6 +43,17 @@ def tree_argument(args: argparse.Namespace) -> Path | None:
         raise UsageError("TREE", "", "give the tree once: TREE or --tree FILE")
     path = args.tree or args.tree_option
     return path.absolute() if path else None
+
+
+def load_tree_argument(args: argparse.Namespace) -> tuple[Path | None, Site, Any]:
+    """The tree given as TREE or --tree, the site config and the loaded tree; raises
+    UsageError (both given) or DefinitionError (a bad file) for the command to report."""
+    from frog_bt.config import load_site
+    from frog_bt.tree.loader import load_tree
+
+    path = tree_argument(args)
+    site = load_site(args.config)
+    return path, site, load_tree(path, site)
 
 
 def writable_file(path: Path, option: str) -> Path:

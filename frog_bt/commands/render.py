@@ -26,11 +26,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from frog_bt.commands.options import add_tree_argument, tree_argument
-from frog_bt.config import load_site
+from frog_bt.commands.options import add_tree_argument, load_tree_argument
 from frog_bt.errors import DefinitionError, UsageError, error_lines
 from frog_bt.tools import render
-from frog_bt.tree.loader import load_tree
 
 FORMATS = ("ascii", "unicode", "dot", "svg", "png", "mermaid", "btcpp")
 
@@ -68,9 +66,7 @@ def draw(root: render.Node, fmt: str, *, keys: bool = False, rankdir: str = "LR"
 
 def run(args: argparse.Namespace) -> int:
     try:
-        path = tree_argument(args)
-        site = load_site(args.config)
-        tree = load_tree(path, site)
+        path, site, tree = load_tree_argument(args)
     except UsageError as exc:
         print(f"frog-bt: {exc}", file=sys.stderr)
         return 2

@@ -93,3 +93,29 @@ def test_no_swap_while_a_tour_runs(tmp_path: Path) -> None:
             assert exe.swaps == 0 and exe.core.tree is tree
 
     asyncio.run(main())
+
+
+def test_a_change_of_links_or_topics_is_refused_it_takes_a_restart(tmp_path: Path) -> None:
+    tour_file = copy_trees(tmp_path)
+    site = load_site()
+    tree = load_tree(tour_file, site)
+    renamed = site.model_copy(update={"topics": {"pose": "/robot/pose"}})
+
+    async def main() -> None:
+        async with Running({"frontend": {"idle_at": 10_000}}, site=site, tree=tree) as run:
+            exe = run.executive
+            for _ in range(300):  # docked and idle: a valid offer would be swapped now
+                if exe.core.ticks and exe.idle():
+                    break
+                await asyncio.sleep(0.01)
+            assert exe.idle()
+            exe.offer(renamed, load_tree(tour_file, renamed))
+            ticks = exe.core.ticks
+            for _ in range(300):
+                if exe.core.ticks >= ticks + 5:
+                    break
+                await asyncio.sleep(0.01)
+            assert exe.core.ticks >= ticks + 5  # idle ticks went by
+            assert exe.swaps == 0 and exe.core.tree is tree
+
+    asyncio.run(main())
