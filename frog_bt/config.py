@@ -186,6 +186,10 @@ class Checkpoint(_Model):
     max_age: Positive = 900.0  # wall seconds: an older checkpoint is not resumed
 
 
+class Recording(_Model):
+    max_bytes: Annotated[int, Field(gt=0)] = 20_000_000_000  # --record DIR: disk budget
+
+
 class Links(_Model):
     rosbridge: str = DEFAULT_ROSBRIDGE_URL
     frontend: str = "{}:{}".format(*DEFAULT_FRONTEND)
@@ -229,6 +233,7 @@ class Site(_Model):
     zones: Zones = Zones()
     safety: Safety = Safety()
     checkpoint: Checkpoint = Checkpoint()
+    recording: Recording = Recording()
     topics: dict[Literal[tuple(INPUTS) + tuple(OUTPUTS)], str] = {}  # type: ignore[valid-type]
 
     @model_validator(mode="after")

@@ -99,6 +99,11 @@ class Samples:
     def __len__(self) -> int:
         return len(self._t)
 
+    def __repr__(self) -> str:
+        levels = " ".join(f"{v:.2f}" for v in self._level[:8])
+        more = " ..." if len(self._level) > 8 else ""
+        return f"{len(self)} samples: {levels}{more}"
+
     def levels(self) -> np.ndarray:
         return np.asarray(self._level, dtype=float)
 

@@ -90,6 +90,10 @@ class EventLog:
         self._events.append(event)
         return event
 
+    def __repr__(self) -> str:
+        latest = ", ".join(e.message.type for e in list(self._events)[-3:])
+        return f"{self.last_index} events, latest {latest or 'none'}"
+
     def since(self, index: int) -> Iterator[Event]:
         return (e for e in self._events if e.index > index)
 

@@ -25,7 +25,7 @@ from frog_bt.runtime.clock import Clock
 from frog_bt.runtime.context import Context
 from frog_bt.tree import observed, ticking
 from frog_bt.tree.loader import LoadedTree
-from frog_bt.tree.observed import acting
+from frog_bt.tree.observed import DECIDED, acting
 from frog_bt.wire import INPUTS, OUTPUTS
 from frog_bt.yamlfile import line_of
 
@@ -50,7 +50,7 @@ class Taps:
     frontend_in: list[Tap] = field(default_factory=list)
     frontend_out: list[Tap] = field(default_factory=list)
     tick: list[Callable[[Core], None]] = field(default_factory=list)
-    blame: list[Tap] = field(default_factory=list)  # (t, channel, node) after each command
+    blame: list[Tap] = field(default_factory=list)  # (t, channel, node, reads) after each command
 
 
 class Core:
@@ -96,16 +96,27 @@ class Core:
         return label
 
     def _note_sender(self) -> None:
+        """Blame: the acting node, and what it and the nodes that decided for it read
+        (those that ended earlier in this tick near it: up to three levels up, e.g. the
+        engagement vote and its samples before ``PlayContent`` or ``FinishPoi``)."""
         node = acting()
         self.blamed = self.who(node)
-        keys = (*getattr(node, "reads", ()), *getattr(node, "optional_reads", ()))
-        self.blamed_reads = {k: _short(peek(k)) for k in keys if k != "/now"}
+        deciders = [node, *reversed([d for d in DECIDED if d is not node
+                                     and _near(d, node)])] if node is not None else []
+        reads: dict[str, str] = {}
+        for decider in deciders:
+            keys = (*getattr(decider, "reads", ()), *getattr(decider, "optional_reads", ()),
+                    *(getattr(decider, "writes", ()) if decider is not node else ()))
+            for key in keys:  # a decider's conclusions too (the engagement decision)
+                if key != "/now" and key not in reads:
+                    reads[key] = _short(peek(key))
+        self.blamed_reads = reads
 
     def _blame(self, channel: str) -> None:
         if self.taps.blame:
             now = self.clock.now()
             for tap in self.taps.blame:
-                tap(now, channel, self.blamed)
+                tap(now, channel, self.blamed, self.blamed_reads)
 
     def _publish(self, role: str, value: Any) -> None:
         topic = self.site.topic(role)
@@ -150,6 +161,7 @@ class Core:
     # ------------------------------------------------------------ ticking
 
     def _pre_tick(self, _tree: py_trees.trees.BehaviourTree) -> None:
+        DECIDED.clear()
         self.snapshot.write()
         for code, at in self.snapshot.get(INPUTS["response"].key):
             self.actions.on_response(code, at)
@@ -175,9 +187,30 @@ class Core:
         return self.ctx.notes[-1][1] if self.ctx.notes else ""
 
 
+NEAR = 3  # levels above a command's sender within which a decider counts
+
+
+def _near(decider: Behaviour, sender: Behaviour) -> bool:
+    """Is ``decider`` within the subtree ``NEAR`` levels above ``sender``?"""
+    top: Behaviour | None = sender
+    for _ in range(NEAR):
+        if top is None or top.parent is None:
+            break
+        top = top.parent
+    up: Behaviour | None = decider
+    while up is not None:
+        if up is top:
+            return True
+        up = up.parent
+    return False
+
+
 def _short(value: Any) -> str:
     """A blackboard value as a short line of text (for a divergence report)."""
     if isinstance(value, Reading):
         value = value.value
-    text = repr(value)
+    if isinstance(value, tuple) and value and hasattr(value[-1], "describe"):
+        text = ": ".join([*map(str, value[:-1]), value[-1].describe()])
+    else:
+        text = value.describe() if hasattr(value, "describe") else repr(value)
     return text if len(text) <= 120 else text[:117] + "..."

@@ -32,8 +32,13 @@ class TourRow:
     recorded_node: str = ""
     replayed_node: str = ""
     signature: str = ""  # node + what differs, for grouping
+    recovered: str = ""  # a file cut short: what was read of it
 
     def line(self) -> str:
+        note = f" [{self.recovered}]" if self.recovered else ""
+        return self._line() + note
+
+    def _line(self) -> str:
         if self.status == "identical":
             return f"{self.file}: identical"
         if self.status == "unreadable":
@@ -61,6 +66,11 @@ def _site(config: str | None) -> Any:
     return load_site(config)
 
 
+def warm(config: Path | None) -> None:
+    """Load the site into this process's cache (before forking workers: they inherit it)."""
+    _site(str(config) if config else None)
+
+
 def _load(tree: str | None, config: str | None) -> tuple[Any, Any]:
     """The site (cached per process) and a fresh tree: a tree keeps its nodes' state, so
     each replay builds its own."""
@@ -77,19 +87,21 @@ def replay_file(path: str, tree: str | None, config: str | None) -> TourRow:
     try:
         site, loaded = _load(tree, config)
         result = Replay(Path(path), site, loaded).run()
+        recovered = "; ".join(result.recovered)
     except Exception as exc:
         reason = f"{type(exc).__name__}: {exc}".splitlines()[0][:200]
         return TourRow(path, "unreadable", reason=reason)
     div = result.divergence
     if div is None:
-        return TourRow(path, "identical")
+        return TourRow(path, "identical", recovered=recovered)
     diff = differences(div.expected, div.got, site)
     recorded = div.expected.node if div.expected else ""
     replayed = div.got.node if div.got else ""
     node = (replayed or recorded or "?").split(" (")[0]
     return TourRow(path, "diverged", at=div.t - result.start, number=div.number,
                    differs=diff, recorded_node=recorded, replayed_node=replayed,
-                   signature=f"{node}: {what_differs(div.expected, div.got, site)}")
+                   signature=f"{node}: {what_differs(div.expected, div.got, site)}",
+                   recovered=recovered)
 
 
 def replay_corpus(files: list[Path], tree: Path | None, config: Path | None,
@@ -111,6 +123,7 @@ def summary(rows: list[TourRow]) -> dict[str, Any]:
     return {"tours": len(rows), "identical": sum(r.status == "identical" for r in rows),
             "diverged": len(diverged),
             "unreadable": sum(r.status == "unreadable" for r in rows),
+            "recovered": sum(bool(r.recovered) for r in rows),
             "by_signature": dict(groups.most_common())}
 
 
@@ -120,4 +133,6 @@ def summary_line(s: dict[str, Any]) -> str:
         parts[0] += ": " + ", ".join(f"{n} at {sig}" for sig, n in s["by_signature"].items())
     if s["unreadable"]:
         parts.append(f"{s['unreadable']} unreadable")
+    if s.get("recovered"):
+        parts.append(f"{s['recovered']} recovered from a cut")
     return "; ".join(parts)

@@ -11,8 +11,9 @@
   bytes;
 * ``/frog_bt/tree``: once, the tree that ran as BehaviorTree.CPP v4 XML
   (``{"format", "file", "xml"}``: Groot2 opens the XML);
-* ``/frog_bt/blame``: after each command, the tree node that sent it
-  (``{"channel", "node"}``), for replay's divergence report;
+* ``/frog_bt/blame``: after each command, the tree node that sent it and the
+  blackboard values it read (``{"channel", "node", "reads"}``), for replay's
+  divergence report;
 * ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``).
   Live ticks coalesce bursts of inputs and fall wherever the event loop gets to
   them, so replay ticks exactly where the live executive did
@@ -36,11 +37,14 @@ when the run command stops on SIGTERM, or on an exception.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import logging
 import math
+import os
 import time
 import weakref
+from collections import deque
 from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any
@@ -52,7 +56,7 @@ from frog_bt import __version__
 from frog_bt.errors import DecodeError
 from frog_bt.frontend.messages import COMMANDS, EVENTS
 from frog_bt.rosbridge.msgs import ROS_TYPES
-from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
+from frog_bt.wire import CLOCK, INPUTS, OUTPUTS, Keep
 
 log = logging.getLogger(__name__)
 
@@ -66,7 +70,11 @@ TREE_TYPE = "frog_bt/Tree"
 DATAGRAM_TYPE = "frog_bt/FrontendDatagram"
 TICK_TYPE = "frog_bt/Tick"
 CHUNK_SIZE = 256 * 1024  # bytes of uncompressed messages per chunk
-FLUSH_EVERY = 2.0  # wall seconds between forced chunk flushes
+FLUSH_EVERY = 1.0  # wall seconds between chunk flushes: a kill loses at most this much
+PRIMER = "/frog_bt/primer"  # what a rotated file carries from before it
+PRIMER_TYPE = "frog_bt/Primer"
+PRIMER_DATAGRAMS = 16  # recent datagrams in, so that their resends stay duplicates
+PRIMER_SEQS = 64  # recent seqs out, so that resends of earlier commands are not new ones
 HELD_LIMIT = 10_000  # messages held before the first /clock
 
 # ------------------------------------------------------------------ JSON Schemas
@@ -108,11 +116,25 @@ SCHEMAS: dict[str, dict[str, Any]] = {
         "xml": {"type": "string", "description": "the tree (Groot2 opens it)"}}},
     BLAME_TYPE: {"type": "object", "title": BLAME_TYPE, "properties": {
         "channel": {"type": "string", "description": "ROS topic or front-end message type"},
-        "node": {"type": "string", "description": "the tree node that sent it"}}},
+        "node": {"type": "string", "description": "the tree node that sent it"},
+        "reads": {"type": "object", "additionalProperties": {"type": "string"},
+                  "description": "the blackboard values that node read, as short text"}}},
+    PRIMER_TYPE: {"type": "object", "title": PRIMER_TYPE, "properties": {
+        "inputs": {"type": "array", "description": "the latest message of each input",
+                   "items": {"type": "object", "properties": {
+                       "topic": {"type": "string"}, "t": {"type": "number"},
+                       "msg": {"type": "object"}}}},
+        "frontend_ready": {"type": "boolean"},
+        "frontend_in": {"type": "array", "items": {"type": "string"}},
+        "frontend_out_seqs": {"type": "array", "items": {"type": "integer"}}}},
     TICK_TYPE: {"type": "object", "title": TICK_TYPE, "properties": {
         "tick": {"type": "integer"},
         "status": {"enum": ["INVALID", "RUNNING", "SUCCESS", "FAILURE"]}}},
 }
+
+
+OWN_TYPES = {FRONTEND_IN: DATAGRAM_TYPE, FRONTEND_OUT: DATAGRAM_TYPE, TICK: TICK_TYPE,
+             BLAME: BLAME_TYPE, TREE: TREE_TYPE, PRIMER: PRIMER_TYPE}
 
 
 def to_ns(t: float) -> int:
@@ -141,6 +163,7 @@ Queued = tuple[int, int, bytes, int]  # channel id, log time (ns), data, sequenc
 
 
 def _write_queued(writer: Writer, queue: list[Queued]) -> None:
+    """Write ``queue`` in order, emptying it."""
     for cid, ns, data, seq in queue:
         writer.add_message(cid, log_time=ns, data=data, publish_time=ns, sequence=seq)
     queue.clear()
@@ -162,14 +185,46 @@ class Recorder:
 
     ``Recorder(path)`` creates the file (``OSError`` when it cannot);
     :meth:`attach` hooks it to an :class:`~frog_bt.runtime.executive.Executive`;
-    :meth:`close` finishes it. A write error is logged once and stops the
-    recording; it never reaches the tick path.
+    :meth:`rotate` finishes the file and carries on in a new one (``--record DIR``,
+    :mod:`frog_bt.tools.rotation`); :meth:`close` finishes it. A write error is
+    logged once and stops the recording; it never reaches the tick path.
     """
 
     def __init__(self, path: Path, *, chunk_size: int = CHUNK_SIZE,
-                 flush_every: float = FLUSH_EVERY) -> None:
-        self.path = Path(path)
-        self._stream: IO[bytes] = open(self.path, "wb")  # noqa: SIM115 - closed by _finish
+                 flush_every: float = FLUSH_EVERY,
+                 metadata: dict[str, str] | None = None) -> None:
+        self._chunk_size = chunk_size
+        self._flush_every = flush_every
+        # Messages wait in _incoming until the event loop's current callback (a tick, an
+        # input) is over, so that a tick pays a list append per message, not an MCAP
+        # record each; _queue holds them stamped, for the writer (and the finalizer).
+        self._incoming: list[tuple[str, float | None, bytes]] = []
+        self._queue: list[Queued] = []
+        self._drain_scheduled = False
+        self._flush_timer: asyncio.TimerHandle | None = None
+        self._syncing = False
+        self._registered: dict[str, str] = {}  # topic -> type, for the next file too
+        self._last_ns = 0
+        self._held: list[tuple[str, bytes]] = []
+        self._ready: Callable[[], bool] = lambda: True
+        self._clock_topic: str | None = None
+        self._tree: bytes | None = None
+        # What a new file starts with (rotation): the latest message of each input kept
+        # as latest, the last /clock, recent datagrams in and the seqs sent out.
+        self._latest_topics: frozenset[str] = frozenset()
+        self.latest_raw: dict[str, tuple[float, bytes]] = {}
+        self._clock_raw: bytes | None = None
+        self.frontend_in: deque[bytes] = deque(maxlen=PRIMER_DATAGRAMS)
+        self.frontend_out_seqs: deque[int] = deque(maxlen=PRIMER_SEQS)
+        self.messages = 0
+        self.dropped = 0  # held before the first /clock beyond HELD_LIMIT
+        self.closed = False
+        self._open(Path(path), metadata)
+
+    def _open(self, path: Path, metadata: dict[str, str] | None) -> None:
+        self.path = path
+        stream: IO[bytes] = open(path, "wb")  # noqa: SIM115 - closed by _finish
+        self._stream = stream
         compression = CompressionType.NONE
         try:
             import lz4.frame  # noqa: F401 - optional, chosen only when installed
@@ -177,28 +232,18 @@ class Recorder:
             compression = CompressionType.LZ4
         except ImportError:
             pass
-        self._writer = Writer(self._stream, chunk_size=chunk_size, compression=compression)
+        self._writer = Writer(stream, chunk_size=self._chunk_size, compression=compression)
         self._writer.start(profile="", library=f"frog-bt {__version__}")
-        # Messages wait in _incoming until the event loop's current callback (a tick, an
-        # input) is over, so that a tick pays a list append per message, not an MCAP
-        # record each; _queue holds them stamped, for the writer (and the finalizer).
-        self._incoming: list[tuple[int, float | None, bytes]] = []
-        self._queue: list[Queued] = []
-        self._drain_scheduled = False
-        self._finalizer = weakref.finalize(self, _finish, self._writer, self._stream,
-                                           self._queue)
-        self._flush_every = flush_every
+        if metadata:
+            self._writer.add_metadata("frog_bt", metadata)
+        self._queue = []
+        self._finalizer = weakref.finalize(self, _finish, self._writer, stream, self._queue)
         self._flushed_at = time.monotonic()
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, int] = {}
         self._sequence: dict[int, int] = {}
-        self._last_ns = 0
-        self._held: list[tuple[int, bytes]] = []
-        self._ready: Callable[[], bool] = lambda: True
-        self._clock_topic: str | None = None
-        self.messages = 0
-        self.dropped = 0  # held before the first /clock beyond HELD_LIMIT
-        self.closed = False
+        for topic, type_ in self._registered.items():
+            self.channel(topic, type_)
 
     # ------------------------------------------------------------ wiring
 
@@ -207,6 +252,8 @@ class Recorder:
         site = executive.site
         for role, topic in (*INPUTS.items(), *OUTPUTS.items()):
             self.channel(site.topic(role), topic.type)
+        self._latest_topics = frozenset(site.topic(role) for role, inp in INPUTS.items()
+                                        if inp.keep is Keep.LATEST)
         if executive.sim_time:
             self._clock_topic = CLOCK.name
             self.channel(CLOCK.name, CLOCK.type)
@@ -216,32 +263,32 @@ class Recorder:
         self.channel(BLAME, BLAME_TYPE)
         clock = executive.clock
         self._ready = lambda: bool(clock.ready)
-        self._write_tree(executive)
+        self._tree = self._tree_message(executive)
+        if self._tree is not None:
+            self._write(TREE, None, self._tree)
         executive.wire.ros_in.append(self.on_ros_in)
         executive.taps.ros_out.append(self.on_ros_out)
         executive.wire.datagram.append(self.on_datagram)
         executive.taps.tick.append(self.on_tick)
         executive.taps.blame.append(self.on_blame)
 
-    def channel(self, topic: str, type_: str) -> int:
-        """The channel id of ``topic``, registering it (and its schema) on first use."""
-        cid = self._channels.get(topic)
-        if cid is None:
+    def channel(self, topic: str, type_: str) -> str:
+        """Register ``topic`` (and its schema) in the file on first use; the topic."""
+        if topic not in self._channels:
             sid = self._schemas.get(type_)
             if sid is None:
                 schema = SCHEMAS.get(type_, {"type": "object"})
                 sid = self._writer.register_schema(type_, "jsonschema", _dumps(schema))
                 self._schemas[type_] = sid
-            cid = self._writer.register_channel(topic, "json", sid)
-            self._channels[topic] = cid
-        return cid
+            self._channels[topic] = self._writer.register_channel(topic, "json", sid)
+            self._registered.setdefault(topic, type_)
+        return topic
 
     # ------------------------------------------------------------ taps (tick path: keep cheap)
 
     def on_ros_in(self, t: float, topic: str, msg: Any) -> None:
-        cid = self._channels.get(topic)
-        if cid is None:
-            cid = self.channel(topic, "unknown")
+        if topic not in self._channels:
+            self.channel(topic, "unknown")
         data = _raw(msg)
         if topic == self._clock_topic:
             try:  # /clock is seen before the clock takes it: stamp it with its own time
@@ -249,51 +296,64 @@ class Recorder:
             except DecodeError:
                 pass
             else:
-                self._write(cid, max(t, clock) if self._ready() else clock, data)
+                self._clock_raw = data
+                self._write(topic, max(t, clock) if self._ready() else clock, data)
                 return
-        self._write(cid, t if self._ready() else None, data)
+        if topic in self._latest_topics:
+            self.latest_raw[topic] = (t, data)
+        self._write(topic, t if self._ready() else None, data)
 
     def on_ros_out(self, t: float, topic: str, msg: Any) -> None:
-        self._write(self._channels.get(topic) or self.channel(topic, "unknown"), t, _dumps(msg))
+        if topic not in self._channels:
+            self.channel(topic, "unknown")
+        self._write(topic, t, _dumps(msg))
 
     def on_datagram(self, direction: str, data: bytes, t: float) -> None:
-        topic = FRONTEND_IN if direction == "in" else FRONTEND_OUT
-        cid = self._channels.get(topic) or self.channel(topic, DATAGRAM_TYPE)
-        self._write(cid, t if self._ready() else None, bytes(data))
+        data = bytes(data)
+        if direction == "in":
+            topic = FRONTEND_IN
+            self.frontend_in.append(data)
+        else:
+            topic = FRONTEND_OUT
+            try:
+                seq = json.loads(data).get("seq")
+            except (ValueError, AttributeError):
+                seq = None
+            if isinstance(seq, int) and seq not in self.frontend_out_seqs:
+                self.frontend_out_seqs.append(seq)
+        self._write(topic, t if self._ready() else None, data)
 
-    def _write_tree(self, executive: Any) -> None:
+    def _tree_message(self, executive: Any) -> bytes | None:
         """The tree that runs, so that a recording explains itself without the files."""
         from frog_bt.tools.btcpp import tree_xml
 
         tree = getattr(getattr(executive, "core", None), "tree", None)
         if tree is None:
-            return
+            return None
         tree_file = Path(tree.file)
         try:
             xml = tree_xml(tree_file, executive.site)
         except Exception as exc:
             log.info("recording without the tree's XML: %s", exc)
-            return
-        self._write(self.channel(TREE, TREE_TYPE), None, _dumps(
-            {"format": "BehaviorTree.CPP v4", "file": str(tree_file), "xml": xml}))
+            return None
+        return _dumps({"format": "BehaviorTree.CPP v4", "file": str(tree_file), "xml": xml})
 
-    def on_blame(self, t: float, channel: str, node: str) -> None:
-        self._write(self._channels.get(BLAME) or self.channel(BLAME, BLAME_TYPE), t,
-                    _dumps({"channel": channel, "node": node}))
+    def on_blame(self, t: float, channel: str, node: str, reads: dict[str, str]) -> None:
+        self._write(BLAME, t, _dumps({"channel": channel, "node": node, "reads": reads}))
 
     def on_tick(self, core: Any) -> None:
         status = core.bt.root.status.name
-        self._write(self._channels.get(TICK) or self.channel(TICK, TICK_TYPE), core.clock.now(),
+        self._write(TICK, core.clock.now(),
                     b'{"tick":%d,"status":"%s"}' % (core.ticks, status.encode()))
 
     # ------------------------------------------------------------ writing
 
-    def _write(self, cid: int, t: float | None, data: bytes) -> None:
+    def _write(self, topic: str, t: float | None, data: bytes) -> None:
         """Take a message (``t`` None: before the clock has a time); it is stamped and
         written once the event loop's current callback is over (at once without a loop)."""
         if self.closed:
             return
-        self._incoming.append((cid, t, data))
+        self._incoming.append((topic, t, data))
         if not self._drain_scheduled:
             try:
                 loop = asyncio.get_running_loop()
@@ -306,22 +366,25 @@ class Recorder:
     def _stamp(self) -> None:
         """Give the incoming messages their log times and sequence numbers, in order."""
         incoming, self._incoming = self._incoming, []
-        for cid, t, data in incoming:
+        for topic, t, data in incoming:
             if t is None:  # before the first /clock: no time yet
                 if len(self._held) < HELD_LIMIT:
-                    self._held.append((cid, data))
+                    self._held.append((topic, data))
                 else:
                     self.dropped += 1
                 continue
             ns = max(to_ns(t), self._last_ns)
             if self._held:
                 held, self._held = self._held, []
-                for held_cid, held_data in held:
-                    self._add(held_cid, ns, held_data)
-            self._add(cid, ns, data)
+                for held_topic, held_data in held:
+                    self._add(held_topic, ns, held_data)
+            self._add(topic, ns, data)
             self._last_ns = ns
 
-    def _add(self, cid: int, ns: int, data: bytes) -> None:
+    def _add(self, topic: str, ns: int, data: bytes) -> None:
+        cid = self._channels.get(topic)
+        if cid is None:  # a channel of ours, first used now (or an unknown topic)
+            cid = self._channels[self.channel(topic, OWN_TYPES.get(topic, "unknown"))]
         seq = self._sequence.get(cid, 0)
         self._sequence[cid] = seq + 1
         self._queue.append((cid, ns, data, seq & 0xFFFFFFFF))
@@ -335,14 +398,72 @@ class Recorder:
         try:
             self._stamp()
             _write_queued(self._writer, self._queue)
-            now = time.monotonic()
-            if now - self._flushed_at >= self._flush_every:
-                self._flushed_at = now
-                self._writer.flush()
+            if time.monotonic() - self._flushed_at >= self._flush_every:
+                self._flush()
+            elif self._flush_timer is None:  # a quiet spell must not keep the tail back
+                try:
+                    loop = asyncio.get_running_loop()
+                except RuntimeError:
+                    return
+                self._flush_timer = loop.call_later(self._flush_every, self._timed_flush)
         except Exception as exc:  # disk full, ...: stop recording, never stop the robot
-            log.error("recording to %s stopped: %s", self.path, exc)
-            self._queue.clear()
-            self.close()
+            self._failed(exc)
+
+    def _timed_flush(self) -> None:
+        self._flush_timer = None
+        if not self.closed:
+            try:
+                self._flush()
+            except Exception as exc:
+                self._failed(exc)
+
+    def _flush(self) -> None:
+        """End the chunk and hand it to the OS (a kill -9 then loses nothing of it), and
+        ask for it on the disk (power loss) in a worker thread, off the event loop."""
+        self._flushed_at = time.monotonic()
+        self._writer.flush()
+        self._stream.flush()
+        if self._syncing:
+            return
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:
+            return
+        self._syncing = True
+        future = loop.run_in_executor(None, _fsync, self._stream)
+        future.add_done_callback(lambda _f: setattr(self, "_syncing", False))
+
+    def _failed(self, exc: Exception) -> None:
+        log.error("recording to %s stopped: %s", self.path, exc)
+        self._queue.clear()
+        self.close()
+
+    def rotate(self, path: Path, metadata: dict[str, str] | None = None,
+               primer: bytes | None = None) -> None:
+        """Finish this file and go on in ``path``: it starts with the tree, the last
+        /clock and ``primer`` (on :data:`PRIMER`), stamped now."""
+        if self.closed:
+            return
+        self._stamp()
+        self._close_file()
+        try:
+            self._open(Path(path), metadata)
+        except OSError as exc:
+            log.error("recording to %s stopped: %s", path, exc)
+            self.closed = True
+            return
+        if self._tree is not None:
+            self._write(TREE, None, self._tree)
+        if self._clock_raw is not None and self._clock_topic is not None:
+            self._write(self._clock_topic, from_ns(self._last_ns), self._clock_raw)
+        if primer is not None:
+            self._write(PRIMER, from_ns(self._last_ns), primer)
+
+    def _close_file(self) -> None:
+        if self._flush_timer is not None:
+            self._flush_timer.cancel()
+            self._flush_timer = None
+        self._finalizer()
 
     def close(self) -> None:
         """Write the summary and footer and close the file; idempotent."""
@@ -359,10 +480,15 @@ class Recorder:
             self._held = []
         if self.dropped:
             log.warning("recording: %d messages before the first /clock dropped", self.dropped)
-        self._finalizer()
+        self._close_file()
 
     def __enter__(self) -> Recorder:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _fsync(stream: IO[bytes]) -> None:
+    with contextlib.suppress(OSError, ValueError):  # closed meanwhile: close synced it
+        os.fsync(stream.fileno())

@@ -29,17 +29,13 @@ recorded inputs are exactly what the new tree would have seen.
 from __future__ import annotations
 
 import json
-import struct
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
 from typing import Any
-
-from mcap.exceptions import InvalidMagic, McapError
-from mcap.reader import make_reader
 
 from frog_bt.config import Site, parse_hostport
 from frog_bt.errors import DecodeError, FrogError
@@ -48,11 +44,10 @@ from frog_bt.frontend.protocol import Endpoint
 from frog_bt.rosbridge.msgs import ROS_TYPES
 from frog_bt.runtime.clock import SITE_TZ, ManualClock
 from frog_bt.runtime.core import Core
-from frog_bt.tools.recording import BLAME, FRONTEND_IN, FRONTEND_OUT, TICK, from_ns
+from frog_bt.tools.mcapfile import RecordingError, RecordingFile, open_recording
+from frog_bt.tools.recording import BLAME, FRONTEND_IN, FRONTEND_OUT, PRIMER, TICK, from_ns
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
-
-MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
 class ReplayError(FrogError):
@@ -68,7 +63,7 @@ class Command:
     channel: str
     payload: dict[str, Any]
     node: str = ""
-    reads: dict[str, str] = field(default_factory=dict)  # replayed: what the node read
+    reads: dict[str, str] = field(default_factory=dict)  # what the node read (blame)
 
     def __str__(self) -> str:
         return f"{self.channel} {json.dumps(self.payload, sort_keys=True)}"
@@ -100,10 +95,25 @@ class ReplayResult:
     exact: bool = True  # ticks taken from the recording
     divergence: Divergence | None = None
     wall: float = 0.0  # seconds the replay took
+    recovered: list[str] = field(default_factory=list)  # files cut short, what was read
 
     @property
     def identical(self) -> bool:
         return self.divergence is None
+
+
+def chain(path: Path) -> list[RecordingFile]:
+    """The recording at ``path``, after its lead-in when it continues one (a tour file of
+    ``--record DIR`` continues the idle file before it: the tree was already running)."""
+    recording = open_recording(path)
+    lead_in = recording.metadata.get("frog_bt", {}).get("lead_in")
+    if not lead_in:
+        return [recording]
+    before = Path(path).parent / lead_in
+    if not before.is_file():
+        raise ReplayError(f"{path}: continues {lead_in}, which is gone (deleted by the "
+                          "recording budget?); it cannot be replayed without it")
+    return [open_recording(before), recording]
 
 
 def local_time(t: float) -> str:
@@ -134,37 +144,19 @@ class Replay:
         self.path = Path(path)
         self.site = site
         self._peer = parse_hostport(site.links.frontend, "links.frontend")[0]
-        if not self.path.is_file():
-            raise ReplayError(f"{self.path}: not a file")
-        self._stream = open(self.path, "rb")  # noqa: SIM115 - closed by close()
-        if self._stream.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
-            self.close()
-            raise ReplayError(f"{self.path}: not an MCAP file")
-        self._stream.seek(0)
         try:
-            self._reader = make_reader(self._stream)
-            summary = self._reader.get_summary()
-        except InvalidMagic:
-            self.close()
-            raise ReplayError(f"{self.path}: not an MCAP file") from None
-        except (McapError, ValueError, EOFError, OSError, IndexError, struct.error) as exc:
-            self.close()
-            raise ReplayError(f"{self.path}: damaged MCAP file, cut short? ({exc})") from None
-        if summary is None:
-            self.close()
-            raise ReplayError(f"{self.path}: MCAP file without a summary, cut short?")
-        schemas = summary.schemas
-        self.types = {ch.topic: schemas[ch.schema_id].name if ch.schema_id in schemas else ""
-                      for ch in summary.channels.values()}
+            self.files = chain(self.path)
+        except RecordingError as exc:
+            raise ReplayError(str(exc)) from None
+        self.types = {topic: type_ for f in self.files for topic, type_ in f.types.items()}
+        self.recovered = [f"{f.path.name}: {f.recovered}" for f in self.files if f.recovered]
         self.outputs = {site.topic(role) for role in OUTPUTS}
         missing = sorted({FRONTEND_IN, FRONTEND_OUT, *self.outputs} - set(self.types))
         if missing:
-            self.close()
             raise ReplayError(f"{self.path}: not a frog-bt recording for this configuration: "
                               f"no channel {', '.join(missing)}")
-        stats = summary.statistics
-        self.start = from_ns(stats.message_start_time) if stats else 0.0
-        self.end = from_ns(stats.message_end_time) if stats else 0.0
+        self.start = from_ns(self.files[0].start)
+        self.end = from_ns(self.files[-1].end)
         self.sim_time = CLOCK.name in self.types
         self.exact = TICK in self.types
         self.period = 1.0 / site.executive.tick_hz
@@ -181,10 +173,11 @@ class Replay:
         self._seqs: set[int] = set()
         self._compared = 0
         self._next_tick = 0.0
-        self.result = ReplayResult(self.start, self.end, self.start, exact=self.exact)
+        self.result = ReplayResult(self.start, self.end, self.start, exact=self.exact,
+                                   recovered=self.recovered)
 
     def close(self) -> None:
-        self._stream.close()
+        """Nothing to release: each file is open only while it is read."""
 
     # ------------------------------------------------------------ outputs of the replayed tree
 
@@ -219,11 +212,11 @@ class Replay:
         result = self.result
         try:
             parted = False
-            for _schema, channel, message in self._reader.iter_messages(log_time_order=True):
-                if parted and channel.topic != BLAME:
+            for topic, ns, data in self._messages():
+                if parted and topic != BLAME:
                     break  # the blame of the diverging command, recorded after it, is read
-                t = from_ns(message.log_time)
-                self._on_message(channel.topic, t, message.data)
+                t = from_ns(ns)
+                self._on_message(topic, t, data)
                 if parted:
                     break
                 result.covered = t
@@ -231,6 +224,8 @@ class Replay:
                     progress(t)
                 parted = result.divergence is not None
             else:
+                if self.recovered:  # cut short: the live run neither halted nor sent more
+                    return self._finish(result, wall0)
                 self.core.halt()  # as the executive does when it stops (face stream off, ...)
                 if result.divergence is None and (self._expected or self._got):
                     expected = self._expected.popleft() if self._expected else None
@@ -238,9 +233,16 @@ class Replay:
                     result.divergence = Divergence(self._compared + 1, expected, got)
         finally:
             self.close()
+        return self._finish(result, wall0)
+
+    def _finish(self, result: ReplayResult, wall0: float) -> ReplayResult:
         result.ticks = self.core.ticks
         result.wall = time.monotonic() - wall0
         return result
+
+    def _messages(self) -> Iterator[tuple[str, int, bytes]]:
+        for recording in self.files:  # a lead-in first, when the file continues one
+            yield from recording.messages()
 
     def _on_message(self, topic: str, t: float, data: bytes) -> None:
         if topic == CLOCK.name and self.sim_time:
@@ -263,6 +265,8 @@ class Replay:
             self._expect_datagram(t, data)
         elif topic == BLAME:
             self._blame(data)
+        elif topic == PRIMER:
+            self._prime(data)
         elif topic in self.outputs:
             self.result.ros_commands += 1
             self._last_expected = Command(t, topic, _without_stamp(json.loads(data)))
@@ -303,6 +307,30 @@ class Replay:
         self._expected.append(self._last_expected)
         self._compare()
 
+    def _prime(self, data: bytes) -> None:
+        """A recorded ``/frog_bt/primer``: what the live executive carried into this file
+        from before it (:mod:`frog_bt.tools.rotation`)."""
+        try:
+            primer = json.loads(data)
+        except ValueError:
+            return
+        for entry in primer.get("inputs", ()):
+            topic = entry.get("topic")
+            inp = self.core.table.get(topic)
+            codec = ROS_TYPES.get(self.types.get(topic, "")) if inp is not None else None
+            if inp is None or codec is None:
+                continue
+            try:
+                value = codec.decode(json.dumps(entry.get("msg")).encode())
+            except DecodeError:
+                continue
+            self.core.inputs.add(inp, value, float(entry.get("t", self.clock.now())))
+        if primer.get("frontend_ready"):
+            self.core.snapshot.bb.set("/frontend_ready", True)
+        for raw in primer.get("frontend_in", ()):  # seen live: their resends are duplicates
+            self.endpoint.receive(raw.encode(), self._peer, self.clock.now())
+        self._seqs.update(primer.get("frontend_out_seqs", ()))
+
     def _blame(self, data: bytes) -> None:
         """A recorded ``/frog_bt/blame``: the node that sent the command just recorded."""
         try:
@@ -316,6 +344,9 @@ class Replay:
         if channel == last.channel or (last.channel == FRONTEND_OUT
                                        and last.payload.get("type") == channel):
             last.node = str(obj.get("node", ""))
+            reads = obj.get("reads")
+            if isinstance(reads, dict):
+                last.reads = {str(k): str(v) for k, v in reads.items()}
 
     # ------------------------------------------------------------ time and ticks
 

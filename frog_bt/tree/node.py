@@ -18,7 +18,7 @@ import py_trees
 from pydantic import BaseModel, ConfigDict
 
 from frog_bt.runtime.context import Context
-from frog_bt.tree.observed import ACTING
+from frog_bt.tree.observed import ACTING, DECIDED
 
 Status = py_trees.common.Status
 SUCCESS, FAILURE, RUNNING, INVALID = Status.SUCCESS, Status.FAILURE, Status.RUNNING, Status.INVALID
@@ -87,6 +87,9 @@ class Declared:
         ACTING.append(self)  # type: ignore[arg-type]
         try:
             yield from super().tick()  # type: ignore[misc]
+            if (self.reads or self.optional_reads) and self.status in (  # type: ignore[attr-defined]
+                    SUCCESS, FAILURE):
+                DECIDED.append(self)  # type: ignore[arg-type]
         except MissingValue as missing:
             self.feedback_message = f"no value for {missing.key}"  # type: ignore[attr-defined]
             self.ctx.note(f"{self.name}: no value for {missing.key}; failing",

@@ -20,6 +20,12 @@ Behaviour = py_trees.behaviour.Behaviour
 ACTING: list[Behaviour] = []
 
 
+# The frog-bt nodes with blackboard reads that ended (SUCCESS or FAILURE) in the current
+# tick, in order: what decided a command sent later in the same tick (blame's reads).
+# The core clears it before each tick.
+DECIDED: list[Behaviour] = []
+
+
 def acting() -> Behaviour | None:
     """The innermost frog-bt node ticking or stopping now, if any."""
     return ACTING[-1] if ACTING else None

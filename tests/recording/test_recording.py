@@ -43,7 +43,8 @@ JSON_TYPES: dict[str, Any] = {"object": dict, "array": list, "string": str, "boo
 
 def conforms(value: Any, schema: dict[str, Any]) -> bool:
     """The subset of JSON Schema the recorder writes: type, properties, items, enum,
-    required, anyOf, minimum/maximum."""
+    required, additionalProperties (a schema), anyOf, minimum/maximum; keys not
+    described are errors."""
     if "anyOf" in schema and not any(conforms(value, s) for s in schema["anyOf"]):
         return False
     if "enum" in schema and value not in schema["enum"]:
@@ -61,8 +62,11 @@ def conforms(value: Any, schema: dict[str, Any]) -> bool:
             return False
     if isinstance(value, dict):
         props = schema.get("properties", {})
+        extra = schema.get("additionalProperties")
         return (all(k in value for k in schema.get("required", ()))
-                and all(k in props and conforms(v, props[k]) for k, v in value.items()))
+                and all(conforms(v, props[k]) if k in props
+                        else isinstance(extra, dict) and conforms(v, extra)
+                        for k, v in value.items()))
     if isinstance(value, list) and "items" in schema:
         return all(conforms(v, schema["items"]) for v in value)
     return True

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import re
 import shutil
 from pathlib import Path
 from typing import Any
@@ -60,11 +61,12 @@ def test_c_a_changed_stop_order_diverges_at_the_first_different_goal(
     assert lines[1].startswith("  expected: /GotoWayPoint {") and "51.7105" in lines[1]
     assert lines[2].startswith("  got:      /GotoWayPoint {") and "52.08933" in lines[2]
     assert lines[3] == "  differs:  waypoint POI4 → POI5"  # in domain terms
-    assert lines[4].startswith("  recorded: sent by Navigate POI4 (goto.yaml:")
-    assert lines[5].startswith("  replayed: sent by Navigate POI5 (goto.yaml:")
+    sent = [line for line in lines if " sent by " in line]
+    assert sent[0].startswith("  recorded: sent by Navigate POI4 (goto.yaml:")
+    assert sent[1].startswith("  replayed: sent by Navigate POI5 (goto.yaml:")
     assert div.expected.node.startswith("Navigate POI4") and div.got.node.startswith(
         "Navigate POI5")  # blame: the node that sent each command, on both sides
-    assert lines[6].startswith("replayed ")
+    assert lines[-1].startswith("replayed ")
 
 
 def test_not_a_file_not_mcap_and_missing_channels_exit_2(
@@ -144,6 +146,36 @@ def test_a_removed_extension_is_blamed_on_the_content_node(
     assert div.got.node.startswith("FinishPoi POI1")
 
 
+def test_a_changed_engagement_gate_names_the_content_nodes_and_the_vote(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Recorded with a visitor whose engagement swings (the ``mixed`` faces): at POI2 the
+    vote over the first and last 15 % of the samples said engaged, and part b played.
+    Voting over 5 % only ties, and a tie means no extension: the report names
+    ``PlayContent POI2 b`` against ``FinishPoi POI2`` and shows the samples and both
+    votes, as each side's deciding nodes read them."""
+    visitor = {"id": 7, "position": [103.0, 36.0], "facing": True, "faces": "mixed"}
+    recorded = record_tour(tmp_path / "mixed.mcap", {"visitors": [visitor]})
+    config = changed_config(tmp_path, lambda d: d["engagement"].update(edge=0.05))
+    site = load_site(config)
+    div = Replay(recorded.path, site, load_tree(site=site)).run().divergence
+    assert div is not None and div.expected is not None and div.got is not None
+    assert differences(div.expected, div.got, site) == (
+        "start_poi poi POI2 waypoint POI2a part b → finish_poi poi POI2")
+    assert div.expected.node.startswith("PlayContent POI2 b (visit_poi.yaml:")
+    assert div.got.node.startswith("FinishPoi POI2 (visit_poi.yaml:")
+    assert div.expected.reads["/engaged"] == "True"
+    assert div.expected.reads["/engagement_decision"].startswith("POI2: engaged: ")
+    assert div.got.reads["/engaged"] == "False"
+    assert div.got.reads["/engagement_decision"].startswith("POI2: not engaged (tie): ")
+    assert div.got.reads["/engagement"] == div.expected.reads["/engagement"]  # same samples
+    assert re.fullmatch(r"\d+ samples: (-?0\.\d\d ){8}\.\.\.", div.got.reads["/engagement"])
+
+    assert main(["replay", str(recorded.path), "--config", str(config), "--quiet"]) == 1
+    out = capsys.readouterr().out
+    assert "  recorded: sent by PlayContent POI2 b" in out
+    assert "    /engagement_decision = POI2: not engaged (tie): " in out
+
+
 def test_a_skipped_stop_is_reported_with_the_nodes_on_both_sides(tmp_path: Path) -> None:
     """Recorded: navigation to POI2 failed once and the retry got there. With one
     navigation attempt only, the replay gives up on POI2: where the recording sent the
@@ -163,9 +195,10 @@ def test_a_skipped_stop_is_reported_with_the_nodes_on_both_sides(tmp_path: Path)
 
 def test_a_corpus_is_replayed_in_parallel_and_summarised(
         tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """Two morning tours (the same recording twice), an afternoon tour and a truncated
-    file, with POI1's variant a moved to end at 10:00: the morning tours diverge at the
-    variant choice, the afternoon one does not, the truncated one is reported and
+    """Two morning tours (the same recording twice), an afternoon tour, a truncated copy
+    and a corrupt file, with POI1's variant a moved to end at 10:00: the morning tours
+    diverge at the variant choice, the afternoon one does not, the truncated one is
+    recovered up to its cut (and still diverges there), the corrupt one is reported and
     skipped; the summary groups the divergences and the JSON report has every row."""
     corpus = tmp_path / "corpus"
     corpus.mkdir()
@@ -173,7 +206,8 @@ def test_a_corpus_is_replayed_in_parallel_and_summarised(
     shutil.copy(tour.path, corpus / "b-morning.mcap")
     record_tour(corpus / "c-afternoon.mcap", {"start_time": "2026-06-01T15:10:00+02:00"})
     data = tour.path.read_bytes()
-    (corpus / "d-truncated.mcap").write_bytes(data[: len(data) // 2])
+    (corpus / "d-truncated.mcap").write_bytes(data[: len(data) * 3 // 4])
+    (corpus / "e-corrupt.mcap").write_bytes(data[:8] + bytes(range(256)) * 4)
     config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(
         until="10:00"))
     report = tmp_path / "report.json"
@@ -184,14 +218,18 @@ def test_a_corpus_is_replayed_in_parallel_and_summarised(
     assert lines[0].startswith(f"{corpus / 'a-morning.mcap'}: diverged at +")
     assert lines[1].startswith(f"{corpus / 'b-morning.mcap'}: diverged at +")
     assert lines[2] == f"{corpus / 'c-afternoon.mcap'}: identical"
-    assert lines[3].startswith(f"{corpus / 'd-truncated.mcap'}: unreadable: ")
+    assert lines[3].startswith(f"{corpus / 'd-truncated.mcap'}: diverged at +")
+    assert lines[3].endswith(" s]") and "[d-truncated.mcap: cut short" in lines[3]
+    assert lines[4].startswith(f"{corpus / 'e-corrupt.mcap'}: unreadable: ")
     assert "waypoint POI1a → POI1b" in lines[0] and "replayed: Navigate POI1" in lines[0]
-    assert lines[4] == ("2 of 4 tours diverge: 2 at Navigate POI1: waypoint; 1 unreadable")
+    assert lines[5] == ("3 of 5 tours diverge: 3 at Navigate POI1: waypoint; 1 unreadable; "
+                        "1 recovered from a cut")
     rows = json.loads(report.read_text())
     assert [r["status"] for r in rows["tours"]] == [
-        "diverged", "diverged", "identical", "unreadable"]
-    assert rows["summary"]["by_signature"] == {"Navigate POI1: waypoint": 2}
-    assert rows["tours"][3]["reason"]  # why it could not be read
+        "diverged", "diverged", "identical", "diverged", "unreadable"]
+    assert rows["summary"]["by_signature"] == {"Navigate POI1: waypoint": 3}
+    assert rows["tours"][4]["reason"]  # why it could not be read
+    assert rows["tours"][3]["recovered"].startswith("d-truncated.mcap: cut short")
 
 
 def test_json_report_names_nodes_reads_and_the_domain_diff(
