@@ -38,7 +38,7 @@ FAST_TOURS: dict[str, Any] = {
 }
 
 
-async def measure(tours: int, speed: float, telemetry: bool, workdir: Path) -> dict[str, Any]:
+async def measure(tours: int, speed: float, telemetry: str, workdir: Path) -> dict[str, Any]:
     from frog_bt.sim import Simulator
 
     listen = (LOOPBACK, free_port())
@@ -49,8 +49,10 @@ async def measure(tours: int, speed: float, telemetry: bool, workdir: Path) -> d
                        "--rosbridge", f"ws://{LOOPBACK}:{sim.rosbridge_port}",
                        "--frontend", f"{LOOPBACK}:{sim.frontend_port}",
                        "--listen", f"{LOOPBACK}:{listen[1]}", "--sim-time"]
-    if telemetry:
-        argv += ["--record", workdir / "memory.mcap", "--rerun", f"save:{workdir / 'memory.rrd'}"]
+    if telemetry in ("on", "record"):
+        argv += ["--record", workdir / "recordings"]  # one file per tour, as on the robot
+    if telemetry in ("on", "rerun"):
+        argv += ["--rerun", f"save:{workdir / 'memory.rrd'}"]
     sim0, wall0 = sim.clock.now(), time.monotonic()
     child = await Child.start(*argv)
     marks: list[dict[str, Any]] = []
@@ -76,13 +78,14 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--tours", type=int, default=100)
     p.add_argument("--speed", type=float, default=300.0, help="sim-time speed factor")
-    p.add_argument("--telemetry", choices=("on", "off"), default="off")
+    p.add_argument("--telemetry", choices=("on", "off", "record", "rerun"), default="off",
+                   help="on: --record DIR and --rerun save:FILE.rrd; or either alone")
     p.add_argument("--out")
     args = p.parse_args()
     import tempfile
 
     with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
-        result = asyncio.run(measure(args.tours, args.speed, args.telemetry == "on", Path(tmp)))
+        result = asyncio.run(measure(args.tours, args.speed, args.telemetry, Path(tmp)))
     emit(result, args.out)
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import logging
+import os
 import signal
 import sys
 from dataclasses import dataclass
@@ -43,8 +44,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="where the executive listens for the front end (default: 127.0.0.1:5006)")
     p.add_argument("--sim-time", action="store_true",
                    help="take time from /clock (ROS use_sim_time); nothing is timed before it")
-    p.add_argument("--record", metavar="FILE.mcap", type=Path,
-                   help="record every message in and out to an MCAP file")
+    p.add_argument("--record", metavar="FILE.mcap|DIR", type=Path,
+                   help="record every message in and out: to one MCAP file (FILE.mcap), or "
+                   "to DIR, one file per tour and idle period within the site config's "
+                   "recording.max_bytes (oldest deleted first)")
     p.add_argument("--rerun", metavar="SPEC",
                    help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve "
                    "(default: off)")
@@ -91,10 +94,26 @@ def resolve(args: argparse.Namespace, site: Site) -> Settings:
         frontend=parse_hostport(args.frontend or site.links.frontend, "--frontend"),
         listen=listen,
         checkpoint=checkpoint,
-        record=None if args.record is None else writable_file(args.record, "--record"),
+        record=None if args.record is None else record_target(args.record),
         rerun=rerun_spec(args.rerun),
         secret=read_secret(site),
     )
+
+
+def record_target(path: Path) -> Path:
+    """``--record``: a ``.mcap`` file (CONTRACT §6), else a directory (created if missing,
+    in an existing folder)."""
+    if path.suffix == ".mcap" and not path.is_dir():
+        return writable_file(path, "--record")
+    if path.exists() and not path.is_dir():
+        raise UsageError("--record", path, "is a file but not .mcap; expected FILE.mcap or "
+                         "a directory")
+    parent = path.parent if not path.exists() else path
+    if not parent.is_dir():
+        raise UsageError("--record", path, f"cannot write there: {parent} does not exist")
+    if not os.access(parent, os.W_OK):
+        raise UsageError("--record", path, "cannot write there: permission denied")
+    return path
 
 
 def banner(args: argparse.Namespace, settings: Settings) -> list[str]:
@@ -118,12 +137,18 @@ __all__ = ["add_arguments", "attach_observers", "read_secret", "run"]
 def attach_observers(executive: Any, *, record: Path | None, rerun: str | None) -> list[Any]:
     """Recorder and telemetry, each imported only when asked for; closed by the caller."""
     observers: list[Any] = []
-    if record is not None:
+    if record is not None and record.suffix == ".mcap" and not record.is_dir():
         from frog_bt.tools.recording import Recorder
 
         recorder = Recorder(record)
         recorder.attach(executive)
         observers.append(recorder)
+    elif record is not None:
+        from frog_bt.tools.rotation import RecordingDir
+
+        recordings = RecordingDir(record, executive.site.recording.max_bytes)
+        recordings.attach(executive)
+        observers.append(recordings)
     if rerun:
         from frog_bt.telemetry import Telemetry
 

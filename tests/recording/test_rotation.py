@@ -1,0 +1,181 @@
+"""`frog-bt run --record DIR`: one file per tour and idle period, a disk budget, a killed writer."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import os
+import signal
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+from mcap.reader import make_reader
+
+from frog_bt.cli import main
+from frog_bt.config import load_site
+from frog_bt.runtime.rehearsal import Rehearsal, free_udp_port
+from frog_bt.sim import Simulator, scenario_from
+from frog_bt.tools.replay import Replay, ReplayError
+from frog_bt.tools.rotation import RecordingDir, numbered
+from frog_bt.tree.loader import load_tree
+
+ROOT = Path(__file__).resolve().parents[2]
+# Tours back to back: a fast robot, short content, a visitor who comes back.
+FAST_TOURS: dict[str, Any] = {
+    "speed": 400.0, "navigation": {"speed": 3.0, "approach_time": 1.0},
+    "docking": {"undock_time": 2.0, "dock_time": 3.0},
+    "content": {"default": 4, "introduction": 3},
+    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0}}
+
+
+def record_day(directory: Path, tours: int, max_bytes: int) -> RecordingDir:
+    """Run the executive (not ``once``) until ``tours`` tours have ended, recording to DIR."""
+    recordings = RecordingDir(directory, max_bytes)
+
+    async def run() -> None:
+        enough = asyncio.Event()
+
+        def prepare(executive: Any) -> None:
+            recordings.attach(executive)
+            executive.taps.tick.append(
+                lambda _core: executive.outcome.tours >= tours and enough.set())
+
+        rehearsal = Rehearsal(scenario_from("default", FAST_TOURS), site=load_site(),
+                              prepare=prepare, once=False)
+        async with rehearsal:
+            await asyncio.wait_for(enough.wait(), 60)
+            rehearsal.executive.stop("enough")
+            await rehearsal.finish()
+
+    try:
+        asyncio.run(run())
+    finally:
+        recordings.close()
+    return recordings
+
+
+def metadata(path: Path) -> dict[str, str]:
+    with open(path, "rb") as f:
+        reader = make_reader(f)
+        assert reader.get_summary() is not None  # closed: summary and footer written
+        return {k: v for m in reader.iter_metadata() if m.name == "frog_bt"
+                for k, v in m.metadata.items()}
+
+
+def test_a_day_is_recorded_one_file_per_tour_and_idle_period_each_replaying_alone(
+        tmp_path: Path) -> None:
+    """Two tours: idle 1, tour 1, idle 2, tour 2, idle 3 (stopped there), named by the
+    clock's local time and number, each closed with a footer; every file replays
+    identically on its own (a tour file after its lead-in, an idle file from its primer)."""
+    recordings = record_day(tmp_path / "day", 2, 10**12)
+    names = [p.name for p in recordings.files]
+    assert [n[16:] for n in names] == ["idle0001.mcap", "tour0001.mcap", "idle0002.mcap",
+                                       "tour0002.mcap", "idle0003.mcap"]
+    assert all(n.startswith("20260601-10") for n in names)  # the scenario's day, not today
+    assert [p for _, p in numbered(tmp_path / "day")] == recordings.files
+    assert metadata(recordings.files[1]) == {"kind": "tour", "tour": "1", "lead_in": names[0]}
+    assert metadata(recordings.files[2]) == {"kind": "idle", "tour": "2"}
+    site = load_site()
+    for path in recordings.files:
+        result = Replay(path, site, load_tree(site=site)).run()
+        assert result.divergence is None, (path.name, result.divergence)
+        assert not result.recovered
+    tour = Replay(recordings.files[3], site, load_tree(site=site)).run()
+    assert tour.ros_commands >= 10 and tour.frontend_commands >= 20  # a whole tour in it
+
+
+def test_the_budget_deletes_the_oldest_tours_first_and_logs_each(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    day = tmp_path / "day"
+    day.mkdir()
+    for name, size in (("20260601-090000-idle0001", 100), ("20260601-090100-tour0001", 400),
+                       ("20260601-100000-idle0002", 100), ("20260601-100100-tour0002", 400),
+                       ("20260601-110000-idle0003", 100)):
+        (day / f"{name}.mcap").write_bytes(b"x" * size)
+    (day / "notes.mcap").write_bytes(b"x" * 5000)  # not ours: never counted nor deleted
+    recordings = RecordingDir(day, 700)
+    assert recordings.number == 4  # numbers go on after the highest in DIR
+    with caplog.at_level(logging.WARNING, logger="frog_bt.tools.rotation"):
+        recordings.enforce_budget()
+    assert sorted(p.name for p in day.iterdir()) == [
+        "20260601-100000-idle0002.mcap", "20260601-100100-tour0002.mcap",
+        "20260601-110000-idle0003.mcap", "notes.mcap"]
+    assert [r.getMessage() for r in caplog.records] == [
+        "recording budget 700 bytes: deleted 20260601-090000-idle0001.mcap (100 bytes)",
+        "recording budget 700 bytes: deleted 20260601-090100-tour0001.mcap (400 bytes)"]
+
+
+def test_a_small_budget_keeps_the_latest_tours_while_recording(tmp_path: Path) -> None:
+    recordings = record_day(tmp_path / "day", 3, 400_000)
+    left = [p.name[16:] for _, p in numbered(tmp_path / "day")]
+    assert recordings.deleted and left[-1] == "idle0004.mcap"
+    assert "idle0001.mcap" not in left and "tour0001.mcap" not in left
+    assert sum(p.stat().st_size for _, p in numbered(tmp_path / "day")) <= 400_000
+
+
+def test_a_tour_without_its_lead_in_says_why_it_cannot_be_replayed(tmp_path: Path) -> None:
+    recordings = record_day(tmp_path / "day", 1, 10**12)
+    recordings.files[0].unlink()
+    site = load_site()
+    with pytest.raises(ReplayError, match=r"continues .*idle0001.mcap, which is gone"):
+        Replay(recordings.files[1], site, load_tree(site=site))
+
+
+def test_a_killed_writers_file_is_recovered_by_replay_and_numbering_goes_on(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`frog-bt run --record DIR` killed with SIGKILL in the middle of a tour: the tour
+    file has no footer; replay says it recovered it, and what is there replays
+    identically. A restarted executive goes on with the next number."""
+    day = tmp_path / "day"
+
+    async def run_and_kill() -> None:
+        listen = free_udp_port()
+        sim = Simulator(scenario_from("default", {**FAST_TOURS, "speed": 50.0}),
+                        rosbridge_port=0, frontend_port=0, executive=("127.0.0.1", listen))
+        await sim.start()
+        proc = await asyncio.create_subprocess_exec(
+            sys.executable, "-m", "frog_bt", "run", "--sim-time", "--checkpoint", "none",
+            "--record", str(day), "--quiet",
+            "--rosbridge", f"ws://127.0.0.1:{sim.rosbridge_port}",
+            "--frontend", f"127.0.0.1:{sim.frontend_port}", "--listen", f"127.0.0.1:{listen}",
+            cwd=ROOT, stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.DEVNULL)
+        try:
+            # In the tour (its file is open) and past a chunk flush (a second of wall time
+            # at most after the fourth goal): then kill, without warning.
+            goals = [0]
+
+            def fourth_goal(record: Any) -> bool:
+                goals[0] += record.channel == "/GotoWayPoint"
+                return goals[0] >= 4
+
+            await sim.wait_for(fourth_goal, timeout=60)
+            for _ in range(200):
+                tours = [p for _, p in numbered(day) if "-tour" in p.name]
+                if tours and tours[-1].stat().st_size > 50_000:
+                    break
+                await asyncio.sleep(0.05)  # polling the file system, bounded: 10 s
+            os.kill(proc.pid, signal.SIGKILL)
+            await proc.wait()
+        finally:
+            if proc.returncode is None:
+                proc.kill()
+                await proc.wait()
+            await sim.stop()
+
+    asyncio.run(run_and_kill())
+    files = [p for _, p in numbered(day)]
+    assert [p.name[16:] for p in files] == ["idle0001.mcap", "tour0001.mcap"]
+    assert main(["replay", str(files[1]), "--quiet"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith(f"note: {files[1].name}: cut short (no summary or footer): "
+                             "recovered ") and out[0].endswith("; replayed up to the cut")
+    assert out[1].startswith("identical: ")
+    assert main(["replay", str(day), "--quiet", "--report",
+                 str(tmp_path / "r.json")]) == 0
+    rows = json.loads((tmp_path / "r.json").read_text())["tours"]
+    assert [r["status"] for r in rows] == ["identical", "identical"]
+    assert rows[1]["recovered"].startswith(f"{files[1].name}: cut short")
+    assert RecordingDir(day, 10**12).number == 2  # a restart goes on with tour 2
