@@ -154,6 +154,7 @@ def attach_observers(executive: Any, *, record: Path | None, rerun: str | None) 
 
         telemetry = Telemetry.open(rerun, executive.site, executive.core.tree)
         telemetry.attach(executive.core)
+        telemetry.attach_links(executive)
         observers.append(telemetry)
     return observers
 

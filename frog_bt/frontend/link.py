@@ -113,6 +113,7 @@ class FrontendLink:
         self._closing = False
         self._warnings = WarningLimiter(logger=log)
         self._settled = asyncio.Event()  # an ack arrived or a command was given up on
+        self.last_heard: float | None = None  # project-clock time of the last datagram in
 
     # ------------------------------------------------------------ lifecycle
 
@@ -258,8 +259,10 @@ class FrontendLink:
 
     def _datagram_received(self, data: bytes, addr: tuple) -> None:
         now = self.clock.now()
-        if self.on_datagram is not None and addr[0] == self._endpoint.peer_host:
-            self.on_datagram("in", data, now)
+        if addr[0] == self._endpoint.peer_host:
+            self.last_heard = now
+            if self.on_datagram is not None:
+                self.on_datagram("in", data, now)
         foreign = self._endpoint.stats.foreign
         received = self._endpoint.receive(data, addr[0], now)
         if received.acked is not None:

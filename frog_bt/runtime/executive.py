@@ -30,6 +30,7 @@ from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
 from frog_bt.runtime.clock import Clock, ManualClock
 from frog_bt.runtime.core import Core
+from frog_bt.runtime.links import Links, link_states
 from frog_bt.runtime.status import link_line, status_line
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.warning_limit import WarningLimiter
@@ -60,6 +61,7 @@ class WireTaps:
 
     ros_in: list[RawTap] = field(default_factory=list)
     datagram: list[Callable[[str, bytes, float], None]] = field(default_factory=list)
+    links: list[Callable[[float, Links], None]] = field(default_factory=list)  # on a change
 
 
 class Executive:
@@ -92,6 +94,8 @@ class Executive:
         self._peer_restarts = 0
         self._checkpoint_warnings = WarningLimiter(60.0, logger=log)
         self._swap: tuple[Site, LoadedTree] | None = None  # a checked tree, for the next idle
+        self.was_connected = False  # to rosbridge, at some point: a loss is a reconnect
+        self.links = link_states(self)
         self.swaps = 0
 
     # ------------------------------------------------------------ I/O callbacks (cache only)
@@ -111,6 +115,7 @@ class Executive:
 
     def _on_link(self, state: LinkState) -> None:
         self.core.inputs.link = state
+        self.was_connected = self.was_connected or state.connected
         actions = self.core.actions
         if not state.connected:
             self._pending_at_loss = actions.pending
@@ -124,7 +129,17 @@ class Executive:
             actions.resend_pending()
             self.core.ctx.note(f"link back: re-sent {actions.pending.kind} to "
                                f"{actions.pending.target}")
+        self.check_links()
         self._wake.set()
+
+    def check_links(self) -> None:
+        """Compare the links' states with the last seen; tell the ``wire.links`` taps."""
+        links = link_states(self)
+        if links != self.links:
+            self.links = links
+            now = self.clock.now() if self.clock.ready else 0.0
+            for tap in self.wire.links:
+                tap(now, links)
 
     def _on_event(self, message: FrontendMessage) -> None:
         self.core.on_event(message)
@@ -162,7 +177,7 @@ class Executive:
     def status_text(self) -> str:
         """The live status: the rosbridge link while it keeps the tree waiting, else the tree."""
         return (link_line(self.client.url, self.client.link, self.clock.ready)
-                or status_line(self.core))
+                or f"{status_line(self.core)} | {self.links.text()}")
 
     async def _until_stopped(self, awaitable: Any) -> bool:
         """Await ``awaitable`` unless stop() comes first; True when it completed."""
@@ -234,6 +249,7 @@ class Executive:
         core.ctx.note(f"tree reloaded: {tree.file}")
 
     def tick(self) -> None:
+        self.check_links()
         if self._swap is not None and self.idle():
             self._swap_tree()
         restarts = self.link.stats.peer_restarts

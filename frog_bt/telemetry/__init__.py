@@ -86,6 +86,28 @@ class Telemetry:
     def attach(self, core: Core) -> None:
         """Append the taps to ``core.taps`` (one core per telemetry)."""
         self.rows.attach(core)
+        self._core = core
+
+    def attach_links(self, executive: Any) -> None:
+        """Each link's state over time (lanes under ``links/``), from the executive."""
+        self._links: dict[str, str] = {}
+        executive.wire.links.append(self.on_links)
+        self.on_links(executive.clock.now() if executive.clock.ready else 0.0, executive.links)
+
+    def on_links(self, t: float, links: Any) -> None:
+        if self._closed:
+            return
+        changes = [(name, state) for name, state in links.items()
+                   if self._links.get(name) != state]
+        self._links.update(changes)
+        if not changes:
+            return
+        core = getattr(self, "_core", None)
+        try:
+            self.writer.write_links(core.ticks if core is not None else 0, t, changes)
+        except Exception:  # telemetry must never stop the robot
+            self.write_errors += 1
+            log.exception("rerun telemetry: could not write the links")
 
     def _full(self) -> None:
         """Rows are full (called inside a tick): write them once the tick is over, so that

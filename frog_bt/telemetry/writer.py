@@ -58,6 +58,16 @@ def status_path(key: str) -> str:
     return f"bt/status/{key}"
 
 
+LINK_STATES = {  # state -> colour of the link lanes (the operator's view)
+    "connected": 0x3CB371FF, "acking": 0x3CB371FF, "wall": 0x3CB371FF, "/clock": 0x3CB371FF,
+    "connecting": 0xE0A030FF, "closed": 0x808080FF, "reconnecting": 0xE0A030FF, "not heard": 0xE0A030FF,
+    "silent": 0xD04040FF, "waiting for /clock": 0xD04040FF}
+
+
+def link_path(name: str) -> str:
+    return f"links/{name}"
+
+
 def _times(rows: Sequence[tuple[Any, ...]]) -> list[rr.TimeColumn]:
     # Nanoseconds as rerun rounds them one by one (round(1e9 * t)), but in one numpy pass:
     # a list of floats costs rerun a Python conversion per row.
@@ -144,6 +154,20 @@ class Writer:
             [STATUS_COLORS[Status[s]] for s in STATES], dtype=np.uint32))
         for node in nodes:
             rec.log(status_path(node.key), config, static=True)
+        links = rr.StateConfiguration(values=list(LINK_STATES), colors=np.array(
+            list(LINK_STATES.values()), dtype=np.uint32))
+        for name in ("rosbridge", "frontend", "clock"):
+            rec.log(link_path(name), links, static=True)
+
+    def write_links(self, tick: int, t: float, changes: list[tuple[str, str]]) -> None:
+        """Links whose state changed at ``t``: their lanes, and one log line."""
+        rec = self.rec
+        rec.set_time(TICK, sequence=tick)
+        rec.set_time(TIME, timestamp=np.datetime64(round(t * 1e9), "ns"))
+        for name, state in changes:
+            rec.log(link_path(name), rr.StateChange(state=state))
+        level = "WARN" if any(LINK_STATES.get(s) != 0x3CB371FF for _, s in changes) else "INFO"
+        rec.log("log/links", rr.TextLog(", ".join(f"{n} {s}" for n, s in changes), level=level))
 
     # ------------------------------------------------------------ batches
 

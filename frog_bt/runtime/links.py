@@ -1,0 +1,61 @@
+"""The state of each link, for the operator: rosbridge, front end, clock.
+
+:func:`link_states` reads them off the executive (no I/O): rosbridge
+``connected`` / ``reconnecting`` / ``connecting`` (never connected yet) / ``closed``; the front end
+``acking`` (it answers), ``silent`` (commands wait for an ack and nothing has come
+from it for :data:`SILENT_AFTER` seconds) or ``not heard`` (nothing from it yet,
+nothing waiting); the clock ``wall``, ``/clock`` or ``waiting for /clock``. The
+executive calls its ``wire.links`` taps with each change (status line, rerun lanes).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+SILENT_AFTER = 2.0  # project-clock seconds without a datagram while commands wait
+
+
+@dataclass(frozen=True, slots=True)
+class Links:
+    rosbridge: str
+    frontend: str
+    clock: str
+
+    def items(self) -> tuple[tuple[str, str], ...]:
+        return (("rosbridge", self.rosbridge), ("frontend", self.frontend),
+                ("clock", self.clock))
+
+    def text(self) -> str:
+        """``rosbridge connected, front end silent, clock /clock``."""
+        return (f"rosbridge {self.rosbridge}, front end {self.frontend}, "
+                f"clock {self.clock}")
+
+
+def rosbridge_state(link: Any, was_connected: bool) -> str:
+    if link.connected:
+        return "connected"
+    if was_connected and link.last_error is None:
+        return "closed"  # by the executive, on its way out
+    return "reconnecting" if was_connected else "connecting"
+
+
+def frontend_state(pending: int, last_heard: float | None, now: float) -> str:
+    if pending and (last_heard is None or now - last_heard > SILENT_AFTER):
+        return "silent"
+    return "acking" if last_heard is not None else "not heard"
+
+
+def clock_state(sim_time: bool, ready: bool) -> str:
+    if not sim_time:
+        return "wall"
+    return "/clock" if ready else "waiting for /clock"
+
+
+def link_states(executive: Any) -> Links:
+    clock = executive.clock
+    link = executive.link
+    now = clock.now() if clock.ready else 0.0
+    return Links(rosbridge_state(executive.client.link, executive.was_connected),
+                 frontend_state(link.pending, link.last_heard, now),
+                 clock_state(executive.sim_time, bool(clock.ready)))
