@@ -61,8 +61,8 @@ class Telemetry:
         self.writer.write_static()
 
     @classmethod
-    def open(cls, spec: str, site: Site, tree: LoadedTree, *, app_id: str = "frog-bt"
-             ) -> Telemetry:
+    def open(cls, spec: str, site: Site, tree: LoadedTree, *, app_id: str = "frog-bt",
+             recording_id: str | None = None) -> Telemetry:
         """A recording streaming to ``spec`` (see :mod:`frog_bt.telemetry.spec`).
 
         Raises ValueError for a spec it does not know, before anything starts.
@@ -70,7 +70,7 @@ class Telemetry:
         sink = parse_spec(spec)
         import rerun as rr
 
-        rec = rr.RecordingStream(app_id)
+        rec = rr.RecordingStream(app_id, recording_id=recording_id)
         if sink.kind == "save":
             rec.save(sink.target)
         elif sink.kind == "connect":

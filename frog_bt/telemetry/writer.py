@@ -58,10 +58,11 @@ def status_path(key: str) -> str:
     return f"bt/status/{key}"
 
 
+LINK_OK, LINK_WAIT, LINK_BAD, LINK_OFF = 0x3CB371FF, 0xE0A030FF, 0xD04040FF, 0x808080FF
 LINK_STATES = {  # state -> colour of the link lanes (the operator's view)
-    "connected": 0x3CB371FF, "acking": 0x3CB371FF, "wall": 0x3CB371FF, "/clock": 0x3CB371FF,
-    "connecting": 0xE0A030FF, "closed": 0x808080FF, "reconnecting": 0xE0A030FF, "not heard": 0xE0A030FF,
-    "silent": 0xD04040FF, "waiting for /clock": 0xD04040FF}
+    "connected": LINK_OK, "acking": LINK_OK, "wall": LINK_OK, "/clock": LINK_OK,
+    "connecting": LINK_WAIT, "reconnecting": LINK_WAIT, "not heard": LINK_WAIT,
+    "silent": LINK_BAD, "waiting for /clock": LINK_BAD, "closed": LINK_OFF}
 
 
 def link_path(name: str) -> str:
@@ -166,7 +167,7 @@ class Writer:
         rec.set_time(TIME, timestamp=np.datetime64(round(t * 1e9), "ns"))
         for name, state in changes:
             rec.log(link_path(name), rr.StateChange(state=state))
-        level = "WARN" if any(LINK_STATES.get(s) != 0x3CB371FF for _, s in changes) else "INFO"
+        level = "WARN" if any(LINK_STATES.get(s) != LINK_OK for _, s in changes) else "INFO"
         rec.log("log/links", rr.TextLog(", ".join(f"{n} {s}" for n, s in changes), level=level))
 
     # ------------------------------------------------------------ batches
