@@ -23,6 +23,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_support import memory_kb
 
 
+def children_rss_kb() -> int:
+    """RSS of this process's children (the telemetry writer), summed."""
+    import multiprocessing
+
+    return sum(memory_kb(c.pid).get("rss_kb", 0) for c in multiprocessing.active_children())
+
+
 def say(event: str, **fields: Any) -> None:
     sys.stdout.write(json.dumps({"event": event, "t": time.monotonic(), **fields}) + "\n")
     sys.stdout.flush()
@@ -33,8 +40,10 @@ async def serve(args: argparse.Namespace) -> None:
     from frog_bt.config import load_site, parse_hostport
     from frog_bt.runtime.clock import SimClock, WallClock
     from frog_bt.runtime.executive import Executive
+    from frog_bt.runtime.memory import pin_malloc_thresholds
     from frog_bt.tree.loader import load_tree
 
+    pin_malloc_thresholds()  # as frog-bt run does
     site = load_site(args.config)
     tree = load_tree(site=site)
     executive = Executive(site, tree, SimClock() if args.sim_time else WallClock(),
@@ -50,7 +59,8 @@ async def serve(args: argparse.Namespace) -> None:
         plain_tick()
         if executive.outcome.tours != tours:
             tours = executive.outcome.tours
-            say("tour", tours=tours, ticks=executive.core.ticks, **memory_kb())
+            say("tour", tours=tours, ticks=executive.core.ticks, **memory_kb(),
+                child_rss_kb=children_rss_kb())
 
     executive.tick = tick  # type: ignore[method-assign]
 

@@ -70,6 +70,9 @@ async def measure(tours: int, speed: float, telemetry: str, workdir: Path) -> di
         "growth_pct": 100.0 * (last["rss_kb"] - first["rss_kb"]) / first["rss_kb"],
         "hwm_kb": last.get("hwm_kb"),
         "rss_kb_by_tour": [m["rss_kb"] for m in marks],
+        "growth_from_tour_10_pct": 100.0 * (last["rss_kb"] - marks[min(9, len(marks) - 1)][
+            "rss_kb"]) / marks[min(9, len(marks) - 1)]["rss_kb"],
+        "child_rss_kb_by_tour": [m.get("child_rss_kb", 0) for m in marks],
         "sim_dropped_frames": sim._rosbridge.dropped,
     }
 

@@ -150,9 +150,13 @@ def attach_observers(executive: Any, *, record: Path | None, rerun: str | None) 
         recordings.attach(executive)
         observers.append(recordings)
     if rerun:
-        from frog_bt.telemetry import Telemetry
+        from frog_bt.telemetry import Telemetry, process
 
-        telemetry = Telemetry.open(rerun, executive.site, executive.core.tree)
+        telemetry: Any
+        if process.available():  # rerun in a process of its own: off the tick, its memory
+            telemetry = process.TelemetryProcess(rerun, executive.site, executive.core.tree)
+        else:
+            telemetry = Telemetry.open(rerun, executive.site, executive.core.tree)
         telemetry.attach(executive.core)
         telemetry.attach_links(executive)
         observers.append(telemetry)
@@ -188,6 +192,9 @@ def run(args: argparse.Namespace) -> int:
 
 async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Settings) -> int:
     from frog_bt.runtime.executive import Executive  # the network stack only when running
+    from frog_bt.runtime.memory import pin_malloc_thresholds
+
+    pin_malloc_thresholds()  # all day without creeping up
     from frog_bt.runtime.status import StatusLine
     from frog_bt.tools.summary import TourSummary
 

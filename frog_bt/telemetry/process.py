@@ -23,6 +23,7 @@ event loop); on platforms without ``fork`` the live executive writes in-process.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import multiprocessing
 import queue
@@ -42,7 +43,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 QUEUE_BATCHES = 64  # batches waiting for the child (50 ticks each: 5 minutes at 10 Hz)
-RECYCLE_ROWS = 500_000  # rows a child writes before a fresh one takes over
+RECYCLE_ROWS = 250_000  # rows a child writes before a fresh one takes over (~20 min)
 CLOSE_TIMEOUT = 6.0  # seconds close() waits for the child to finish its file
 
 
@@ -125,10 +126,8 @@ class TelemetryProcess:
 
     def _stop_child(self, timeout: float) -> None:
         inbox, child = self._inbox, self._child
-        try:
+        with contextlib.suppress(queue.Full):
             inbox.put(("close",), timeout=timeout)
-        except queue.Full:
-            pass
         inbox.close()
         inbox.join_thread()
         child.join(timeout)
@@ -166,6 +165,11 @@ class TelemetryProcess:
             if self._written >= self.recycle_rows:
                 self._stop_child(CLOSE_TIMEOUT)
                 self._start_child()
+                links, self._links = self._links, {}  # the new file's lanes start with them
+                if links and self._core is not None:
+                    self._send(("links", self._core.ticks, self._core.clock.now(),
+                                list(links.items())))
+                    self._links = links
 
     def _send(self, item: tuple[Any, ...]) -> bool:
         if self._closed:
