@@ -89,40 +89,31 @@ async def one_tour(stops: int, telemetry: bool, workdir: Path) -> dict[str, Any]
                           sim_time=True, once=True)
     observers: list[Any] = []
     writes: list[int] = []
-    if telemetry:
-        from frog_bt.telemetry import Telemetry
-        from frog_bt.tools.recording import Recorder
+    if telemetry:  # as frog-bt run --record FILE --rerun save:FILE attaches them
+        from frog_bt.commands.run import attach_observers
+        from frog_bt.runtime.memory import pin_malloc_thresholds
 
-        tel = Telemetry.open(f"save:{workdir / 'ticks.rrd'}", site, tree)
-        tel.attach(executive.core)
-        # Rows go to rerun every 50 ticks, after the tick, in steps between other work:
-        # time those too (what telemetry costs beyond the tick itself).
-        plain_write, plain_step = tel.writer.write, getattr(tel, "_next_step", None)
+        pin_malloc_thresholds()
+        observers = attach_observers(executive, record=workdir / "ticks.mcap",
+                                     rerun=f"save:{workdir / 'ticks.rrd'}")
+        tel = observers[-1]
+        if hasattr(tel, "_next_step"):  # written in-process (no fork): time its steps too
+            plain_step = tel._next_step
 
-        def timed_write(batch: Any) -> None:
-            t0 = time.perf_counter_ns()
-            plain_write(batch)
-            writes.append(time.perf_counter_ns() - t0)
+            def timed_step() -> bool:
+                t0 = time.perf_counter_ns()
+                more = plain_step()
+                writes.append(time.perf_counter_ns() - t0)
+                return more
 
-        def timed_step() -> bool:
-            t0 = time.perf_counter_ns()
-            more = plain_step()
-            writes.append(time.perf_counter_ns() - t0)
-            return more
-
-        tel.writer.write = timed_write  # type: ignore[method-assign]
-        if plain_step is not None:  # writing in steps (else all in one write)
             tel._next_step = timed_step  # type: ignore[method-assign]
-        recorder = Recorder(workdir / "ticks.mcap")
-        recorder.attach(executive)
-        observers = [tel, recorder]
 
     core = executive.core
     inner = core.tick
     samples: dict[str, list[int]] = defaultdict(list)
     phases: dict[int, str] = {}
     dock, recruit_at = site.tour.dock, site.tour.recruit_at
-    clock = time.perf_counter_ns
+    clock = time.thread_time_ns  # the tick thread's CPU time: not the time others took
 
     def timed_tick() -> Any:
         t0 = clock()

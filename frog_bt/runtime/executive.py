@@ -30,7 +30,7 @@ from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
 from frog_bt.runtime.clock import Clock, ManualClock
 from frog_bt.runtime.core import Core
-from frog_bt.runtime.links import Links, link_states
+from frog_bt.runtime.links import Links, link_states, states
 from frog_bt.runtime.status import link_line, status_line
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.warning_limit import WarningLimiter
@@ -96,6 +96,7 @@ class Executive:
         self._swap: tuple[Site, LoadedTree] | None = None  # a checked tree, for the next idle
         self.was_connected = False  # to rosbridge, at some point: a loss is a reconnect
         self.links = link_states(self)
+        self._link_states = (self.links.rosbridge, self.links.frontend, self.links.clock)
         self.swaps = 0
 
     # ------------------------------------------------------------ I/O callbacks (cache only)
@@ -134,9 +135,10 @@ class Executive:
 
     def check_links(self) -> None:
         """Compare the links' states with the last seen; tell the ``wire.links`` taps."""
-        links = link_states(self)
-        if links != self.links:
-            self.links = links
+        now_states = states(self)
+        if now_states != self._link_states:
+            self._link_states = now_states
+            self.links = links = Links(*now_states)
             now = self.clock.now() if self.clock.ready else 0.0
             for tap in self.wire.links:
                 tap(now, links)

@@ -52,10 +52,15 @@ def clock_state(sim_time: bool, ready: bool) -> str:
     return "/clock" if ready else "waiting for /clock"
 
 
-def link_states(executive: Any) -> Links:
+def states(executive: Any) -> tuple[str, str, str]:
+    """(rosbridge, front end, clock): cheap enough for every tick."""
     clock = executive.clock
     link = executive.link
-    now = clock.now() if clock.ready else 0.0
-    return Links(rosbridge_state(executive.client.link, executive.was_connected),
-                 frontend_state(link.pending, link.last_heard, now),
-                 clock_state(executive.sim_time, bool(clock.ready)))
+    ready = bool(clock.ready)
+    return (rosbridge_state(executive.client.link, executive.was_connected),
+            frontend_state(link.pending, link.last_heard, clock.now() if ready else 0.0),
+            clock_state(executive.sim_time, ready))
+
+
+def link_states(executive: Any) -> Links:
+    return Links(*states(executive))

@@ -23,6 +23,7 @@ event loop); on platforms without ``fork`` the live executive writes in-process.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import logging
 import multiprocessing
@@ -101,7 +102,7 @@ class TelemetryProcess:
         self.site = site
         self.tree = tree
         self.index = TreeIndex.of(tree.root)
-        self.rows = Rows(site, self.index, batch_ticks=batch_ticks, on_full=self.flush)
+        self.rows = Rows(site, self.index, batch_ticks=batch_ticks, on_full=self._full)
         self.recording_id = str(uuid.uuid4())
         self.recycle_rows = recycle_rows or RECYCLE_ROWS
         self._context = multiprocessing.get_context("fork")
@@ -112,6 +113,7 @@ class TelemetryProcess:
         self._links: dict[str, str] = {}
         self._core: Core | None = None
         self._closed = False
+        self._flush_pending = False
         self._start_child()
 
     def _start_child(self) -> None:
@@ -154,8 +156,21 @@ class TelemetryProcess:
             tick = self._core.ticks if self._core is not None else 0
             self._send(("links", tick, t, changes))
 
+    def _full(self) -> None:
+        """Rows are full (inside a tick): send them once the tick is over."""
+        if self._flush_pending:
+            return
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:
+            self.flush()
+            return
+        self._flush_pending = True
+        loop.call_soon(self.flush)
+
     def flush(self) -> None:
         """Send the buffered rows to the child (never waits: a full queue drops them)."""
+        self._flush_pending = False
         if self._closed:
             return
         batch = self.rows.drain()

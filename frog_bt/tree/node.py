@@ -22,6 +22,7 @@ from frog_bt.tree.observed import ACTING, DECIDED
 
 Status = py_trees.common.Status
 SUCCESS, FAILURE, RUNNING, INVALID = Status.SUCCESS, Status.FAILURE, Status.RUNNING, Status.INVALID
+ENDED = frozenset((SUCCESS, FAILURE))
 
 
 class MissingValue(Exception):
@@ -51,6 +52,7 @@ class Declared:
 
     def _declare(self, params: BaseModel | None) -> None:
         """Call from ``__init__`` once the py_trees base is initialised."""
+        self._reads_any = bool(self.reads or self.optional_reads)  # blame: a decider
         self.params: Any = params if params is not None else type(self).Params()
         self._ctx: Context | None = None
         if self.reads or self.optional_reads or self.writes:
@@ -87,8 +89,7 @@ class Declared:
         ACTING.append(self)  # type: ignore[arg-type]
         try:
             yield from super().tick()  # type: ignore[misc]
-            if (self.reads or self.optional_reads) and self.status in (  # type: ignore[attr-defined]
-                    SUCCESS, FAILURE):
+            if self._reads_any and self.status in ENDED:  # type: ignore[attr-defined]
                 DECIDED.append(self)  # type: ignore[arg-type]
         except MissingValue as missing:
             self.feedback_message = f"no value for {missing.key}"  # type: ignore[attr-defined]
