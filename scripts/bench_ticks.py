@@ -67,7 +67,7 @@ def phase_of(node: Any, dock: str, recruit_at: str) -> str:
     return "other"
 
 
-async def one_tour(stops: int, telemetry: bool, workdir: Path) -> dict[str, Any]:
+async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
     from frog_bt.config import load_site
     from frog_bt.runtime.clock import SimClock
     from frog_bt.runtime.executive import Executive
@@ -89,13 +89,14 @@ async def one_tour(stops: int, telemetry: bool, workdir: Path) -> dict[str, Any]
                           sim_time=True, once=True)
     observers: list[Any] = []
     writes: list[int] = []
-    if telemetry:  # as frog-bt run --record FILE --rerun save:FILE attaches them
+    if telemetry != "off":  # as frog-bt run --record FILE --rerun save:FILE attaches them
         from frog_bt.commands.run import attach_observers
         from frog_bt.runtime.memory import pin_malloc_thresholds
 
         pin_malloc_thresholds()
-        observers = attach_observers(executive, record=workdir / "ticks.mcap",
-                                     rerun=f"save:{workdir / 'ticks.rrd'}")
+        observers = attach_observers(
+            executive, record=workdir / "ticks.mcap" if telemetry != "rerun" else None,
+            rerun=f"save:{workdir / 'ticks.rrd'}" if telemetry != "record" else None)
         tel = observers[-1]
         if hasattr(tel, "_next_step"):  # written in-process (no fork): time its steps too
             plain_step = tel._next_step
@@ -153,11 +154,12 @@ async def one_tour(stops: int, telemetry: bool, workdir: Path) -> dict[str, Any]
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--stops", type=int, default=7)
-    p.add_argument("--telemetry", choices=("on", "off"), default="off")
+    p.add_argument("--telemetry", choices=("on", "off", "record", "rerun"), default="off",
+                   help="on: --record FILE and --rerun save:FILE.rrd; or either alone")
     p.add_argument("--out", help="write the JSON result here (default: stdout)")
     args = p.parse_args()
     with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
-        result = asyncio.run(one_tour(args.stops, args.telemetry == "on", Path(tmp)))
+        result = asyncio.run(one_tour(args.stops, args.telemetry, Path(tmp)))
     emit(result, args.out)
 
 

@@ -197,6 +197,11 @@ class FrontendLink:
         """Messages sent and not yet acked or given up on."""
         return self._endpoint.pending
 
+    @property
+    def oldest_pending(self) -> float | None:
+        """When the oldest message waiting for its ack was first sent (None: none waits)."""
+        return self._endpoint.oldest_pending
+
     # ------------------------------------------------------------ sending
 
     def send(self, message: FrontendMessage) -> None:

@@ -70,6 +70,7 @@ class _Pending:
     message: FrontendMessage
     sends: int
     next_send: float
+    first_sent: float = 0.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -109,7 +110,7 @@ class Endpoint:
         # Encode first: a message that cannot be encoded must not use up a seq.
         data = encode_datagram(message.type, seq, message_fields(message))
         self.next_seq += 1
-        self._pending[seq] = _Pending(data, message, 1, now + self.resend_after)
+        self._pending[seq] = _Pending(data, message, 1, now + self.resend_after, now)
         self.stats.sent += 1
         return data
 
@@ -191,3 +192,10 @@ class Endpoint:
     @property
     def pending(self) -> int:
         return len(self._pending)
+
+    @property
+    def oldest_pending(self) -> float | None:
+        """When the oldest command still waiting for its ack was first sent."""
+        for pending in self._pending.values():  # in order of sending
+            return pending.first_sent
+        return None

@@ -1,11 +1,12 @@
 """The state of each link, for the operator: rosbridge, front end, clock.
 
 :func:`link_states` reads them off the executive (no I/O): rosbridge
-``connected`` / ``reconnecting`` / ``connecting`` (never connected yet) / ``closed``; the front end
-``acking`` (it answers), ``silent`` (commands wait for an ack and nothing has come
-from it for :data:`SILENT_AFTER` seconds) or ``not heard`` (nothing from it yet,
-nothing waiting); the clock ``wall``, ``/clock`` or ``waiting for /clock``. The
-executive calls its ``wire.links`` taps with each change (status line, rerun lanes).
+``connected`` / ``reconnecting`` / ``connecting`` (never connected yet) /
+``closed``; the front end ``acking`` (it answers), ``silent`` (a command has
+waited :data:`SILENT_AFTER` seconds for its ack and nothing has come from the
+front end since it was sent) or ``not heard`` (nothing from it yet); the clock
+``wall``, ``/clock`` or ``waiting for /clock``. The executive calls its
+``wire.links`` taps with each change (status line, rerun lanes).
 """
 
 from __future__ import annotations
@@ -40,8 +41,11 @@ def rosbridge_state(link: Any, was_connected: bool) -> str:
     return "reconnecting" if was_connected else "connecting"
 
 
-def frontend_state(pending: int, last_heard: float | None, now: float) -> str:
-    if pending and (last_heard is None or now - last_heard > SILENT_AFTER):
+def frontend_state(oldest_pending: float | None, last_heard: float | None, now: float) -> str:
+    """``silent`` when a command has waited more than :data:`SILENT_AFTER` for its ack
+    and nothing came from the front end since it was sent."""
+    if (oldest_pending is not None and now - oldest_pending > SILENT_AFTER
+            and (last_heard is None or last_heard < oldest_pending)):
         return "silent"
     return "acking" if last_heard is not None else "not heard"
 
@@ -58,7 +62,7 @@ def states(executive: Any) -> tuple[str, str, str]:
     link = executive.link
     ready = bool(clock.ready)
     return (rosbridge_state(executive.client.link, executive.was_connected),
-            frontend_state(link.pending, link.last_heard, clock.now() if ready else 0.0),
+            frontend_state(link.oldest_pending, link.last_heard, clock.now() if ready else 0.0),
             clock_state(executive.sim_time, ready))
 
 

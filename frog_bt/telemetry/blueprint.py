@@ -42,7 +42,7 @@ def default_blueprint(index: TreeIndex) -> rrb.Blueprint:
         rrb.Spatial2DView(name="Map", origin="/", contents=["+ /map/**"]),
         rrb.Vertical(lanes, rrb.StateTimelineView(name="Links", origin="/links",
                                                   time_view=SO_FAR),
-                     plots, row_shares=[3, 1, 2]),
+                     plots, row_shares=[5, 3, 4]),
         rrb.TextLogView(name="Log", origin="/log", columns=rrb.archetypes.TextLogColumns(
             # the viewer cuts time columns to "#..." this narrow; a row click sets the cursor
             timeline_columns=[rrb.components.TimelineColumn(TIME, visible=False),

@@ -167,7 +167,8 @@ class Writer:
         rec.set_time(TIME, timestamp=np.datetime64(round(t * 1e9), "ns"))
         for name, state in changes:
             rec.log(link_path(name), rr.StateChange(state=state))
-        level = "WARN" if any(LINK_STATES.get(s) != LINK_OK for _, s in changes) else "INFO"
+        level = "WARN" if any(LINK_STATES.get(s) in (LINK_WAIT, LINK_BAD)
+                              for _, s in changes) else "INFO"
         rec.log("log/links", rr.TextLog(", ".join(f"{n} {s}" for n, s in changes), level=level))
 
     # ------------------------------------------------------------ batches

@@ -12,12 +12,13 @@ from frog_bt.runtime.links import Links, frontend_state
 from frog_bt.telemetry import Telemetry
 
 
-def test_front_end_state_needs_waiting_commands_and_a_quiet_peer() -> None:
-    assert frontend_state(0, None, 10.0) == "not heard"
-    assert frontend_state(0, 1.0, 10.0) == "acking"  # nothing waits: quiet is fine
-    assert frontend_state(2, 9.0, 10.0) == "acking"  # waiting, but heard just now
-    assert frontend_state(2, 7.0, 10.0) == "silent"
-    assert frontend_state(1, None, 10.0) == "silent"
+def test_front_end_state_needs_a_command_waiting_and_a_quiet_peer() -> None:
+    assert frontend_state(None, None, 10.0) == "not heard"
+    assert frontend_state(None, 1.0, 10.0) == "acking"  # nothing waits: quiet is fine
+    assert frontend_state(9.5, 1.0, 10.0) == "acking"  # sent just now: not yet silent
+    assert frontend_state(7.0, 7.5, 10.0) == "acking"  # heard since it was sent
+    assert frontend_state(7.0, 1.0, 10.0) == "silent"  # waited 3 s, nothing since
+    assert frontend_state(7.0, None, 10.0) == "silent"
 
 
 def test_an_outage_and_a_silent_front_end_show_as_link_states(tmp_path: Path) -> None:
