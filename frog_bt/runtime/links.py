@@ -33,6 +33,13 @@ class Links:
                 f"clock {self.clock}")
 
 
+def changed(seen: dict[str, str], links: Links) -> list[tuple[str, str]]:
+    """The (link, state) pairs of ``links`` that differ from ``seen``, which takes them."""
+    out = [(name, state) for name, state in links.items() if seen.get(name) != state]
+    seen.update(out)
+    return out
+
+
 def rosbridge_state(link: Any, was_connected: bool) -> str:
     if link.connected:
         return "connected"

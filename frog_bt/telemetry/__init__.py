@@ -95,12 +95,10 @@ class Telemetry:
         self.on_links(executive.clock.now() if executive.clock.ready else 0.0, executive.links)
 
     def on_links(self, t: float, links: Any) -> None:
-        if self._closed:
-            return
-        changes = [(name, state) for name, state in links.items()
-                   if self._links.get(name) != state]
-        self._links.update(changes)
-        if not changes:
+        from frog_bt.runtime.links import changed
+
+        changes = changed(self._links, links)
+        if self._closed or not changes:
             return
         core = getattr(self, "_core", None)
         try:

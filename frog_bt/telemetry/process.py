@@ -32,6 +32,7 @@ import uuid
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from frog_bt.runtime.links import changed
 from frog_bt.telemetry.layout import TreeIndex
 from frog_bt.telemetry.rows import Rows
 from frog_bt.telemetry.spec import parse_spec
@@ -149,9 +150,7 @@ class TelemetryProcess:
         self.on_links(executive.clock.now() if executive.clock.ready else 0.0, executive.links)
 
     def on_links(self, t: float, links: Any) -> None:
-        changes = [(name, state) for name, state in links.items()
-                   if self._links.get(name) != state]
-        self._links.update(changes)
+        changes = changed(self._links, links)
         if changes:
             tick = self._core.ticks if self._core is not None else 0
             self._send(("links", tick, t, changes))
