@@ -200,3 +200,31 @@ def test_sigterm_stops_the_run_within_2_s_and_leaves_valid_mcap(tmp_path: Path) 
     from frog_bt.cli import main as cli  # the cut-short tour replays identically too
 
     assert cli(["replay", str(path), "--quiet"]) == 0
+
+
+def test_what_was_flushed_survives_a_kill(tmp_path: Path) -> None:
+    """A chunk is handed to the OS at each flush (every second; here at every drain): a
+    copy of the file taken while the recorder runs, as a kill -9 leaves it, has no
+    footer, and every message flushed before it is recovered."""
+    from frog_bt.tools.mcapfile import open_recording
+
+    path, copy = tmp_path / "live.mcap", tmp_path / "killed.mcap"
+
+    async def run() -> None:
+        executive = fake_executive()
+        executive.clock.set(1_780_000_000.0)
+        recorder = Recorder(path, flush_every=0.0)
+        recorder.attach(executive)
+        (datagram,) = executive.wire.datagram
+        for i in range(1, 31):
+            datagram("in", b'{"type":"frontend_idle","seq":%d}' % i, 1_780_000_000.0 + i)
+            await asyncio.sleep(0)  # the drain runs once this callback is over
+        copy.write_bytes(path.read_bytes())  # what a kill -9 now would leave
+        recorder.close()
+
+    asyncio.run(run())
+    recording = open_recording(copy)
+    assert recording.recovered.startswith("cut short (no summary or footer): recovered ")
+    got = [data for topic, _, data in recording.messages() if topic == FRONTEND_IN]
+    assert len(got) == 30 and got[-1] == b'{"type":"frontend_idle","seq":30}'
+    assert not open_recording(path).recovered  # the closed file is whole
