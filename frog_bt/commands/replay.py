@@ -199,7 +199,6 @@ def run_one(args: argparse.Namespace) -> int:
         try:
             telemetry = Telemetry.open(args.rerun, site, tree)
         except (ValueError, OSError) as exc:
-            replay.close()
             print(f"frog-bt replay: {exc}", file=sys.stderr)
             return 2
         telemetry.attach(replay.core)

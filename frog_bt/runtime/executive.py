@@ -30,7 +30,7 @@ from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
 from frog_bt.runtime.clock import Clock, ManualClock
 from frog_bt.runtime.core import Core
-from frog_bt.runtime.links import Links, link_states, states
+from frog_bt.runtime.links import Links, states
 from frog_bt.runtime.status import link_line, status_line
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.warning_limit import WarningLimiter
@@ -95,8 +95,7 @@ class Executive:
         self._checkpoint_warnings = WarningLimiter(60.0, logger=log)
         self._swap: tuple[Site, LoadedTree] | None = None  # a checked tree, for the next idle
         self.was_connected = False  # to rosbridge, at some point: a loss is a reconnect
-        self.links = link_states(self)
-        self._link_states = (self.links.rosbridge, self.links.frontend, self.links.clock)
+        self._link_states = states(self)
         self.swaps = 0
 
     # ------------------------------------------------------------ I/O callbacks (cache only)
@@ -133,12 +132,17 @@ class Executive:
         self.check_links()
         self._wake.set()
 
+    @property
+    def links(self) -> Links:
+        """Each link's state as of the latest check."""
+        return Links(*self._link_states)
+
     def check_links(self) -> None:
         """Compare the links' states with the last seen; tell the ``wire.links`` taps."""
         now_states = states(self)
         if now_states != self._link_states:
             self._link_states = now_states
-            self.links = links = Links(*now_states)
+            links = self.links
             now = self.clock.now() if self.clock.ready else 0.0
             for tap in self.wire.links:
                 tap(now, links)

@@ -1,6 +1,6 @@
 """The state of each link, for the operator: rosbridge, front end, clock.
 
-:func:`link_states` reads them off the executive (no I/O): rosbridge
+:func:`states` reads them off the executive (no I/O, cheap enough for every tick): rosbridge
 ``connected`` / ``reconnecting`` / ``connecting`` (never connected yet) /
 ``closed``; the front end ``acking`` (it answers), ``silent`` (a command has
 waited :data:`SILENT_AFTER` seconds for its ack and nothing has come from the
@@ -72,6 +72,3 @@ def states(executive: Any) -> tuple[str, str, str]:
             frontend_state(link.oldest_pending, link.last_heard, clock.now() if ready else 0.0),
             clock_state(executive.sim_time, ready))
 
-
-def link_states(executive: Any) -> Links:
-    return Links(*states(executive))

@@ -54,6 +54,8 @@ class Telemetry:
         self.rows = Rows(site, self.index, batch_ticks=batch_ticks, on_full=self._full)
         self.writer = Writer(rec, site, self.index)
         self._closed = False
+        self._core: Core | None = None
+        self._links: dict[str, str] = {}
         self._flush_pending = False
         self._writing: deque[tuple[int, Iterator[None]]] = deque()  # batches being written
         self.write_errors = 0  # batches that could not be written (logged, never raised)
@@ -90,7 +92,6 @@ class Telemetry:
 
     def attach_links(self, executive: Any) -> None:
         """Each link's state over time (lanes under ``links/``), from the executive."""
-        self._links: dict[str, str] = {}
         executive.wire.links.append(self.on_links)
         self.on_links(executive.clock.now() if executive.clock.ready else 0.0, executive.links)
 
@@ -100,7 +101,7 @@ class Telemetry:
         changes = changed(self._links, links)
         if self._closed or not changes:
             return
-        core = getattr(self, "_core", None)
+        core = self._core
         try:
             self.writer.write_links(core.ticks if core is not None else 0, t, changes)
         except Exception:  # telemetry must never stop the robot

@@ -64,9 +64,9 @@ def _serve(spec: str, site: Site, tree: LoadedTree, recording_id: str,
             try:
                 item = inbox.get(timeout=5.0)
             except queue.Empty:
-                if multiprocessing.parent_process() is None or not \
-                        multiprocessing.parent_process().is_alive():
-                    return
+                parent = multiprocessing.parent_process()
+                if parent is None or not parent.is_alive():
+                    return  # the executive was killed: finish the file
                 continue
             kind = item[0]
             if kind == "batch":

@@ -212,10 +212,10 @@ class Recorder:
         # What a new file starts with (rotation): the latest message of each input kept
         # as latest, the last /clock, recent datagrams in and the seqs sent out.
         self._latest_topics: frozenset[str] = frozenset()
-        self.latest_raw: dict[str, tuple[float, bytes]] = {}
+        self._latest_raw: dict[str, tuple[float, bytes]] = {}
         self._clock_raw: bytes | None = None
-        self.frontend_in: deque[bytes] = deque(maxlen=PRIMER_DATAGRAMS)
-        self.frontend_out_seqs: deque[int] = deque(maxlen=PRIMER_SEQS)
+        self._frontend_in: deque[bytes] = deque(maxlen=PRIMER_DATAGRAMS)
+        self._frontend_out_seqs: deque[int] = deque(maxlen=PRIMER_SEQS)
         self.messages = 0
         self.dropped = 0  # held before the first /clock beyond HELD_LIMIT
         self.closed = False
@@ -300,7 +300,7 @@ class Recorder:
                 self._write(topic, max(t, clock) if self._ready() else clock, data)
                 return
         if topic in self._latest_topics:
-            self.latest_raw[topic] = (t, data)
+            self._latest_raw[topic] = (t, data)
         self._write(topic, t if self._ready() else None, data)
 
     def on_ros_out(self, t: float, topic: str, msg: Any) -> None:
@@ -312,15 +312,15 @@ class Recorder:
         data = bytes(data)
         if direction == "in":
             topic = FRONTEND_IN
-            self.frontend_in.append(data)
+            self._frontend_in.append(data)
         else:
             topic = FRONTEND_OUT
             try:
                 seq = json.loads(data).get("seq")
             except (ValueError, AttributeError):
                 seq = None
-            if isinstance(seq, int) and seq not in self.frontend_out_seqs:
-                self.frontend_out_seqs.append(seq)
+            if isinstance(seq, int) and seq not in self._frontend_out_seqs:
+                self._frontend_out_seqs.append(seq)
         self._write(topic, t if self._ready() else None, data)
 
     def _tree_message(self, executive: Any) -> bytes | None:
@@ -437,6 +437,15 @@ class Recorder:
         log.error("recording to %s stopped: %s", self.path, exc)
         self._queue.clear()
         self.close()
+
+    def primer(self, frontend_ready: bool) -> bytes:
+        """A :data:`PRIMER` message: what the executive carries from before now."""
+        inputs = [{"topic": topic, "t": t, "msg": json.loads(data)}
+                  for topic, (t, data) in sorted(self._latest_raw.items())]
+        return _dumps({
+            "inputs": inputs, "frontend_ready": frontend_ready,
+            "frontend_in": [d.decode("utf-8", "replace") for d in self._frontend_in],
+            "frontend_out_seqs": list(self._frontend_out_seqs)})
 
     def rotate(self, path: Path, metadata: dict[str, str] | None = None,
                primer: bytes | None = None) -> None:

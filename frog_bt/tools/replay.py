@@ -176,9 +176,6 @@ class Replay:
         self.result = ReplayResult(self.start, self.end, self.start, exact=self.exact,
                                    recovered=self.recovered)
 
-    def close(self) -> None:
-        """Nothing to release: each file is open only while it is read."""
-
     # ------------------------------------------------------------ outputs of the replayed tree
 
     def _publish(self, topic: str, msg: dict[str, Any]) -> None:
@@ -210,32 +207,25 @@ class Replay:
         """Replay to the end, or to the first divergence; the result says which."""
         wall0 = time.monotonic()
         result = self.result
-        try:
-            parted = False
-            for topic, ns, data in self._messages():
-                if parted and topic != BLAME:
-                    break  # the blame of the diverging command, recorded after it, is read
-                t = from_ns(ns)
-                self._on_message(topic, t, data)
-                if parted:
-                    break
-                result.covered = t
-                if progress is not None:
-                    progress(t)
-                parted = result.divergence is not None
-            else:
-                if self.recovered:  # cut short: the live run neither halted nor sent more
-                    return self._finish(result, wall0)
+        parted = False
+        for topic, ns, data in self._messages():
+            if parted and topic != BLAME:
+                break  # the blame of the diverging command, recorded after it, is read
+            t = from_ns(ns)
+            self._on_message(topic, t, data)
+            if parted:
+                break
+            result.covered = t
+            if progress is not None:
+                progress(t)
+            parted = result.divergence is not None
+        else:
+            if not self.recovered:  # cut short: the live run neither halted nor sent more
                 self.core.halt()  # as the executive does when it stops (face stream off, ...)
                 if result.divergence is None and (self._expected or self._got):
                     expected = self._expected.popleft() if self._expected else None
                     got = self._got.popleft() if self._got else None
                     result.divergence = Divergence(self._compared + 1, expected, got)
-        finally:
-            self.close()
-        return self._finish(result, wall0)
-
-    def _finish(self, result: ReplayResult, wall0: float) -> ReplayResult:
         result.ticks = self.core.ticks
         result.wall = time.monotonic() - wall0
         return result

@@ -29,7 +29,6 @@ logged.
 
 from __future__ import annotations
 
-import json
 import logging
 import re
 import time
@@ -111,8 +110,9 @@ class RecordingDir:
         elif core.bt.root.status == Status.SUCCESS:
             if self.kind == "tour":
                 self.number += 1
-            self._rotate("idle", {"kind": "idle", "tour": str(self.number)},
-                         self._primer(core))
+            assert self.recorder is not None
+            primer = self.recorder.primer(bool(core.snapshot.get("/frontend_ready")))
+            self._rotate("idle", {"kind": "idle", "tour": str(self.number)}, primer)
 
     def _rename_first(self) -> None:
         """Under sim time the first file is opened before /clock: name it by the clock's
@@ -129,18 +129,6 @@ class RecordingDir:
             return
         recorder.path = path
         self.files[-1] = path
-
-    def _primer(self, core: Any) -> bytes:
-        recorder = self.recorder
-        assert recorder is not None
-        inputs = [{"topic": topic, "t": t, "msg": json.loads(data)}
-                  for topic, (t, data) in sorted(recorder.latest_raw.items())]
-        return json.dumps({
-            "inputs": inputs,
-            "frontend_ready": bool(core.snapshot.get("/frontend_ready")),
-            "frontend_in": [d.decode("utf-8", "replace") for d in recorder.frontend_in],
-            "frontend_out_seqs": list(recorder.frontend_out_seqs),
-        }, separators=(",", ":")).encode()
 
     def _rotate(self, kind: str, metadata: dict[str, str], primer: bytes | None) -> None:
         recorder = self.recorder
