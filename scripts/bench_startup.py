@@ -66,7 +66,7 @@ async def startup_runs(runs: int, extra: list[str]) -> dict[str, Any]:
 
 def import_time() -> float:
     """Seconds for a fresh interpreter to import what ``frog-bt run`` needs."""
-    code = ("import frog_bt.commands.run, frog_bt.runtime.executive, frog_bt.runtime.status; "
+    code = ("import frog_bt.commands.run, frog_bt.runtime.executive, frog_bt.observers.status; "
             "from frog_bt.config import load_site; from frog_bt.tree.loader import load_tree; "
             "load_tree(site=load_site())")
     t0 = time.perf_counter()

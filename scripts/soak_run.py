@@ -271,9 +271,9 @@ def lost_commands(record_dir: Path) -> tuple[int, int]:
     """(front-end commands sent, never acked), from the recordings in order: a command's
     seq is taken once (resends are not new), an ack with its seq settles it; when the
     numbering starts again (a restarted executive), what is open is lost."""
+    from frog_bt.observers.recording import FRONTEND_IN, FRONTEND_OUT
+    from frog_bt.observers.rotation import numbered
     from frog_bt.tools.mcapfile import RecordingError, open_recording
-    from frog_bt.tools.recording import FRONTEND_IN, FRONTEND_OUT
-    from frog_bt.tools.rotation import numbered
 
     sent = lost = 0
     open_seqs: set[int] = set()

@@ -10,6 +10,7 @@ import py_trees
 
 from frog_bt.config import Site, load_site
 from frog_bt.frontend.messages import FrontendMessage
+from frog_bt.kernel.clock import ManualClock
 from frog_bt.rosbridge.msgs import (
     PersonDetection,
     PersonDetections,
@@ -18,7 +19,6 @@ from frog_bt.rosbridge.msgs import (
     TrackedPeople,
     TrackedPerson,
 )
-from frog_bt.runtime.clock import ManualClock
 from frog_bt.runtime.core import Core
 from frog_bt.tree.loader import LoadedTree, load_tree
 

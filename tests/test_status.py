@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import time
 
+from frog_bt.observers.status import link_line
 from frog_bt.rosbridge.link import LinkState
-from frog_bt.runtime.status import link_line
 
 
 def test_unreachable_rosbridge_is_named_with_attempt_delay_and_plain_reason():

@@ -16,11 +16,11 @@ import pytest
 from bench import Bench, write_tree
 
 from frog_bt.config import load_site
+from frog_bt.kernel.blackboard import Reading
+from frog_bt.kernel.clock import WallClock
+from frog_bt.observers.recording import SCHEMAS
 from frog_bt.rosbridge import msgs
-from frog_bt.runtime.blackboard import Reading
-from frog_bt.runtime.clock import WallClock
 from frog_bt.runtime.executive import Executive
-from frog_bt.tools.recording import SCHEMAS
 from frog_bt.tree.leaf import LEAVES, RUNNING, SUCCESS, Leaf, Status
 from frog_bt.tree.loader import load_tree
 from frog_bt.wire import INPUTS, Input

@@ -6,7 +6,7 @@ from typing import Literal
 
 from pydantic import Field
 
-from frog_bt.runtime.blackboard import Reading
+from frog_bt.kernel.blackboard import Reading
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
 
 TARGET = {"dock": "docked", "undock": "undocked"}

@@ -19,9 +19,9 @@ import math
 from frog_bt.behaviours.navigation import PoiParams
 from frog_bt.config import ZoneShape
 from frog_bt.frontend.messages import FollowMe, SpecialContent, Volume
+from frog_bt.kernel.blackboard import Reading
 from frog_bt.maths.zones import Membership, Shape
 from frog_bt.rosbridge.msgs import Pose
-from frog_bt.runtime.blackboard import Reading
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import Status
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pydantic import Field, ValidationInfo, field_validator
 
-from frog_bt.runtime.actions import CODE_NAMES, Request
+from frog_bt.kernel.actions import CODE_NAMES, Request
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
 from frog_bt.wire import SUCCEEDED
 

@@ -15,8 +15,8 @@ from collections import deque
 
 from frog_bt.behaviours.navigation import PoiParams
 from frog_bt.frontend.messages import Projector as ProjectorCommand
+from frog_bt.kernel.blackboard import Reading
 from frog_bt.rosbridge.msgs import Pose
-from frog_bt.runtime.blackboard import Reading
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import Status
 

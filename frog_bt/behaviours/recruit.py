@@ -9,9 +9,9 @@ from pydantic import Field
 from frog_bt.frontend.messages import AskTour as AskTourCommand
 from frog_bt.frontend.messages import StartIntroduction as StartIntroductionCommand
 from frog_bt.frontend.messages import UserNegative, UserPositive
+from frog_bt.kernel.actions import CODE_NAMES, Request
+from frog_bt.kernel.blackboard import EventLog, Reading
 from frog_bt.rosbridge.msgs import PersonDetection, PersonDetections, Pose
-from frog_bt.runtime.actions import CODE_NAMES, Request
-from frog_bt.runtime.blackboard import EventLog, Reading
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
 from frog_bt.wire import SUCCEEDED
 

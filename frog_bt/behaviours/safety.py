@@ -9,8 +9,8 @@ import py_trees
 from pydantic import Field
 
 from frog_bt.frontend.messages import Tour
+from frog_bt.kernel.blackboard import Reading
 from frog_bt.rosbridge.msgs import Diagnostics
-from frog_bt.runtime.blackboard import Reading
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
 

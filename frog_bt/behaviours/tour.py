@@ -8,7 +8,7 @@ from pydantic import Field
 
 from frog_bt.config import Timeouts
 from frog_bt.frontend.messages import EVENTS, Tour
-from frog_bt.runtime.blackboard import EventLog
+from frog_bt.kernel.blackboard import EventLog
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
 
 

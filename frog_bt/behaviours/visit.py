@@ -10,8 +10,8 @@ from pydantic import Field
 from frog_bt.behaviours.navigation import PoiParams
 from frog_bt.frontend.messages import ContentDone, FrontendIdle, StartPoi
 from frog_bt.frontend.messages import FinishPoi as FinishPoiCommand
+from frog_bt.kernel.blackboard import EventLog, Reading
 from frog_bt.rosbridge.msgs import Pose, TrackedPeople
-from frog_bt.runtime.blackboard import EventLog, Reading
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
 
 

@@ -58,9 +58,9 @@ def run(args: argparse.Namespace) -> int:
 
 async def _demo(site, tree, scenario, args) -> int:  # type: ignore[no-untyped-def]
     from frog_bt.commands.run import attach_observers
+    from frog_bt.observers.status import StatusLine
+    from frog_bt.observers.summary import TourSummary
     from frog_bt.runtime.rehearsal import Rehearsal
-    from frog_bt.runtime.status import StatusLine
-    from frog_bt.tools.summary import TourSummary
 
     summary = TourSummary(site)
     status = None if args.quiet else StatusLine()

@@ -47,8 +47,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def btcpp_xml(path: Path | None, site: Any) -> str:
-    """The tree as BehaviorTree.CPP v4 XML (:func:`frog_bt.tools.btcpp.tree_xml`)."""
-    from frog_bt.tools.btcpp import tree_xml
+    """The tree as BehaviorTree.CPP v4 XML (:func:`frog_bt.tree.btcpp.tree_xml`)."""
+    from frog_bt.tree.btcpp import tree_xml
     from frog_bt.tree.loader import DEFAULT_TREE
 
     return tree_xml(path or DEFAULT_TREE, site)

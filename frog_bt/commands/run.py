@@ -27,10 +27,10 @@ from frog_bt.commands.options import add_tree_and_config, read_secret, rerun_spe
 from frog_bt.config import DEFAULT_CONFIG, Site, check_ws_url, load_site, parse_hostport
 from frog_bt.errors import FrogError, UsageError, error_lines
 from frog_bt.frontend.link import AddressError
+from frog_bt.kernel.clock import SimClock, WallClock
 from frog_bt.runtime.checkpoint import STATE_DIR
 from frog_bt.runtime.checkpoint import claim as claim_checkpoint
 from frog_bt.runtime.checkpoint import default_path as default_checkpoint
-from frog_bt.runtime.clock import SimClock, WallClock
 from frog_bt.tree.loader import DEFAULT_TREE, load_tree
 
 
@@ -138,13 +138,13 @@ def attach_observers(executive: Any, *, record: Path | None, rerun: str | None) 
     """Recorder and telemetry, each imported only when asked for; closed by the caller."""
     observers: list[Any] = []
     if record is not None and record.suffix == ".mcap" and not record.is_dir():
-        from frog_bt.tools.recording import Recorder
+        from frog_bt.observers.recording import Recorder
 
         recorder = Recorder(record)
         recorder.attach(executive)
         observers.append(recorder)
     elif record is not None:
-        from frog_bt.tools.rotation import RecordingDir
+        from frog_bt.observers.rotation import RecordingDir
 
         recordings = RecordingDir(record, executive.site.recording.max_bytes)
         recordings.attach(executive)
@@ -195,8 +195,8 @@ async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Setti
     from frog_bt.runtime.memory import pin_malloc_thresholds
 
     pin_malloc_thresholds()  # all day without creeping up
-    from frog_bt.runtime.status import StatusLine
-    from frog_bt.tools.summary import TourSummary
+    from frog_bt.observers.status import StatusLine
+    from frog_bt.observers.summary import TourSummary
 
     clock = SimClock() if args.sim_time else WallClock()
     executive = Executive(site, tree, clock, rosbridge_url=settings.url,

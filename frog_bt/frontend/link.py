@@ -5,7 +5,7 @@ originates to ``peer`` from that socket and answers every datagram with an ack
 sent back to the datagram's source address. All protocol decisions (numbering,
 acks, resends, duplicates, foreign hosts, malformed datagrams) are the
 :class:`~frog_bt.frontend.protocol.Endpoint`'s; this module only moves bytes and
-turns the injected :class:`~frog_bt.runtime.clock.Clock` into resend wake-ups.
+turns the injected :class:`~frog_bt.kernel.clock.Clock` into resend wake-ups.
 
 The same class serves both sides:
 
@@ -30,7 +30,7 @@ from collections.abc import Callable
 
 from frog_bt.frontend.messages import EVENTS, FrontendMessage
 from frog_bt.frontend.protocol import MAX_DATAGRAM, Endpoint, LinkStats
-from frog_bt.runtime.clock import Clock
+from frog_bt.kernel.clock import Clock
 from frog_bt.warning_limit import WarningLimiter
 
 log = logging.getLogger(__name__)

@@ -17,13 +17,23 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
-from frog_bt.rosbridge.msgs import Face
+
+class FaceLike(Protocol):
+    """What the maths reads of one face sample (the wire's ``Face`` has these)."""
+
+    @property
+    def engagement(self) -> float: ...
+    @property
+    def distance(self) -> float: ...
+    @property
+    def facing(self) -> bool: ...
 
 
-def qualifies(face: Face, near: float) -> bool:
+def qualifies(face: FaceLike, near: float) -> bool:
     return face.facing and face.distance <= near
 
 

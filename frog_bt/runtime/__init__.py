@@ -1,2 +1,3 @@
-"""The run-time: the I/O-free core, the online executive around it, the blackboard
-snapshot, the one clock, checkpoints, the run-time context and robot actions."""
+"""Execution: the I/O-free core that ticks a tree, the online executive around it, the
+rehearsal (executive and simulator in one loop), hot reload (watch), checkpoints and the
+process's memory settings. What they run on is :mod:`frog_bt.kernel`."""

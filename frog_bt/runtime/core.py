@@ -19,10 +19,10 @@ import py_trees
 
 from frog_bt.config import Site
 from frog_bt.frontend.messages import FrontendMessage
-from frog_bt.runtime.actions import Actions
-from frog_bt.runtime.blackboard import Inputs, Reading, Snapshot, peek
-from frog_bt.runtime.clock import Clock
-from frog_bt.runtime.context import Context
+from frog_bt.kernel.actions import Actions
+from frog_bt.kernel.blackboard import Inputs, Reading, Snapshot, peek
+from frog_bt.kernel.clock import Clock
+from frog_bt.kernel.context import Context
 from frog_bt.tree import observed, ticking
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.tree.observed import DECIDED, acting

@@ -24,14 +24,14 @@ import py_trees
 from frog_bt.config import Site
 from frog_bt.frontend.link import FrontendLink
 from frog_bt.frontend.messages import EVENTS, FrontendMessage
+from frog_bt.kernel.clock import Clock, ManualClock
+from frog_bt.observers.links import Links, states
+from frog_bt.observers.status import link_line, status_line
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
-from frog_bt.runtime.clock import Clock, ManualClock
 from frog_bt.runtime.core import Core
-from frog_bt.runtime.links import Links, states
-from frog_bt.runtime.status import link_line, status_line
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.warning_limit import WarningLimiter
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS

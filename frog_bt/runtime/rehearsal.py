@@ -18,7 +18,7 @@ from collections.abc import Callable
 from typing import Any
 
 from frog_bt.config import Site
-from frog_bt.runtime.clock import SimClock
+from frog_bt.kernel.clock import SimClock
 from frog_bt.runtime.executive import Executive, Outcome
 from frog_bt.sim import Simulator
 from frog_bt.sim.scenario import Scenario

@@ -25,7 +25,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from frog_bt.errors import ConfigError
 from frog_bt.frontend import messages as fm
-from frog_bt.runtime.clock import SITE_TZ
+from frog_bt.kernel.clock import SITE_TZ
 from frog_bt.yamlfile import PathError, load_yaml, validate
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]

@@ -96,7 +96,7 @@ class Telemetry:
         self.on_links(executive.clock.now() if executive.clock.ready else 0.0, executive.links)
 
     def on_links(self, t: float, links: Any) -> None:
-        from frog_bt.runtime.links import changed
+        from frog_bt.observers.links import changed
 
         changes = changed(self._links, links)
         if self._closed or not changes:

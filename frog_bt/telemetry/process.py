@@ -32,7 +32,7 @@ import uuid
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from frog_bt.runtime.links import changed
+from frog_bt.observers.links import changed
 from frog_bt.telemetry.layout import TreeIndex
 from frog_bt.telemetry.rows import Rows
 from frog_bt.telemetry.spec import parse_spec

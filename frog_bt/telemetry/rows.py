@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import py_trees
 
-from frog_bt.runtime.blackboard import peek
+from frog_bt.kernel.blackboard import peek
 from frog_bt.telemetry.layout import TreeIndex
 from frog_bt.wire import INPUTS
 

@@ -1,1 +1,2 @@
-"""Tools around the tour: render a tree, record and replay a tour, summarise it."""
+"""Offline tools over trees and recorded tours: render a tree, read, replay and batch-replay
+recordings. Live observers of a running tour are :mod:`frog_bt.observers`."""

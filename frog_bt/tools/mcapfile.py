@@ -2,7 +2,7 @@
 
 :func:`open_recording` gives a :class:`RecordingFile`: its channels' schema names,
 its first and last message times, its ``frog_bt`` metadata (see
-:mod:`frog_bt.tools.rotation`) and an iterator over its messages in log-time order.
+:mod:`frog_bt.observers.rotation`) and an iterator over its messages in log-time order.
 
 A file frog-bt wrote is read front to back (the recorder writes in log-time order,
 and reading in file order skips the reader's merge heap); any other MCAP is read

@@ -1,15 +1,15 @@
 """Re-run the tree offline on a recording's inputs, on the recording's clock.
 
-:class:`Replay` reads an MCAP recording (:mod:`frog_bt.tools.recording`) in log-time
+:class:`Replay` reads an MCAP recording (:mod:`frog_bt.observers.recording`) in log-time
 order and feeds a fresh :class:`~frog_bt.runtime.core.Core` on a
-:class:`~frog_bt.runtime.clock.ManualClock` that takes the recorded times: ROS inputs
+:class:`~frog_bt.kernel.clock.ManualClock` that takes the recorded times: ROS inputs
 go through :data:`~frog_bt.rosbridge.msgs.ROS_TYPES` (by the channel's schema name) to
 ``Core.on_ros``; ``/frontend/in`` datagrams go through a fresh
 :class:`~frog_bt.frontend.protocol.Endpoint`, so duplicates are suppressed exactly
 as live, to ``Core.on_event``; ``/clock`` moves the clock (under sim time what
 arrived before the first ``/clock`` is fed with the clock not yet ready, as live).
 
-Ticks: a recording made by :class:`~frog_bt.tools.recording.Recorder` has the live
+Ticks: a recording made by :class:`~frog_bt.observers.recording.Recorder` has the live
 ticks (``/frog_bt/tick``), and replay ticks exactly there, in the same place
 among the inputs. Live ticks coalesce bursts of inputs and land wherever the
 event loop gets to them, so no rule can recompute them; with the recorded ones,
@@ -41,11 +41,11 @@ from frog_bt.config import Site, parse_hostport
 from frog_bt.errors import DecodeError, FrogError
 from frog_bt.frontend.messages import EVENTS, FrontendMessage, message_fields
 from frog_bt.frontend.protocol import Endpoint
+from frog_bt.kernel.clock import SITE_TZ, ManualClock
+from frog_bt.observers.recording import BLAME, FRONTEND_IN, FRONTEND_OUT, PRIMER, TICK, from_ns
 from frog_bt.rosbridge.msgs import ROS_TYPES
-from frog_bt.runtime.clock import SITE_TZ, ManualClock
 from frog_bt.runtime.core import Core
 from frog_bt.tools.mcapfile import RecordingError, RecordingFile, open_recording
-from frog_bt.tools.recording import BLAME, FRONTEND_IN, FRONTEND_OUT, PRIMER, TICK, from_ns
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
@@ -299,7 +299,7 @@ class Replay:
 
     def _prime(self, data: bytes) -> None:
         """A recorded ``/frog_bt/primer``: what the live executive carried into this file
-        from before it (:mod:`frog_bt.tools.rotation`)."""
+        from before it (:mod:`frog_bt.observers.rotation`)."""
         try:
             primer = json.loads(data)
         except ValueError:
@@ -383,7 +383,7 @@ def _fields(command: Command, site: Site) -> tuple[str, dict[str, Any]]:
     """What a command is (``/GotoWayPoint``, ``start_poi``) and its fields in domain
     terms: a goal's waypoint by name, a front-end message's fields."""
     if command.channel == site.topic("goto"):
-        from frog_bt.tools.summary import TourSummary  # the one waypoint matcher
+        from frog_bt.observers.summary import TourSummary  # the one waypoint matcher
 
         return command.channel, {"waypoint": TourSummary(site).waypoint_of(command.payload)}
     if command.channel == FRONTEND_OUT:

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import py_trees
 
-from frog_bt.runtime.blackboard import input_keys
+from frog_bt.kernel.blackboard import input_keys
 
 Behaviour = py_trees.behaviour.Behaviour
 Keys = frozenset[str]

@@ -7,7 +7,7 @@ against these declarations before anything connects, and ``render`` draws a
 tree with no robot.
 
 Lifecycle (py_trees): ``__init__`` holds only what rendering needs; ``setup``
-receives the run-time :class:`~frog_bt.runtime.context.Context`; ``initialise`` starts
+receives the run-time :class:`~frog_bt.kernel.context.Context`; ``initialise`` starts
 work, ``update`` polls it and never blocks, ``terminate`` cancels it and may be
 called twice.
 """

@@ -45,9 +45,9 @@ import frog_bt.behaviours  # noqa: F401 - registers the leaf types
 from frog_bt import resources
 from frog_bt.config import Site
 from frog_bt.errors import TreeError, TreeErrors, format_path
+from frog_bt.kernel.keys import key_types, type_name
 from frog_bt.tree.decorators import DECORATORS
 from frog_bt.tree.flow import Gap, gaps
-from frog_bt.tree.keys import key_types, type_name
 from frog_bt.tree.leaf import LEAVES
 from frog_bt.tree.observed import Parallel, Selector, Sequence
 from frog_bt.yamlfile import line_of, load_yaml, validate
@@ -352,7 +352,7 @@ def _type_errors(tree: LoadedTree) -> Iterator[TreeError]:
             if key not in types:
                 yield TreeError(where.file, where.path,
                                 f"{who} uses {key}, which no key declaration knows "
-                                "(frog_bt/tree/keys.py)")
+                                "(frog_bt/kernel/keys.py)")
             elif key in declared and declared[key] != types[key]:
                 yield TreeError(where.file, where.path,
                                 f"{who} takes {key} as {type_name(declared[key])}, but "
@@ -391,7 +391,7 @@ def load_tree(path: str | Path | None = None, site: Site | None = None) -> Loade
     builder = _Builder(site)
     source = path
     if path.suffix.lower() == ".xml":  # BehaviorTree.CPP v4 (Groot2): its trees as documents
-        from frog_bt.tools.btcpp import read_xml
+        from frog_bt.tree.btcpp import read_xml
 
         builder.documents, main = read_xml(path)
         path = path.parent / main

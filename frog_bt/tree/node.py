@@ -5,7 +5,7 @@ are errors), the blackboard keys it reads (``reads``: something must write them;
 ``optional_reads``: a default applies while nothing has) and the keys it writes.
 The loader checks a whole tree against these declarations before anything
 connects. At run time ``setup`` hands the node the
-:class:`~frog_bt.runtime.context.Context`; :meth:`Declared.get` and :meth:`Declared.set`
+:class:`~frog_bt.kernel.context.Context`; :meth:`Declared.get` and :meth:`Declared.set`
 reach the blackboard.
 """
 
@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 import py_trees
 from pydantic import BaseModel, ConfigDict
 
-from frog_bt.runtime.context import Context
+from frog_bt.kernel.context import Context
 from frog_bt.tree.observed import ACTING, DECIDED
 
 Status = py_trees.common.Status
@@ -109,6 +109,6 @@ class Declared:
 
 
 def _input_keys() -> frozenset[str]:
-    from frog_bt.runtime.blackboard import input_keys  # the runtime imports the tree
+    from frog_bt.kernel.blackboard import input_keys  # the runtime imports the tree
 
     return frozenset(input_keys())

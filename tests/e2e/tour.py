@@ -12,12 +12,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from frog_bt.config import Site, load_site
+from frog_bt.observers.summary import TourSummary
 from frog_bt.runtime.executive import Executive, Outcome
 from frog_bt.runtime.rehearsal import Rehearsal, free_udp_port
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.traffic import Record
-from frog_bt.tools.summary import TourSummary
 from frog_bt.tree.loader import LoadedTree
 
 # High speed and short content: a whole tour takes a few seconds of wall time.

@@ -27,7 +27,7 @@ from frog_bt.frontend.messages import (
     Volume,
 )
 from frog_bt.frontend.protocol import MAX_DATAGRAM
-from frog_bt.runtime.clock import ManualClock
+from frog_bt.kernel.clock import ManualClock
 from frog_bt.warning_limit import WarningLimiter
 
 HOST = "127.0.0.1"

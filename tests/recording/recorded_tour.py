@@ -8,12 +8,12 @@ from pathlib import Path
 from typing import Any
 
 from frog_bt.config import Site, load_site
+from frog_bt.observers.recording import Recorder
 from frog_bt.runtime.executive import Executive, Outcome
 from frog_bt.runtime.rehearsal import Rehearsal
 from frog_bt.sim import scenario_from
 from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.traffic import Record
-from frog_bt.tools.recording import Recorder
 from frog_bt.tree.loader import LoadedTree
 
 # High speed and short content, as in tests/e2e: a tour takes a few seconds of wall time.

@@ -19,12 +19,8 @@ from recorded_tour import RecordedTour, scenario
 from rosmsgs import encode_clock
 
 from frog_bt.config import load_site
-from frog_bt.runtime.clock import SimClock
-from frog_bt.runtime.core import Taps
-from frog_bt.runtime.executive import WireTaps
-from frog_bt.runtime.rehearsal import free_udp_port
-from frog_bt.sim import Simulator
-from frog_bt.tools.recording import (
+from frog_bt.kernel.clock import SimClock
+from frog_bt.observers.recording import (
     DATAGRAM_TYPE,
     FRONTEND_IN,
     FRONTEND_OUT,
@@ -34,6 +30,10 @@ from frog_bt.tools.recording import (
     from_ns,
     to_ns,
 )
+from frog_bt.runtime.core import Taps
+from frog_bt.runtime.executive import WireTaps
+from frog_bt.runtime.rehearsal import free_udp_port
+from frog_bt.sim import Simulator
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -152,7 +152,8 @@ def test_nanosecond_stamps_give_the_clock_time_back(t: float) -> None:
 
 def test_a_crash_still_leaves_valid_mcap(tmp_path: Path) -> None:
     path = tmp_path / "crash.mcap"
-    code = ("import sys; from pathlib import Path; from frog_bt.tools.recording import Recorder\n"
+    code = ("import sys; from pathlib import Path\n"
+            "from frog_bt.observers.recording import Recorder\n"
             "r = Recorder(Path(sys.argv[1]))\n"
             "r.on_datagram('out', b'{\"type\":\"tour\",\"seq\":1}', 1.0)\n"
             "raise RuntimeError('boom')\n")

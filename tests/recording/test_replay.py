@@ -252,7 +252,7 @@ def test_a_recording_carries_the_tree_that_ran(tour: RecordedTour) -> None:
     """The tree's BT.CPP XML is on /frog_bt/tree: the recording explains itself."""
     from mcap.reader import make_reader
 
-    from frog_bt.tools.btcpp import tree_xml
+    from frog_bt.tree.btcpp import tree_xml
     from frog_bt.tree.loader import DEFAULT_TREE
 
     with open(tour.path, "rb") as f:

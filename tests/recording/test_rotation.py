@@ -16,10 +16,10 @@ from mcap.reader import make_reader
 
 from frog_bt.cli import main
 from frog_bt.config import load_site
+from frog_bt.observers.rotation import RecordingDir, numbered
 from frog_bt.runtime.rehearsal import Rehearsal, free_udp_port
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.tools.replay import Replay, ReplayError
-from frog_bt.tools.rotation import RecordingDir, numbered
 from frog_bt.tree.loader import load_tree
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -98,7 +98,7 @@ def test_the_budget_deletes_the_oldest_tours_first_and_logs_each(
     (day / "notes.mcap").write_bytes(b"x" * 5000)  # not ours: never counted nor deleted
     recordings = RecordingDir(day, 700)
     assert recordings.number == 4  # numbers go on after the highest in DIR
-    with caplog.at_level(logging.WARNING, logger="frog_bt.tools.rotation"):
+    with caplog.at_level(logging.WARNING, logger="frog_bt.observers.rotation"):
         recordings.enforce_budget()
     assert sorted(p.name for p in day.iterdir()) == [
         "20260601-100000-idle0002.mcap", "20260601-100100-tour0002.mcap",

@@ -20,12 +20,12 @@ from dataclasses import dataclass
 from typing import Any
 
 from frog_bt.config import Site, load_site
+from frog_bt.observers.summary import TourSummary
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.executive import Executive
 from frog_bt.runtime.rehearsal import Rehearsal
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.sim.traffic import Record
-from frog_bt.tools.summary import TourSummary
 
 FAST = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
 WAIT = 30.0  # wall seconds: a safety net for every wait, never a pace

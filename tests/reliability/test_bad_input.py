@@ -43,8 +43,8 @@ from frog_bt.config import load_site
 from frog_bt.errors import DecodeError
 from frog_bt.frontend import messages as fm
 from frog_bt.frontend.protocol import Endpoint, decode_datagram, encode_datagram
+from frog_bt.kernel.clock import SimClock
 from frog_bt.rosbridge.protocol import Publish, decode_frame
-from frog_bt.runtime.clock import SimClock
 from frog_bt.runtime.executive import Executive
 from frog_bt.runtime.rehearsal import free_udp_port
 from frog_bt.tree.loader import load_tree

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from harness import TourRun
 
-from frog_bt.runtime.links import Links, frontend_state
+from frog_bt.observers.links import Links, frontend_state
 from frog_bt.telemetry import Telemetry
 
 

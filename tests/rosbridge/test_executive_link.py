@@ -6,7 +6,7 @@ import asyncio
 from typing import Any
 
 from frog_bt.config import load_site
-from frog_bt.runtime.clock import WallClock
+from frog_bt.kernel.clock import WallClock
 from frog_bt.runtime.executive import Executive
 from frog_bt.runtime.rehearsal import free_udp_port
 from frog_bt.tree.loader import load_tree

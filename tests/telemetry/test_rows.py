@@ -123,7 +123,7 @@ def test_telemetry_over_a_core_ticked_by_hand(bench: Bench, tmp_path: Path):
 
 
 def test_rows_before_the_clock_has_a_time_take_the_first_ticks_time(tmp_path: Path):
-    from frog_bt.runtime.clock import SimClock
+    from frog_bt.kernel.clock import SimClock
 
     bench = Bench(write_tree(tmp_path, TREE))
     clock = SimClock()
@@ -138,7 +138,7 @@ def test_rows_before_the_clock_has_a_time_take_the_first_ticks_time(tmp_path: Pa
 
 
 def test_rows_that_never_got_a_time_are_dropped(tmp_path: Path):
-    from frog_bt.runtime.clock import SimClock
+    from frog_bt.kernel.clock import SimClock
 
     bench = Bench(write_tree(tmp_path, TREE))
     bench.core.clock = SimClock()

@@ -33,7 +33,7 @@ from typing import Any, Generic, TypeVar
 import py_trees
 
 from frog_bt.frontend.messages import FrontendIdle, FrontendMessage
-from frog_bt.runtime.clock import Clock
+from frog_bt.kernel.clock import Clock
 from frog_bt.wire import INPUTS, Input, Keep
 
 T = TypeVar("T")

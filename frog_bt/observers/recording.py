@@ -186,7 +186,7 @@ class Recorder:
     ``Recorder(path)`` creates the file (``OSError`` when it cannot);
     :meth:`attach` hooks it to an :class:`~frog_bt.runtime.executive.Executive`;
     :meth:`rotate` finishes the file and carries on in a new one (``--record DIR``,
-    :mod:`frog_bt.tools.rotation`); :meth:`close` finishes it. A write error is
+    :mod:`frog_bt.observers.rotation`); :meth:`close` finishes it. A write error is
     logged once and stops the recording; it never reaches the tick path.
     """
 
@@ -325,7 +325,7 @@ class Recorder:
 
     def _tree_message(self, executive: Any) -> bytes | None:
         """The tree that runs, so that a recording explains itself without the files."""
-        from frog_bt.tools.btcpp import tree_xml
+        from frog_bt.tree.btcpp import tree_xml
 
         tree = getattr(getattr(executive, "core", None), "tree", None)
         if tree is None:

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from frog_bt.config import Poi
+from frog_bt.kernel.clock import Clock
 from frog_bt.rosbridge.msgs import Pose
-from frog_bt.runtime.clock import Clock
 from frog_bt.wire import ABORTED, ACTIVE, FAILED, SUCCEEDED
 
 log = logging.getLogger(__name__)

@@ -1,6 +1,6 @@
 """``frog-bt run --record DIR``: a day of recordings, one file per tour and idle period.
 
-:class:`RecordingDir` keeps one :class:`~frog_bt.tools.recording.Recorder` and moves
+:class:`RecordingDir` keeps one :class:`~frog_bt.observers.recording.Recorder` and moves
 it to a new file at two points, always between ticks:
 
 * when a tour starts (the tree's ``TourStatus started``): the idle period before it
@@ -19,7 +19,7 @@ Files are named by their start time (site local time) and tour number,
 ``20260601-103012-tour0003.mcap``; numbers go on from the highest in DIR, so a
 restarted executive does not reuse one. Each file has its summary and footer
 once it is closed; one cut short (kill -9, power loss) loses at most the last
-second (:data:`~frog_bt.tools.recording.FLUSH_EVERY`) and replay recovers it.
+second (:data:`~frog_bt.observers.recording.FLUSH_EVERY`) and replay recovers it.
 
 The disk budget (``recording.max_bytes``): after each rotation, while DIR's
 recordings add up to more, the oldest tour number's files (its idle file and
@@ -38,8 +38,8 @@ from typing import Any
 
 import py_trees
 
-from frog_bt.runtime.clock import SITE_TZ
-from frog_bt.tools.recording import Recorder
+from frog_bt.kernel.clock import SITE_TZ
+from frog_bt.observers.recording import Recorder
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status

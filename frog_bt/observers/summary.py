@@ -13,10 +13,10 @@ from typing import Any
 
 from frog_bt.config import Site
 from frog_bt.frontend.messages import StartPoi, Tour, UserPositive
+from frog_bt.kernel.blackboard import peek
+from frog_bt.kernel.context import Incident
 from frog_bt.maths.engagement import Decision
 from frog_bt.rosbridge.msgs import POSE
-from frog_bt.runtime.blackboard import peek
-from frog_bt.runtime.context import Incident
 from frog_bt.wire import SUCCEEDED
 
 

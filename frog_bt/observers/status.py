@@ -18,7 +18,7 @@ from typing import Any, TextIO
 
 import py_trees
 
-from frog_bt.runtime.blackboard import peek
+from frog_bt.kernel.blackboard import peek
 from frog_bt.runtime.core import Core
 
 

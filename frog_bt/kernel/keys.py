@@ -1,6 +1,6 @@
 """The blackboard keys and their types: one declaration per key.
 
-Inputs get their types from the wire table (a :class:`~frog_bt.runtime.blackboard.Reading`
+Inputs get their types from the wire table (a :class:`~frog_bt.kernel.blackboard.Reading`
 of the ROS value, or for samples and queues a tuple); the keys tree nodes write
 are listed in :data:`WRITTEN`. A node type may state the type it reads or writes
 a key as (``key_types``); the check before anything connects refuses a node whose
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from frog_bt.kernel.blackboard import EventLog, Reading
 from frog_bt.maths.engagement import Decision, Samples
-from frog_bt.runtime.blackboard import EventLog, Reading
 from frog_bt.wire import INPUTS, Keep
 
 # keys tree nodes write -> the type of their value (None allowed where it says so)

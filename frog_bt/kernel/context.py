@@ -12,9 +12,9 @@ from typing import Literal
 
 from frog_bt.config import Site
 from frog_bt.frontend.messages import FrontendMessage
-from frog_bt.runtime.actions import Actions
+from frog_bt.kernel.actions import Actions
+from frog_bt.kernel.clock import Clock
 from frog_bt.runtime.checkpoint import Progress, Resume
-from frog_bt.runtime.clock import Clock
 
 # What went wrong or differently on a tour: the summaries and the status line list these.
 IncidentKind = Literal[
