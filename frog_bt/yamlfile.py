@@ -20,7 +20,15 @@ from frog_bt.errors import DefinitionError
 M = TypeVar("M", bound=BaseModel)
 
 
+Marks = dict[tuple[str | int, ...], tuple[int, int]]  # path in a file -> (line, column)
+
+
 def load_yaml(path: str | Path, error: type[DefinitionError]) -> Any:
+    return load_yaml_marked(path, error)[0]
+
+
+def load_yaml_marked(path: str | Path, error: type[DefinitionError]) -> tuple[Any, Marks]:
+    """The file's data, and where each path in it is written (line, column from 1)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -34,15 +42,10 @@ def load_yaml(path: str | Path, error: type[DefinitionError]) -> Any:
         where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
         problem = getattr(exc, "problem", None) or str(exc)
         raise error(str(path), (), f"not valid YAML: {where}{problem}") from exc
-    marks: dict[tuple[str | int, ...], tuple[int, int]] = {}
+    marks: Marks = {}
     if node is not None:
         _marks(node, (), marks)
-    MARKS[str(path)] = marks
-    return data
-
-
-# file (as given to load_yaml) -> path in it -> (line, column), both from 1
-MARKS: dict[str, dict[tuple[str | int, ...], tuple[int, int]]] = {}
+    return data, marks
 
 
 def _marks(node: yaml.Node, path: tuple[str | int, ...],
@@ -57,9 +60,18 @@ def _marks(node: yaml.Node, path: tuple[str | int, ...],
             _marks(item, (*path, i), out)
 
 
-def line_of(file: str, path: tuple[str | int, ...]) -> tuple[int, int] | None:
-    """(line, column) of ``path`` in a loaded ``file``, or of its nearest ancestor there."""
-    marks = MARKS.get(str(file))
+def line_of(file: str, path: tuple[str | int, ...], marks: Marks | None = None
+            ) -> tuple[int, int] | None:
+    """(line, column) of ``path`` in ``file``, or of its nearest ancestor there: from
+    ``marks`` when given, else the file is read again (errors only: nothing is kept)."""
+    if marks is None:
+        try:
+            node = yaml.compose(Path(file).read_text(encoding="utf-8"), Loader=yaml.SafeLoader)
+        except (OSError, UnicodeDecodeError, yaml.YAMLError):
+            return None
+        marks = {}
+        if node is not None:
+            _marks(node, (), marks)
     if not marks:
         return None
     for n in range(len(path), -1, -1):

@@ -120,7 +120,7 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
         t0 = clock()
         status = inner()
         dt = clock() - t0
-        tip = core.bt.root.tip()
+        tip = core.root.tip()
         phase = phases.get(id(tip))
         if phase is None:
             phase = phases[id(tip)] = phase_of(tip, dock, recruit_at)

@@ -73,7 +73,7 @@ class Bench:
         self.clock.advance(seconds)
 
     def node(self, name: str) -> py_trees.behaviour.Behaviour:
-        matches = [n for n in self.core.bt.root.iterate() if n.name == name]
+        matches = [n for n in self.core.root.iterate() if n.name == name]
         assert len(matches) == 1, f"{len(matches)} nodes named {name!r}"
         return matches[0]
 

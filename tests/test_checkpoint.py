@@ -13,24 +13,24 @@ from frog_bt.runtime.checkpoint import Progress, Resume, claim, default_path, lo
 
 def test_progress_round_trips_and_an_empty_one_removes_the_file(tmp_path):
     path = tmp_path / "state" / "checkpoint.json"
-    progress = Progress()
-    progress.complete("start")
-    progress.complete("recruit", visitor=7)
+    progress = Progress().complete("start").complete("recruit", visitor=7)
     save(path, progress)
     resume = load(path)
-    assert resume is not None and resume.order == ["start", "recruit"] and resume.visitor == 7
+    assert resume is not None and resume.order == ("start", "recruit") and resume.visitor == 7
+    assert resume.done == {"start", "recruit"}
     assert [p.name for p in path.parent.iterdir()] == ["checkpoint.json"]  # no temp file left
-    progress.clear()
-    save(path, progress)
+    save(path, Progress())
     assert not path.exists()
 
 
 def test_running_a_checkpoint_again_drops_it_and_everything_after():
     progress = Progress()
     for name in ("start", "recruit", "stop 0", "stop 1"):
-        progress.complete(name)
-    progress.begin("recruit")  # the visitor was lost: recruit again
-    assert progress.done == ["start"]
+        progress = progress.complete(name)
+    again = progress.begin("recruit")  # the visitor was lost: recruit again
+    assert again.done == ("start",)
+    assert progress.done == ("start", "recruit", "stop 0", "stop 1")  # values: not mutated
+    assert again.begin("stop 5") is again
 
 
 def test_old_unreadable_or_foreign_checkpoints_are_not_resumed(tmp_path):
@@ -67,11 +67,12 @@ def test_a_claimed_checkpoint_cannot_be_claimed_again_until_released(tmp_path):
 
 def test_resume_is_announced_where_the_tour_picks_up_and_how_old_it_is():
     stops = ["POI1", "POI2", "POI3"]
-    resume = Resume({"start", "recruit", "stop 0"}, 7, ["start", "recruit", "stop 0"], 1000.0)
+    done = ("start", "recruit", "stop 0")
+    resume = Resume(frozenset(done), 7, done, 1000.0)
     assert resume.announce(stops, now=1180.0) == (
         "resuming the tour at POI2: checkpoint 3 min old")
-    assert Resume(set(), None, ["start", "recruit"], 1000.0).announce(stops, 1010.0) == (
+    assert Resume(frozenset(), None, ("start", "recruit"), 1000.0).announce(stops, 1010.0) == (
         "resuming the tour at POI1: checkpoint 10 s old")
-    assert Resume(set(), None, ["start"], 0.0).where(stops) == "at the recruitment"
-    assert Resume(set(), None, ["start", "recruit", "stop 2"], 0.0).where(stops) == (
+    assert Resume(frozenset(), None, ("start",), 0.0).where(stops) == "at the recruitment"
+    assert Resume(frozenset(), None, ("start", "recruit", "stop 2"), 0.0).where(stops) == (
         "on the way back to the dock")

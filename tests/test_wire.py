@@ -16,29 +16,32 @@ import pytest
 from bench import Bench, write_tree
 
 from frog_bt.config import load_site
-from frog_bt.kernel.blackboard import Reading
 from frog_bt.kernel.clock import WallClock
+from frog_bt.kernel.key import Reading
 from frog_bt.observers.recording import SCHEMAS
 from frog_bt.rosbridge import msgs
 from frog_bt.runtime.executive import Executive
 from frog_bt.tree.leaf import LEAVES, RUNNING, SUCCESS, Leaf, Status
 from frog_bt.tree.loader import load_tree
-from frog_bt.wire import INPUTS, Input
+from frog_bt.wire import INPUTS, Input, input_key
+
+# In frog_bt/wire.py, beside its topic: the input's key (its type is the value's Reading)
+CORRIDOR = input_key("/corridor", Reading[str], "whether the corridor ahead is clear")
 
 
 class CorridorClear(Leaf):
     """Reads ``/corridor``: SUCCESS once the lidar says ``clear``, else RUNNING."""
 
-    reads = ("/corridor",)
+    reads = (CORRIDOR,)
 
     def update(self) -> Status:
-        reading: Reading[str] | None = self.get("/corridor")
+        reading = self.get(CORRIDOR)
         return SUCCESS if reading is not None and reading.value == "clear" else RUNNING
 
 
 @pytest.fixture
 def corridor(monkeypatch: pytest.MonkeyPatch) -> Iterator[Input]:
-    entry = Input("/lidar/corridor", msgs.STRING, "/corridor")  # the one table entry
+    entry = Input("/lidar/corridor", msgs.STRING, CORRIDOR)  # the one table entry
     monkeypatch.setitem(INPUTS, "corridor", entry)
     monkeypatch.setitem(LEAVES, "CorridorClear", CorridorClear)  # and its leaf
     yield entry
@@ -71,5 +74,5 @@ def test_a_leaf_reading_a_key_no_input_writes_is_refused(tmp_path: Path,
                                                          monkeypatch: pytest.MonkeyPatch
                                                          ) -> None:
     monkeypatch.setitem(LEAVES, "CorridorClear", CorridorClear)
-    with pytest.raises(Exception, match="reads /corridor: nothing writes it"):
+    with pytest.raises(Exception, match="uses /corridor, which no key declaration knows"):
         load_tree(write_tree(tmp_path, "root: {type: CorridorClear}"), load_site())

@@ -6,7 +6,8 @@ from typing import Literal
 
 from pydantic import Field
 
-from frog_bt.kernel.blackboard import Reading
+from frog_bt.kernel import keys
+from frog_bt.kernel.outcomes import IncidentKind
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
 
 TARGET = {"dock": "docked", "undock": "undocked"}
@@ -32,11 +33,11 @@ class Docking(Leaf):
         timeout: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
             "seconds before it fails (default: site timeouts.dock / timeouts.undock)"))
 
-    reads = ("/docking", "/now")
+    reads = (keys.DOCKING, keys.NOW)
 
     def initialise(self) -> None:
         action = self.params.action
-        state: Reading[str] | None = self.get("/docking")
+        state = self.get(keys.DOCKING)
         self.sent_at = self.ctx.clock.now()
         self.already = state is not None and state.value == TARGET[action]
         self.took = False
@@ -49,7 +50,7 @@ class Docking(Leaf):
     def update(self) -> Status:
         if self.already:
             return SUCCESS
-        state: Reading[str] | None = self.get("/docking")
+        state = self.get(keys.DOCKING)
         if state is not None and state.at >= self.sent_at:
             if state.value == TARGET[self.params.action]:
                 return SUCCESS
@@ -57,11 +58,11 @@ class Docking(Leaf):
                 self.took = True
             if state.value == "failed" and (
                     self.took or state.at - self.sent_at >= FAILED_GRACE):
-                self.ctx.note(f"{self.params.action} failed", incident="docking failed")
+                self.ctx.note(f"{self.params.action} failed", incident=IncidentKind.DOCKING_FAILED)
                 return FAILURE
-        if self.get("/now") - self.sent_at >= self.timeout:
+        if self.need(keys.NOW) - self.sent_at >= self.timeout:
             self.ctx.note(f"{self.params.action}: no {TARGET[self.params.action]} "
-                          f"within {self.timeout:g} s", incident="docking failed")
+                          f"within {self.timeout:g} s", incident=IncidentKind.DOCKING_FAILED)
             return FAILURE
         self.feedback_message = f"{state.value if state else 'no state'}"
         return RUNNING

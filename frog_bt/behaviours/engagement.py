@@ -15,6 +15,7 @@ import py_trees
 from pydantic import Field
 
 from frog_bt.frontend.messages import Engagement
+from frog_bt.kernel import keys
 from frog_bt.maths.engagement import Decision, Samples, decide, meter, qualifies
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
@@ -34,37 +35,35 @@ class FaceStream(FrogDecorator):
     Returns the child's status.
     """
 
-    reads = ("/faces", "/now")
-    writes = ("/icl", "/engagement", "/engagement_meter")
+    reads = (keys.FACES, keys.NOW)
+    writes = (keys.ICL, keys.ENGAGEMENT, keys.ENGAGEMENT_METER)
 
-    def provides(self) -> tuple[str, ...]:
+    def provides(self) -> tuple[keys.Key[object], ...]:
         """What the child may read while the stream is on (the data-flow check)."""
         return self.writes
 
-    def __init__(self, name: str, child: py_trees.behaviour.Behaviour,
-                 params: Params | None = None) -> None:
-        super().__init__(name, child, params)
-        self._on = False
+    def _on(self) -> bool:
+        """Is the stream on? (``/icl``: the one place this is kept.)"""
+        return self._bb is not None and bool(self.get(keys.ICL))
 
     def initialise(self) -> None:
         self.ctx.actions.icl(True)
-        self._on = True
         self.samples = Samples()
         self.last_face_data = self.ctx.clock.now()
         self.next_meter = self.ctx.clock.now() + self.ctx.site.engagement.window
-        self.set("/icl", True)
-        self.set("/engagement", self.samples)
+        self.set(keys.ICL, True)
+        self.set(keys.ENGAGEMENT, self.samples)
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
         # Store this tick's samples before the child runs, so a decision taken
         # in this tick counts every sample that arrived before it.
-        if self._on and self.status == RUNNING:
+        if self.status == RUNNING and self._on():
             self._collect()
         yield from super().tick()
 
     def _collect(self) -> None:
         near = self.ctx.site.engagement.near
-        faces = self.get("/faces", ())
+        faces = self.get(keys.FACES) or ()
         now = self.ctx.clock.now()
         if faces:
             self.last_face_data = now
@@ -75,21 +74,20 @@ class FaceStream(FrogDecorator):
                 self.samples.add(t, face.engagement)
 
     def update(self) -> Status:
-        if self._on:
+        if self._on():
             window = self.ctx.site.engagement.window
-            now = self.get("/now")
+            now = self.need(keys.NOW)
             while now >= self.next_meter:
                 level = meter(self.samples.window(self.next_meter - window, self.next_meter))
                 self.ctx.send(Engagement(level))
-                self.set("/engagement_meter", level)
+                self.set(keys.ENGAGEMENT_METER, level)
                 self.next_meter += window
         return self.decorated.status
 
     def terminate(self, new_status: Status) -> None:
-        if self._on:  # idempotent: py_trees may call terminate twice
-            self._on = False
+        if self._on():  # idempotent: py_trees may call terminate twice
             self.ctx.actions.icl(False)
-            self.set("/icl", False)
+            self.set(keys.ICL, False)
 
 
 @register
@@ -106,17 +104,16 @@ class DecideEngagement(Leaf):
         about: str = Field("", description="what the decision is about, for notes and "
                            "telemetry (the POI, or introduction)")
 
-    optional_reads = ("/engagement",)
-    writes = ("/engaged", "/engagement_decision")
-    key_types = {"/engaged": bool | None, "/engagement_decision": tuple[str, Decision]}
+    optional_reads = (keys.ENGAGEMENT,)
+    writes = (keys.ENGAGED, keys.ENGAGEMENT_DECISION)
 
     def update(self) -> Status:
         cfg = self.ctx.site.engagement
-        samples: Samples | None = self.get("/engagement")
+        samples = self.get(keys.ENGAGEMENT)
         levels = samples.levels() if samples is not None else Samples().levels()
         decision: Decision = decide(levels, cfg.edge, cfg.on_tie)
-        self.set("/engaged", decision.engaged)
-        self.set("/engagement_decision", (self.params.about, decision))
+        self.set(keys.ENGAGED, decision.engaged)
+        self.set(keys.ENGAGEMENT_DECISION, (self.params.about, decision))
         self.ctx.note(f"{self.params.about or 'engagement'}: {decision.describe()}")
         return SUCCESS
 
@@ -129,11 +126,10 @@ class Engaged(Leaf):
     ``engagement.no_data`` decides.
     """
 
-    reads = ("/engaged",)
-    key_types = {"/engaged": bool | None}
+    reads = (keys.ENGAGED,)
 
     def update(self) -> Status:
-        engaged = self.get("/engaged")
+        engaged = self.get(keys.ENGAGED)
         if engaged is None:
             engaged = self.ctx.site.engagement.no_data
         return SUCCESS if engaged else FAILURE

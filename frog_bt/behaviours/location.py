@@ -19,7 +19,8 @@ import math
 from frog_bt.behaviours.navigation import PoiParams
 from frog_bt.config import ZoneShape
 from frog_bt.frontend.messages import FollowMe, SpecialContent, Volume
-from frog_bt.kernel.blackboard import Reading
+from frog_bt.kernel import keys
+from frog_bt.kernel.key import Reading
 from frog_bt.maths.zones import Membership, Shape
 from frog_bt.rosbridge.msgs import Pose
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
@@ -28,8 +29,8 @@ from frog_bt.tree.leaf import Status
 
 def fresh_pose(node: FrogDecorator) -> Reading[Pose] | None:
     """``/pose`` when fresher than ``safety.pose_max_age``; else None, and the node says so."""
-    pose: Reading[Pose] | None = node.get("/pose")
-    if pose is None or pose.age(node.get("/now")) > node.ctx.site.safety.pose_max_age:
+    pose = node.get(keys.POSE)
+    if pose is None or pose.age(node.need(keys.NOW)) > node.ctx.site.safety.pose_max_age:
         node.feedback_message = "pose stale or missing: location features paused"
         return None
     node.feedback_message = ""
@@ -51,7 +52,7 @@ class LocationAware(FrogDecorator):
     hysteresis at the borders. Returns the child's status.
     """
 
-    reads = ("/pose", "/now")
+    reads = (keys.POSE, keys.NOW)
 
     def initialise(self) -> None:
         cfg = self.ctx.site.zones.volume
@@ -84,9 +85,9 @@ class GuidedDrive(FrogDecorator):
     """
 
     Params = PoiParams
-    reads = ("/pose", "/now")
-    optional_reads = ("/waypoint", "/special_done")
-    writes = ("/special_done",)
+    reads = (keys.POSE, keys.NOW)
+    optional_reads = (keys.WAYPOINT, keys.SPECIAL_DONE)
+    writes = (keys.SPECIAL_DONE,)
 
     def __init__(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
         super().__init__(*args, **kwargs)
@@ -102,16 +103,16 @@ class GuidedDrive(FrogDecorator):
         if pose is not None:
             p = (pose.value.x, pose.value.y)
             site = self.ctx.site
-            target = site.pois.get(self.get("/waypoint") or self.params.poi)
+            target = site.pois.get(self.get(keys.WAYPOINT) or self.params.poi)
             radius = site.zones.arrival_radius(self.params.poi)
             if (self._on and target is not None
                     and math.hypot(p[0] - target.x, p[1] - target.y) <= radius):
                 self._follow_off(f"within {radius:g} m of {self.params.poi}")
-            done: frozenset[str] = self.get("/special_done") or frozenset()
+            done: frozenset[str] = self.get(keys.SPECIAL_DONE) or frozenset()
             for spot, shape in self.spots:
                 if spot not in done and shape.contains(p):
                     done = done | {spot}
-                    self.set("/special_done", done)
+                    self.set(keys.SPECIAL_DONE, done)
                     self.ctx.send(SpecialContent(spot))
                     self.ctx.note(f"special content: {spot} nearby")
         return self.decorated.status

@@ -4,9 +4,19 @@ from __future__ import annotations
 
 from pydantic import Field, ValidationInfo, field_validator
 
-from frog_bt.kernel.actions import CODE_NAMES, Request
+from frog_bt.kernel import keys
+from frog_bt.kernel.actions import Goal
+from frog_bt.kernel.outcomes import IncidentKind
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
 from frog_bt.wire import SUCCEEDED
+
+
+def goal_state(sent: Goal, latest: Goal | None) -> Goal | None:
+    """``sent`` as the board's ``/goal`` says it is now; None once a newer goal replaced
+    it. Within the tick that sent it the board may still hold an older goal."""
+    if latest is None or latest.id < sent.id:
+        return sent
+    return latest if latest.id == sent.id else None
 
 
 class PoiParams(Params):
@@ -27,8 +37,8 @@ class Navigate(Leaf):
     """Drive to ``poi``, choosing its time-of-day variant from the project clock.
 
     Sends ``/GotoWayPoint`` in initialise (a new goal replaces the active one).
-    Reads ``/now``; writes ``/target`` (the logical POI), ``/waypoint`` (the
-    variant chosen, e.g. ``POI1b``) and clears ``/skipped``. SUCCESS on
+    Reads ``/now`` and ``/goal`` (its result); writes ``/target`` (the logical POI),
+    ``/waypoint`` (the variant chosen, e.g. ``POI1b``) and clears ``/skipped``. SUCCESS on
     ``/FROG_response`` 2; FAILURE on 3 or 4, when another goal replaces this
     one, or after ``timeout`` seconds (default: site ``timeouts.navigation``).
     """
@@ -37,44 +47,45 @@ class Navigate(Leaf):
         timeout: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
             "seconds before it fails (default: site timeouts.navigation)"))
 
-    reads = ("/now",)
-    writes = ("/target", "/waypoint", "/skipped")
+    reads = (keys.NOW, keys.GOAL)
+    writes = (keys.TARGET, keys.WAYPOINT, keys.SKIPPED)
 
     def initialise(self) -> None:
         site, clock = self.ctx.site, self.ctx.clock
         poi = self.params.poi
         waypoint = site.waypoint_for(poi, clock.local_time().time())
-        self.request: Request | None = self.ctx.actions.goto(waypoint, site.pois[waypoint])
+        self.goal: Goal | None = self.ctx.actions.goto(waypoint, site.pois[waypoint])
         self.timeout = self.params.timeout or site.timeouts.navigation
-        self.set("/target", poi)
-        self.set("/waypoint", waypoint)
-        self.set("/skipped", None)
+        self.set(keys.TARGET, poi)
+        self.set(keys.WAYPOINT, waypoint)
+        self.set(keys.SKIPPED, None)
         self.ctx.note(f"go to {waypoint}" + (f" ({poi} at {clock.local_time():%H:%M})"
                                              if waypoint != poi else ""))
 
     def update(self) -> Status:
-        request = self.request
-        assert request is not None
-        if request.code == SUCCEEDED:
-            self.ctx.note(f"arrived at {request.target}")
+        assert self.goal is not None
+        target = self.goal.target
+        goal = goal_state(self.goal, self.get(keys.GOAL))
+        if goal is None:
+            self.ctx.note(f"navigation to {target} replaced by another goal")
+            return FAILURE
+        if goal.code == SUCCEEDED:
+            self.ctx.note(f"arrived at {target}")
             return SUCCESS
-        if request.done:
-            self.ctx.note(f"navigation to {request.target} {CODE_NAMES[request.code]}",
-                          incident="navigation failed")
+        if goal.done:
+            self.ctx.note(f"navigation to {target} {goal.state()}",
+                          incident=IncidentKind.NAVIGATION_FAILED)
             return FAILURE
-        if self.ctx.actions.pending is not request:
-            self.ctx.note(f"navigation to {request.target} replaced by another goal")
+        if self.need(keys.NOW) - goal.sent_at >= self.timeout:
+            self.ctx.note(f"navigation to {target}: no arrival within {self.timeout:g} s",
+                          incident=IncidentKind.NAVIGATION_FAILED)
             return FAILURE
-        if self.get("/now") - request.sent_at >= self.timeout:
-            self.ctx.note(f"navigation to {request.target}: no arrival within {self.timeout:g} s",
-                          incident="navigation failed")
-            return FAILURE
-        self.feedback_message = f"{request.target}: {CODE_NAMES.get(request.code, 'sent')}"
+        self.feedback_message = f"{target}: {goal.state()}"
         return RUNNING
 
     def terminate(self, new_status: Status) -> None:
         if new_status in (INVALID, FAILURE):
-            self.ctx.actions.cancel(getattr(self, "request", None))
+            self.ctx.actions.cancel(getattr(self, "goal", None))
 
 
 @register
@@ -85,12 +96,12 @@ class SkipStop(Leaf):
     """
 
     Params = PoiParams
-    writes = ("/skipped",)
+    writes = (keys.SKIPPED,)
 
     def update(self) -> Status:
-        self.set("/skipped", self.params.poi)
+        self.set(keys.SKIPPED, self.params.poi)
         self.ctx.note(f"skipped {self.params.poi}: navigation kept failing",
-                      incident="stop skipped", subject=self.params.poi)
+                      incident=IncidentKind.STOP_SKIPPED, subject=self.params.poi)
         return SUCCESS
 
 
@@ -99,7 +110,7 @@ class Skipped(Leaf):
     """Is ``poi`` being skipped? Reads ``/skipped`` (optional). SUCCESS if so, else FAILURE."""
 
     Params = PoiParams
-    optional_reads = ("/skipped",)
+    optional_reads = (keys.SKIPPED,)
 
     def update(self) -> Status:
-        return SUCCESS if self.get("/skipped") == self.params.poi else FAILURE
+        return SUCCESS if self.get(keys.SKIPPED) == self.params.poi else FAILURE

@@ -15,8 +15,7 @@ from collections import deque
 
 from frog_bt.behaviours.navigation import PoiParams
 from frog_bt.frontend.messages import Projector as ProjectorCommand
-from frog_bt.kernel.blackboard import Reading
-from frog_bt.rosbridge.msgs import Pose
+from frog_bt.kernel import keys
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import Status
 
@@ -43,8 +42,8 @@ class Projector(FrogDecorator):
     class Params(PoiParams):
         pass
 
-    reads = ("/pose", "/now")
-    optional_reads = ("/waypoint",)
+    reads = (keys.POSE, keys.NOW)
+    optional_reads = (keys.WAYPOINT,)
 
     def __init__(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
         super().__init__(*args, **kwargs)
@@ -59,11 +58,11 @@ class Projector(FrogDecorator):
         return self.decorated.status
 
     def _consider(self) -> None:
-        pose: Reading[Pose] | None = self.get("/pose")
-        target = self.ctx.site.pois.get(self.get("/waypoint") or self.params.poi)
+        pose = self.get(keys.POSE)
+        target = self.ctx.site.pois.get(self.get(keys.WAYPOINT) or self.params.poi)
         if pose is None or target is None:
             return
-        if pose.age(self.get("/now")) > self.ctx.site.safety.pose_max_age:
+        if pose.age(self.need(keys.NOW)) > self.ctx.site.safety.pose_max_age:
             self.feedback_message = "pose stale: no arrival estimate"
             return
         cfg = self.ctx.site.projector

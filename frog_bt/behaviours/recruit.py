@@ -6,12 +6,14 @@ import math
 
 from pydantic import Field
 
+from frog_bt.behaviours.navigation import goal_state
 from frog_bt.frontend.messages import AskTour as AskTourCommand
 from frog_bt.frontend.messages import StartIntroduction as StartIntroductionCommand
 from frog_bt.frontend.messages import UserNegative, UserPositive
-from frog_bt.kernel.actions import CODE_NAMES, Request
-from frog_bt.kernel.blackboard import EventLog, Reading
-from frog_bt.rosbridge.msgs import PersonDetection, PersonDetections, Pose
+from frog_bt.kernel import keys
+from frog_bt.kernel.actions import Goal
+from frog_bt.kernel.outcomes import IncidentKind
+from frog_bt.rosbridge.msgs import PersonDetection, Pose
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
 from frog_bt.wire import SUCCEEDED
 
@@ -48,24 +50,23 @@ class SeekVisitor(Leaf):
     Writes ``/visitor`` (the person id). RUNNING until someone qualifies, then SUCCESS.
     """
 
-    reads = ("/persons", "/pose", "/now")
-    optional_reads = ("/declined", "/approach_failed")
-    writes = ("/visitor",)
-    key_types = {"/visitor": int}
+    reads = (keys.PERSONS, keys.POSE, keys.NOW)
+    optional_reads = (keys.DECLINED, keys.APPROACH_FAILED)
+    writes = (keys.VISITOR,)
 
     def update(self) -> Status:
         cfg = self.ctx.site.recruit
-        persons: Reading[PersonDetections] | None = self.get("/persons")
-        pose: Reading[Pose] | None = self.get("/pose")
-        now = self.get("/now")
+        persons = self.get(keys.PERSONS)
+        pose = self.get(keys.POSE)
+        now = self.need(keys.NOW)
         if pose is None:
             self.feedback_message = "no pose yet"
             return RUNNING
         if persons is None or persons.age(now) > cfg.detection_max_age:
             self.feedback_message = "no recent person detections"
             return RUNNING
-        declined = self.get("/declined") or frozenset()
-        cooling = cooling_down(self.get("/approach_failed"), now, cfg.retry_after)
+        declined = self.get(keys.DECLINED) or frozenset()
+        cooling = cooling_down(self.get(keys.APPROACH_FAILED), now, cfg.retry_after)
         person = facing_visitor(persons.value.persons, pose.value, cfg.facing_min,
                                 cfg.facing_max, declined | cooling)
         if person is None:
@@ -74,7 +75,7 @@ class SeekVisitor(Leaf):
                 f" but {', '.join(map(str, sorted(cooling)))} (approach failed)"
                 if cooling else "")
             return RUNNING
-        self.set("/visitor", person.id)
+        self.set(keys.VISITOR, person.id)
         self.ctx.note(f"visitor {person.id} faces the robot "
                       f"({person.orientation:.0f} deg), nearest of {len(persons.value.persons)}")
         return SUCCESS
@@ -84,7 +85,8 @@ class SeekVisitor(Leaf):
 class ApproachVisitor(Leaf):
     """Approach ``/visitor`` with ``/ApproachPeopleFar``, never faster than the site allows.
 
-    Reads ``/visitor``, ``/now``, ``/approach_failed``; writes ``/approach_failed``.
+    Reads ``/visitor``, ``/now``, ``/goal`` (its result), ``/approach_failed``; writes
+    ``/approach_failed``.
     The command goes out once ``recruit.approach_interval`` seconds have passed
     since the previous approach (RUNNING until then). SUCCESS on
     ``/FROG_response`` 2; FAILURE on 3 or 4, or after ``timeout`` (default: site
@@ -95,14 +97,15 @@ class ApproachVisitor(Leaf):
     class Params(Params):
         timeout: float | None = Timeout
 
-    reads = ("/visitor", "/now")
-    optional_reads = ("/approach_failed",)
-    writes = ("/approach_failed",)
-    key_types = {"/visitor": int, "/approach_failed": dict}
+    reads = (keys.VISITOR, keys.NOW, keys.GOAL)
+    optional_reads = (keys.APPROACH_FAILED,)
+    writes = (keys.APPROACH_FAILED,)
 
     def initialise(self) -> None:
-        self.visitor = self.get("/visitor")
-        self.request: Request | None = None
+        visitor = self.get(keys.VISITOR)
+        assert visitor is not None  # a required read of a leaf's key: never None
+        self.visitor = visitor
+        self.goal: Goal | None = None
         self.timeout = self.params.timeout or self.ctx.site.timeouts.approach
         self._send_when_due()
 
@@ -112,38 +115,40 @@ class ApproachVisitor(Leaf):
         if now < due:
             self.feedback_message = f"next approach in {due - now:.1f} s"
             return
-        self.request = actions.approach(self.visitor)
+        self.goal = actions.approach(self.visitor)
         self.ctx.note(f"approach visitor {self.visitor}")
 
     def update(self) -> Status:
-        if self.request is None:
+        if self.goal is None:
             self._send_when_due()
-            if self.request is None:
+            if self.goal is None:
                 return RUNNING
-        request = self.request
-        if request.code == SUCCEEDED:
+        goal = goal_state(self.goal, self.get(keys.GOAL))
+        if goal is None:
+            return self._failed("replaced")
+        if goal.code == SUCCEEDED:
             self.ctx.note(f"approached visitor {self.visitor}")
             return SUCCESS
-        if request.done or self.ctx.actions.pending is not request:
-            return self._failed(CODE_NAMES.get(request.code, "replaced"))
-        if self.get("/now") - request.sent_at >= self.timeout:
+        if goal.done:
+            return self._failed(goal.state())
+        if self.need(keys.NOW) - goal.sent_at >= self.timeout:
             return self._failed("timed out")
         return RUNNING
 
     def _failed(self, how: str) -> Status:
-        failed = dict(self.get("/approach_failed") or {})
-        now = self.get("/now")
+        failed = dict(self.get(keys.APPROACH_FAILED) or {})
+        now = self.need(keys.NOW)
         retry_after = self.ctx.site.recruit.retry_after
         failed = {pid: at for pid, at in failed.items() if now - at < retry_after}
         failed[self.visitor] = now
-        self.set("/approach_failed", failed)
+        self.set(keys.APPROACH_FAILED, failed)
         self.ctx.note(f"approach of visitor {self.visitor} {how}: seek again "
-                      f"(not them for {retry_after:g} s)", incident="approach failed")
+                      f"(not them for {retry_after:g} s)", incident=IncidentKind.APPROACH_FAILED)
         return FAILURE
 
     def terminate(self, new_status: Status) -> None:
         if new_status in (INVALID, FAILURE):
-            self.ctx.actions.cancel(getattr(self, "request", None))
+            self.ctx.actions.cancel(getattr(self, "goal", None))
 
 
 @register
@@ -153,10 +158,10 @@ class StartIntroduction(Leaf):
     Reads ``/icl`` (optional: False without a FaceStream scope). SUCCESS.
     """
 
-    optional_reads = ("/icl",)
+    optional_reads = (keys.ICL,)
 
     def update(self) -> Status:
-        self.ctx.send(StartIntroductionCommand(bool(self.get("/icl"))))
+        self.ctx.send(StartIntroductionCommand(bool(self.get(keys.ICL))))
         return SUCCESS
 
 
@@ -168,10 +173,10 @@ class AskTour(Leaf):
     samples, None (sent as null) without face data. SUCCESS.
     """
 
-    optional_reads = ("/engaged",)
+    optional_reads = (keys.ENGAGED,)
 
     def update(self) -> Status:
-        self.ctx.send(AskTourCommand(self.get("/engaged")))
+        self.ctx.send(AskTourCommand(self.get(keys.ENGAGED)))
         return SUCCESS
 
 
@@ -188,31 +193,29 @@ class WaitAnswer(Leaf):
     class Params(Params):
         timeout: float | None = Timeout
 
-    reads = ("/events", "/visitor", "/now")
-    optional_reads = ("/declined",)
-    writes = ("/declined",)
-    key_types = {"/visitor": int, "/declined": frozenset}
+    reads = (keys.EVENTS, keys.VISITOR, keys.NOW)
+    optional_reads = (keys.DECLINED,)
+    writes = (keys.DECLINED,)
 
     def initialise(self) -> None:
-        events: EventLog = self.get("/events")
-        self.since = events.last_index
+        self.since = self.need(keys.EVENTS).last_index
         self.started = self.ctx.clock.now()
         self.timeout = self.params.timeout or self.ctx.site.timeouts.answer
 
     def update(self) -> Status:
-        events: EventLog = self.get("/events")
-        visitor = self.get("/visitor")
-        for event in events.since(self.since):
+        visitor = self.need(keys.VISITOR)
+        for event in self.need(keys.EVENTS).since(self.since):
             if isinstance(event.message, UserPositive):
                 self.ctx.note(f"visitor {visitor} wants the tour")
                 return SUCCESS
             if isinstance(event.message, UserNegative):
                 return self._decline(visitor, "does not want the tour")
-        if self.get("/now") - self.started >= self.timeout:
+        if self.need(keys.NOW) - self.started >= self.timeout:
             return self._decline(visitor, f"gave no answer within {self.timeout:g} s")
         return RUNNING
 
     def _decline(self, visitor: int, why: str) -> Status:
-        self.set("/declined", (self.get("/declined") or frozenset()) | {visitor})
-        self.ctx.note(f"visitor {visitor} {why}: seek again", incident="visitor declined")
+        self.set(keys.DECLINED, (self.get(keys.DECLINED) or frozenset()) | {visitor})
+        self.ctx.note(f"visitor {visitor} {why}: seek again",
+                      incident=IncidentKind.VISITOR_DECLINED)
         return FAILURE

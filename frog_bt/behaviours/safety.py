@@ -9,7 +9,16 @@ import py_trees
 from pydantic import Field
 
 from frog_bt.frontend.messages import Tour
-from frog_bt.kernel.blackboard import Reading
+from frog_bt.kernel import keys
+from frog_bt.kernel.key import Reading
+from frog_bt.kernel.outcomes import (
+    AbortCause,
+    AbortReason,
+    Incident,
+    IncidentKind,
+    TourState,
+)
+from frog_bt.kernel.progress import EMPTY, Progress
 from frog_bt.rosbridge.msgs import Diagnostics
 from frog_bt.tree.decorators import FrogDecorator, register_decorator
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
@@ -31,35 +40,38 @@ class MustAbort(Leaf):
 
     Reads ``/diagnostics`` (only when fresher than ``safety.diagnostics_max_age``),
     ``/now``, ``/tour_state`` (optional) and ``/abort_reason`` (optional).
-    Writes ``/abort_reason``. SUCCESS while an abort is under way (the reason
-    is latched until :class:`ClearAbort`); FAILURE otherwise.
+    Writes ``/abort_reason`` (an :class:`~frog_bt.kernel.outcomes.AbortReason`).
+    SUCCESS while an abort is under way (the reason is latched until
+    :class:`ClearAbort`); FAILURE otherwise.
     """
 
-    reads = ("/diagnostics", "/now")
-    optional_reads = ("/tour_state", "/abort_reason")
-    writes = ("/abort_reason",)
+    reads = (keys.DIAGNOSTICS, keys.NOW)
+    optional_reads = (keys.TOUR_STATE, keys.ABORT_REASON)
+    writes = (keys.ABORT_REASON,)
 
     def update(self) -> Status:
-        if self.get("/abort_reason"):
+        if self.get(keys.ABORT_REASON) is not None:
             return SUCCESS
-        if self.get("/tour_state") != "started":
+        if self.get(keys.TOUR_STATE) is not TourState.STARTED:
             return FAILURE
         cfg = self.ctx.site.safety
-        diagnostics = fresh_diagnostics(self.get("/diagnostics"), self.get("/now"),
+        diagnostics = fresh_diagnostics(self.get(keys.DIAGNOSTICS), self.need(keys.NOW),
                                         cfg.diagnostics_max_age)
         if diagnostics is None:
             self.feedback_message = "diagnostics stale or missing: not acted on"
             return FAILURE
-        reason = ""
+        reason: AbortReason | None = None
         if diagnostics.faults:
-            reason = "electronics fault: " + "; ".join(diagnostics.faults)
+            reason = AbortReason(AbortCause.FAULT,
+                                 "electronics fault: " + "; ".join(diagnostics.faults))
         elif diagnostics.battery is not None and diagnostics.battery < cfg.battery_low:
-            reason = f"battery {diagnostics.battery:.0f}% below {cfg.battery_low:g}%"
-        if not reason:
+            reason = AbortReason(AbortCause.BATTERY, f"battery {diagnostics.battery:.0f}% "
+                                                     f"below {cfg.battery_low:g}%")
+        if reason is None:
             self.feedback_message = ""
             return FAILURE
-        self.set("/abort_reason", reason)
-        self.ctx.note(f"abort the tour: {reason}", incident="tour aborted")
+        self.set(keys.ABORT_REASON, reason)
+        self.ctx.note(f"abort the tour: {reason.text}", incident=IncidentKind.TOUR_ABORTED)
         return SUCCESS
 
 
@@ -67,12 +79,12 @@ class MustAbort(Leaf):
 class ClearAbort(Leaf):
     """The abort is done: clear ``/abort_reason`` (kept as ``/abort_reason_last``). SUCCESS."""
 
-    optional_reads = ("/abort_reason",)
-    writes = ("/abort_reason", "/abort_reason_last")
+    optional_reads = (keys.ABORT_REASON,)
+    writes = (keys.ABORT_REASON, keys.ABORT_REASON_LAST)
 
     def update(self) -> Status:
-        self.set("/abort_reason_last", self.get("/abort_reason"))
-        self.set("/abort_reason", None)
+        self.set(keys.ABORT_REASON_LAST, self.get(keys.ABORT_REASON))
+        self.set(keys.ABORT_REASON, None)
         return SUCCESS
 
 
@@ -80,19 +92,26 @@ class ClearAbort(Leaf):
 class GiveUp(Leaf):
     """The tour cannot go on: tell the front end why (``tour aborted``) and fail.
 
-    The reason is the latest decision note (e.g. "undock failed"). Writes
-    ``/tour_state``. FAILURE, always: the executive stops with that reason.
+    The reason is the latest incident of the journal (e.g. ``undock failed``, a docking
+    failure), a typed value. Writes ``/tour_state``, ``/tour_reason``, ``/progress``
+    (cleared) and ``/gave_up`` (the incident: the executive stops with its words).
+    FAILURE, always.
     """
 
-    writes = ("/tour_state",)
+    writes = (keys.TOUR_STATE, keys.TOUR_REASON, keys.PROGRESS, keys.GAVE_UP)
 
     def update(self) -> Status:
-        reason = self.ctx.notes[-1][1] if self.ctx.notes else "the tour cannot go on"
-        self.ctx.send(Tour("aborted", reason))
-        self.set("/tour_state", "aborted")
-        self.ctx.progress.clear()
-        self.ctx.gave_up = reason
-        self.ctx.note(f"giving up: {reason}", incident="gave up")
+        cause = self.ctx.journal.last_incident()
+        if cause is None:
+            cause = Incident(self.ctx.clock.now(), IncidentKind.GAVE_UP,
+                             "the tour cannot go on")
+        reason = cause.text
+        self.ctx.send(Tour(TourState.ABORTED.value, reason))
+        self.set(keys.TOUR_STATE, TourState.ABORTED)
+        self.set(keys.TOUR_REASON, reason)
+        self.set(keys.PROGRESS, EMPTY)
+        self.set(keys.GAVE_UP, cause)
+        self.ctx.note(f"giving up: {reason}", incident=IncidentKind.GAVE_UP)
         self.feedback_message = reason
         return FAILURE
 
@@ -103,31 +122,35 @@ class ConfirmResume(Leaf):
 
     Only a robot that reports itself away from the dock (``/docking`` not
     ``docked``) within ``checkpoint.confirm`` seconds resumes; otherwise the
-    checkpoint is dropped and a fresh tour starts. Reads ``/docking``, ``/now``.
-    SUCCESS once decided (at once without a checkpoint).
+    checkpoint is dropped (``/resume`` and ``/progress`` cleared) and a fresh tour
+    starts. Reads ``/docking``, ``/now``, ``/resume``; writes ``/resumed`` (how, in
+    words). SUCCESS once decided (at once without a checkpoint).
     """
 
-    reads = ("/docking", "/now")
+    reads = (keys.DOCKING, keys.NOW)
+    optional_reads = (keys.RESUME,)
+    writes = (keys.RESUME, keys.RESUMED, keys.PROGRESS)
 
     def initialise(self) -> None:
         self.started = self.ctx.clock.now()
 
     def update(self) -> Status:
-        resume = self.ctx.resume
+        resume = self.get(keys.RESUME)
         if resume is None:
             return SUCCESS
-        state: Reading[str] | None = self.get("/docking")
+        state = self.get(keys.DOCKING)
         if state is not None and state.value not in ("docked", "docking"):
             announce = resume.announce([stop.poi for stop in self.ctx.site.tour.stops])
-            self.ctx.resumed = announce
-            self.ctx.note(f"{announce} ({resume.describe()})", incident="resumed")
+            self.set(keys.RESUMED, announce)
+            self.ctx.note(f"{announce} ({resume.describe()})", incident=IncidentKind.RESUMED)
             log.warning("%s", announce)
             return SUCCESS
-        if state is not None or self.get("/now") - self.started >= self.ctx.site.checkpoint.confirm:
+        confirm = self.ctx.site.checkpoint.confirm
+        if state is not None or self.need(keys.NOW) - self.started >= confirm:
             why = f"the robot is {state.value}" if state else "no docking state"
             self.ctx.note(f"checkpoint dropped ({why}): a fresh tour")
-            self.ctx.resume = None
-            self.ctx.progress.clear()
+            self.set(keys.RESUME, None)
+            self.set(keys.PROGRESS, EMPTY)
             return SUCCESS
         self.feedback_message = "checkpoint found: waiting for the docking state"
         return RUNNING
@@ -139,42 +162,52 @@ class Checkpointed(FrogDecorator):
 
     A tour resumed from a checkpoint skips it (SUCCESS without running the
     child) when the checkpoint says it was done, restoring ``/visitor``.
-    Running it again drops it and every later checkpoint from the progress.
-    Reads ``/visitor`` (optional); writes ``/visitor``. Returns the child's status.
+    Running it again drops it and every later checkpoint from ``/progress``.
+    Reads ``/visitor``, ``/resume``, ``/progress`` (optional); writes ``/visitor``,
+    ``/resume`` (the part skipped, once) and ``/progress``. Returns the child's status.
     """
 
     class Params(Params):
         checkpoint: str = Field(min_length=1, description=(
             "the part's name in the checkpoint (unique in the tree)"))
 
-    optional_reads = ("/visitor",)
-    writes = ("/visitor",)
-    key_types = {"/visitor": int}
+    optional_reads = (keys.VISITOR, keys.RESUME, keys.PROGRESS)
+    writes = (keys.VISITOR, keys.RESUME, keys.PROGRESS)
     skips_child = True  # resumed: SUCCESS without the child (the data-flow check)
+    _skip = False
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
-        if self.status != RUNNING and self._resumed_past():
-            self.status = SUCCESS
-            yield self
-            return
-        yield from super().tick()
+        # Resumed past this part: py_trees' plain behaviour tick (initialise, update,
+        # stop) instead of the decorator's, which would tick the child.
+        self._skip = self.status != RUNNING and self._resumed_past()
+        if self._skip:
+            yield from py_trees.behaviour.Behaviour.tick(self)
+        else:
+            yield from super().tick()
+
+    def _progress(self) -> Progress:
+        return self.get(keys.PROGRESS) or EMPTY
 
     def _resumed_past(self) -> bool:
-        resume, name = self.ctx.resume, self.params.checkpoint
+        resume, name = self.get(keys.RESUME), self.params.checkpoint
         if resume is None or name not in resume.done:
             return False
-        resume.done.discard(name)
+        self.set(keys.RESUME, resume.without(name))
         if resume.visitor is not None:
-            self.set("/visitor", resume.visitor)
-        self.ctx.progress.complete(name, resume.visitor)
+            self.set(keys.VISITOR, resume.visitor)
+        self.set(keys.PROGRESS, self._progress().complete(name, resume.visitor))
         self.ctx.note(f"resumed: {name} already done")
         return True
 
     def initialise(self) -> None:
-        self.ctx.progress.begin(self.params.checkpoint)
+        if not self._skip:
+            self.set(keys.PROGRESS, self._progress().begin(self.params.checkpoint))
 
     def update(self) -> Status:
+        if self._skip:
+            return SUCCESS
         status = self.decorated.status
         if status == SUCCESS:
-            self.ctx.progress.complete(self.params.checkpoint, self.get("/visitor"))
+            self.set(keys.PROGRESS, self._progress().complete(self.params.checkpoint,
+                                                              self.get(keys.VISITOR)))
         return status

@@ -8,7 +8,9 @@ from pydantic import Field
 
 from frog_bt.config import Timeouts
 from frog_bt.frontend.messages import EVENTS, Tour
-from frog_bt.kernel.blackboard import EventLog
+from frog_bt.kernel import keys
+from frog_bt.kernel.outcomes import IncidentKind, TourState
+from frog_bt.kernel.progress import EMPTY
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
 
 
@@ -22,13 +24,14 @@ class WaitFrontendIdle(Leaf):
     tour back. RUNNING until ready, then SUCCESS.
     """
 
-    reads = ("/frontend_ready", "/now", "/diagnostics")
+    reads = (keys.FRONTEND_READY, keys.NOW, keys.DIAGNOSTICS)
 
     def update(self) -> Status:
         cfg = self.ctx.site.safety
-        reading = self.get("/diagnostics")
+        reading = self.get(keys.DIAGNOSTICS)
         diagnostics = (reading.value if reading is not None
-                       and reading.age(self.get("/now")) <= cfg.diagnostics_max_age else None)
+                       and reading.age(self.need(keys.NOW)) <= cfg.diagnostics_max_age
+                       else None)
         if diagnostics is not None and diagnostics.faults:
             self.feedback_message = "fault: " + "; ".join(diagnostics.faults)
             return RUNNING
@@ -37,7 +40,7 @@ class WaitFrontendIdle(Leaf):
             self.feedback_message = (f"charging: battery {diagnostics.battery:.0f}% "
                                      f"< {cfg.battery_resume:g}%")
             return RUNNING
-        if self.get("/frontend_ready"):
+        if self.get(keys.FRONTEND_READY):
             return SUCCESS
         self.feedback_message = "waiting for frontend_idle"
         return RUNNING
@@ -48,11 +51,10 @@ class TourStatus(Leaf):
     """Send ``tour`` with ``state`` and ``reason`` to the front end.
 
     An ``aborted`` tour without a ``reason`` gives ``/abort_reason`` (optional read).
-    Ending or aborting a tour clears the checkpointed progress.
+    Ending or aborting a tour clears the checkpointed progress (``/progress``).
 
     Writes ``/frontend_ready`` (False: the next tour needs a fresh
-    ``frontend_idle``), ``/declined`` and ``/special_done`` (cleared when a tour
-    starts) and ``/tour_state``. SUCCESS.
+    ``frontend_idle``), ``/tour_state`` and ``/tour_reason``. SUCCESS.
     """
 
     class Params(Params):
@@ -60,22 +62,21 @@ class TourStatus(Leaf):
             description="the tour state sent to the front end")
         reason: str = Field("", description="why (with aborted; default: the abort reason)")
 
-    optional_reads = ("/abort_reason",)
-    writes = ("/frontend_ready", "/declined", "/special_done", "/tour_state")
+    optional_reads = (keys.ABORT_REASON,)
+    writes = (keys.FRONTEND_READY, keys.TOUR_STATE, keys.TOUR_REASON, keys.PROGRESS)
 
     def update(self) -> Status:
         p = self.params
-        reason = p.reason or (self.get("/abort_reason") or "" if p.state == "aborted" else "")
-        self.ctx.send(Tour(p.state, reason))
-        self.ctx.note(f"tour {p.state}" + (f": {reason}" if reason else ""))
-        if p.state != "started":
-            self.ctx.progress.clear()
-        self.set("/frontend_ready", False)
-        self.set("/tour_state", p.state)
-        self.ctx.tour_state, self.ctx.tour_reason = p.state, reason
-        if p.state == "started":
-            self.set("/declined", frozenset())
-            self.set("/special_done", frozenset())
+        state = TourState(p.state)
+        abort = self.get(keys.ABORT_REASON) if state is TourState.ABORTED else None
+        reason = p.reason or (abort.text if abort is not None else "")
+        self.ctx.send(Tour(state.value, reason))
+        self.ctx.note(f"tour {state}" + (f": {reason}" if reason else ""))
+        if state is not TourState.STARTED:
+            self.set(keys.PROGRESS, EMPTY)
+        self.set(keys.FRONTEND_READY, False)
+        self.set(keys.TOUR_STATE, state)
+        self.set(keys.TOUR_REASON, reason)
         return SUCCESS
 
 
@@ -101,23 +102,23 @@ class WaitEvent(Leaf):
         on_timeout: Literal["failure", "success"] = Field(
             "failure", description="what a wait that ran out returns")
 
-    reads = ("/events", "/now")
+    reads = (keys.EVENTS, keys.NOW)
 
     def initialise(self) -> None:
-        events: EventLog = self.get("/events")
-        self.since = events.last_index
+        self.since = self.need(keys.EVENTS).last_index
         self.started = self.ctx.clock.now()
         timeout = self.params.timeout
         self.timeout = self.ctx.site.timeout(timeout) if isinstance(timeout, str) else timeout
 
     def update(self) -> Status:
-        events: EventLog = self.get("/events")
+        events = self.need(keys.EVENTS)
         if events.first_since(self.since, EVENTS[self.params.event]) is not None:
             return SUCCESS
-        if self.get("/now") - self.started >= self.timeout:
+        if self.need(keys.NOW) - self.started >= self.timeout:
             success = self.params.on_timeout == "success"
             self.ctx.note(f"no {self.params.event} within {self.timeout:g} s"
-                          + (": carrying on" if success else ""), incident="event missing")
+                          + (": carrying on" if success else ""),
+                          incident=IncidentKind.EVENT_MISSING)
             return SUCCESS if success else FAILURE
         self.feedback_message = f"waiting for {self.params.event}"
         return RUNNING

@@ -10,7 +10,8 @@ from pydantic import Field
 from frog_bt.behaviours.navigation import PoiParams
 from frog_bt.frontend.messages import ContentDone, FrontendIdle, StartPoi
 from frog_bt.frontend.messages import FinishPoi as FinishPoiCommand
-from frog_bt.kernel.blackboard import EventLog, Reading
+from frog_bt.kernel import keys
+from frog_bt.kernel.outcomes import IncidentKind
 from frog_bt.rosbridge.msgs import Pose, TrackedPeople
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
 
@@ -40,7 +41,7 @@ class VisitorFollows(Leaf):
             "seconds nobody may be seen before the visitor counts as lost "
             "(default: site follow.grace)"))
 
-    reads = ("/people", "/pose", "/now")
+    reads = (keys.PEOPLE, keys.POSE, keys.NOW)
 
     def initialise(self) -> None:
         cfg = self.ctx.site.follow
@@ -49,20 +50,20 @@ class VisitorFollows(Leaf):
         self.started = self.ctx.clock.now()
 
     def update(self) -> Status:
-        people: Reading[TrackedPeople] | None = self.get("/people")
-        pose: Reading[Pose] | None = self.get("/pose")
-        now = self.get("/now")
+        people = self.get(keys.PEOPLE)
+        pose = self.get(keys.POSE)
+        now = self.need(keys.NOW)
         safety = self.ctx.site.safety
         fresh = (people is not None and people.age(now) <= safety.people_max_age
                  and pose is not None and pose.age(now) <= safety.pose_max_age)
-        if fresh and someone_within(people.value, pose.value, self.radius):
+        if fresh and people and pose and someone_within(people.value, pose.value, self.radius):
             return SUCCESS
         if now - self.started >= self.grace:
             if not fresh:
                 self.ctx.note("laser tracking or pose stale: assuming the visitor follows")
                 return SUCCESS
             self.ctx.note(f"nobody within {self.radius:g} m for {self.grace:g} s: "
-                          "visitor lost, back to recruit", incident="visitor lost")
+                          "visitor lost, back to recruit", incident=IncidentKind.VISITOR_LOST)
             return FAILURE
         self.feedback_message = ("waiting for the visitor to catch up" if fresh
                                  else "laser tracking or pose stale: waiting")
@@ -85,16 +86,15 @@ class PlayContent(Leaf):
         timeout: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
             "seconds before going on without content_done (default: site timeouts.content)"))
 
-    reads = ("/events", "/now")
-    optional_reads = ("/waypoint",)
+    reads = (keys.EVENTS, keys.NOW)
+    optional_reads = (keys.WAYPOINT,)
 
     def initialise(self) -> None:
         p = self.params
-        events: EventLog = self.get("/events")
-        self.since = events.last_index
+        self.since = self.need(keys.EVENTS).last_index
         self.started = self.ctx.clock.now()
         self.timeout = p.timeout or self.ctx.site.timeouts.content
-        self.waypoint = self.get("/waypoint") or p.poi
+        self.waypoint = self.get(keys.WAYPOINT) or p.poi
         self.restart_seen = self.since
         self.ctx.send(StartPoi(p.poi, self.waypoint, p.part))
 
@@ -106,7 +106,7 @@ class PlayContent(Leaf):
 
     def update(self) -> Status:
         p = self.params
-        events: EventLog = self.get("/events")
+        events = self.need(keys.EVENTS)
         if events.first_since(self.since, ContentDone, poi=p.poi, part=p.part) is not None:
             return SUCCESS
         restart = events.first_since(self.restart_seen, FrontendIdle)
@@ -115,9 +115,9 @@ class PlayContent(Leaf):
             self.restart_seen = restart.index
             self.ctx.send(StartPoi(p.poi, self.waypoint, p.part))
             self.ctx.note(f"front end restarted: {p.poi} part {p.part} sent again")
-        if self.get("/now") - self.started >= self.timeout:
+        if self.need(keys.NOW) - self.started >= self.timeout:
             self.ctx.note(f"{p.poi} part {p.part}: no content_done within "
-                          f"{self.timeout:g} s, going on", incident="content timeout")
+                          f"{self.timeout:g} s, going on", incident=IncidentKind.CONTENT_TIMEOUT)
             return SUCCESS
         self.feedback_message = f"playing {p.poi} part {p.part}"
         return RUNNING

@@ -1,11 +1,15 @@
-"""Commands to the robot over rosbridge, and the one request awaiting ``/FROG_response``.
+"""Commands to the robot over rosbridge, and the one goal awaiting ``/FROG_response``.
 
 ``/GotoWayPoint`` and ``/ApproachPeopleFar`` share ``/FROG_response`` and carry
 no goal id, so at most one of them is pending at a time: a new goal replaces
 the active one (CONTRACT §1), and a response that arrives while nothing is
-pending is stale and ignored. Responses are applied to the pending
-:class:`Request` in the pre-tick snapshot, so every tick sees one consistent
-state.
+pending is stale and ignored.
+
+Results reach the tree as values, not by mutation: the pre-tick step applies the
+responses that arrived (:meth:`Actions.on_response`) and writes the newest goal's state
+to :data:`frog_bt.kernel.keys.GOAL`, so every tick sees one consistent state. A leaf
+keeps the :class:`Goal` it sent and compares ids: the key's goal is its own, a newer
+one (it was replaced), or, within the tick that sent it, an older one.
 """
 
 from __future__ import annotations
@@ -14,96 +18,103 @@ import itertools
 import logging
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, replace
+from typing import Literal
 
 from frog_bt.config import Poi
 from frog_bt.kernel.clock import Clock
 from frog_bt.rosbridge.msgs import Pose
-from frog_bt.wire import ABORTED, ACTIVE, FAILED, SUCCEEDED
+from frog_bt.wire import Response
 
 log = logging.getLogger(__name__)
-TERMINAL = (SUCCEEDED, FAILED, ABORTED)
-CODE_NAMES = {ACTIVE: "active", SUCCEEDED: "succeeded", FAILED: "failed", ABORTED: "aborted"}
+
+GoalKind = Literal["goto", "approach"]  # also the output role it is published on
 
 
-@dataclass(slots=True)
-class Request:
-    """A goal or approach sent to the robot; ``code`` is the latest response (0: none yet)."""
+@dataclass(frozen=True, slots=True)
+class Goal:
+    """A goal or approach sent to the robot, and its latest response (None: none yet)."""
 
     id: int
-    kind: str  # "goto" | "approach"
+    kind: GoalKind
     target: str
     sent_at: float
-    value: Any = None  # as published, for a re-send
-    code: int = 0
+    value: Pose | int  # as published, for a re-send
+    code: Response | None = None
     answered_at: float | None = None
 
     @property
     def done(self) -> bool:
-        return self.code in TERMINAL
+        return self.code is not None and self.code.terminal
+
+    def state(self) -> str:
+        """``sent``, or the latest response's word (``active``, ``succeeded``, ...)."""
+        return "sent" if self.code is None else self.code.word
 
 
-Publish = Callable[[str, Any], None]  # (output role, value: the wire table encodes it)
+Publish = Callable[[str, object], None]  # (output role, value: the wire table encodes it)
 
 
 class Actions:
-    """Publishes robot commands by role (``goto``, ``approach``, ``icl``, ``dock``)."""
+    """Publishes robot commands by role (``goto``, ``approach``, ``icl``, ``dock``) and
+    tracks the one pending goal (a service: leaves learn results from the blackboard)."""
 
     def __init__(self, publish: Publish, clock: Clock) -> None:
         self._publish = publish
         self._clock = clock
         self._ids = itertools.count(1)
-        self.pending: Request | None = None
+        self.pending: Goal | None = None
+        self.latest: Goal | None = None  # the newest goal sent, with its latest response
         self.stale_responses = 0
-        self.face_stream = False
         self.last_approach_at = -math.inf  # project-clock time of the last approach sent
 
-    def goto(self, waypoint: str, poi: Poi) -> Request:
+    def goto(self, waypoint: str, poi: Poi) -> Goal:
         now = self._clock.now()
-        goal = Pose(now, "map", poi.x, poi.y, poi.z, poi.w)
-        self._publish("goto", goal)
-        return self._replace(Request(next(self._ids), "goto", waypoint, now, goal))
+        pose = Pose(now, "map", poi.x, poi.y, poi.z, poi.w)
+        self._publish("goto", pose)
+        return self._replace(Goal(next(self._ids), "goto", waypoint, now, pose))
 
-    def approach(self, person_id: int) -> Request:
+    def approach(self, person_id: int) -> Goal:
         self._publish("approach", person_id)
         self.last_approach_at = now = self._clock.now()
-        return self._replace(Request(next(self._ids), "approach", str(person_id), now,
-                                     person_id))
+        return self._replace(Goal(next(self._ids), "approach", str(person_id), now, person_id))
 
-    def resend_pending(self) -> Request | None:
+    def resend_pending(self) -> Goal | None:
         """Publish the pending goal or approach again (after a reconnect its answer may
-        have been lost while the link was down). The request keeps waiting as before."""
-        request = self.pending
-        if request is not None and request.value is not None:
-            self._publish(request.kind, request.value)  # the kind is the output role
-            log.info("re-sent %s %s after a reconnect", request.kind, request.target)
-        return request
+        have been lost while the link was down). The goal keeps waiting as before."""
+        goal = self.pending
+        if goal is not None:
+            self._publish(goal.kind, goal.value)  # the kind is the output role
+            log.info("re-sent %s %s after a reconnect", goal.kind, goal.target)
+        return goal
 
-    def _replace(self, request: Request) -> Request:
-        self.pending = request
-        return request
+    def _replace(self, goal: Goal) -> Goal:
+        self.pending = self.latest = goal
+        return goal
 
-    def cancel(self, request: Request | None) -> None:
-        """Stop waiting for ``request``; a later response to it is stale."""
-        if request is not None and self.pending is request:
+    def cancel(self, goal: Goal | None) -> None:
+        """Stop waiting for ``goal``; a later response to it is stale."""
+        if goal is not None and self.pending is not None and self.pending.id == goal.id:
             self.pending = None
 
-    def on_response(self, code: int, at: float) -> Request | None:
-        """Apply one ``/FROG_response`` code; returns the request it answered, if any."""
-        request = self.pending
-        if request is None:
+    def on_response(self, code: int, at: float) -> Goal | None:
+        """Apply one ``/FROG_response`` code; the goal it answered, if any. A code the
+        contract does not know is counted as stale."""
+        goal = self.pending
+        known = Response.of(code)
+        if goal is None or known is None:
             self.stale_responses += 1
-            log.debug("ignored /FROG_response %d: nothing pending", code)
+            log.debug("ignored /FROG_response %d: %s", code,
+                      "nothing pending" if known is not None else "unknown code")
             return None
-        request.code, request.answered_at = code, at
-        if code in TERMINAL:
-            self.pending = None
-        return request
+        goal = replace(goal, code=known, answered_at=at)
+        self.pending = None if goal.done else goal
+        if self.latest is not None and self.latest.id == goal.id:
+            self.latest = goal
+        return goal
 
     def dock(self, action: str) -> None:
         self._publish("dock", action)
 
     def icl(self, on: bool) -> None:
-        self.face_stream = on
         self._publish("icl", "start" if on else "stop")

@@ -342,7 +342,7 @@ class Recorder:
         self._write(BLAME, t, _dumps({"channel": channel, "node": node, "reads": reads}))
 
     def on_tick(self, core: Any) -> None:
-        status = core.bt.root.status.name
+        status = core.root.status.name
         self._write(TICK, core.clock.now(),
                     b'{"tick":%d,"status":"%s"}' % (core.ticks, status.encode()))
 

@@ -38,7 +38,9 @@ from typing import Any
 
 import py_trees
 
+from frog_bt.kernel import keys
 from frog_bt.kernel.clock import SITE_TZ
+from frog_bt.kernel.outcomes import TourState
 from frog_bt.observers.recording import Recorder
 
 log = logging.getLogger(__name__)
@@ -75,7 +77,7 @@ class RecordingDir:
         self.deleted: list[Path] = []
         self.files: list[Path] = []  # written by this run, in order
         self._clock: Any = None
-        self._tour_state: str | None = None
+        self._tour_state: TourState | None = None
         self._named_by_clock = False
 
     @property
@@ -101,17 +103,18 @@ class RecordingDir:
         """Between ticks: a tour started, or the tree's run ended."""
         if not self._named_by_clock:
             self._rename_first()
-        state, before = core.ctx.tour_state, self._tour_state
+        state, before = core.board.get(keys.TOUR_STATE), self._tour_state
         self._tour_state = state
-        if self.kind == "idle" and state == "started" and before != "started":
+        if (self.kind == "idle" and state is TourState.STARTED
+                and before is not TourState.STARTED):
             lead_in = self.path.name if self.path is not None else ""
             self._rotate("tour", {"kind": "tour", "tour": str(self.number),
                                   "lead_in": lead_in}, None)
-        elif core.bt.root.status == Status.SUCCESS:
+        elif core.root.status == Status.SUCCESS:
             if self.kind == "tour":
                 self.number += 1
             assert self.recorder is not None
-            primer = self.recorder.primer(bool(core.snapshot.get("/frontend_ready")))
+            primer = self.recorder.primer(bool(core.board.get(keys.FRONTEND_READY)))
             self._rotate("idle", {"kind": "idle", "tour": str(self.number)}, primer)
 
     def _rename_first(self) -> None:

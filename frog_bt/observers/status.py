@@ -18,13 +18,13 @@ from typing import Any, TextIO
 
 import py_trees
 
-from frog_bt.kernel.blackboard import peek
+from frog_bt.kernel import keys
 from frog_bt.runtime.core import Core
 
 
 def phase(core: Core) -> str:
     """The running child of the first sequence on the running path: the tour's phase."""
-    node = core.bt.root
+    node = core.root
     running = py_trees.common.Status.RUNNING
     while True:
         if isinstance(node, py_trees.decorators.Decorator):
@@ -66,18 +66,21 @@ def _plain_error(error: str) -> str:
 
 
 def status_line(core: Core) -> str:
-    tip = core.bt.root.tip()
-    diagnostics = peek("/diagnostics")
+    tip = core.root.tip()
+    board = core.board
+    diagnostics = board.get(keys.DIAGNOSTICS)
     battery = diagnostics.value.battery if diagnostics is not None else None
+    visitor = board.get(keys.VISITOR)
     parts = [
         phase(core),
-        f"poi {peek('/waypoint') or '-'}",
+        f"poi {board.get(keys.WAYPOINT) or '-'}",
         f"tip {tip.name if tip else '-'}",
-        f"visitor {peek('/visitor') if peek('/visitor') is not None else '-'}",
+        f"visitor {visitor if visitor is not None else '-'}",
         f"battery {battery:.0f}%" if battery is not None else "battery -",
     ]
-    if core.ctx.resumed:
-        parts.insert(0, core.ctx.resumed)
+    resumed = board.get(keys.RESUMED)
+    if resumed:
+        parts.insert(0, resumed)
     return " | ".join(parts)
 
 

@@ -13,8 +13,9 @@ from typing import Any
 
 from frog_bt.config import Site
 from frog_bt.frontend.messages import StartPoi, Tour, UserPositive
-from frog_bt.kernel.blackboard import peek
+from frog_bt.kernel import keys
 from frog_bt.kernel.context import Incident
+from frog_bt.kernel.outcomes import IncidentKind
 from frog_bt.maths.engagement import Decision
 from frog_bt.rosbridge.msgs import POSE
 from frog_bt.wire import SUCCEEDED
@@ -72,19 +73,21 @@ class TourSummary:
             self.recruited.append(self.approached[-1])
 
     def tick(self, core: Any) -> None:
-        decision = peek("/engagement_decision")
+        board = core.board
+        decision = board.get(keys.ENGAGEMENT_DECISION)
         if decision is not None and decision is not self._last_decision:
             self._last_decision = decision
             self.decisions.append(decision)
-        ctx = core.ctx
-        if ctx.incident_total != self._seen_incidents:
-            for incident in ctx.incidents[self._seen_incidents - ctx.incident_total:]:
+        journal = core.journal
+        if journal.incident_total != self._seen_incidents:
+            for incident in journal.incidents[self._seen_incidents - journal.incident_total:]:
                 self.incidents.append(incident)
-                if incident.kind == "stop skipped":
+                if incident.kind is IncidentKind.STOP_SKIPPED:
                     self.skipped.append(incident.subject)
-            self._seen_incidents = ctx.incident_total
-        if ctx.resumed and self.resumed is None:
-            self.resumed = ctx.resumed
+            self._seen_incidents = journal.incident_total
+        resumed = board.get(keys.RESUMED)
+        if resumed and self.resumed is None:
+            self.resumed = resumed
 
     def attach(self, taps: Any) -> None:
         taps.tick.append(self.tick)

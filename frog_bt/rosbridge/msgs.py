@@ -66,6 +66,8 @@ def encode_time(t: float) -> Time:
     usecs = round((t - secs) * 1e6)
     if usecs >= 1_000_000:
         secs, usecs = secs + 1, 0
+    if secs >= 2**32:  # a float just below 2**32 rounds to it: the last instant uint32 holds
+        return Time(secs=2**32 - 1, nsecs=999_999_999)
     return Time(secs=int(secs), nsecs=int(usecs) * 1000)
 
 

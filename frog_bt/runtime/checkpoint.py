@@ -1,9 +1,8 @@
 """Tour progress, checkpointed to a small file so a restarted executive resumes the tour.
 
-:class:`Progress` is the ordered list of checkpoints (``start``, ``recruit``,
-``stop 0``, ``stop 1``, …) completed in the current tour, and the visitor being
-guided. Starting a checkpoint again drops it and everything after it (a lost
-visitor: recruit again, then every stop again). The executive writes the file
+:class:`~frog_bt.kernel.progress.Progress` (on the blackboard) is the ordered list of
+checkpoints completed in the current tour, and the visitor being guided. The executive
+writes the file
 atomically (write a temporary file, fsync, rename) whenever progress changes,
 and deletes it when a tour ends or is aborted.
 
@@ -28,76 +27,15 @@ import os
 import re
 import tempfile
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
 from frog_bt.errors import UsageError
+from frog_bt.kernel.progress import VERSION, Progress, Resume
 
 STATE_DIR = Path(os.environ.get("XDG_STATE_HOME", Path.home() / ".local" / "state")) / "frog-bt"
 
-VERSION = 1
-
-
-@dataclass
-class Progress:
-    done: list[str] = field(default_factory=list)
-    visitor: int | None = None
-    changes: int = 0  # bumped on every change, so the writer knows when to save
-
-    def begin(self, name: str) -> None:
-        if name in self.done:
-            del self.done[self.done.index(name):]
-            self.changes += 1
-
-    def complete(self, name: str, visitor: int | None = None) -> None:
-        if name not in self.done:
-            self.done.append(name)
-        if visitor is not None:
-            self.visitor = visitor
-        self.changes += 1
-
-    def clear(self) -> None:
-        if self.done or self.visitor is not None:
-            self.done, self.visitor = [], None
-            self.changes += 1
-
-    def to_json(self) -> dict[str, object]:
-        return {"version": VERSION, "done": list(self.done), "visitor": self.visitor,
-                "written": time.time()}
-
-
-@dataclass
-class Resume:
-    """What a restarted executive skips (each name once) and the visitor it restores."""
-
-    done: set[str]
-    visitor: int | None
-    order: list[str] = field(default_factory=list)
-    written: float = 0.0  # wall time the checkpoint was written
-
-    def describe(self) -> str:
-        last = self.order[-1] if self.order else "nothing"
-        return f"after {last}" + (f", visitor {self.visitor}" if self.visitor is not None else "")
-
-    def announce(self, stops: list[str], now: float | None = None) -> str:
-        """``resuming the tour at POI4: checkpoint 3 min old`` (``stops``: the tour's POIs)."""
-        return f"resuming the tour {self.where(stops)}: checkpoint {self.age_text(now)} old"
-
-    def where(self, stops: list[str]) -> str:
-        """Where the resumed tour picks up, in the tour's words."""
-        done_stops = [int(n.split()[1]) for n in self.order if re.fullmatch(r"stop \d+", n)]
-        if done_stops:
-            following = max(done_stops) + 1
-            return (f"at {stops[following]}" if following < len(stops)
-                    else "on the way back to the dock")
-        if "recruit" in self.order:
-            return f"at {stops[0]}" if stops else "after recruiting"
-        return "at the recruitment"
-
-    def age_text(self, now: float | None = None) -> str:
-        age = max(0.0, (time.time() if now is None else now) - self.written)
-        return f"{age:.0f} s" if age < 90 else f"{age / 60:.0f} min"
+__all__ = ["VERSION", "Progress", "Resume", "claim", "default_path", "load", "save"]
 
 
 def default_path(config: Path, listen: tuple[str, int], state_dir: Path = STATE_DIR) -> Path:
@@ -147,7 +85,7 @@ def save(path: Path, progress: Progress) -> None:
     fd, tmp = tempfile.mkstemp(prefix=".checkpoint-", dir=path.parent)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(progress.to_json(), f)
+            json.dump(progress.to_json(time.time()), f)
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
@@ -175,4 +113,4 @@ def load(path: Path, max_age: float = math.inf) -> Resume | None:
         return None
     if visitor is not None and (isinstance(visitor, bool) or not isinstance(visitor, int)):
         visitor = None
-    return Resume(set(done), visitor, list(done), float(written))
+    return Resume(frozenset(done), visitor, tuple(done), float(written))

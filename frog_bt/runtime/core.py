@@ -19,21 +19,24 @@ import py_trees
 
 from frog_bt.config import Site
 from frog_bt.frontend.messages import FrontendMessage
+from frog_bt.kernel import keys
 from frog_bt.kernel.actions import Actions
-from frog_bt.kernel.blackboard import Inputs, Reading, Snapshot, peek
+from frog_bt.kernel.blackboard import Board, Inputs, Snapshot
 from frog_bt.kernel.clock import Clock
 from frog_bt.kernel.context import Context
-from frog_bt.tree import observed, ticking
+from frog_bt.kernel.journal import Journal
+from frog_bt.kernel.key import Reading
+from frog_bt.tree import observed
 from frog_bt.tree.loader import LoadedTree
-from frog_bt.tree.observed import DECIDED, acting
+from frog_bt.tree.observed import Trace
 from frog_bt.wire import INPUTS, OUTPUTS
-from frog_bt.yamlfile import line_of
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
 
 Tap = Callable[[float, str, Any], None]  # (project-clock time, channel, payload)
 Behaviour = py_trees.behaviour.Behaviour
+__all__ = ["Core", "Taps"]
 
 
 @dataclass(slots=True)
@@ -69,11 +72,12 @@ class Core:
         self.table = {site.topic(role): inp for role, inp in INPUTS.items()}
         self.inputs = Inputs(self.table)
         self.actions = Actions(self._publish, clock)
-        py_trees.blackboard.Blackboard.clear()  # one tree per process at a time
-        self.ctx = Context(clock, site, self.actions, self._send_message)
-        self.snapshot = Snapshot(self.inputs, clock)
-        self.bt = py_trees.trees.BehaviourTree(tree.root)
-        self.bt.add_pre_tick_handler(self._pre_tick)
+        self.board = Board()  # this core's own: nothing global, two cores in one process
+        self.trace = Trace()
+        self.journal = Journal(clock)
+        self.ctx = Context(clock, site, self.actions, self._send_message, self.journal)
+        self.snapshot = Snapshot(self.board, self.inputs, clock, self.actions)
+        self.root = tree.root
         self.ticks = 0
         self._setup = False
         # Nodes ticked or stopped since the last tick's taps ran: every node whose status
@@ -90,7 +94,7 @@ class Core:
         label = self._labels.get(id(node))
         if label is None:
             where = self.tree.where.get(id(node))
-            line = line_of(where.file, where.path) if where else None
+            line = where.line if where else None
             place = f" ({Path(where.file).name}:{line[0]})" if where and line else ""
             label = self._labels[id(node)] = f"{node.name}{place}"
         return label
@@ -99,17 +103,17 @@ class Core:
         """Blame: the acting node, and what it and the nodes that decided for it read
         (those that ended earlier in this tick near it: up to three levels up, e.g. the
         engagement vote and its samples before ``PlayContent`` or ``FinishPoi``)."""
-        node = acting()
+        node = self.trace.current()
         self.blamed = self.who(node)
-        deciders = [node, *reversed([d for d in DECIDED if d is not node
+        deciders = [node, *reversed([d for d in self.trace.decided if d is not node
                                      and _near(d, node)])] if node is not None else []
         reads: dict[str, str] = {}
         for decider in deciders:
-            keys = (*getattr(decider, "reads", ()), *getattr(decider, "optional_reads", ()),
+            seen = (*getattr(decider, "reads", ()), *getattr(decider, "optional_reads", ()),
                     *(getattr(decider, "writes", ()) if decider is not node else ()))
-            for key in keys:  # a decider's conclusions too (the engagement decision)
-                if key != "/now" and key not in reads:
-                    reads[key] = _short(peek(key))
+            for key in seen:  # a decider's conclusions too (the engagement decision)
+                if key is not keys.NOW and key.name not in reads:
+                    reads[key.name] = _short(self.board.get(key))
         self.blamed_reads = reads
 
     def _blame(self, channel: str) -> None:
@@ -135,8 +139,9 @@ class Core:
         self._blame(message.type)
 
     def setup(self) -> None:
+        """Hand every node the context, this core's board and trace (py_trees' setup)."""
         if not self._setup:
-            self.bt.setup(ctx=self.ctx)
+            py_trees.trees.setup(self.root, ctx=self.ctx, board=self.board, trace=self.trace)
             self._setup = True
 
     # ------------------------------------------------------------ inputs (cache only)
@@ -160,31 +165,28 @@ class Core:
 
     # ------------------------------------------------------------ ticking
 
-    def _pre_tick(self, _tree: py_trees.trees.BehaviourTree) -> None:
-        DECIDED.clear()
-        self.snapshot.write()
-        for code, at in self.snapshot.get(INPUTS["response"].key):
-            self.actions.on_response(code, at)
-
     def tick(self) -> Status:
-        """Snapshot the inputs, tick the tree once, run the tick taps; the root's status."""
+        """The pre-tick step (snapshot the inputs, apply the responses), one tick of the
+        root, the tick taps; the root's status."""
         self.setup()
+        self.trace.decided.clear()
+        self.snapshot.write()
         touched = self.touched
-        touched.extend(ticking.tick(self.bt))  # stopped nodes are already in it
+        touched.extend(self.root.tick())  # stopped nodes are already in it
         self.ticks += 1
         for tap in self.taps.tick:
             tap(self)
         touched.clear()
-        return self.bt.root.status
+        return self.root.status
 
     def halt(self) -> None:
         """Stop whatever runs; scopes clean up (face stream off, ...)."""
-        if self.bt.root.status == Status.RUNNING:
-            self.bt.root.stop(Status.INVALID)
+        if self.root.status == Status.RUNNING:
+            self.root.stop(Status.INVALID)
 
     @property
     def last_note(self) -> str:
-        return self.ctx.notes[-1][1] if self.ctx.notes else ""
+        return self.journal.last_note
 
 
 NEAR = 3  # levels above a command's sender within which a decider counts

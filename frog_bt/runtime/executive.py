@@ -24,7 +24,10 @@ import py_trees
 from frog_bt.config import Site
 from frog_bt.frontend.link import FrontendLink
 from frog_bt.frontend.messages import EVENTS, FrontendMessage
+from frog_bt.kernel import keys
 from frog_bt.kernel.clock import Clock, ManualClock
+from frog_bt.kernel.outcomes import IncidentKind, TourState
+from frog_bt.kernel.progress import EMPTY, Progress
 from frog_bt.observers.links import Links, states
 from frog_bt.observers.status import link_line, status_line
 from frog_bt.rosbridge.client import RosbridgeClient
@@ -84,9 +87,9 @@ class Executive:
         self.core = Core(site, tree, clock, self.client.publish, self.link.send)
         self.taps = self.core.taps
         self.checkpoint = checkpoint
-        self._saved = 0
+        self._saved: Progress = EMPTY
         if checkpoint is not None and not fresh:
-            self.core.ctx.resume = load_checkpoint(checkpoint, site.checkpoint.max_age)
+            self.core.board.set(keys.RESUME, load_checkpoint(checkpoint, site.checkpoint.max_age))
         self._wake = asyncio.Event()
         self._stopping = asyncio.Event()
         self._pending_at_loss: object = None
@@ -114,7 +117,6 @@ class Executive:
                 tap(now, topic, msg)
 
     def _on_link(self, state: LinkState) -> None:
-        self.core.inputs.link = state
         self.was_connected = self.was_connected or state.connected
         actions = self.core.actions
         if not state.connected:
@@ -233,21 +235,20 @@ class Executive:
     def idle(self) -> bool:
         """Docked, and no tour running: a safe point to swap the tree."""
         docking = self.core.inputs.latest.get(INPUTS["docking_state"].key)
-        return (self.core.ctx.tour_state != "started" and docking is not None
-                and docking.value == "docked")
+        return (self.core.board.get(keys.TOUR_STATE) is not TourState.STARTED
+                and docking is not None and docking.value == "docked")
 
     def _swap_tree(self) -> None:
         assert self._swap is not None
         site, tree = self._swap
         self._swap = None
         old = self.core
-        ready = old.snapshot.get("/frontend_ready")
         old.halt()
         core = Core(site, tree, self.clock, self.client.publish, self.link.send)
         core.taps = old.taps  # the observers (status, recording, summary) carry on
         core.inputs.latest.update(old.inputs.latest)  # what the robot last said still holds
-        core.inputs.link = old.inputs.link
-        core.snapshot.bb.set("/frontend_ready", ready)
+        for key in (keys.FRONTEND_READY, keys.TOUR_STATE, keys.TOUR_REASON):
+            core.board.set(key, old.board.get(key))  # the executive's view of the tours
         core.setup()
         self.core, self.site, self.swaps = core, site, self.swaps + 1
         nodes = sum(1 for _ in tree.nodes())
@@ -261,11 +262,11 @@ class Executive:
         restarts = self.link.stats.peer_restarts
         if restarts != self._peer_restarts:
             self._peer_restarts = restarts
-            self.core.ctx.note("front end restarted", incident="front end restarted")
+            self.core.ctx.note("front end restarted", incident=IncidentKind.FRONTEND_RESTARTED)
         status = self.core.tick()
-        progress = self.core.ctx.progress
-        if self.checkpoint is not None and progress.changes != self._saved:
-            self._saved = progress.changes
+        progress = self.core.board.get(keys.PROGRESS) or EMPTY
+        if self.checkpoint is not None and progress != self._saved:
+            self._saved = progress
             try:
                 save_checkpoint(self.checkpoint, progress)
             except OSError as exc:  # a full disk must not stop the tour; warn once a minute
@@ -273,9 +274,9 @@ class Executive:
                     "checkpoint", f"cannot write the checkpoint {self.checkpoint}: "
                                   f"{exc.strerror or exc}")
         if status == Status.SUCCESS:
-            ctx = self.core.ctx
-            if ctx.tour_state == "aborted":
-                reason = f"tour aborted: {ctx.tour_reason or self.core.last_note}"
+            board = self.core.board
+            if board.get(keys.TOUR_STATE) is TourState.ABORTED:
+                reason = f"tour aborted: {board.get(keys.TOUR_REASON) or 'no reason given'}"
                 log.warning("%s", reason)
                 if self.once:
                     self.stop(reason, 1)
@@ -285,7 +286,8 @@ class Executive:
                 self.stop("tour ended docked", 0)
         elif status == Status.FAILURE:
             # the tree gave up (GiveUp told the front end): the robot cannot go on
-            reason = self.core.ctx.gave_up or "the tour tree failed"
+            gave_up = self.core.board.get(keys.GAVE_UP)
+            reason = gave_up.text if gave_up is not None else "the tour tree failed"
             log.error("cannot go on: %s", reason)
             self.stop(reason, 1)
 

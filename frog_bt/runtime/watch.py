@@ -4,7 +4,9 @@
 the site configuration every ``interval`` wall seconds (file changes happen in
 wall time; nothing of the tour is timed by it). A change is loaded and checked
 in full (the same loader as at start: parameters, data flow) in a worker thread,
-so the tick never waits for it. A valid tree is handed to ``accept``; the
+so the tick never waits for it. Building a tree touches nothing of the running one:
+the loader keeps no state between loads, and a tree gets a board only when a core
+sets it up (each core owns its own). A valid tree is handed to ``accept``; the
 executive swaps it in at its next safe point (docked, no tour running). A bad
 one is reported, one line per error, and the running tree stays.
 """

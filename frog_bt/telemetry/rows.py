@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import py_trees
 
-from frog_bt.kernel.blackboard import peek
+from frog_bt.kernel import keys
 from frog_bt.telemetry.layout import TreeIndex
 from frog_bt.wire import INPUTS
 
@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     from frog_bt.runtime.core import Core
 
 Status = py_trees.common.Status
-ENGAGEMENT_KEYS = ("/engagement_meter", "/engagement_decision")  # guarded: may not exist
+ENGAGEMENT_KEYS = (keys.ENGAGEMENT_METER, keys.ENGAGEMENT_DECISION)
 
 
 @dataclass(slots=True)
@@ -173,7 +173,7 @@ class Rows:
         if changed:
             self._statuses = statuses
             batch.statuses.append((tick, t, statuses))
-        notes = core.ctx.notes
+        notes = core.journal.notes
         if notes and notes[-1] is not self._last_note:
             i = len(notes) - 1
             while i >= 0 and notes[i] is not self._last_note:
@@ -181,10 +181,10 @@ class Rows:
             batch.notes.extend((tick, at, text) for at, text in notes[i + 1:])
             self._last_note = notes[-1]
         for key in ENGAGEMENT_KEYS:
-            value = peek(key)
-            if value is not self._blackboard.get(key):
-                self._blackboard[key] = value
-                batch.blackboard.append((tick, t, key, value))
+            value = core.board.get(key)
+            if value is not self._blackboard.get(key.name):
+                self._blackboard[key.name] = value
+                batch.blackboard.append((tick, t, key.name, value))
         self._ticks_since_drain += 1
         if self._ticks_since_drain >= self.batch_ticks and self.on_full is not None:
             self.on_full()

@@ -25,7 +25,7 @@ from frog_bt.rosbridge.msgs import POSE
 from frog_bt.telemetry.layout import TreeIndex, tidy_layout
 from frog_bt.telemetry.rows import Batch
 from frog_bt.telemetry.site_map import poi_marks, tour_routes, zone_outlines
-from frog_bt.wire import ABORTED, FAILED, SUCCEEDED
+from frog_bt.wire import ABORTED, FAILED, Response
 
 Status = py_trees.common.Status
 TICK, TIME = "tick", "time"  # the timelines: tick number, project-clock time
@@ -40,7 +40,6 @@ ROBOT, TRAIL, GOAL, POI, FACE = 0x58A6FFFF, 0xF5B400DD, 0xF778BAFF, 0xE6EDF3FF, 
 # Negative radii are UI points: markers stay visible however far the map is zoomed out.
 R_ROBOT, R_POI, R_VISITOR, R_TRACKED, R_GOAL = -7.0, -4.0, -5.0, -9.0, -6.0
 R_ROUTE, R_TRAIL, R_ZONE, R_ARROW = -1.5, -2.0, -1.0, -1.5
-CODE_NAMES = {1: "active", SUCCEEDED: "succeeded", FAILED: "failed", ABORTED: "aborted"}
 WARNING_NOTE = re.compile(r"fail|timed out|no \S+ within|abort|skip|lost|nobody|declin|refus"
                           r"|replaced|not engaged|no face data", re.IGNORECASE)
 PERIODIC = frozenset({"engagement"})  # front-end commands sent on a timer: DEBUG, not INFO
@@ -289,10 +288,11 @@ class Writer:
                     ros_log.append((tick, t, "WARN" if value.faults else "INFO",
                                     "faults: " + ("; ".join(value.faults) or "none")))
             elif role == "response":
-                name = CODE_NAMES.get(value, str(value))
-                level = "WARN" if value in (FAILED, ABORTED) else "INFO"
+                code = Response.of(value)
+                name = code.word if code is not None else "unknown"
+                level = "WARN" if code in (FAILED, ABORTED) else "INFO"
                 ros_log.append((tick, t, level, f"/FROG_response {value} ({name})"))
-                if value in (SUCCEEDED, FAILED, ABORTED):
+                if code is not None and code.terminal:
                     goals.append((tick, 0, t, None))
             elif role == "docking_state" and value != self._docking:
                 self._docking = value

@@ -115,9 +115,12 @@ def _outline(behaviour: Behaviour, ids: Iterator[int]) -> Node:
     kind, memory, params = _kind(behaviour)
     children = tuple(_outline(child, ids) for child in behaviour.children)
     return Node(node_id, kind, type(behaviour).__name__, " ".join(behaviour.name.split()),
-                params, tuple(getattr(behaviour, "reads", ())),
-                tuple(getattr(behaviour, "optional_reads", ())),
-                tuple(getattr(behaviour, "writes", ())), memory, children)
+                params, _key_names(behaviour, "reads"), _key_names(behaviour, "optional_reads"),
+                _key_names(behaviour, "writes"), memory, children)
+
+
+def _key_names(behaviour: Behaviour, group: str) -> tuple[str, ...]:
+    return tuple(key.name for key in getattr(behaviour, group, ()))
 
 
 def _kind(b: Behaviour) -> tuple[str, bool, tuple[tuple[str, str], ...]]:
@@ -131,7 +134,9 @@ def _kind(b: Behaviour) -> tuple[str, bool, tuple[tuple[str, str], ...]]:
         return "parallel", False, (("policy", type(policy).__name__),)
     if isinstance(b, py_trees.composites.Sequence | py_trees.composites.Selector):
         kind = "sequence" if isinstance(b, py_trees.composites.Sequence) else "selector"
-        return kind, b.memory, (("memory", _value(b.memory)),)
+        scope = getattr(b, "scope", None)
+        return kind, b.memory, (("memory", _value(b.memory)),
+                                *((("scope", scope.name.lower()),) if scope is not None else ()))
     kind = ("decorator" if isinstance(b, py_trees.decorators.Decorator) else
             "composite" if isinstance(b, py_trees.composites.Composite) else "leaf")
     describe = getattr(b, "describe", None)

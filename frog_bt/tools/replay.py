@@ -41,6 +41,7 @@ from frog_bt.config import Site, parse_hostport
 from frog_bt.errors import DecodeError, FrogError
 from frog_bt.frontend.messages import EVENTS, FrontendMessage, message_fields
 from frog_bt.frontend.protocol import Endpoint
+from frog_bt.kernel import keys
 from frog_bt.kernel.clock import SITE_TZ, ManualClock
 from frog_bt.observers.recording import BLAME, FRONTEND_IN, FRONTEND_OUT, PRIMER, TICK, from_ns
 from frog_bt.rosbridge.msgs import ROS_TYPES
@@ -316,7 +317,7 @@ class Replay:
                 continue
             self.core.inputs.add(inp, value, float(entry.get("t", self.clock.now())))
         if primer.get("frontend_ready"):
-            self.core.snapshot.bb.set("/frontend_ready", True)
+            self.core.board.set(keys.FRONTEND_READY, True)
         for raw in primer.get("frontend_in", ()):  # seen live: their resends are duplicates
             self.endpoint.receive(raw.encode(), self._peer, self.clock.now())
         self._seqs.update(primer.get("frontend_out_seqs", ()))

@@ -43,6 +43,7 @@ CONTROLS = {("Sequence", True): "Sequence", ("Sequence", False): "ReactiveSequen
 FROM_CONTROL = {v: k for k, v in CONTROLS.items()}
 RETRY, FORCE = "RetryUntilSuccessful", "ForceSuccess"
 # frog-bt types whose name is a different BT.CPP built-in: exported under another name
+SCOPE = "_frogScope"  # a composite's scope: no BT.CPP equivalent
 RENAMED = {"Timeout": "ClockTimeout"}  # ours counts project-clock seconds, BT.CPP's wall ms
 FROM_RENAMED = {v: k for k, v in RENAMED.items()}
 _VAR = re.compile(r"^\{\w+\}$")
@@ -104,6 +105,7 @@ class _Exporter:
         type_ = data["type"]
         params = {k: v for k, v in data.items()
                   if k not in ("type", "name", "when", "child", "children", "memory")}
+        scope = params.pop("scope", None)
         if type_ in ("Sequence", "Selector"):
             element = ET.Element(CONTROLS[(type_, bool(data["memory"]))])
         elif type_ == "Parallel":
@@ -123,6 +125,8 @@ class _Exporter:
             self.used.add(type_)
         if "name" in data:
             element.set("name", str(data["name"]))
+        if scope is not None:
+            element.set(SCOPE, _text(scope))  # BT.CPP ignores "_" attributes it does not know
         for key, value in params.items():
             element.set(str(key), _text(value))
         _when(element, data.get("when"))
@@ -195,6 +199,7 @@ def _from_element(element: ET.Element) -> dict[str, Any]:
             data["with"] = {k: _value(v) for k, v in attrs.items()}
     else:
         tag = element.tag
+        scope = attrs.pop(SCOPE, None)
         if tag in FROM_CONTROL:
             type_, memory = FROM_CONTROL[tag]
             data = {"type": type_, "memory": memory}
@@ -214,6 +219,8 @@ def _from_element(element: ET.Element) -> dict[str, Any]:
             data = {"type": FROM_RENAMED.get(tag, tag)}
         if "name" in attrs:
             data["name"] = attrs.pop("name")
+        if scope is not None:
+            data["scope"] = scope
         data.update({k: _value(v) for k, v in attrs.items()})
         children = [_from_element(c) for c in element]
         if tag in FROM_CONTROL or tag == "Parallel":

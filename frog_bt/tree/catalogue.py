@@ -1,9 +1,10 @@
 """The catalogue of every node type a tree file can name: parameters, keys, docstring.
 
 Built from the registries (:data:`~frog_bt.tree.leaf.LEAVES`,
-:data:`~frog_bt.tree.decorators.DECORATORS`) and the composites' structural keys,
-so it cannot drift from the code. ``frog-bt leaves`` prints it as Markdown or
-JSON; the node reference in ``docs/TREES.md`` is its Markdown (a test compares).
+:data:`~frog_bt.tree.decorators.DECORATORS`, :data:`~frog_bt.tree.composites.COMPOSITES`)
+and the key declarations (:mod:`frog_bt.kernel.keys`), so it cannot drift from the code.
+``frog-bt leaves`` prints it as Markdown or JSON; the node reference in ``docs/TREES.md``
+is its Markdown (a test compares).
 """
 
 from __future__ import annotations
@@ -19,6 +20,9 @@ from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
 import frog_bt.behaviours  # noqa: F401 - registers the leaf types
+from frog_bt.kernel.key import Key
+from frog_bt.kernel.keys import by_name
+from frog_bt.tree.composites import COMPOSITES
 from frog_bt.tree.decorators import DECORATORS
 from frog_bt.tree.leaf import LEAVES
 
@@ -41,26 +45,6 @@ class NodeType:
     writes: tuple[str, ...] = ()
     doc: str = ""
     children: str = field(default="")  # "children" | "child" | ""
-
-
-COMPOSITES = (
-    NodeType("Sequence", "composite", (
-        Param("memory", "bool", "required",
-              "true: resume at the running child; false: re-check every child each tick"),),
-        doc="Runs its children in order; SUCCESS when all succeed, FAILURE at the first "
-            "that fails.", children="children"),
-    NodeType("Selector", "composite", (
-        Param("memory", "bool", "required",
-              "true: resume at the running child; false: try from the first each tick"),),
-        doc="Tries its children in order; SUCCESS at the first that succeeds, FAILURE when "
-            "all fail.", children="children"),
-    NodeType("Parallel", "composite", (
-        Param("policy", "all | one", "all", "SUCCESS when all children / one child succeed"),
-        Param("synchronise", "bool", True, "with policy all: a succeeded child is not "
-              "ticked again")),
-        doc="Ticks all its children every tick; FAILURE as soon as one fails.",
-        children="children"),
-)
 
 
 def _type_name(annotation: Any) -> str:
@@ -87,17 +71,38 @@ def _params(model: type[BaseModel]) -> tuple[Param, ...]:
     return tuple(out)
 
 
+def _names(keys: tuple[Key[Any], ...]) -> tuple[str, ...]:
+    return tuple(k.name for k in keys)
+
+
 def _node(cls: Any, kind: str) -> NodeType:
-    return NodeType(cls.__name__, kind, _params(cls.Params), tuple(cls.reads),
-                    tuple(cls.optional_reads), tuple(cls.writes),
-                    inspect.cleandoc(cls.__doc__ or ""), "child" if kind == "decorator" else "")
+    children = {"composite": "children", "decorator": "child"}.get(kind, "")
+    return NodeType(cls.__name__, kind, _params(cls.Params),
+                    _names(getattr(cls, "reads", ())), _names(getattr(cls, "optional_reads", ())),
+                    _names(getattr(cls, "writes", ())), inspect.cleandoc(cls.__doc__ or ""),
+                    children)
 
 
 def catalogue() -> list[NodeType]:
     """Every node type, composites first, then decorators and leaves by name."""
-    return [*COMPOSITES,
+    return [*(_node(COMPOSITES[n], "composite") for n in COMPOSITES),
             *(_node(DECORATORS[n], "decorator") for n in sorted(DECORATORS)),
             *(_node(LEAVES[n], "leaf") for n in sorted(LEAVES))]
+
+
+@dataclass(frozen=True, slots=True)
+class KeyInfo:
+    name: str
+    type: str
+    source: str  # input | leaf | executive
+    scope: str  # process | tour | visitor | stop
+    meaning: str
+
+
+def key_catalogue() -> list[KeyInfo]:
+    """Every key a tree can read or write, by name."""
+    return [KeyInfo(k.name, k.type_name, k.source.value, k.scope.name.lower(), k.doc)
+            for _, k in sorted(by_name().items())]
 
 
 def as_json(nodes: list[NodeType]) -> str:
@@ -138,4 +143,14 @@ def as_markdown(nodes: list[NodeType]) -> str:
             if keys:
                 line = "; ".join(keys)
                 out.append(line[0].upper() + line[1:] + ".\n")
+    out.append("### Keys\n")
+    out.append("Every value a tree reads or writes (`frog_bt/kernel/keys.py`, and the "
+               "robot's inputs in `frog_bt/wire.py`). A value lives as long as its scope: "
+               "starting a scope clears its keys and those of narrower scopes "
+               "(tour > visitor > stop).\n")
+    out.append("| key | type | written by | scope | meaning |")
+    out.append("|---|---|---|---|---|")
+    for k in key_catalogue():
+        out.append(f"| `{k.name}` | {_cell(k.type)} | {k.source} | {k.scope} | "
+                   f"{_cell(k.meaning)} |")
     return "\n".join(out).rstrip() + "\n"

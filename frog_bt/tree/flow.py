@@ -18,29 +18,29 @@ every path that reaches it), and after it succeeds:
   is sure;
 * a leaf needs its ``reads`` (not its ``optional_reads``), and surely wrote its
   ``writes`` once it succeeded;
-* a *scope* (each tour stop of a ``foreach``) starts without the keys that
-  belong to one stop (:data:`SCOPED`): a value left over from an earlier stop or
-  from the introduction is never this stop's.
+* a node that starts a *scope* (each tour stop of a ``foreach``, ``scope:`` in a tree
+  file) starts without the keys of that scope and the narrower ones (each key declares
+  its :class:`~frog_bt.kernel.key.Scope`): a value left over from an earlier stop or
+  from an earlier visitor's introduction is never this one's. At run time the same
+  node clears those keys when it starts, so optional reads never see them either.
 
-The input keys (the wire table's, ``/now``, ``/events``, ...) are always there.
+The input and executive keys (the wire table's, ``/now``, ``/events``, ...) are always
+there.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import py_trees
 
-from frog_bt.kernel.blackboard import input_keys
+from frog_bt.kernel.key import Key, Scope
+from frog_bt.kernel.keys import always
 
 Behaviour = py_trees.behaviour.Behaviour
-Keys = frozenset[str]
-
-# Keys whose value belongs to one tour stop: a stop scope starts without them.
-SCOPED: dict[str, Keys] = {
-    "stop": frozenset({"/engaged", "/engagement_decision", "/skipped"}),
-}
+Keys = frozenset[Key[Any]]
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,30 +48,29 @@ class Gap:
     """A node that reads a key no node surely writes before it."""
 
     node: Behaviour
-    key: str
+    key: Key[Any]
     writers: tuple[Behaviour, ...]  # nodes that write it elsewhere (none: nothing does)
-    scope: str | None  # the scope that dropped an earlier value, if one did
+    scope: Scope | None  # the scope that dropped an earlier value, if one did
 
 
-def gaps(root: Behaviour, scopes: dict[int, str] | None = None) -> list[Gap]:
+def gaps(root: Behaviour) -> list[Gap]:
     """Every read no writer surely precedes, in tree order."""
-    scopes = scopes or {}
     found: list[Gap] = []
-    writers: dict[str, list[Behaviour]] = {}
+    writers: dict[Key[Any], list[Behaviour]] = {}
     for node in root.iterate():
         for key in getattr(node, "writes", ()):
             writers.setdefault(key, []).append(node)
 
-    def need(node: Behaviour, have: Keys, lost: dict[str, str]) -> None:
+    def need(node: Behaviour, have: Keys, lost: dict[Key[Any], Scope]) -> None:
         for key in getattr(node, "reads", ()):
             if key not in have:
                 found.append(Gap(node, key, tuple(w for w in writers.get(key, ())
                                                   if w is not node), lost.get(key)))
 
-    def visit(node: Behaviour, have: Keys, lost: dict[str, str]) -> Keys:
-        scope = scopes.get(id(node))
+    def visit(node: Behaviour, have: Keys, lost: dict[Key[Any], Scope]) -> Keys:
+        scope: Scope | None = getattr(node, "scope", None)
         if scope is not None:
-            gone = have & SCOPED.get(scope, frozenset())
+            gone = frozenset(k for k in have if k.scope.within(scope))
             lost = {**lost, **{k: scope for k in gone}}
             have = have - gone
         need(node, have, lost)
@@ -91,7 +90,7 @@ def gaps(root: Behaviour, scopes: dict[int, str] | None = None) -> list[Gap]:
             return _all(outs, have)
         own = frozenset(getattr(node, "writes", ()))
         if isinstance(node, py_trees.decorators.Decorator):
-            provides: Callable[[], Iterable[str]] | None = getattr(node, "provides", None)
+            provides: Callable[[], Iterable[Key[Any]]] | None = getattr(node, "provides", None)
             given = have | frozenset(provides() if provides is not None else ())
             after = visit(node.decorated, given, lost)
             if getattr(node, "child_may_fail", False):
@@ -101,7 +100,7 @@ def gaps(root: Behaviour, scopes: dict[int, str] | None = None) -> list[Gap]:
             return after | own
         return have | own
 
-    visit(root, frozenset(input_keys()), {})
+    visit(root, always(), {})
     return found
 
 

@@ -5,7 +5,8 @@ mapping with a ``type``:
 
 * composites ``Sequence`` / ``Selector`` (``memory`` is required: it changes
   behaviour, so it is always explicit) and ``Parallel`` (``policy: all | one``),
-  with ``children``;
+  with ``children`` (:mod:`frog_bt.tree.composites`; ``scope:`` makes one start a
+  scope);
 * decorators (:mod:`frog_bt.tree.decorators`: ``Retry``, ``Timeout``,
   ``FaceStream``), with ``child``;
 * leaves (:mod:`frog_bt.behaviours`), their parameters given inline.
@@ -45,16 +46,16 @@ import frog_bt.behaviours  # noqa: F401 - registers the leaf types
 from frog_bt import resources
 from frog_bt.config import Site
 from frog_bt.errors import TreeError, TreeErrors, format_path
-from frog_bt.kernel.keys import key_types, type_name
+from frog_bt.kernel.key import Scope
+from frog_bt.kernel.keys import by_name
+from frog_bt.tree.composites import COMPOSITES
 from frog_bt.tree.decorators import DECORATORS
 from frog_bt.tree.flow import Gap, gaps
 from frog_bt.tree.leaf import LEAVES
-from frog_bt.tree.observed import Parallel, Selector, Sequence
-from frog_bt.yamlfile import line_of, load_yaml, validate
+from frog_bt.yamlfile import Marks, line_of, load_yaml_marked, validate
 
 DEFAULT_TREE_DIR = resources.tree_dir()
 DEFAULT_TREE = DEFAULT_TREE_DIR / resources.TREE_FILE
-COMPOSITES = ("Sequence", "Selector", "Parallel")
 STRUCTURE = {"type", "name", "when"}
 _VAR = re.compile(r"\{(\w+)\}")
 
@@ -66,6 +67,7 @@ Behaviour = py_trees.behaviour.Behaviour
 class Where:
     file: str
     path: Path_
+    line: tuple[int, int] | None = None  # (line, column) in the file, where known
 
 
 @dataclass
@@ -76,7 +78,7 @@ class LoadedTree:
     file: str
     description: str = ""
     where: dict[int, Where] = field(default_factory=dict)  # id(node) -> file and path
-    scopes: dict[int, str] = field(default_factory=dict)  # id(node) -> scope it starts
+    scopes: dict[int, Scope] = field(default_factory=dict)  # id(node) -> scope it starts
 
     def nodes(self) -> Iterator[Behaviour]:
         yield from self.root.iterate()
@@ -93,10 +95,11 @@ class _Builder:
     def __init__(self, site: Site | None) -> None:
         self.site = site
         self.where: dict[int, Where] = {}
-        self.scopes: dict[int, str] = {}  # id(node) -> the scope it starts ("stop")
+        self.scopes: dict[int, Scope] = {}  # id(node) -> the scope it starts
         self.errors: list[TreeError] = []  # found so far; the build goes on past each
         self.documents: dict[str, Any] | None = None  # name -> document (imported XML)
         self.stack: list[Path] = []
+        self.marks: dict[str, Marks] = {}  # file -> where each path in it is written
 
     # ------------------------------------------------------------ files
 
@@ -107,7 +110,8 @@ class _Builder:
             if path.name not in self.documents:
                 raise TreeError(str(path), (), "no such BehaviorTree in the XML file")
             return self.documents[path.name]
-        return load_yaml(path, TreeError)
+        data, self.marks[str(path)] = load_yaml_marked(path, TreeError)
+        return data
 
     def file(self, path: Path, variables: dict[str, Any]) -> tuple[Behaviour | None, str]:
         if path.resolve() in (p.resolve() for p in self.stack):
@@ -178,15 +182,23 @@ class _Builder:
             hint = f"; did you mean {close[0]!r}?" if close else f" (known: {', '.join(known)})"
             raise TreeError(file, (*path, "type"), f"unknown type {type_!r}{hint}")
         if behaviour is not None:
-            self.where[id(behaviour)] = Where(file, path)
+            self.where[id(behaviour)] = Where(file, path,
+                                              line_of(file, path, self.marks.get(file, {})))
             return [behaviour]
         return []
 
     def _composite(self, type_: str, data: dict[str, Any], file: str, path: Path_,
                    variables: dict[str, Any], name: str) -> Behaviour:
-        allowed = STRUCTURE | {"children"} | ({"memory"} if type_ != "Parallel" else
-                                              {"policy", "synchronise"})
-        self._no_unknown(data, allowed, file, path, type_)
+        cls = COMPOSITES[type_]
+        raw = {k: v for k, v in data.items() if k not in STRUCTURE | {"children"}}
+        if "memory" in cls.Params.model_fields:
+            if "memory" not in raw:
+                raise TreeError(file, (*path, "memory"), f"missing required key: a {type_} "
+                                "must say memory: true or false")
+            if not isinstance(raw["memory"], bool):
+                raise TreeError(file, (*path, "memory"),
+                                f"expected true or false, got {_short(raw['memory'])}")
+        params = self._params(cls.Params, raw, file, path, variables)
         children_data = data.get("children")
         if not isinstance(children_data, list) or not children_data:
             raise TreeError(file, (*path, "children"), "expected a non-empty list of nodes")
@@ -194,27 +206,10 @@ class _Builder:
         children: list[Behaviour] = []
         for i, child in enumerate(children_data):
             children += self._collect(child, file, (*path, "children", i), variables)
-        name = name or type_
-        if type_ == "Parallel":
-            policy = data.get("policy", "all")
-            sync = data.get("synchronise", True)
-            if policy not in ("all", "one"):
-                raise TreeError(file, (*path, "policy"), f"expected 'all' or 'one', got {policy!r}")
-            if not isinstance(sync, bool):
-                raise TreeError(file, (*path, "synchronise"), "expected true or false")
-            pol = (py_trees.common.ParallelPolicy.SuccessOnAll(synchronise=sync)
-                   if policy == "all" else
-                   py_trees.common.ParallelPolicy.SuccessOnOne())
-            return Parallel(name, policy=pol, children=children)
-        if "memory" not in data:
-            raise TreeError(file, (*path, "memory"),
-                            f"missing required key: a {type_} must say memory: true or false")
-        memory = data["memory"]
-        if not isinstance(memory, bool):
-            raise TreeError(file, (*path, "memory"),
-                            f"expected true or false, got {_short(memory)}")
-        cls = Sequence if type_ == "Sequence" else Selector
-        return cls(name, memory=memory, children=children)
+        node = cls.build(name or type_, params, children)
+        if node.scope is not None:
+            self.scopes[id(node)] = node.scope
+        return node
 
     def _decorator(self, type_: str, data: dict[str, Any], file: str, path: Path_,
                    variables: dict[str, Any], name: str) -> Behaviour | None:
@@ -270,7 +265,9 @@ class _Builder:
         for stop in stops:
             nodes = self._include({k: v for k, v in data.items() if k != "foreach"}, file, path,
                                   {**variables, **stop})
-            self.scopes.update((id(n), "stop") for n in nodes)
+            for n in nodes:
+                n.scope = Scope.STOP  # type: ignore[attr-defined] - every built node is Observed
+                self.scopes[id(n)] = Scope.STOP
             out += nodes
         return out
 
@@ -323,11 +320,10 @@ def _short(value: Any) -> str:
 
 
 def check_keys(tree: LoadedTree) -> None:
-    """Every key a node reads or writes is known and of the type the node takes it as
-    (:mod:`.keys`), and every key it reads is written before it on every path
-    (:mod:`.flow`)."""
-    errors: list[TreeError] = list(_type_errors(tree))
-    for gap in gaps(tree.root, tree.scopes):
+    """Every key a node reads or writes is declared (:mod:`frog_bt.kernel.keys`), and every
+    key it reads is written before it on every path (:mod:`.flow`)."""
+    errors: list[TreeError] = list(_undeclared(tree))
+    for gap in gaps(tree.root):
         error = _gap_error(tree, gap)
         if str(error) not in (str(e) for e in errors):  # one per place, not per stop
             errors.append(error)
@@ -341,30 +337,26 @@ def raise_all(errors: list[TreeError]) -> None:
     raise errors[0] if len(errors) == 1 else TreeErrors(errors)
 
 
-def _type_errors(tree: LoadedTree) -> Iterator[TreeError]:
-    types = key_types()
+def _undeclared(tree: LoadedTree) -> Iterator[TreeError]:
+    declared = by_name()
     for node in tree.nodes():
         where = tree.where.get(id(node), Where(tree.file, ()))
         who = f"{type(node).__name__} {node.name!r}"
-        declared: dict[str, Any] = getattr(node, "key_types", {})
         for key in (*getattr(node, "reads", ()), *getattr(node, "optional_reads", ()),
                     *getattr(node, "writes", ())):
-            if key not in types:
+            if declared.get(key.name) is not key:
                 yield TreeError(where.file, where.path,
-                                f"{who} uses {key}, which no key declaration knows "
-                                "(frog_bt/kernel/keys.py)")
-            elif key in declared and declared[key] != types[key]:
-                yield TreeError(where.file, where.path,
-                                f"{who} takes {key} as {type_name(declared[key])}, but "
-                                f"{key} holds {type_name(types[key])}")
+                                f"{who} uses {key.name}, which no key declaration knows "
+                                "(frog_bt/kernel/keys.py, or an input of frog_bt/wire.py)")
 
 
 def _gap_error(tree: LoadedTree, gap: Gap) -> TreeError:
     where = tree.where.get(id(gap.node), Where(tree.file, ()))
     reader = f"{type(gap.node).__name__} {gap.node.name!r}"
     if gap.scope is not None:
-        why = (f"a {gap.scope} starts without it: the value from before this {gap.scope} "
-               f"is not this {gap.scope}'s; write it in this {gap.scope}, before the reader")
+        scope = gap.scope.name.lower()
+        why = (f"a {scope} starts without it: the value from before this {scope} "
+               f"is not this {scope}'s; write it in this {scope}, before the reader")
     elif gap.writers:
         at = [_at(tree, w) for w in gap.writers[:3]]
         why = (f"{', '.join(at)} write{'s' if len(at) == 1 else ''} it, but not before it on "
@@ -372,14 +364,14 @@ def _gap_error(tree: LoadedTree, gap: Gap) -> TreeError:
                "parallel, or a part that may fail or be skipped)")
     else:
         why = "nothing writes it"
-    return TreeError(where.file, where.path, f"{reader} reads {gap.key}: {why}")
+    return TreeError(where.file, where.path, f"{reader} reads {gap.key.name}: {why}")
 
 
 def _at(tree: LoadedTree, node: Behaviour) -> str:
     where = tree.where.get(id(node))
     if where is None:
         return f"{type(node).__name__} {node.name!r}"
-    line = line_of(where.file, where.path)
+    line = where.line
     place = f"{Path(where.file).name}:{line[0]}" if line else (
         f"{Path(where.file).name}: {format_path(where.path)}")
     return f"{type(node).__name__} {node.name!r} ({place})"

@@ -1,36 +1,42 @@
 """What every frog-bt leaf and decorator declares and reaches.
 
 A node type declares its parameters (``Params``, a pydantic model: unknown keys
-are errors), the blackboard keys it reads (``reads``: something must write them;
-``optional_reads``: a default applies while nothing has) and the keys it writes.
-The loader checks a whole tree against these declarations before anything
+are errors) and the typed keys (:mod:`frog_bt.kernel.keys`) it reads (``reads``:
+something must write them before; ``optional_reads``: None while nothing has) and
+writes. The loader checks a whole tree against these declarations before anything
 connects. At run time ``setup`` hands the node the
-:class:`~frog_bt.kernel.context.Context`; :meth:`Declared.get` and :meth:`Declared.set`
-reach the blackboard.
+:class:`~frog_bt.kernel.context.Context` (services), the core's board and trace;
+:meth:`Declared.get` and :meth:`Declared.set` reach the board, for declared keys only.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
 import py_trees
 from pydantic import BaseModel, ConfigDict
 
 from frog_bt.kernel.context import Context
-from frog_bt.tree.observed import ACTING, DECIDED
+from frog_bt.kernel.key import Key, Source
+from frog_bt.kernel.outcomes import IncidentKind
+
+if TYPE_CHECKING:
+    from frog_bt.kernel.blackboard import Board
+    from frog_bt.tree.observed import Trace
 
 Status = py_trees.common.Status
 SUCCESS, FAILURE, RUNNING, INVALID = Status.SUCCESS, Status.FAILURE, Status.RUNNING, Status.INVALID
 ENDED = frozenset((SUCCESS, FAILURE))
+T = TypeVar("T")
 
 
 class MissingValue(Exception):
     """A required key a tree node writes has no value yet (the tree was built wrong
     past the load-time check): the reading node fails with this reason."""
 
-    def __init__(self, key: str) -> None:
-        super().__init__(key)
+    def __init__(self, key: Key[Any]) -> None:
+        super().__init__(key.name)
         self.key = key
 
 
@@ -41,13 +47,12 @@ class Params(BaseModel):
 
 
 class Declared:
-    """Mixin for py_trees behaviours: declared parameters and keys, context, blackboard."""
+    """Mixin for py_trees behaviours: declared parameters and keys, context, board."""
 
     Params: ClassVar[type[BaseModel]] = Params
-    reads: ClassVar[tuple[str, ...]] = ()
-    optional_reads: ClassVar[tuple[str, ...]] = ()
-    writes: ClassVar[tuple[str, ...]] = ()
-    key_types: ClassVar[dict[str, Any]] = {}  # key -> the type this node takes it as
+    reads: ClassVar[tuple[Key[Any], ...]] = ()
+    optional_reads: ClassVar[tuple[Key[Any], ...]] = ()
+    writes: ClassVar[tuple[Key[Any], ...]] = ()
     name: str
 
     def _declare(self, params: BaseModel | None) -> None:
@@ -55,15 +60,16 @@ class Declared:
         self._reads_any = bool(self.reads or self.optional_reads)  # blame: a decider
         self.params: Any = params if params is not None else type(self).Params()
         self._ctx: Context | None = None
-        if self.reads or self.optional_reads or self.writes:
-            self.bb = self.attach_blackboard_client(name=self.name)  # type: ignore[attr-defined]
-            for key in (*self.reads, *self.optional_reads):
-                self.bb.register_key(key, access=py_trees.common.Access.READ)
-            for key in self.writes:
-                self.bb.register_key(key, access=py_trees.common.Access.WRITE)
+        self._bb: Board | None = None
+        self._trace_: Trace | None = None
+        self._readable = frozenset((*self.reads, *self.optional_reads, *self.writes))
+        self._writable = frozenset(self.writes)
+        self._required = frozenset(k for k in self.reads if k.source is Source.LEAF)
 
     def setup(self, **kwargs: Any) -> None:
         self._ctx = kwargs["ctx"]
+        self._bb = kwargs["board"]
+        self._trace_ = kwargs["trace"]
 
     @property
     def ctx(self) -> Context:
@@ -71,44 +77,53 @@ class Declared:
             raise RuntimeError(f"{self.name}: ticked before setup(ctx=...)")
         return self._ctx
 
-    def get(self, key: str, default: Any = None) -> Any:
-        """The blackboard value of ``key``, or ``default`` while nothing has written it.
+    def get(self, key: Key[T]) -> T | None:
+        """The board's value of ``key`` (declared in ``reads``, ``optional_reads`` or
+        ``writes``), None while nothing has written it.
 
-        A required read (``reads``) of a key that tree nodes write never returns None:
-        the node then FAILs with the reason in its feedback (inputs may be None: no
-        data yet, which the leaves handle)."""
-        try:
-            value = self.bb.get(key)
-        except KeyError:
-            value = default
-        if value is None and key in self.reads and key not in _input_keys():
+        A required read (``reads``) of a key that tree nodes write, and that none has
+        written in this scope, fails the node with the reason in its feedback (inputs
+        may be None: no data yet, which the leaves handle)."""
+        if key not in self._readable:
+            raise KeyError(f"{self.name} reads {key.name} without declaring it")
+        board = self._bb
+        assert board is not None, "get() before setup()"
+        value = board.get(key)
+        if value is None and key in self._required and not board.written(key):
             raise MissingValue(key)
         return value
 
+    def need(self, key: Key[T]) -> T:
+        """:meth:`get` for a key the snapshot always writes (``/now``, ``/events``)."""
+        value = self.get(key)
+        assert value is not None, f"{key.name} is written before every tick"
+        return value
+
+    def set(self, key: Key[T], value: T | None) -> None:
+        if key not in self._writable:
+            raise KeyError(f"{self.name} writes {key.name} without declaring it")
+        assert self._bb is not None, "set() before setup()"
+        self._bb.set(key, value)
+
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
-        ACTING.append(self)  # type: ignore[arg-type]
+        trace = self._trace_
+        assert trace is not None, "ticked before setup(trace=...)"
+        trace.acting.append(self)  # type: ignore[arg-type]
         try:
+            if self.status != RUNNING:  # type: ignore[attr-defined]
+                self.start_scope()  # type: ignore[attr-defined]
             yield from super().tick()  # type: ignore[misc]
             if self._reads_any and self.status in ENDED:  # type: ignore[attr-defined]
-                DECIDED.append(self)  # type: ignore[arg-type]
+                trace.decided.append(self)  # type: ignore[arg-type]
         except MissingValue as missing:
-            self.feedback_message = f"no value for {missing.key}"  # type: ignore[attr-defined]
-            self.ctx.note(f"{self.name}: no value for {missing.key}; failing",
-                          incident="missing value", subject=missing.key)
+            self.feedback_message = f"no value for {missing.key.name}"  # type: ignore[attr-defined]
+            self.ctx.note(f"{self.name}: no value for {missing.key.name}; failing",
+                          incident=IncidentKind.MISSING_VALUE, subject=missing.key.name)
             self.stop(FAILURE)  # type: ignore[attr-defined]
             yield self  # type: ignore[misc]
         finally:
-            ACTING.pop()
-
-    def set(self, key: str, value: Any) -> None:
-        self.bb.set(key, value, overwrite=True)
+            trace.acting.pop()
 
     def describe(self) -> dict[str, Any]:
         """Parameters as shown by ``render`` (unset ones omitted)."""
         return self.params.model_dump(exclude_none=True)
-
-
-def _input_keys() -> frozenset[str]:
-    from frog_bt.kernel.blackboard import input_keys  # the runtime imports the tree
-
-    return frozenset(input_keys())

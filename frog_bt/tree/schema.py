@@ -16,6 +16,7 @@ from typing import Any
 
 from frog_bt.config import Site
 from frog_bt.tree.catalogue import catalogue
+from frog_bt.tree.composites import COMPOSITES
 from frog_bt.tree.decorators import DECORATORS
 from frog_bt.tree.leaf import LEAVES
 
@@ -44,18 +45,14 @@ def tree_schema() -> dict[str, Any]:
     defs: dict[str, Any] = {}
     kinds: list[dict[str, Any]] = []
     for node in catalogue():
+        cls = COMPOSITES.get(node.name) or DECORATORS.get(node.name) or LEAVES[node.name]
+        props, required = _params(cls, defs)
         if node.kind == "composite":
-            props: dict[str, Any] = {p.name: {"anyOf": [
-                {"type": "boolean"} if p.type == "bool" else {"enum": ["all", "one"]},
-                VARIABLE], "description": p.meaning} for p in node.params}
             props["children"] = {"type": "array", "items": NODE, "minItems": 1}
-            required = ["children", *(["memory"] if node.name != "Parallel" else [])]
-        else:
-            cls = DECORATORS.get(node.name) or LEAVES[node.name]
-            props, required = _params(cls, defs)
-            if node.kind == "decorator":
-                props["child"] = NODE
-                required = [*required, "child"]
+            required = [*required, "children"]
+        elif node.kind == "decorator":
+            props["child"] = NODE
+            required = [*required, "child"]
         kinds.append({
             "title": node.name, "description": node.doc.split("\n\n")[0],
             "type": "object", "additionalProperties": False,

@@ -58,4 +58,4 @@ def test_dock_gives_up_after_the_site_timeout_without_a_docked_state(tmp_path):
     assert bench.tick() == RUNNING
     bench.advance(0.1)
     assert bench.tick() == FAILURE
-    assert [i.text for i in bench.core.ctx.incidents] == ["dock: no docked within 120 s"]
+    assert [i.text for i in bench.core.journal.incidents] == ["dock: no docked within 120 s"]

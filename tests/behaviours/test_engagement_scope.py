@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import py_trees
 import pytest
 from bench import Bench, write_tree
 
 from frog_bt.frontend.messages import ContentDone, Engagement, FinishPoi, StartPoi
+from frog_bt.kernel import keys
 from frog_bt.rosbridge.msgs import Face, FaceData
 
 TREE = """
@@ -57,7 +57,7 @@ def test_icl_on_for_the_scope_and_meter_every_two_seconds(tmp_path):
     # window (0, 2]: 0.4, -0.6, 0.8 (0.9 far) -> engaged side mean 0.6
     # window (2, 4]: -0.5 (-0.7 not facing), -0.9 -> -0.7
     assert meters == [pytest.approx(0.6), pytest.approx(-0.7)]
-    about, decision = py_trees.blackboard.Blackboard.storage["/engagement_decision"]
+    about, decision = bench.core.board.get(keys.ENGAGEMENT_DECISION)
     assert (about, decision.stored, decision.votes) == ("POI1", 5, 2)  # ceil(0.75) from each end
     # first (0.4) engaged, last (-0.9) not: a tie -> no extension by default
     assert decision.tie and decision.engaged is False

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import py_trees
 import pytest
 from bench import AFTERNOON, MORNING, Bench, write_tree
 
+from frog_bt.kernel import keys
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS
 
 NAVIGATE = "root: {type: Navigate, poi: POI1, timeout: 30}"
@@ -40,7 +40,7 @@ def test_time_of_day_variant_in_madrid(tmp_path, poi, clock_time, waypoint):
     expected = bench.site.pois[waypoint]
     assert (msg["pose"]["position"]["x"], msg["pose"]["orientation"]["z"]) == (
         expected.x, expected.z)
-    assert py_trees.blackboard.Blackboard.storage["/waypoint"] == waypoint
+    assert bench.core.board.get(keys.WAYPOINT) == waypoint
 
 
 def test_succeeds_on_response_2_only_after_active(tmp_path):

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import itertools
 
-import py_trees
 import pytest
 from bench import Bench, write_tree
 
@@ -17,13 +16,14 @@ from frog_bt.frontend.messages import (
     UserNegative,
     UserPositive,
 )
+from frog_bt.kernel import keys
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS
 
 SEEK = "root: {type: SeekVisitor}"
 
 
 def visitor(bench):
-    return py_trees.blackboard.Blackboard.storage.get("/visitor")
+    return bench.core.board.get(keys.VISITOR)
 
 
 def test_nearest_facing_person_is_chosen(tmp_path):
@@ -159,7 +159,7 @@ def test_a_person_whose_approach_always_fails_is_approached_once_a_minute(tmp_pa
     assert all(60 < b - a <= 60.3 for a, b in itertools.pairwise(times))
     assert {(topic, data) for _, topic, data in sent} == {("/ApproachPeopleFar", 7)}
     assert "approach of visitor 7 aborted: seek again (not them for 60 s)" in [
-        text for _, text in bench.core.ctx.notes]
+        text for _, text in bench.core.journal.notes]
 
 
 def test_lost_finish_introduction_asks_the_visitor_after_the_timeout(tmp_path):
@@ -177,7 +177,7 @@ def test_lost_finish_introduction_asks_the_visitor_after_the_timeout(tmp_path):
     bench.tick()
     assert [m for m in bench.take_sent() if not isinstance(m, Engagement)] == [
         AskTour(engaged=None)]
-    kinds = [i.kind for i in bench.core.ctx.incidents]
+    kinds = [i.kind for i in bench.core.journal.incidents]
     assert kinds == ["event missing"]
 
 
@@ -205,8 +205,8 @@ def test_no_answer_within_the_site_timeout_declines_and_seeks_again(tmp_path):
     assert bench.tick() == RUNNING
     bench.advance(0.1)
     assert bench.tick() == FAILURE
-    assert py_trees.blackboard.Blackboard.storage["/declined"] == frozenset({7})
-    assert bench.core.ctx.incidents[-1].text == (
+    assert bench.core.board.get(keys.DECLINED) == frozenset({7})
+    assert bench.core.journal.incidents[-1].text == (
         "visitor 7 gave no answer within 120 s: seek again")
 
 
@@ -221,7 +221,7 @@ def test_an_unanswered_approach_fails_after_the_site_timeout(tmp_path):
     assert bench.tick() == RUNNING
     bench.advance(0.1)
     assert bench.tick() == FAILURE
-    assert bench.core.ctx.incidents[-1].kind == "approach failed"
+    assert bench.core.journal.incidents[-1].kind == "approach failed"
 
 
 def test_a_command_is_blamed_on_its_node_with_what_it_read(tmp_path):

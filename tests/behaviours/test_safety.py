@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import py_trees
 from bench import Bench, write_tree
 
 from frog_bt.frontend.messages import ContentDone, FrontendIdle, Tour, Volume
+from frog_bt.kernel import keys
 from frog_bt.rosbridge.msgs import Diagnostics
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS
 
@@ -60,7 +60,7 @@ def test_a_tour_starts_only_when_charged_and_without_faults(tmp_path):
     bench.event(FrontendIdle())
     diagnostics(bench, 25.0)
     assert bench.tick() == RUNNING
-    assert bench.core.bt.root.feedback_message == "charging: battery 25% < 30%"
+    assert bench.core.root.feedback_message == "charging: battery 25% < 30%"
     diagnostics(bench, 31.0, "lidar: stale")
     assert bench.tick() == RUNNING
     diagnostics(bench, 31.0)
@@ -82,7 +82,7 @@ def test_location_features_pause_on_a_stale_pose(tmp_path):
     bench.advance(3.0)  # no pose since: stale; the robot may have left the shop
     bench.tick()
     assert bench.take_sent() == []
-    assert bench.core.bt.root.feedback_message.startswith("pose stale")
+    assert bench.core.root.feedback_message.startswith("pose stale")
     bench.pose(60.0, 60.0)
     bench.tick()
     assert bench.take_sent() == [Volume(100)]
@@ -102,8 +102,8 @@ def test_silent_face_stream_is_reported_and_gives_no_data(tmp_path):
     bench.tick()
     bench.advance(4.0)
     bench.tick()
-    assert bench.core.bt.root.feedback_message == "no face data for 4 s"
+    assert bench.core.root.feedback_message == "no face data for 4 s"
     bench.event(ContentDone("POI1", "a"))
     assert bench.tick() == SUCCESS
-    about, decision = py_trees.blackboard.Blackboard.storage["/engagement_decision"]
+    about, decision = bench.core.board.get(keys.ENGAGEMENT_DECISION)
     assert (about, decision.engaged, decision.stored) == ("POI1", None, 0)

@@ -40,7 +40,7 @@ def test_stale_tracking_is_not_taken_for_a_lost_visitor(tmp_path):
     bench.tick()
     bench.advance(3)
     assert bench.tick() == RUNNING
-    assert bench.core.bt.root.feedback_message == "laser tracking or pose stale: waiting"
+    assert bench.core.root.feedback_message == "laser tracking or pose stale: waiting"
     bench.advance(7)
     assert bench.tick() == SUCCESS
     assert "stale: assuming the visitor follows" in bench.core.last_note

@@ -113,7 +113,7 @@ async def _crash_and_resume(tmp_path) -> tuple[list[str], list[str], int, list[s
         await sim.wait_for(is_("start_poi", poi="POI2", part="a"), 60)
         first.own_sim = False
     saved = load_checkpoint(checkpoint)
-    assert saved is not None and saved.order == ["start", "recruit", "stop 0"]
+    assert saved is not None and saved.order == ("start", "recruit", "stop 0")
     assert saved.visitor == 7
     restart_t = sim.clock.now()
     async with Running({}, sim=sim, listen=listen, checkpoint=checkpoint, once=True) as second:

@@ -11,6 +11,8 @@ from tour import Running
 
 from frog_bt import resources
 from frog_bt.config import load_site
+from frog_bt.kernel import keys
+from frog_bt.kernel.outcomes import TourState
 from frog_bt.runtime.watch import Watch
 from frog_bt.tree.loader import load_tree
 
@@ -51,7 +53,7 @@ def test_a_valid_change_takes_over_when_idle_and_a_bad_one_is_refused(tmp_path: 
             good = recruit.read_text()
             recruit.write_text(good.replace("      - {type: SeekVisitor}\n", ""))
             assert await watch.check() is False
-            assert len(refused) == 1 and "recruit.yaml:16:9:" in refused[0][0]
+            assert len(refused) == 1 and "recruit.yaml:17:9:" in refused[0][0]
             assert await watch.check() is None  # reported once, not at every poll
             assert exe.core.tree is tree
 
@@ -71,7 +73,7 @@ def test_a_valid_change_takes_over_when_idle_and_a_bad_one_is_refused(tmp_path: 
                 if exe.core.ticks:
                     break
                 await asyncio.sleep(0.01)
-            tip = exe.core.bt.root.tip()
+            tip = exe.core.root.tip()
             assert tip is not None and tip.name == f"{WAIT} again"
 
     asyncio.run(main())
@@ -89,7 +91,7 @@ def test_no_swap_while_a_tour_runs(tmp_path: Path) -> None:
                                    and r.payload.get("state") == "started", 30)
             exe.offer(site, load_tree(tour_file, site))
             await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 30)
-            assert exe.core.ctx.tour_state == "started" and not exe.idle()
+            assert exe.core.board.get(keys.TOUR_STATE) is TourState.STARTED and not exe.idle()
             assert exe.swaps == 0 and exe.core.tree is tree
 
     asyncio.run(main())

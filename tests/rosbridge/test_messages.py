@@ -400,3 +400,8 @@ def test_json_text_decodes_as_the_objects_convert(ros_type: str, data: st.DataOb
         return  # NaN or infinity: not JSON, rosbridge cannot send it
     codec = ROS_TYPES[ros_type]
     assert _outcome(codec.decode, text) == _outcome(codec.convert, msg)
+
+
+def test_encode_time_at_the_end_of_uint32_does_not_overflow() -> None:
+    back = encode_time(Time(secs=2**32 - 1, nsecs=999_999_999).seconds)
+    assert (back.secs, back.nsecs) == (2**32 - 1, 999_999_999)

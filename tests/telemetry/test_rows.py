@@ -65,7 +65,7 @@ def test_rows_belong_to_the_tick_that_consumes_or_produces_them(bench: Bench):
 def test_notes_are_taken_once_even_when_the_list_is_trimmed(bench: Bench):
     rows = rows_on(bench)
     ctx = bench.core.ctx
-    ctx.note_limit = 4
+    bench.core.journal.limit = 4
     ctx.note("a")
     bench.tick()
     for text in "bcdef":

@@ -31,7 +31,7 @@ def test_every_error_with_file_line_and_column(tmp_path: Path,
     found = [re.match(r"(.+):(\d+):(\d+): (\S+): (\w+) '", line) for line in lines[:-1]]
     assert all(found), lines
     assert [(Path(m[1]).name, int(m[2]), m[5]) for m in found if m] == [
-        ("recruit.yaml", 16, "ApproachVisitor"), ("recruit.yaml", 29, "WaitAnswer")]
+        ("recruit.yaml", 17, "ApproachVisitor"), ("recruit.yaml", 30, "WaitAnswer")]
 
 
 def test_a_bad_config_is_one_line_and_exit_2(tmp_path: Path,
@@ -66,9 +66,9 @@ def test_structural_errors_all_at_once_sorted_by_line(tmp_path: Path,
 
 
 @pytest.mark.parametrize(("file", "old", "new", "where"), [
-    ("recruit.yaml", "      - {type: SeekVisitor}\n", "", "recruit.yaml:16:9:"),
+    ("recruit.yaml", "      - {type: SeekVisitor}\n", "", "recruit.yaml:17:9:"),
     ("recruit.yaml", "      - {type: SeekVisitor}\n      - {type: ApproachVisitor}\n",
-     "      - {type: ApproachVisitor}\n      - {type: SeekVisitor}\n", "recruit.yaml:16:9:"),
+     "      - {type: ApproachVisitor}\n      - {type: SeekVisitor}\n", "recruit.yaml:17:9:"),
     ("visit_poi.yaml",
      '                      - {type: DecideEngagement, about: "{poi}", when: face_stream}\n',
      "", "visit_poi.yaml:59:31:"),

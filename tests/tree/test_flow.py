@@ -13,6 +13,8 @@ from bench import Bench, write_tree
 from frog_bt import resources
 from frog_bt.config import load_site
 from frog_bt.errors import TreeError
+from frog_bt.kernel.key import Key, Scope, Source
+from frog_bt.kernel.outcomes import IncidentKind
 from frog_bt.tree import loader
 from frog_bt.tree.leaf import FAILURE, LEAVES, SUCCESS, Leaf, Status
 from frog_bt.tree.loader import load_tree
@@ -54,7 +56,7 @@ def test_seek_visitor_after_approach_visitor_is_refused(trees: Path) -> None:
          "      - {type: ApproachVisitor}\n      - {type: SeekVisitor}\n")
     message = refused(trees)
     assert "ApproachVisitor 'ApproachVisitor' reads /visitor" in message
-    assert "SeekVisitor 'SeekVisitor' (recruit.yaml:17)" in message
+    assert "SeekVisitor 'SeekVisitor' (recruit.yaml:18)" in message
 
 
 def test_removing_decide_engagement_at_the_stops_is_refused(trees: Path) -> None:
@@ -120,14 +122,13 @@ def test_a_missing_value_at_run_time_fails_the_leaf_with_a_reason(
     assert bench.tick() == FAILURE
     node = bench.node("ApproachVisitor")
     assert node.feedback_message == "no value for /visitor"
-    assert [i.kind for i in bench.core.ctx.incidents] == ["missing value"]
+    assert [i.kind for i in bench.core.journal.incidents] == [IncidentKind.MISSING_VALUE]
 
 
 class VisitorName(Leaf):
-    """Reads ``/visitor`` as a name (wrongly: it holds the tracked id)."""
+    """Reads ``/visitor`` declared again, as a name (wrongly: one declaration, an id)."""
 
-    reads = ("/visitor",)
-    key_types = {"/visitor": str}
+    reads = (Key("/visitor", str, Source.LEAF, Scope.TOUR, "the visitor's name"),)
 
     def update(self) -> Status:
         return SUCCESS
@@ -136,17 +137,17 @@ class VisitorName(Leaf):
 class Mood(Leaf):
     """Reads ``/mood``, which no key declaration knows."""
 
-    reads = ("/mood",)
+    reads = (Key("/mood", str, Source.LEAF, Scope.TOUR, "how the visitor feels"),)
 
     def update(self) -> Status:
         return SUCCESS
 
 
 @pytest.mark.parametrize(("leaf", "message"), [
-    (VisitorName, "VisitorName 'VisitorName' takes /visitor as str, but /visitor holds int"),
+    (VisitorName, "VisitorName 'VisitorName' uses /visitor, which no key declaration knows"),
     (Mood, "Mood 'Mood' uses /mood, which no key declaration knows"),
 ])
-def test_keys_have_types(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+def test_keys_are_declared_once(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                          leaf: type[Leaf], message: str) -> None:
     monkeypatch.setitem(LEAVES, leaf.__name__, leaf)
     path = write_tree(tmp_path, f"""

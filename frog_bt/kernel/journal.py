@@ -1,0 +1,47 @@
+"""The decision log: every decision with its reason, and the incidents among them.
+
+A service of the context (:attr:`~frog_bt.kernel.context.Context.journal`): leaves
+write to it, observers (status line, telemetry, summaries, blame) read it. Incidents are
+typed (:class:`~frog_bt.kernel.outcomes.Incident`); nothing reads the notes' text to
+learn what happened.
+"""
+
+from __future__ import annotations
+
+from frog_bt.kernel.clock import Clock
+from frog_bt.kernel.outcomes import Incident, IncidentKind
+
+
+class Journal:
+    """Notes ``(t, text)`` and incidents, each list bounded to about ``limit`` entries."""
+
+    def __init__(self, clock: Clock, limit: int = 1000) -> None:
+        self._clock = clock
+        self.limit = limit
+        self.notes: list[tuple[float, str]] = []
+        self.incidents: list[Incident] = []
+        self.incident_total = 0  # incidents ever recorded (the list keeps the latest)
+
+    def note(self, text: str, incident: IncidentKind | None = None, subject: str = ""
+             ) -> Incident | None:
+        """Record a decision and its reason; ``incident`` marks one a summary must list
+        (returned)."""
+        now = self._clock.now()
+        if len(self.notes) >= self.limit:
+            del self.notes[: self.limit // 2]
+        self.notes.append((now, text))
+        if incident is None:
+            return None
+        if len(self.incidents) >= self.limit:
+            del self.incidents[: self.limit // 2]
+        record = Incident(now, incident, text, subject)
+        self.incidents.append(record)
+        self.incident_total += 1
+        return record
+
+    @property
+    def last_note(self) -> str:
+        return self.notes[-1][1] if self.notes else ""
+
+    def last_incident(self) -> Incident | None:
+        return self.incidents[-1] if self.incidents else None

@@ -1,0 +1,66 @@
+"""What happened, as types: tour states, incident kinds and the reasons a tour ends early.
+
+Nothing in frog-bt learns what happened by reading text: the status line, summaries,
+telemetry levels, the executive's exit and the front end's ``tour`` reason all come
+from these values. Their words (``.value``) are the ones the contract and the log use.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+
+class TourState(enum.StrEnum):
+    """The ``tour`` states sent to the front end (CONTRACT §2)."""
+
+    STARTED = "started"
+    ENDED = "ended"
+    ABORTED = "aborted"
+
+
+class IncidentKind(enum.StrEnum):
+    """What went wrong or differently on a tour: summaries and the status line list these."""
+
+    DOCKING_FAILED = "docking failed"
+    NAVIGATION_FAILED = "navigation failed"
+    STOP_SKIPPED = "stop skipped"
+    APPROACH_FAILED = "approach failed"
+    VISITOR_DECLINED = "visitor declined"
+    VISITOR_LOST = "visitor lost"
+    EVENT_MISSING = "event missing"
+    CONTENT_TIMEOUT = "content timeout"
+    FRONTEND_RESTARTED = "front end restarted"
+    TOUR_ABORTED = "tour aborted"
+    GAVE_UP = "gave up"
+    RESUMED = "resumed"
+    MISSING_VALUE = "missing value"
+    LINK_LOST = "link lost"
+
+
+class AbortCause(enum.StrEnum):
+    """Why a running tour is being ended politely (back to the dock)."""
+
+    BATTERY = "battery"
+    FAULT = "electronics fault"
+
+
+@dataclass(frozen=True, slots=True)
+class AbortReason:
+    """A polite abort: its cause, and the words the front end and the log get."""
+
+    cause: AbortCause
+    text: str  # "battery 12% below 15%"
+
+    def __str__(self) -> str:
+        return self.text
+
+
+@dataclass(frozen=True, slots=True)
+class Incident:
+    """One thing that went wrong or differently, at a project-clock time."""
+
+    at: float
+    kind: IncidentKind
+    text: str  # plain words: "skipped POI3: navigation kept failing"
+    subject: str = ""  # what it is about, where a summary needs it (the POI skipped)

@@ -1,0 +1,95 @@
+"""The composites a tree file can name, with their parameters declared once.
+
+Each is py_trees' own composite, observed (:mod:`frog_bt.tree.observed`), with a
+``Params`` model like a leaf's: the loader validates a tree file's entry with it, and
+``frog-bt leaves``, the JSON Schema and docs/TREES.md read the same declaration.
+``scope`` makes the composite start a scope: its keys are cleared each time it starts
+(:class:`~frog_bt.kernel.key.Scope`).
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar, Literal
+
+import py_trees
+from pydantic import Field
+
+from frog_bt.kernel.key import Scope
+from frog_bt.tree.node import Params
+from frog_bt.tree.observed import Observed
+
+Behaviour = py_trees.behaviour.Behaviour
+ScopeName = Literal["tour", "visitor", "stop"]
+SCOPE_DOC = ("the scope this part starts: its values (and narrower ones) are cleared each "
+             "time it starts (tour, visitor, stop)")
+
+
+class _Composite(Observed):
+    Params: ClassVar[type[Params]]
+
+    def initialise(self) -> None:
+        self.start_scope()  # py_trees calls it from the tick, as the composite starts
+
+    @classmethod
+    def build(cls, name: str, params: Any, children: list[Behaviour]) -> Behaviour:
+        raise NotImplementedError
+
+
+def _scoped(node: Observed, params: Any) -> None:
+    if params.scope is not None:
+        node.scope = Scope[params.scope.upper()]
+
+
+class Sequence(_Composite, py_trees.composites.Sequence):
+    """Runs its children in order; SUCCESS when all succeed, FAILURE at the first that
+    fails."""
+
+    class Params(Params):
+        memory: bool = Field(description="true: resume at the running child; false: "
+                                         "re-check every child each tick")
+        scope: ScopeName | None = Field(None, description=SCOPE_DOC)
+
+    @classmethod
+    def build(cls, name: str, params: Any, children: list[Behaviour]) -> Behaviour:
+        node = cls(name, memory=params.memory, children=children)
+        _scoped(node, params)
+        return node
+
+
+class Selector(_Composite, py_trees.composites.Selector):
+    """Tries its children in order; SUCCESS at the first that succeeds, FAILURE when all
+    fail."""
+
+    class Params(Params):
+        memory: bool = Field(description="true: resume at the running child; false: try "
+                                         "from the first each tick")
+        scope: ScopeName | None = Field(None, description=SCOPE_DOC)
+
+    @classmethod
+    def build(cls, name: str, params: Any, children: list[Behaviour]) -> Behaviour:
+        node = cls(name, memory=params.memory, children=children)
+        _scoped(node, params)
+        return node
+
+
+class Parallel(_Composite, py_trees.composites.Parallel):
+    """Ticks all its children every tick; FAILURE as soon as one fails."""
+
+    class Params(Params):
+        policy: Literal["all", "one"] = Field(
+            "all", description="SUCCESS when all children / one child succeed")
+        synchronise: bool = Field(True, description="with policy all: a succeeded child is "
+                                                    "not ticked again")
+        scope: ScopeName | None = Field(None, description=SCOPE_DOC)
+
+    @classmethod
+    def build(cls, name: str, params: Any, children: list[Behaviour]) -> Behaviour:
+        policy = (py_trees.common.ParallelPolicy.SuccessOnAll(synchronise=params.synchronise)
+                  if params.policy == "all" else py_trees.common.ParallelPolicy.SuccessOnOne())
+        node = cls(name, policy=policy, children=children)
+        _scoped(node, params)
+        return node
+
+
+COMPOSITES: dict[str, type[_Composite]] = {
+    "Sequence": Sequence, "Selector": Selector, "Parallel": Parallel}
