@@ -186,6 +186,10 @@ class Checkpoint(_Model):
     max_age: Positive = 900.0  # wall seconds: an older checkpoint is not resumed
 
 
+class OperatorCfg(_Model):
+    pause_max: Positive = 300.0  # seconds an operator's pause may last; then the tour ends
+
+
 class Recording(_Model):
     max_bytes: Annotated[int, Field(gt=0)] = 20_000_000_000  # --record DIR: disk budget
 
@@ -234,6 +238,7 @@ class Site(_Model):
     safety: Safety = Safety()
     checkpoint: Checkpoint = Checkpoint()
     recording: Recording = Recording()
+    operator: OperatorCfg = OperatorCfg()
     topics: dict[Literal[tuple(INPUTS) + tuple(OUTPUTS)], str] = {}  # type: ignore[valid-type]
 
     @model_validator(mode="after")

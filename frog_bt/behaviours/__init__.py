@@ -5,6 +5,7 @@ from frog_bt.behaviours import (
     engagement,
     location,
     navigation,
+    operator,
     projector,
     recruit,
     safety,
@@ -12,5 +13,5 @@ from frog_bt.behaviours import (
     visit,
 )
 
-__all__ = ["docking", "engagement", "location", "navigation", "projector", "recruit", "safety",
-           "tour", "visit"]
+__all__ = ["docking", "engagement", "location", "navigation", "operator", "projector",
+           "recruit", "safety", "tour", "visit"]

@@ -36,7 +36,8 @@ class PoiParams(Params):
 class Navigate(Leaf):
     """Drive to ``poi``, choosing its time-of-day variant from the project clock.
 
-    Sends ``/GotoWayPoint`` in initialise (a new goal replaces the active one).
+    Sends ``/GotoWayPoint`` in initialise (a new goal replaces the active one), or once
+    the operator's pause ends (``/paused``, optional: RUNNING until then).
     Reads ``/now`` and ``/goal`` (its result); writes ``/target`` (the logical POI),
     ``/waypoint`` (the variant chosen, e.g. ``POI1b``) and clears ``/skipped``. SUCCESS on
     ``/FROG_response`` 2; FAILURE on 3 or 4, when another goal replaces this
@@ -48,21 +49,32 @@ class Navigate(Leaf):
             "seconds before it fails (default: site timeouts.navigation)"))
 
     reads = (keys.NOW, keys.GOAL)
+    optional_reads = (keys.PAUSED,)
     writes = (keys.TARGET, keys.WAYPOINT, keys.SKIPPED)
 
     def initialise(self) -> None:
+        self.goal: Goal | None = None
+        self.timeout = self.params.timeout or self.ctx.site.timeouts.navigation
+        self.set(keys.TARGET, self.params.poi)
+        self.set(keys.SKIPPED, None)
+        if not self.get(keys.PAUSED):
+            self._send()
+
+    def _send(self) -> None:
         site, clock = self.ctx.site, self.ctx.clock
         poi = self.params.poi
         waypoint = site.waypoint_for(poi, clock.local_time().time())
-        self.goal: Goal | None = self.ctx.actions.goto(waypoint, site.pois[waypoint])
-        self.timeout = self.params.timeout or site.timeouts.navigation
-        self.set(keys.TARGET, poi)
+        self.goal = self.ctx.actions.goto(waypoint, site.pois[waypoint])
         self.set(keys.WAYPOINT, waypoint)
-        self.set(keys.SKIPPED, None)
         self.ctx.note(f"go to {waypoint}" + (f" ({poi} at {clock.local_time():%H:%M})"
                                              if waypoint != poi else ""))
 
     def update(self) -> Status:
+        if self.goal is None:
+            if self.get(keys.PAUSED):
+                self.feedback_message = f"paused: {self.params.poi} waits"
+                return RUNNING
+            self._send()
         assert self.goal is not None
         target = self.goal.target
         goal = goal_state(self.goal, self.get(keys.GOAL))

@@ -36,17 +36,18 @@ def fresh_diagnostics(reading: Reading[Diagnostics] | None, now: float,
 
 @register
 class MustAbort(Leaf):
-    """Must the tour be aborted? (battery low or an electronics fault, during a tour)
+    """Must the tour be aborted? (an operator sent the robot home, battery low or an
+    electronics fault, during a tour)
 
-    Reads ``/diagnostics`` (only when fresher than ``safety.diagnostics_max_age``),
-    ``/now``, ``/tour_state`` (optional) and ``/abort_reason`` (optional).
-    Writes ``/abort_reason`` (an :class:`~frog_bt.kernel.outcomes.AbortReason`).
-    SUCCESS while an abort is under way (the reason is latched until
-    :class:`ClearAbort`); FAILURE otherwise.
+    Reads ``/home`` (optional: the operator's request, with its reason), ``/diagnostics``
+    (only when fresher than ``safety.diagnostics_max_age``), ``/now``, ``/tour_state``
+    (optional) and ``/abort_reason`` (optional). Writes ``/abort_reason`` (an
+    :class:`~frog_bt.kernel.outcomes.AbortReason`). SUCCESS while an abort is under way
+    (the reason is latched until :class:`ClearAbort`); FAILURE otherwise.
     """
 
     reads = (keys.DIAGNOSTICS, keys.NOW)
-    optional_reads = (keys.TOUR_STATE, keys.ABORT_REASON)
+    optional_reads = (keys.TOUR_STATE, keys.ABORT_REASON, keys.HOME)
     writes = (keys.ABORT_REASON,)
 
     def update(self) -> Status:
@@ -54,6 +55,11 @@ class MustAbort(Leaf):
             return SUCCESS
         if self.get(keys.TOUR_STATE) is not TourState.STARTED:
             return FAILURE
+        home = self.get(keys.HOME)
+        if home is not None:
+            self.set(keys.ABORT_REASON, home)
+            self.ctx.note(f"abort the tour: {home.text}", incident=IncidentKind.TOUR_ABORTED)
+            return SUCCESS
         cfg = self.ctx.site.safety
         diagnostics = fresh_diagnostics(self.get(keys.DIAGNOSTICS), self.need(keys.NOW),
                                         cfg.diagnostics_max_age)
@@ -77,14 +83,16 @@ class MustAbort(Leaf):
 
 @register
 class ClearAbort(Leaf):
-    """The abort is done: clear ``/abort_reason`` (kept as ``/abort_reason_last``). SUCCESS."""
+    """The abort is done: clear ``/abort_reason`` (kept as ``/abort_reason_last``) and the
+    operator's ``/home`` request. SUCCESS."""
 
     optional_reads = (keys.ABORT_REASON,)
-    writes = (keys.ABORT_REASON, keys.ABORT_REASON_LAST)
+    writes = (keys.ABORT_REASON, keys.ABORT_REASON_LAST, keys.HOME)
 
     def update(self) -> Status:
         self.set(keys.ABORT_REASON_LAST, self.get(keys.ABORT_REASON))
         self.set(keys.ABORT_REASON, None)
+        self.set(keys.HOME, None)
         return SUCCESS
 
 

@@ -75,7 +75,8 @@ class PlayContent(Leaf):
     """Play part ``part`` of ``poi``'s content and wait until it is done.
 
     Sends ``start_poi`` (with the waypoint chosen on the way, ``/waypoint``) in
-    initialise. Reads ``/events``, ``/now`` and, optionally, ``/waypoint``. SUCCESS on the
+    initialise, or once the operator's pause ends (``/paused``: RUNNING until then).
+    Reads ``/events``, ``/now`` and, optionally, ``/waypoint`` and ``/paused``. SUCCESS on the
     matching ``content_done``, or after ``timeout`` seconds (default: site
     ``timeouts.content``) with a note: a silent front end must not stop the tour.
     Interrupted while playing, it sends ``finish_poi`` to stop the content.
@@ -87,25 +88,36 @@ class PlayContent(Leaf):
             "seconds before going on without content_done (default: site timeouts.content)"))
 
     reads = (keys.EVENTS, keys.NOW)
-    optional_reads = (keys.WAYPOINT,)
+    optional_reads = (keys.WAYPOINT, keys.PAUSED)
 
     def initialise(self) -> None:
+        self.playing = False
+        self.waypoint = self.get(keys.WAYPOINT) or self.params.poi
+        if not self.get(keys.PAUSED):
+            self._start()
+
+    def _start(self) -> None:
         p = self.params
+        self.playing = True
         self.since = self.need(keys.EVENTS).last_index
         self.started = self.ctx.clock.now()
         self.timeout = p.timeout or self.ctx.site.timeouts.content
-        self.waypoint = self.get(keys.WAYPOINT) or p.poi
         self.restart_seen = self.since
         self.ctx.send(StartPoi(p.poi, self.waypoint, p.part))
 
     def terminate(self, new_status: Status) -> None:
         # Interrupted (a tour aborted, a shutdown): stop the content that is playing.
-        if new_status == INVALID and self.status == RUNNING:
+        if new_status == INVALID and self.status == RUNNING and getattr(self, "playing", False):
             self.ctx.send(FinishPoiCommand(self.params.poi))
             self.ctx.note(f"{self.params.poi} interrupted: content stopped")
 
     def update(self) -> Status:
         p = self.params
+        if not self.playing:
+            if self.get(keys.PAUSED):
+                self.feedback_message = f"paused: {p.poi} part {p.part} waits"
+                return RUNNING
+            self._start()
         events = self.need(keys.EVENTS)
         if events.first_since(self.since, ContentDone, poi=p.poi, part=p.part) is not None:
             return SUCCESS

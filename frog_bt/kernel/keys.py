@@ -71,6 +71,16 @@ ABORT_REASON_LAST = _key("/abort_reason_last", AbortReason, L, Scope.PROCESS,
 ICL = _key("/icl", bool, L, Scope.PROCESS,
            "the face data stream is on (its scope's own: no other scope clears it)")
 
+# -- the operator's requests (written between ticks from the console or frog-bt ctl)
+HOME = _key("/home", AbortReason, E, Scope.TOUR,
+            "an operator asked the robot home: end the tour politely and dock")
+SKIP = _key("/skip", int, E, Scope.TOUR,
+            "skip requests this tour: a stop seeing the count grow is left for the next")
+PAUSED = _key("/paused", bool, E, Scope.PROCESS,
+              "an operator paused the tour: no new drive, no new content")
+IN_SERVICE = _key("/in_service", bool, E, Scope.PROCESS,
+                  "the robot may start tours (false: finish this one, then stay docked)")
+
 # -- one tour
 DECLINED = _key("/declined", frozenset, L, Scope.TOUR, "visitor ids who said no this tour")
 APPROACH_FAILED = _key("/approach_failed", dict, L, Scope.TOUR,

@@ -36,6 +36,7 @@ class IncidentKind(enum.StrEnum):
     RESUMED = "resumed"
     MISSING_VALUE = "missing value"
     LINK_LOST = "link lost"
+    OPERATOR = "operator"  # an operator command changed the tour
 
 
 class AbortCause(enum.StrEnum):
@@ -43,6 +44,7 @@ class AbortCause(enum.StrEnum):
 
     BATTERY = "battery"
     FAULT = "electronics fault"
+    OPERATOR = "operator"  # sent home from the console or frog-bt ctl
 
 
 @dataclass(frozen=True, slots=True)

@@ -26,6 +26,8 @@ from frog_bt.kernel.clock import Clock
 from frog_bt.kernel.context import Context
 from frog_bt.kernel.journal import Journal
 from frog_bt.kernel.key import Reading
+from frog_bt.kernel.outcomes import AbortReason
+from frog_bt.runtime.operator import Answer, Command, Operator
 from frog_bt.tree import observed
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.tree.observed import Trace
@@ -54,6 +56,8 @@ class Taps:
     frontend_out: list[Tap] = field(default_factory=list)
     tick: list[Callable[[Core], None]] = field(default_factory=list)
     blame: list[Tap] = field(default_factory=list)  # (t, channel, node, reads) after each command
+    operator: list[Callable[[float, int, Command, Answer], None]] = field(
+        default_factory=list)  # (t, tick it precedes, command, answer) for each command
 
 
 class Core:
@@ -78,6 +82,10 @@ class Core:
         self.ctx = Context(clock, site, self.actions, self._send_message, self.journal)
         self.snapshot = Snapshot(self.board, self.inputs, clock, self.actions)
         self.root = tree.root
+        self._skippable = [n for n in tree.root.iterate() if getattr(n, "handles_skip", False)]
+        self.operator = Operator(self.board, self.journal, self._stops_now,
+                                 site.operator.pause_max)
+        self.pause_ran_out: AbortReason | None = None  # set by the tick it happened before
         self.ticks = 0
         self._setup = False
         # Nodes ticked or stopped since the last tick's taps ran: every node whose status
@@ -163,6 +171,22 @@ class Core:
             tap(now, message.type, message)
         self.inputs.events.append((message, now))
 
+    # ------------------------------------------------------------ operator commands
+
+    def _stops_now(self) -> list[str]:
+        """The stops being visited or driven to now (what a skip would leave)."""
+        return [n.params.poi for n in self._skippable  # type: ignore[attr-defined]
+                if n.status == Status.RUNNING]
+
+    def command(self, command: Command) -> Answer:
+        """Apply an operator command now: call it between ticks (it takes effect in the
+        next one). The operator taps hear it, with its answer."""
+        now = self.clock.now()
+        answer = self.operator.apply(command, now)
+        for tap in self.taps.operator:
+            tap(now, self.ticks + 1, command, answer)
+        return answer
+
     # ------------------------------------------------------------ ticking
 
     def tick(self) -> Status:
@@ -170,6 +194,7 @@ class Core:
         root, the tick taps; the root's status."""
         self.setup()
         self.trace.decided.clear()
+        self.pause_ran_out = self.operator.check_pause(self.clock.now())
         self.snapshot.write()
         touched = self.touched
         touched.extend(self.root.tick())  # stopped nodes are already in it

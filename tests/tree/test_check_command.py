@@ -70,8 +70,8 @@ def test_structural_errors_all_at_once_sorted_by_line(tmp_path: Path,
     ("recruit.yaml", "      - {type: SeekVisitor}\n      - {type: ApproachVisitor}\n",
      "      - {type: ApproachVisitor}\n      - {type: SeekVisitor}\n", "recruit.yaml:17:9:"),
     ("visit_poi.yaml",
-     '                      - {type: DecideEngagement, about: "{poi}", when: face_stream}\n',
-     "", "visit_poi.yaml:59:31:"),
+     '                        - {type: DecideEngagement, about: "{poi}", when: face_stream}\n',
+     "", "visit_poi.yaml:63:33:"),
 ], ids=["no SeekVisitor", "SeekVisitor after ApproachVisitor", "no DecideEngagement at stops"])
 def test_the_designers_mistakes_are_refused_with_file_and_line(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], file: str, old: str, new: str,

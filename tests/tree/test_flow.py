@@ -61,7 +61,7 @@ def test_seek_visitor_after_approach_visitor_is_refused(trees: Path) -> None:
 
 def test_removing_decide_engagement_at_the_stops_is_refused(trees: Path) -> None:
     edit(trees / "visit_poi.yaml",
-         '                      - {type: DecideEngagement, about: "{poi}", when: face_stream}\n',
+         '                        - {type: DecideEngagement, about: "{poi}", when: face_stream}\n',
          "")
     message = refused(trees)
     assert "visit_poi.yaml" in message and "Engaged 'Engaged' reads /engaged" in message
