@@ -98,7 +98,7 @@ def run_corpus(args: argparse.Namespace) -> int:
     from concurrent.futures import ProcessPoolExecutor
 
     from frog_bt.tools import replay as _replay  # noqa: F401 - imported once, before the fork
-    from frog_bt.tools.corpus import recordings, replay_corpus, summary, summary_line, warm
+    from frog_bt.tools.corpus import recordings, replay_corpus, summary, summary_line
 
     if args.rerun:
         print("frog-bt replay: --rerun takes one recording", file=sys.stderr)
@@ -109,7 +109,6 @@ def run_corpus(args: argparse.Namespace) -> int:
     try:
         site = load_site(args.config)  # checked once, up front
         load_tree(args.tree, site)
-        warm(args.config)
     except DefinitionError as exc:
         for line in error_lines(exc):
             print(f"frog-bt replay: {line}", file=sys.stderr)
@@ -119,13 +118,14 @@ def run_corpus(args: argparse.Namespace) -> int:
         print("frog-bt replay: no recordings (*.mcap) found", file=sys.stderr)
         return 2
     bar = None if args.quiet or not sys.stderr.isatty() else CountBar(sys.stderr)
-    # Forked workers start with the modules and the site already loaded (~0.5 s each
-    # otherwise); where fork is unavailable, the platform's default start method.
+    # Forked workers start with the modules already imported (~0.5 s each otherwise);
+    # where fork is unavailable, the platform's default start method. The site goes
+    # with each task.
     methods = multiprocessing.get_all_start_methods()
     context = multiprocessing.get_context("fork" if "fork" in methods else None)
     with ProcessPoolExecutor(max_workers=args.jobs, mp_context=context) as pool:
         rows = []
-        for row in replay_corpus(files, args.tree, args.config, pool, bar):
+        for row in replay_corpus(files, args.tree, site, pool, bar):
             rows.append(row)
             if bar is not None:
                 bar.clear()

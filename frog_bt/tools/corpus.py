@@ -12,13 +12,14 @@ signature, the replayed node and what differs.
 
 from __future__ import annotations
 
-import functools
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Executor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
+
+from frog_bt.config import Site
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,33 +60,15 @@ def recordings(paths: Iterable[Path]) -> list[Path]:
     return out
 
 
-@functools.lru_cache(maxsize=4)
-def _site(config: str | None) -> Any:
-    from frog_bt.config import load_site
-
-    return load_site(config)
-
-
-def warm(config: Path | None) -> None:
-    """Load the site into this process's cache (before forking workers: they inherit it)."""
-    _site(str(config) if config else None)
-
-
-def _load(tree: str | None, config: str | None) -> tuple[Any, Any]:
-    """The site (cached per process) and a fresh tree: a tree keeps its nodes' state, so
-    each replay builds its own."""
+def replay_file(path: str, tree: str | None, site: Site) -> TourRow:
+    """Replay one recording (in a worker process) with a fresh tree (a tree keeps its
+    nodes' state, so each replay builds its own); any failure is an unreadable row. The
+    site comes with the task: a worker keeps nothing between tasks."""
+    from frog_bt.tools.replay import Replay, differences, what_differs
     from frog_bt.tree.loader import load_tree
 
-    site = _site(config)
-    return site, load_tree(tree, site)
-
-
-def replay_file(path: str, tree: str | None, config: str | None) -> TourRow:
-    """Replay one recording (in a worker process); any failure is an unreadable row."""
-    from frog_bt.tools.replay import Replay, differences, what_differs
-
     try:
-        site, loaded = _load(tree, config)
+        loaded = load_tree(tree, site)
         result = Replay(Path(path), site, loaded).run()
         recovered = "; ".join(result.recovered)
     except Exception as exc:
@@ -104,12 +87,12 @@ def replay_file(path: str, tree: str | None, config: str | None) -> TourRow:
                    recovered=recovered)
 
 
-def replay_corpus(files: list[Path], tree: Path | None, config: Path | None,
+def replay_corpus(files: list[Path], tree: Path | None, site: Site,
                   executor: Executor, progress: Callable[[int, int], None] | None = None
                   ) -> Iterator[TourRow]:
     """One row per recording, in order, replayed through ``executor``."""
-    futures = [executor.submit(replay_file, str(f), str(tree) if tree else None,
-                               str(config) if config else None) for f in files]
+    futures = [executor.submit(replay_file, str(f), str(tree) if tree else None, site)
+               for f in files]
     for done, future in enumerate(futures, 1):
         row = future.result()
         if progress is not None:
