@@ -19,7 +19,7 @@ from frog_bt.rosbridge.msgs import (
     TrackedPeople,
     TrackedPerson,
 )
-from frog_bt.runtime.core import Core
+from frog_bt.runtime.core import Core, Taps
 from frog_bt.tree.loader import LoadedTree, load_tree
 
 MORNING = 1780302600.0  # 2026-06-01 10:30 Europe/Madrid
@@ -33,6 +33,12 @@ def write_tree(tmp_path: Path, text: str, name: str = "t.yaml") -> Path:
 
 
 class Bench:
+    """A core ticked by hand; an observers.Host without wire traffic or links."""
+
+    wire = None
+    links = None
+    sim_time = False
+
     def __init__(self, tree: LoadedTree | Path | str, site: Site | None = None,
                  start: float = MORNING) -> None:
         self.site = site or load_site()
@@ -44,6 +50,10 @@ class Bench:
         self.core = Core(self.site, tree, self.clock,
                          lambda topic, msg: self.published.append((topic, msg)),
                          lambda message: self.sent.append(message))
+
+    @property
+    def taps(self) -> Taps:
+        return self.core.taps
 
     # inputs
     def ros(self, role: str, value: Any) -> None:

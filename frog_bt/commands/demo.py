@@ -17,11 +17,15 @@ import logging
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from frog_bt.commands.options import add_tree_and_config
-from frog_bt.config import load_site
+from frog_bt.config import Site, load_site
 from frog_bt.errors import DefinitionError, error_lines
-from frog_bt.tree.loader import load_tree
+from frog_bt.tree.loader import LoadedTree, load_tree
+
+if TYPE_CHECKING:
+    from frog_bt.sim.scenario import Scenario
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -56,21 +60,22 @@ def run(args: argparse.Namespace) -> int:
     return asyncio.run(_demo(site, tree, scenario, args))
 
 
-async def _demo(site, tree, scenario, args) -> int:  # type: ignore[no-untyped-def]
+async def _demo(site: Site, tree: LoadedTree, scenario: Scenario,
+                args: argparse.Namespace) -> int:
     from frog_bt.commands.run import attach_observers
+    from frog_bt.observers import Observer, attach_all, close_all
     from frog_bt.observers.status import StatusLine
     from frog_bt.observers.summary import TourSummary
+    from frog_bt.runtime.executive import Executive
     from frog_bt.runtime.rehearsal import Rehearsal
 
     summary = TourSummary(site)
     status = None if args.quiet else StatusLine()
     rerun = None if args.rerun == "off" else args.rerun
-    observers: list = []
+    observers: list[Observer] = []
 
-    def prepare(executive) -> None:  # type: ignore[no-untyped-def]
-        summary.attach(executive.taps)
-        if status is not None:
-            executive.taps.tick.append(status.update)
+    def prepare(executive: Executive) -> None:
+        observers.extend(attach_all(executive, [summary, *([status] if status else [])]))
         observers.extend(attach_observers(executive, record=args.record, rerun=rerun))
 
     wall0 = time.monotonic()
@@ -85,10 +90,7 @@ async def _demo(site, tree, scenario, args) -> int:  # type: ignore[no-untyped-d
                 outcome.code, outcome.reason = 1, (f"no docked finish within {args.timeout:g} s "
                                                    "of wall time")
     finally:
-        for observer in observers:
-            observer.close()
-        if status is not None:
-            status.close()
+        close_all(observers)
     clock = rehearsal.executive.clock
     wall, simulated = time.monotonic() - wall0, rehearsal.sim.clock.now() - sim0
     print(f"frog-bt demo: scenario {args.scenario!r}, started "

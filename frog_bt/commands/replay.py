@@ -149,7 +149,9 @@ def report(result: Any, site: Any) -> dict[str, Any]:
         "identical": div is None, "start": result.start, "end": result.end,
         "inputs": result.inputs, "ticks": result.ticks,
         "ros_commands": result.ros_commands, "frontend_commands": result.frontend_commands,
-        "exact_ticks": result.exact, "recovered": result.recovered}
+        "exact_ticks": result.exact, "recovered": result.recovered,
+        "operator_commands": result.operator_commands,
+        "bad_messages": result.bad_count, "bad": result.bad}
     if div is not None:
         def side(command: Any) -> dict[str, Any] | None:
             if command is None:
@@ -201,7 +203,7 @@ def run_one(args: argparse.Namespace) -> int:
         except (ValueError, OSError) as exc:
             print(f"frog-bt replay: {exc}", file=sys.stderr)
             return 2
-        telemetry.attach(replay.core)
+        telemetry.attach(replay)
         from frog_bt.telemetry.compare import compare_lanes
 
         compare_lanes(telemetry.rec, replay, site)
@@ -216,6 +218,8 @@ def run_one(args: argparse.Namespace) -> int:
         if telemetry is not None:
             telemetry.close()
     commands = f"{result.ros_commands} ROS and {result.frontend_commands} front-end commands"
+    if result.operator_commands:
+        commands += f", {result.operator_commands} operator commands"
     if args.format == "json":
         print(json.dumps(report(result, site), indent=1))
         return 0 if result.divergence is None else 1
@@ -223,6 +227,10 @@ def run_one(args: argparse.Namespace) -> int:
         print("note: the recording has no /frog_bt/tick channel; ticks follow the live rules")
     for recovered in result.recovered:
         print(f"note: {recovered}; replayed up to the cut")
+    if result.bad_count:
+        print(f"note: {result.bad_count} bad message(s) of frog-bt's own channels, skipped:")
+        for reason in result.bad:
+            print(f"  {reason}")
     div = result.divergence
     if div is None:
         print(f"identical: {commands}")

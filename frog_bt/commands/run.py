@@ -20,7 +20,7 @@ import signal
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from frog_bt import __version__
 from frog_bt.commands.options import add_tree_and_config, read_secret, rerun_spec, writable_file
@@ -28,10 +28,14 @@ from frog_bt.config import DEFAULT_CONFIG, Site, check_ws_url, load_site, parse_
 from frog_bt.errors import FrogError, UsageError, error_lines
 from frog_bt.frontend.link import AddressError
 from frog_bt.kernel.clock import SimClock, WallClock
+from frog_bt.observers import Observer, attach_all, close_all
 from frog_bt.runtime.checkpoint import STATE_DIR
 from frog_bt.runtime.checkpoint import claim as claim_checkpoint
 from frog_bt.runtime.checkpoint import default_path as default_checkpoint
 from frog_bt.tree.loader import DEFAULT_TREE, load_tree
+
+if TYPE_CHECKING:
+    from frog_bt.runtime.executive import Executive
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -134,33 +138,28 @@ def banner(args: argparse.Namespace, settings: Settings) -> list[str]:
 __all__ = ["add_arguments", "attach_observers", "read_secret", "run"]
 
 
-def attach_observers(executive: Any, *, record: Path | None, rerun: str | None) -> list[Any]:
-    """Recorder and telemetry, each imported only when asked for; closed by the caller."""
-    observers: list[Any] = []
+def attach_observers(executive: Executive, *, record: Path | None, rerun: str | None
+                     ) -> list[Observer]:
+    """Recorder and telemetry, each imported only when asked for, attached; the caller
+    closes them (:func:`~frog_bt.observers.close_all`)."""
+    observers: list[Observer] = []
     if record is not None and record.suffix == ".mcap" and not record.is_dir():
         from frog_bt.observers.recording import Recorder
 
-        recorder = Recorder(record)
-        recorder.attach(executive)
-        observers.append(recorder)
+        observers.append(Recorder(record))
     elif record is not None:
         from frog_bt.observers.rotation import RecordingDir
 
-        recordings = RecordingDir(record, executive.site.recording.max_bytes)
-        recordings.attach(executive)
-        observers.append(recordings)
+        observers.append(RecordingDir(record, executive.site.recording.max_bytes))
     if rerun:
         from frog_bt.telemetry import Telemetry, process
 
-        telemetry: Any
         if process.available():  # rerun in a process of its own: off the tick, its memory
-            telemetry = process.TelemetryProcess(rerun, executive.site, executive.core.tree)
+            observers.append(process.TelemetryProcess(rerun, executive.site,
+                                                      executive.core.tree))
         else:
-            telemetry = Telemetry.open(rerun, executive.site, executive.core.tree)
-        telemetry.attach(executive.core)
-        telemetry.attach_links(executive)
-        observers.append(telemetry)
-    return observers
+            observers.append(Telemetry.open(rerun, executive.site, executive.core.tree))
+    return attach_all(executive, observers)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -191,7 +190,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Settings) -> int:
-    from frog_bt.runtime.executive import Executive  # the network stack only when running
+    from frog_bt.runtime.executive import Executive
     from frog_bt.runtime.memory import pin_malloc_thresholds
 
     pin_malloc_thresholds()  # all day without creeping up
@@ -208,11 +207,11 @@ async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Setti
         loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)
     summary = TourSummary(site) if args.once else None
     if summary is not None:
-        summary.attach(executive.taps)
+        summary.attach(executive)
     status = None if args.quiet else StatusLine(source=executive.status_text)
     refresher = None
     if status is not None:
-        executive.taps.tick.append(status.update)
+        status.attach(executive)
         # The tree does not tick while rosbridge is unreachable (or before /clock):
         # the line must still say what the executive is waiting for.
         refresher = asyncio.create_task(_refresh(status))
@@ -230,8 +229,7 @@ async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Setti
             watcher.cancel()
         if refresher is not None:
             refresher.cancel()
-        for observer in observers:
-            observer.close()
+        close_all(observers)
         if status is not None:
             status.close()
     if summary is not None and executive.core.ticks:

@@ -198,6 +198,12 @@ class FrontendLink:
         return self._endpoint.pending
 
     @property
+    def next_resend(self) -> float | None:
+        """Project-clock time the next resend is due; None while nothing waits for an
+        ack (then nothing is ever resent)."""
+        return self._endpoint.next_deadline
+
+    @property
     def oldest_pending(self) -> float | None:
         """When the oldest message waiting for its ack was first sent (None: none waits)."""
         return self._endpoint.oldest_pending

@@ -11,7 +11,7 @@ gives the JSON fields of a message (without ``type`` and ``seq``).
 
 from __future__ import annotations
 
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal, Union
 
 import msgspec
 
@@ -22,6 +22,7 @@ Part = Literal["a", "b"]
 TourState = Literal["started", "ended", "aborted"]
 Level = Annotated[float, msgspec.Meta(ge=-1.0, le=1.0)]
 Percent = Annotated[int, msgspec.Meta(ge=0, le=100)]
+Seq = Annotated[int, msgspec.Meta(ge=0)]
 
 
 class FrontendMessage(msgspec.Struct, frozen=True):
@@ -123,14 +124,42 @@ TOUR_STATES: tuple[str, ...] = TourState.__args__  # type: ignore[attr-defined]
 
 class Envelope(msgspec.Struct, frozen=True):
     """What every datagram has: its type and sequence number (any other fields are the
-    message's)."""
+    message's). Read alone only to answer a datagram that did not decode whole."""
 
     type: str
-    seq: Annotated[int, msgspec.Meta(ge=0)]
+    seq: Seq
 
 
 decode_envelope = decoder(Envelope)
-_DECODERS = {cls: decoder(cls) for cls in (*COMMANDS.values(), *EVENTS.values())}
+
+
+class Ack(msgspec.Struct, frozen=True, tag_field="type", tag="ack"):
+    seq: Seq
+
+
+def _datagram(cls: type[FrontendMessage]) -> type[msgspec.Struct]:
+    """``cls`` as a whole datagram: its fields, ``seq``, and ``type`` as the union's tag."""
+    return msgspec.defstruct(f"{cls.__name__}Datagram", [("seq", Seq)], bases=(cls,),
+                             tag_field="type", tag=cls.type, frozen=True, kw_only=True)
+
+
+class DatagramDecoder:
+    """Datagrams whose messages are in ``table`` (or acks), decoded in one pass: a msgspec
+    tagged union on ``type``. A message comes back as its plain class (without ``seq``)."""
+
+    def __init__(self, table: dict[str, type[FrontendMessage]]) -> None:
+        self.table = table
+        datagrams = {_datagram(cls): cls for cls in table.values()}
+        self._plain = datagrams
+        self._decode = decoder(Union[(Ack, *datagrams)])  # type: ignore[arg-type]
+
+    def decode(self, data: bytes) -> tuple[int, FrontendMessage | None]:
+        """``(seq, message)``, ``message`` None for an ack; DecodeError naming the field."""
+        datagram = self._decode(data)
+        if isinstance(datagram, Ack):
+            return datagram.seq, None
+        cls = self._plain[type(datagram)]
+        return datagram.seq, cls(*(getattr(datagram, f) for f in cls.__struct_fields__))
 
 
 def decode_message(obj: dict[str, Any] | bytes,
@@ -143,6 +172,8 @@ def decode_message(obj: dict[str, Any] | bytes,
         raise DecodeError(f"unknown message type {type_!r}"[:200], ("type",))
     return convert(obj, cls) if isinstance(obj, dict) else _DECODERS[cls](obj)
 
+
+_DECODERS = {cls: decoder(cls) for cls in (*COMMANDS.values(), *EVENTS.values())}
 
 
 def message_fields(message: FrontendMessage) -> dict[str, Any]:

@@ -26,10 +26,10 @@ from typing import Any
 from frog_bt.codec import encode
 from frog_bt.errors import DecodeError
 from frog_bt.frontend.messages import (
+    DatagramDecoder,
     Envelope,
     FrontendMessage,
     decode_envelope,
-    decode_message,
     message_fields,
 )
 
@@ -103,6 +103,10 @@ class Endpoint:
     _pending: OrderedDict[int, _Pending] = field(default_factory=OrderedDict)
     _seen: OrderedDict[int, float] = field(default_factory=OrderedDict)
     _highest: int = 0  # highest seq of a valid message since the peer (re)started
+    _decoder: DatagramDecoder = field(init=False)
+
+    def __post_init__(self) -> None:
+        self._decoder = DatagramDecoder(self.inbound)
 
     def send(self, message: FrontendMessage, now: float) -> bytes:
         """Datagram for a new message; it is resent by :meth:`poll` until acked."""
@@ -115,16 +119,20 @@ class Endpoint:
         return data
 
     def receive(self, data: bytes, host: str, now: float) -> Received:
+        """One datagram from ``host``, decoded in one pass (ack or message); one that does
+        not decode whole is still acked when its ``type`` and ``seq`` are readable."""
         if host != self.peer_host:
             self.stats.foreign += 1
             return Received()
-        try:
-            envelope = decode_datagram(data)
-        except DecodeError as exc:
+        if len(data) > MAX_DATAGRAM:
             self.stats.malformed += 1
-            return Received(error=exc)
-        seq = envelope.seq
-        if envelope.type == "ack":
+            return Received(error=DecodeError(f"datagram of {len(data)} bytes exceeds "
+                                              f"{MAX_DATAGRAM}"))
+        try:
+            seq, message = self._decoder.decode(data)
+        except DecodeError as exc:
+            return self._malformed(data, exc, now)
+        if message is None:  # an ack
             pending = self._pending.pop(seq, None)
             if pending is None:
                 return Received()
@@ -133,26 +141,41 @@ class Endpoint:
         reply = encode_datagram("ack", seq)
         self._prune(now)
         restart = seq < self._highest and (
-            envelope.type in self.restart_types or (seq == 1 and seq not in self._seen))
+            message.type in self.restart_types or (seq == 1 and seq not in self._seen))
         if seq in self._seen and not restart:
             self.stats.duplicates += 1
             return Received(reply=reply)
-        try:
-            message = decode_message(data, self.inbound)
-        except DecodeError as exc:
-            self._seen[seq] = now
-            self.stats.malformed += 1
-            return Received(reply=reply, error=exc)
         if restart:
             # Only a valid message may reset the numbering: garbage must not.
             self.stats.peer_restarts += 1
             log.info("peer %s restarted: %s seq %d after seq %d; forgetting seen seqs",
-                     self.peer_host, envelope.type, seq, self._highest)
+                     self.peer_host, message.type, seq, self._highest)
             self.forget_seen()
         self._seen[seq] = now
         self._highest = max(self._highest, seq)
         self.stats.received += 1
         return Received(message=message, reply=reply)
+
+    def _malformed(self, data: bytes, error: DecodeError, now: float) -> Received:
+        """A datagram that did not decode whole: acked (and its seq remembered) if its
+        envelope reads, so the peer stops resending it; counted either way."""
+        try:
+            envelope = decode_envelope(data)
+        except DecodeError as exc:
+            self.stats.malformed += 1
+            return Received(error=exc)
+        if envelope.type == "ack":
+            self.stats.malformed += 1
+            return Received(error=error)
+        if envelope.type not in self._decoder.table:
+            error = DecodeError(f"unknown message type {envelope.type!r}"[:200], ("type",))
+        self._prune(now)
+        if envelope.seq in self._seen:
+            self.stats.duplicates += 1
+            return Received(reply=encode_datagram("ack", envelope.seq))
+        self._seen[envelope.seq] = now
+        self.stats.malformed += 1
+        return Received(reply=encode_datagram("ack", envelope.seq), error=error)
 
     def _prune(self, now: float) -> None:
         while self._seen:

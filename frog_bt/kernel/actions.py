@@ -52,7 +52,8 @@ class Goal:
         return "sent" if self.code is None else self.code.word
 
 
-Publish = Callable[[str, object], None]  # (output role, value: the wire table encodes it)
+# (output role, value: the wire table encodes it, the goal it carries: goto and approach)
+Publish = Callable[[str, object, "Goal | None"], None]
 
 
 class Actions:
@@ -71,20 +72,22 @@ class Actions:
     def goto(self, waypoint: str, poi: Poi) -> Goal:
         now = self._clock.now()
         pose = Pose(now, "map", poi.x, poi.y, poi.z, poi.w)
-        self._publish("goto", pose)
-        return self._replace(Goal(next(self._ids), "goto", waypoint, now, pose))
+        goal = self._replace(Goal(next(self._ids), "goto", waypoint, now, pose))
+        self._publish("goto", pose, goal)
+        return goal
 
     def approach(self, person_id: int) -> Goal:
-        self._publish("approach", person_id)
         self.last_approach_at = now = self._clock.now()
-        return self._replace(Goal(next(self._ids), "approach", str(person_id), now, person_id))
+        goal = self._replace(Goal(next(self._ids), "approach", str(person_id), now, person_id))
+        self._publish("approach", person_id, goal)
+        return goal
 
     def resend_pending(self) -> Goal | None:
         """Publish the pending goal or approach again (after a reconnect its answer may
         have been lost while the link was down). The goal keeps waiting as before."""
         goal = self.pending
         if goal is not None:
-            self._publish(goal.kind, goal.value)  # the kind is the output role
+            self._publish(goal.kind, goal.value, goal)  # the kind is the output role
             log.info("re-sent %s %s after a reconnect", goal.kind, goal.target)
         return goal
 
@@ -114,7 +117,7 @@ class Actions:
         return goal
 
     def dock(self, action: str) -> None:
-        self._publish("dock", action)
+        self._publish("dock", action, None)
 
     def icl(self, on: bool) -> None:
-        self._publish("icl", "start" if on else "stop")
+        self._publish("icl", "start" if on else "stop", None)

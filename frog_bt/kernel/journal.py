@@ -8,17 +8,31 @@ learn what happened.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from frog_bt.kernel.clock import Clock
-from frog_bt.kernel.outcomes import Incident, IncidentKind
+from frog_bt.kernel.outcomes import Incident, IncidentKind, Level
+
+
+class Note(NamedTuple):
+    """One decision: when, in plain words, and the incident it is, if any."""
+
+    at: float
+    text: str
+    kind: IncidentKind | None = None
+
+    @property
+    def level(self) -> Level:
+        return self.kind.level if self.kind is not None else Level.INFO
 
 
 class Journal:
-    """Notes ``(t, text)`` and incidents, each list bounded to about ``limit`` entries."""
+    """Notes and incidents, each list bounded to about ``limit`` entries."""
 
     def __init__(self, clock: Clock, limit: int = 1000) -> None:
         self._clock = clock
         self.limit = limit
-        self.notes: list[tuple[float, str]] = []
+        self.notes: list[Note] = []
         self.incidents: list[Incident] = []
         self.incident_total = 0  # incidents ever recorded (the list keeps the latest)
 
@@ -29,7 +43,7 @@ class Journal:
         now = self._clock.now()
         if len(self.notes) >= self.limit:
             del self.notes[: self.limit // 2]
-        self.notes.append((now, text))
+        self.notes.append(Note(now, text, incident))
         if incident is None:
             return None
         if len(self.incidents) >= self.limit:
@@ -41,7 +55,7 @@ class Journal:
 
     @property
     def last_note(self) -> str:
-        return self.notes[-1][1] if self.notes else ""
+        return self.notes[-1].text if self.notes else ""
 
     def last_incident(self) -> Incident | None:
         return self.incidents[-1] if self.incidents else None

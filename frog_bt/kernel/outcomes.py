@@ -19,8 +19,18 @@ class TourState(enum.StrEnum):
     ABORTED = "aborted"
 
 
+class Level(enum.StrEnum):
+    """How loud a logged thing is (the log's and the viewer's levels)."""
+
+    DEBUG = "DEBUG"
+    INFO = "INFO"
+    WARN = "WARN"
+    ERROR = "ERROR"
+
+
 class IncidentKind(enum.StrEnum):
-    """What went wrong or differently on a tour: summaries and the status line list these."""
+    """What went wrong or differently on a tour: summaries and the status line list these;
+    each kind has its :attr:`level` (telemetry, the log)."""
 
     DOCKING_FAILED = "docking failed"
     NAVIGATION_FAILED = "navigation failed"
@@ -37,6 +47,14 @@ class IncidentKind(enum.StrEnum):
     MISSING_VALUE = "missing value"
     LINK_LOST = "link lost"
     OPERATOR = "operator"  # an operator command changed the tour
+
+    @property
+    def level(self) -> Level:
+        return _LEVELS.get(self, Level.WARN)
+
+
+_LEVELS = {IncidentKind.RESUMED: Level.INFO, IncidentKind.OPERATOR: Level.INFO,
+           IncidentKind.GAVE_UP: Level.ERROR}
 
 
 class AbortCause(enum.StrEnum):

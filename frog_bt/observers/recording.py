@@ -47,54 +47,36 @@ import weakref
 from collections import deque
 from collections.abc import Callable
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import msgspec
 from mcap.writer import CompressionType, Writer
 
-from frog_bt import __version__
+from frog_bt import __version__, channels
+from frog_bt.channels import ALERT, BLAME, OPERATOR, PRIMER, TICK, TREE, struct_schema
 from frog_bt.errors import DecodeError
 from frog_bt.frontend.messages import COMMANDS, EVENTS
 from frog_bt.rosbridge.msgs import ROS_TYPES
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS, Keep
 
+if TYPE_CHECKING:
+    from frog_bt.observers import Host
+    from frog_bt.runtime.core import Core, Outgoing
+    from frog_bt.runtime.operator import Answer, Command
+
 log = logging.getLogger(__name__)
 
 FRONTEND_IN = "/frontend/in"
 FRONTEND_OUT = "/frontend/out"
-TICK = "/frog_bt/tick"
-BLAME = "/frog_bt/blame"  # the tree node that sent each command, right after it
-BLAME_TYPE = "frog_bt/Blame"
-TREE = "/frog_bt/tree"  # the tree that ran, as BehaviorTree.CPP v4 XML, once at the start
-TREE_TYPE = "frog_bt/Tree"
 DATAGRAM_TYPE = "frog_bt/FrontendDatagram"
-TICK_TYPE = "frog_bt/Tick"
 CHUNK_SIZE = 256 * 1024  # bytes of uncompressed messages per chunk
 FLUSH_EVERY = 1.0  # wall seconds between chunk flushes: a kill loses at most this much
-PRIMER = "/frog_bt/primer"  # what a rotated file carries from before it
-PRIMER_TYPE = "frog_bt/Primer"
 PRIMER_DATAGRAMS = 16  # recent datagrams in, so that their resends stay duplicates
 PRIMER_SEQS = 64  # recent seqs out, so that resends of earlier commands are not new ones
 HELD_LIMIT = 10_000  # messages held before the first /clock
 
 # ------------------------------------------------------------------ JSON Schemas
-# From the wire table's Structs (refs inlined: one self-contained schema per channel).
-
-
-def _inline(node: Any, defs: dict[str, Any]) -> Any:
-    if isinstance(node, dict):
-        if "$ref" in node:
-            return _inline(defs[node["$ref"].rsplit("/", 1)[1]], defs)
-        return {k: _inline(v, defs) for k, v in node.items() if k != "$defs"}
-    if isinstance(node, list):
-        return [_inline(v, defs) for v in node]
-    return node
-
-
-def struct_schema(types: Any, title: str) -> dict[str, Any]:
-    """The JSON schema of a Struct type (or a union of them), refs inlined."""
-    schema = msgspec.json.decode(msgspec.json.encode(msgspec.json.schema(types)))  # as JSON
-    return {**_inline(schema, schema.get("$defs", {})), "title": title}
+# From the wire table's Structs and our own channels' (frog_bt/channels.py).
 
 
 def _datagram_schema() -> dict[str, Any]:
@@ -108,33 +90,19 @@ def _datagram_schema() -> dict[str, Any]:
             "required": ["type", "seq"]}
 
 
-SCHEMAS: dict[str, dict[str, Any]] = {
-    **{name: struct_schema(codec.wire, name) for name, codec in ROS_TYPES.items()},
-    DATAGRAM_TYPE: _datagram_schema(),
-    TREE_TYPE: {"type": "object", "title": TREE_TYPE, "properties": {
-        "format": {"type": "string"}, "file": {"type": "string"},
-        "xml": {"type": "string", "description": "the tree (Groot2 opens it)"}}},
-    BLAME_TYPE: {"type": "object", "title": BLAME_TYPE, "properties": {
-        "channel": {"type": "string", "description": "ROS topic or front-end message type"},
-        "node": {"type": "string", "description": "the tree node that sent it"},
-        "reads": {"type": "object", "additionalProperties": {"type": "string"},
-                  "description": "the blackboard values that node read, as short text"}}},
-    PRIMER_TYPE: {"type": "object", "title": PRIMER_TYPE, "properties": {
-        "inputs": {"type": "array", "description": "the latest message of each input",
-                   "items": {"type": "object", "properties": {
-                       "topic": {"type": "string"}, "t": {"type": "number"},
-                       "msg": {"type": "object"}}}},
-        "frontend_ready": {"type": "boolean"},
-        "frontend_in": {"type": "array", "items": {"type": "string"}},
-        "frontend_out_seqs": {"type": "array", "items": {"type": "integer"}}}},
-    TICK_TYPE: {"type": "object", "title": TICK_TYPE, "properties": {
-        "tick": {"type": "integer"},
-        "status": {"enum": ["INVALID", "RUNNING", "SUCCESS", "FAILURE"]}}},
-}
+OWN_SCHEMAS: dict[str, dict[str, Any]] = {DATAGRAM_TYPE: _datagram_schema(),
+                                          **channels.schemas()}
 
 
-OWN_TYPES = {FRONTEND_IN: DATAGRAM_TYPE, FRONTEND_OUT: DATAGRAM_TYPE, TICK: TICK_TYPE,
-             BLAME: BLAME_TYPE, TREE: TREE_TYPE, PRIMER: PRIMER_TYPE}
+def schema_for(type_: str) -> dict[str, Any]:
+    """The JSON Schema of a channel's type: a ROS type's from its Struct (whatever the
+    wire table holds now), or one of ours."""
+    codec = ROS_TYPES.get(type_)
+    if codec is not None:
+        return struct_schema(codec.wire, type_)
+    return OWN_SCHEMAS.get(type_, {"type": "object"})
+OWN_TYPES = {FRONTEND_IN: DATAGRAM_TYPE, FRONTEND_OUT: DATAGRAM_TYPE,
+             **{channel: name for channel, (name, _) in channels.TYPES.items()}}
 
 
 def to_ns(t: float) -> int:
@@ -247,37 +215,42 @@ class Recorder:
 
     # ------------------------------------------------------------ wiring
 
-    def attach(self, executive: Any) -> None:
-        """Register every channel and hook the executive's wire and core taps."""
-        site = executive.site
+    def attach(self, host: Host) -> None:
+        """Register every channel and hook the executive's wire and core taps (a live
+        host only: a recording needs the raw traffic)."""
+        wire = host.wire
+        if wire is None:
+            raise ValueError("a recorder attaches to the live executive (raw traffic)")
+        site = host.site
         for role, topic in (*INPUTS.items(), *OUTPUTS.items()):
             self.channel(site.topic(role), topic.type)
         self._latest_topics = frozenset(site.topic(role) for role, inp in INPUTS.items()
                                         if inp.keep is Keep.LATEST)
-        if executive.sim_time:
+        if host.sim_time:
             self._clock_topic = CLOCK.name
             self.channel(CLOCK.name, CLOCK.type)
         self.channel(FRONTEND_IN, DATAGRAM_TYPE)
         self.channel(FRONTEND_OUT, DATAGRAM_TYPE)
-        self.channel(TICK, TICK_TYPE)
-        self.channel(BLAME, BLAME_TYPE)
-        clock = executive.clock
+        for channel in (TICK, BLAME, OPERATOR, ALERT):
+            self.channel(channel, OWN_TYPES[channel])
+        clock = host.clock
         self._ready = lambda: bool(clock.ready)
-        self._tree = self._tree_message(executive)
+        self._tree = self._tree_message(host)
         if self._tree is not None:
             self._write(TREE, None, self._tree)
-        executive.wire.ros_in.append(self.on_ros_in)
-        executive.taps.ros_out.append(self.on_ros_out)
-        executive.wire.datagram.append(self.on_datagram)
-        executive.taps.tick.append(self.on_tick)
-        executive.taps.blame.append(self.on_blame)
+        wire.ros_in.append(self.on_ros_in)
+        host.taps.ros_out.append(self.on_ros_out)
+        wire.datagram.append(self.on_datagram)
+        host.taps.tick.append(self.on_tick)
+        host.taps.blame.append(self.on_blame)
+        host.taps.operator.append(self.on_operator)
 
     def channel(self, topic: str, type_: str) -> str:
         """Register ``topic`` (and its schema) in the file on first use; the topic."""
         if topic not in self._channels:
             sid = self._schemas.get(type_)
             if sid is None:
-                schema = SCHEMAS.get(type_, {"type": "object"})
+                schema = schema_for(type_)
                 sid = self._writer.register_schema(type_, "jsonschema", _dumps(schema))
                 self._schemas[type_] = sid
             self._channels[topic] = self._writer.register_channel(topic, "json", sid)
@@ -303,7 +276,8 @@ class Recorder:
             self._latest_raw[topic] = (t, data)
         self._write(topic, t if self._ready() else None, data)
 
-    def on_ros_out(self, t: float, topic: str, msg: Any) -> None:
+    def on_ros_out(self, t: float, out: Outgoing) -> None:
+        topic, msg = out.topic, out.msg
         if topic not in self._channels:
             self.channel(topic, "unknown")
         self._write(topic, t, _dumps(msg))
@@ -323,28 +297,32 @@ class Recorder:
                 self._frontend_out_seqs.append(seq)
         self._write(topic, t if self._ready() else None, data)
 
-    def _tree_message(self, executive: Any) -> bytes | None:
+    def _tree_message(self, host: Host) -> bytes | None:
         """The tree that runs, so that a recording explains itself without the files."""
         from frog_bt.tree.btcpp import tree_xml
 
-        tree = getattr(getattr(executive, "core", None), "tree", None)
-        if tree is None:
-            return None
-        tree_file = Path(tree.file)
         try:
-            xml = tree_xml(tree_file, executive.site)
+            tree_file = Path(host.core.tree.file)
+            xml = tree_xml(tree_file, host.site)
         except Exception as exc:
             log.info("recording without the tree's XML: %s", exc)
             return None
-        return _dumps({"format": "BehaviorTree.CPP v4", "file": str(tree_file), "xml": xml})
+        return channels.encode(channels.Tree("BehaviorTree.CPP v4", str(tree_file), xml))
 
     def on_blame(self, t: float, channel: str, node: str, reads: dict[str, str]) -> None:
-        self._write(BLAME, t, _dumps({"channel": channel, "node": node, "reads": reads}))
+        self._write(BLAME, t, channels.encode(channels.Blame(channel, node, reads)))
 
-    def on_tick(self, core: Any) -> None:
+    def on_operator(self, t: float, tick: int, command: Command, answer: Answer) -> None:
+        self._write(OPERATOR, t, channels.encode(channels.Operator(
+            tick, command.value, answer.ok, answer.text)))
+
+    def on_alert(self, t: float, alert: channels.Alert) -> None:
+        """An alert raised, cleared or acknowledged (the executive's alert book calls it)."""
+        self._write(ALERT, t, channels.encode(alert))
+
+    def on_tick(self, core: Core) -> None:
         status = core.root.status.name
-        self._write(TICK, core.clock.now(),
-                    b'{"tick":%d,"status":"%s"}' % (core.ticks, status.encode()))
+        self._write(TICK, core.clock.now(), channels.encode(channels.Tick(core.ticks, status)))
 
     # ------------------------------------------------------------ writing
 
@@ -440,12 +418,12 @@ class Recorder:
 
     def primer(self, frontend_ready: bool) -> bytes:
         """A :data:`PRIMER` message: what the executive carries from before now."""
-        inputs = [{"topic": topic, "t": t, "msg": json.loads(data)}
-                  for topic, (t, data) in sorted(self._latest_raw.items())]
-        return _dumps({
-            "inputs": inputs, "frontend_ready": frontend_ready,
-            "frontend_in": [d.decode("utf-8", "replace") for d in self._frontend_in],
-            "frontend_out_seqs": list(self._frontend_out_seqs)})
+        return channels.encode(channels.Primer(
+            inputs=[channels.PrimerInput(topic, t, msgspec.Raw(data))
+                    for topic, (t, data) in sorted(self._latest_raw.items())],
+            frontend_ready=frontend_ready,
+            frontend_in=[d.decode("utf-8", "replace") for d in self._frontend_in],
+            frontend_out_seqs=list(self._frontend_out_seqs)))
 
     def rotate(self, path: Path, metadata: dict[str, str] | None = None,
                primer: bytes | None = None) -> None:

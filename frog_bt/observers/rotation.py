@@ -41,6 +41,7 @@ import py_trees
 from frog_bt.kernel import keys
 from frog_bt.kernel.clock import SITE_TZ
 from frog_bt.kernel.outcomes import TourState
+from frog_bt.observers import Host
 from frog_bt.observers.recording import Recorder
 
 log = logging.getLogger(__name__)
@@ -90,14 +91,14 @@ class RecordingDir:
         stamp = datetime.fromtimestamp(t, SITE_TZ).strftime("%Y%m%d-%H%M%S")
         return self.directory / f"{stamp}-{kind}{self.number:04d}.mcap"
 
-    def attach(self, executive: Any) -> None:
-        self._clock = executive.clock
-        self._named_by_clock = bool(executive.clock.ready)
+    def attach(self, host: Host) -> None:
+        self._clock = host.clock
+        self._named_by_clock = bool(host.clock.ready)
         path = self._name("idle")
         self.recorder = Recorder(path, metadata={"kind": "idle", "tour": str(self.number)})
         self.files.append(path)
-        self.recorder.attach(executive)
-        executive.taps.tick.append(self.on_tick)  # after the recorder's: the tick is in
+        self.recorder.attach(host)
+        host.taps.tick.append(self.on_tick)  # after the recorder's: the tick is in
 
     def on_tick(self, core: Any) -> None:
         """Between ticks: a tour started, or the tree's run ended."""

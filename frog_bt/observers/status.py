@@ -19,6 +19,7 @@ from typing import Any, TextIO
 import py_trees
 
 from frog_bt.kernel import keys
+from frog_bt.observers import Host
 from frog_bt.runtime.core import Core
 
 
@@ -95,6 +96,10 @@ class StatusLine:
         self.source = source
         self._last = ""
         self._drawn_at = 0.0
+
+    def attach(self, host: Host) -> None:
+        """Redraw after each tick (``frog-bt run`` also refreshes it while nothing ticks)."""
+        host.taps.tick.append(self.update)
 
     def update(self, core: Core | None = None) -> None:
         now = time.monotonic()

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from frog_bt.config import Site
 from frog_bt.frontend.messages import StartPoi, Tour, UserPositive
@@ -17,8 +17,12 @@ from frog_bt.kernel import keys
 from frog_bt.kernel.context import Incident
 from frog_bt.kernel.outcomes import IncidentKind
 from frog_bt.maths.engagement import Decision
+from frog_bt.observers import Host
 from frog_bt.rosbridge.msgs import POSE
 from frog_bt.wire import SUCCEEDED
+
+if TYPE_CHECKING:
+    from frog_bt.runtime.core import Outgoing
 
 
 @dataclass
@@ -46,12 +50,12 @@ class TourSummary:
         return f"({pose.x:.1f}, {pose.y:.1f})"
 
     # taps: (t, channel, payload)
-    def ros_out(self, t: float, topic: str, msg: Any) -> None:
-        if topic == self.site.topic("goto"):
-            self._goal = self.waypoint_of(msg)
-        elif topic == self.site.topic("approach"):
+    def ros_out(self, t: float, out: Outgoing) -> None:
+        if out.role == "goto" and out.goal is not None:
+            self._goal = out.goal.target  # the waypoint, as the tree named it
+        elif out.role == "approach" and isinstance(out.value, int):
             self._goal = None
-            self.approached.append(msg["data"])
+            self.approached.append(out.value)
 
     def ros_in(self, t: float, topic: str, value: Any) -> None:
         if topic == self.site.topic("response") and value == SUCCEEDED and self._goal:
@@ -89,12 +93,16 @@ class TourSummary:
         if resumed and self.resumed is None:
             self.resumed = resumed
 
-    def attach(self, taps: Any) -> None:
+    def attach(self, host: Host) -> None:
+        taps = host.taps
         taps.tick.append(self.tick)
         taps.ros_out.append(self.ros_out)
         taps.ros_in.append(self.ros_in)
         taps.frontend_out.append(self.frontend_out)
         taps.frontend_in.append(self.frontend_in)
+
+    def close(self) -> None:
+        """Nothing to finish: the summary is read from its fields."""
 
     # ------------------------------------------------------------ verdict
 

@@ -20,7 +20,7 @@ import py_trees
 from frog_bt.config import Site
 from frog_bt.frontend.messages import FrontendMessage
 from frog_bt.kernel import keys
-from frog_bt.kernel.actions import Actions
+from frog_bt.kernel.actions import Actions, Goal
 from frog_bt.kernel.blackboard import Board, Inputs, Snapshot
 from frog_bt.kernel.clock import Clock
 from frog_bt.kernel.context import Context
@@ -38,20 +38,33 @@ Status = py_trees.common.Status
 
 Tap = Callable[[float, str, Any], None]  # (project-clock time, channel, payload)
 Behaviour = py_trees.behaviour.Behaviour
-__all__ = ["Core", "Taps"]
+__all__ = ["Core", "Outgoing", "Taps"]
+
+
+@dataclass(frozen=True, slots=True)
+class Outgoing:
+    """One command to the robot: its output role and topic, the typed value, the
+    ``msg`` dict sent, and the goal it carries (goto, approach; None for the others)."""
+
+    role: str
+    topic: str
+    value: object
+    msg: dict[str, Any]
+    goal: Goal | None = None
 
 
 @dataclass(slots=True)
 class Taps:
     """Observers of what crosses the core (recording, telemetry, summaries, status line).
 
-    ``ros_in`` gets typed values, ``ros_out`` the ``msg`` dicts sent, ``frontend_in``
-    and ``frontend_out`` typed front-end messages (channel = message type), ``tick``
-    the core after each tick. Taps must be quick: they run on the tick path.
+    ``ros_in`` gets typed values, ``ros_out`` each :class:`Outgoing` command,
+    ``frontend_in`` and ``frontend_out`` typed front-end messages (channel = message
+    type), ``tick`` the core after each tick. Taps must be quick: they run on the tick
+    path.
     """
 
     ros_in: list[Tap] = field(default_factory=list)
-    ros_out: list[Tap] = field(default_factory=list)
+    ros_out: list[Callable[[float, Outgoing], None]] = field(default_factory=list)
     frontend_in: list[Tap] = field(default_factory=list)
     frontend_out: list[Tap] = field(default_factory=list)
     tick: list[Callable[[Core], None]] = field(default_factory=list)
@@ -130,13 +143,15 @@ class Core:
             for tap in self.taps.blame:
                 tap(now, channel, self.blamed, self.blamed_reads)
 
-    def _publish(self, role: str, value: Any) -> None:
+    def _publish(self, role: str, value: object, goal: Goal | None) -> None:
         topic = self.site.topic(role)
         self._note_sender()
         msg = OUTPUTS[role].codec.encode(value)
         self._publish_topic(topic, msg)
-        for tap in self.taps.ros_out:
-            tap(self.clock.now(), topic, msg)
+        if self.taps.ros_out:
+            out = Outgoing(role, topic, value, msg, goal)
+            for tap in self.taps.ros_out:
+                tap(self.clock.now(), out)
         self._blame(topic)
 
     def _send_message(self, message: FrontendMessage) -> None:

@@ -4,13 +4,14 @@ The only part of frog-bt that imports rerun, and only once a :class:`Telemetry`
 is opened, so ``import frog_bt.telemetry`` is cheap and works without rerun::
 
     telemetry = Telemetry.open("save:tour.rrd", site, tree)
-    telemetry.attach(core)      # taps on the core: cheap appends on the tick path
+    telemetry.attach(host)      # taps on the core: cheap appends on the tick path
     ...                         # buffered rows are written in batches every 50 ticks
     telemetry.close()           # writes what is left and finishes the file
 
 Modules: :mod:`.spec` (the ``--rerun`` value), :mod:`.layout` (tree numbering and
 the graph's tidy layout), :mod:`.site_map` (POIs, routes, zones as geometry),
-:mod:`.rows` (the taps), :mod:`.writer` and :mod:`.blueprint` (rerun). What is
+:mod:`.rows` (the taps), :mod:`.observer` (what both writers share), :mod:`.writer`
+and :mod:`.blueprint` (rerun). What is
 logged where: ``docs/TELEMETRY.md``.
 """
 
@@ -20,15 +21,17 @@ import asyncio
 import logging
 from collections import deque
 from collections.abc import Iterator
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from frog_bt.telemetry.layout import TreeIndex, tidy_layout
-from frog_bt.telemetry.rows import Rows
+from frog_bt.telemetry.observer import TelemetryObserver
 from frog_bt.telemetry.spec import Sink, parse_spec
 
 if TYPE_CHECKING:
+    from rerun import RecordingStream
+
     from frog_bt.config import Site
-    from frog_bt.runtime.core import Core
+    from frog_bt.observers.links import LinkStatus
     from frog_bt.tree.loader import LoadedTree
 
 __all__ = ["Sink", "Telemetry", "TreeIndex", "parse_spec", "tidy_layout"]
@@ -38,25 +41,20 @@ CLOSE_TIMEOUT = 5.0  # seconds close() waits for the sink
 STEP_PAUSE = 0.0005  # seconds between two steps of writing a batch (see Telemetry._step)
 
 
-class Telemetry:
-    """One rerun recording of one executive run. Build it with :meth:`open`."""
+class Telemetry(TelemetryObserver):
+    """One rerun recording of one executive run (or replay). Build it with :meth:`open`."""
 
-    def __init__(self, rec: Any, site: Site, tree: LoadedTree, *,
+    def __init__(self, rec: RecordingStream, site: Site, tree: LoadedTree, *,
                  batch_ticks: int = BATCH_TICKS) -> None:
         """Log to ``rec`` (a ``rerun.RecordingStream`` with its sink already set)."""
         from frog_bt.telemetry.blueprint import default_blueprint
         from frog_bt.telemetry.writer import Writer
 
+        super().__init__(site, tree, batch_ticks=batch_ticks)
         self.rec = rec
         rec.set_log_time_enabled(False)  # only the tick and project-clock timelines
         rec.set_log_tick_enabled(False)
-        self.index = TreeIndex.of(tree.root)
-        self.rows = Rows(site, self.index, batch_ticks=batch_ticks, on_full=self._full)
         self.writer = Writer(rec, site, self.index)
-        self._closed = False
-        self._core: Core | None = None
-        self._links: dict[str, str] = {}
-        self._flush_pending = False
         self._writing: deque[tuple[int, Iterator[None]]] = deque()  # batches being written
         self.write_errors = 0  # batches that could not be written (logged, never raised)
         rec.send_blueprint(default_blueprint(self.index), make_active=True, make_default=True)
@@ -85,43 +83,15 @@ class Telemetry:
             rec.spawn(port=sink.port)
         return cls(rec, site, tree)
 
-    def attach(self, core: Core) -> None:
-        """Append the taps to ``core.taps`` (one core per telemetry)."""
-        self.rows.attach(core)
-        self._core = core
-
-    def attach_links(self, executive: Any) -> None:
-        """Each link's state over time (lanes under ``links/``), from the executive."""
-        executive.wire.links.append(self.on_links)
-        self.on_links(executive.clock.now() if executive.clock.ready else 0.0, executive.links)
-
-    def on_links(self, t: float, links: Any) -> None:
-        from frog_bt.observers.links import changed
-
-        changes = changed(self._links, links)
-        if self._closed or not changes:
-            return
-        core = self._core
+    def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]
+                     ) -> None:
         try:
-            self.writer.write_links(core.ticks if core is not None else 0, t, changes)
+            self.writer.write_links(tick, t, changes)
         except Exception:  # telemetry must never stop the robot
             self.write_errors += 1
             log.exception("rerun telemetry: could not write the links")
 
-    def _full(self) -> None:
-        """Rows are full (called inside a tick): write them once the tick is over, so that
-        what the tick sent leaves first and the tick itself stays short; at once when no
-        event loop runs (replay)."""
-        try:
-            loop = asyncio.get_running_loop()
-        except RuntimeError:
-            self.flush()
-            return
-        if not self._flush_pending:
-            self._flush_pending = True
-            loop.call_soon(self._flush_later)
-
-    def _flush_later(self) -> None:
+    def _flush_soon(self) -> None:
         """Write the rows in steps (:meth:`Writer.steps`) with short pauses between them,
         so that an input arriving meanwhile waits for one step (a fraction of a
         millisecond), not for the whole batch."""

@@ -23,24 +23,23 @@ event loop); on platforms without ``fork`` the live executive writes in-process.
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import logging
 import multiprocessing
+import multiprocessing.queues
 import queue
 import uuid
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-from frog_bt.observers.links import changed
-from frog_bt.telemetry.layout import TreeIndex
-from frog_bt.telemetry.rows import Rows
+from frog_bt.observers.links import LinkStatus
+from frog_bt.telemetry.observer import TelemetryObserver
+from frog_bt.telemetry.rows import Batch
 from frog_bt.telemetry.spec import parse_spec
 from frog_bt.warning_limit import WarningLimiter
 
 if TYPE_CHECKING:
     from frog_bt.config import Site
-    from frog_bt.runtime.core import Core
     from frog_bt.tree.loader import LoadedTree
 
 log = logging.getLogger(__name__)
@@ -53,8 +52,11 @@ def available() -> bool:
     return "fork" in multiprocessing.get_all_start_methods()
 
 
+Item = tuple[object, ...]  # ("batch", Batch) | ("links", tick, t, changes) | ("close",)
+
+
 def _serve(spec: str, site: Site, tree: LoadedTree, recording_id: str,
-           inbox: Any) -> None:
+           inbox: multiprocessing.queues.Queue[Item]) -> None:
     """The child: write what comes until ``close`` (or the parent is gone)."""
     from frog_bt.telemetry import Telemetry
 
@@ -70,12 +72,14 @@ def _serve(spec: str, site: Site, tree: LoadedTree, recording_id: str,
                 continue
             kind = item[0]
             if kind == "batch":
+                batch = item[1]
+                assert isinstance(batch, Batch)
                 try:
-                    telemetry.writer.write(item[1])
+                    telemetry.writer.write(batch)
                 except Exception:
-                    log.exception("rerun telemetry: could not write %d rows", len(item[1]))
+                    log.exception("rerun telemetry: could not write %d rows", len(batch))
             elif kind == "links":
-                telemetry.writer.write_links(*item[1:])
+                telemetry.writer.write_links(*item[1:])  # type: ignore[arg-type]
             elif kind == "close":
                 return
     finally:
@@ -91,19 +95,15 @@ def _numbered(spec: str, n: int) -> str:
     return f"save:{path.with_suffix(f'.{n}{path.suffix}')}"
 
 
-class TelemetryProcess:
+class TelemetryProcess(TelemetryObserver):
     """The executive's side: rows buffered here, written by a child; see the module
-    docstring. The same interface as :class:`~frog_bt.telemetry.Telemetry` for
-    ``frog-bt run``: :meth:`attach`, :meth:`attach_links`, :meth:`flush`, :meth:`close`."""
+    docstring. Attached and closed like :class:`~frog_bt.telemetry.Telemetry`."""
 
     def __init__(self, spec: str, site: Site, tree: LoadedTree, *, batch_ticks: int = 50,
                  recycle_rows: int | None = None) -> None:
         parse_spec(spec)  # ValueError for a spec it does not know, before anything starts
+        super().__init__(site, tree, batch_ticks=batch_ticks)
         self.spec = spec
-        self.site = site
-        self.tree = tree
-        self.index = TreeIndex.of(tree.root)
-        self.rows = Rows(site, self.index, batch_ticks=batch_ticks, on_full=self._full)
         self.recording_id = str(uuid.uuid4())
         self.recycle_rows = recycle_rows or RECYCLE_ROWS
         self._context = multiprocessing.get_context("fork")
@@ -111,10 +111,6 @@ class TelemetryProcess:
         self.dropped = 0  # batches not written (the queue was full)
         self._written = 0  # rows sent to the current child
         self._warnings = WarningLimiter(60.0, logger=log)
-        self._links: dict[str, str] = {}
-        self._core: Core | None = None
-        self._closed = False
-        self._flush_pending = False
         self._start_child()
 
     def _start_child(self) -> None:
@@ -141,31 +137,12 @@ class TelemetryProcess:
 
     # ------------------------------------------------------------ the executive's side
 
-    def attach(self, core: Core) -> None:
-        self.rows.attach(core)
-        self._core = core
+    def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]
+                     ) -> None:
+        self._send(("links", tick, t, changes))
 
-    def attach_links(self, executive: Any) -> None:
-        executive.wire.links.append(self.on_links)
-        self.on_links(executive.clock.now() if executive.clock.ready else 0.0, executive.links)
-
-    def on_links(self, t: float, links: Any) -> None:
-        changes = changed(self._links, links)
-        if changes:
-            tick = self._core.ticks if self._core is not None else 0
-            self._send(("links", tick, t, changes))
-
-    def _full(self) -> None:
-        """Rows are full (inside a tick): send them once the tick is over."""
-        if self._flush_pending:
-            return
-        try:
-            loop = asyncio.get_running_loop()
-        except RuntimeError:
-            self.flush()
-            return
-        self._flush_pending = True
-        loop.call_soon(self.flush)
+    def _flush_soon(self) -> None:
+        self.flush()
 
     def flush(self) -> None:
         """Send the buffered rows to the child (never waits: a full queue drops them)."""
@@ -185,7 +162,7 @@ class TelemetryProcess:
                                 list(links.items())))
                     self._links = links
 
-    def _send(self, item: tuple[Any, ...]) -> bool:
+    def _send(self, item: Item) -> bool:
         if self._closed:
             return False
         try:

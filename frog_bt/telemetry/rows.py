@@ -25,12 +25,13 @@ from typing import TYPE_CHECKING, Any
 import py_trees
 
 from frog_bt.kernel import keys
+from frog_bt.kernel.outcomes import Level
 from frog_bt.telemetry.layout import TreeIndex
 from frog_bt.wire import INPUTS
 
 if TYPE_CHECKING:
     from frog_bt.config import Site
-    from frog_bt.runtime.core import Core
+    from frog_bt.runtime.core import Core, Outgoing
 
 Status = py_trees.common.Status
 ENGAGEMENT_KEYS = (keys.ENGAGEMENT_METER, keys.ENGAGEMENT_DECISION)
@@ -46,7 +47,7 @@ class Batch:
     # ^ side ("ros" | "frontend"), channel (topic | message type), payload
     events: list[tuple[int, float, str, Any]] = field(default_factory=list)  # type, message
     statuses: list[tuple[int, float, tuple[Status, ...]]] = field(default_factory=list)
-    notes: list[tuple[int, float, str]] = field(default_factory=list)
+    notes: list[tuple[int, float, str, Level]] = field(default_factory=list)
     blackboard: list[tuple[int, float, str, Any]] = field(default_factory=list)  # key, value
 
     def restamp(self, t: float) -> None:
@@ -130,10 +131,10 @@ class Rows:
         elif role is not None:
             self.batch.inputs.append((*stamp, role, value))
 
-    def ros_out(self, t: float, topic: str, msg: Any) -> None:
+    def ros_out(self, t: float, out: Outgoing) -> None:
         stamp = self._stamp(t)
         if stamp is not None:
-            self.batch.outputs.append((*stamp, "ros", topic, msg))
+            self.batch.outputs.append((*stamp, "ros", out.topic, out))
 
     def frontend_out(self, t: float, type_: str, message: Any) -> None:
         stamp = self._stamp(t)
@@ -178,7 +179,7 @@ class Rows:
             i = len(notes) - 1
             while i >= 0 and notes[i] is not self._last_note:
                 i -= 1
-            batch.notes.extend((tick, at, text) for at, text in notes[i + 1:])
+            batch.notes.extend((tick, n.at, n.text, n.level) for n in notes[i + 1:])
             self._last_note = notes[-1]
         for key in ENGAGEMENT_KEYS:
             value = core.board.get(key)

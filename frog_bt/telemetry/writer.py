@@ -10,10 +10,9 @@ Entity paths are listed in ``docs/TELEMETRY.md``.
 from __future__ import annotations
 
 import math
-import re
 from collections import deque
 from collections.abc import Iterator, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import py_trees
@@ -21,11 +20,15 @@ import rerun as rr
 
 from frog_bt.config import Site
 from frog_bt.frontend.messages import message_fields
-from frog_bt.rosbridge.msgs import POSE
+from frog_bt.observers.links import Health, LinkStatus
+from frog_bt.rosbridge.msgs import Pose
 from frog_bt.telemetry.layout import TreeIndex, tidy_layout
 from frog_bt.telemetry.rows import Batch
 from frog_bt.telemetry.site_map import poi_marks, tour_routes, zone_outlines
 from frog_bt.wire import ABORTED, FAILED, Response
+
+if TYPE_CHECKING:
+    from frog_bt.runtime.core import Outgoing
 
 Status = py_trees.common.Status
 TICK, TIME = "tick", "time"  # the timelines: tick number, project-clock time
@@ -40,8 +43,6 @@ ROBOT, TRAIL, GOAL, POI, FACE = 0x58A6FFFF, 0xF5B400DD, 0xF778BAFF, 0xE6EDF3FF, 
 # Negative radii are UI points: markers stay visible however far the map is zoomed out.
 R_ROBOT, R_POI, R_VISITOR, R_TRACKED, R_GOAL = -7.0, -4.0, -5.0, -9.0, -6.0
 R_ROUTE, R_TRAIL, R_ZONE, R_ARROW = -1.5, -2.0, -1.0, -1.5
-WARNING_NOTE = re.compile(r"fail|timed out|no \S+ within|abort|skip|lost|nobody|declin|refus"
-                          r"|replaced|not engaged|no face data", re.IGNORECASE)
 PERIODIC = frozenset({"engagement"})  # front-end commands sent on a timer: DEBUG, not INFO
 TRAIL_STEP = 0.5  # metres between trail points
 TRAIL_POINTS = 1000  # the trail keeps the last 500 m or so
@@ -57,11 +58,8 @@ def status_path(key: str) -> str:
     return f"bt/status/{key}"
 
 
-LINK_OK, LINK_WAIT, LINK_BAD, LINK_OFF = 0x3CB371FF, 0xE0A030FF, 0xD04040FF, 0x808080FF
-LINK_STATES = {  # state -> colour of the link lanes (the operator's view)
-    "connected": LINK_OK, "acking": LINK_OK, "wall": LINK_OK, "/clock": LINK_OK,
-    "connecting": LINK_WAIT, "reconnecting": LINK_WAIT, "not heard": LINK_WAIT,
-    "silent": LINK_BAD, "waiting for /clock": LINK_BAD, "closed": LINK_OFF}
+HEALTH_COLORS = {Health.OK: 0x3CB371FF, Health.WAIT: 0xE0A030FF, Health.BAD: 0xD04040FF,
+                 Health.OFF: 0x808080FF}  # the colour of a link lane, by its state's health
 
 
 def link_path(name: str) -> str:
@@ -154,20 +152,20 @@ class Writer:
             [STATUS_COLORS[Status[s]] for s in STATES], dtype=np.uint32))
         for node in nodes:
             rec.log(status_path(node.key), config, static=True)
-        links = rr.StateConfiguration(values=list(LINK_STATES), colors=np.array(
-            list(LINK_STATES.values()), dtype=np.uint32))
+        links = rr.StateConfiguration(values=[s.value for s in LinkStatus], colors=np.array(
+            [HEALTH_COLORS[s.health] for s in LinkStatus], dtype=np.uint32))
         for name in ("rosbridge", "frontend", "clock"):
             rec.log(link_path(name), links, static=True)
 
-    def write_links(self, tick: int, t: float, changes: list[tuple[str, str]]) -> None:
+    def write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]) -> None:
         """Links whose state changed at ``t``: their lanes, and one log line."""
         rec = self.rec
         rec.set_time(TICK, sequence=tick)
         rec.set_time(TIME, timestamp=np.datetime64(round(t * 1e9), "ns"))
         for name, state in changes:
-            rec.log(link_path(name), rr.StateChange(state=state))
-        level = "WARN" if any(LINK_STATES.get(s) in (LINK_WAIT, LINK_BAD)
-                              for _, s in changes) else "INFO"
+            rec.log(link_path(name), rr.StateChange(state=state.value))
+        level = "WARN" if any(s.health in (Health.WAIT, Health.BAD) for _, s in changes) \
+            else "INFO"
         rec.log("log/links", rr.TextLog(", ".join(f"{n} {s}" for n, s in changes), level=level))
 
     # ------------------------------------------------------------ batches
@@ -196,9 +194,8 @@ class Writer:
         for tick, t, _, message in batch.events:
             logs.setdefault("log/frontend/in", []).append(
                 (tick, t, "INFO", "← front end " + _describe(message)))
-        for tick, t, text in batch.notes:
-            level = "WARN" if WARNING_NOTE.search(text) else "INFO"
-            logs.setdefault("log/notes", []).append((tick, t, level, text))
+        for tick, t, text, level in batch.notes:  # the level is the note's incident kind's
+            logs.setdefault("log/notes", []).append((tick, t, level.value, text))
         self._read_blackboard(batch)
         for path, rows in logs.items():
             if not rows:  # an empty temporal chunk crashes the 0.41 viewer's time panel
@@ -346,13 +343,13 @@ class Writer:
                 logs.setdefault("log/frontend/out", []).append(
                     (tick, t, level, "→ front end " + _describe(payload)))
                 continue
-            role = self.topics.get(channel)
-            text = f"{channel} {payload.get('data', '')}".rstrip()
+            out: Outgoing = payload
+            role = out.role
+            text = f"{channel} {out.msg.get('data', '')}".rstrip()
             if role == "icl":  # stray samples after a stop must not bridge two sessions
                 self._end_face_session(tick, t)
-            if role == "goto":
-                pose = POSE.convert(payload)
-                name = self._waypoint(pose.x, pose.y, pose.qz, pose.qw)
+            if role == "goto" and isinstance(out.value, Pose) and out.goal is not None:
+                pose, name = out.value, out.goal.target
                 text = f"{channel} {name} ({pose.x:.1f}, {pose.y:.1f})"
                 goals.append((tick, 1, t, (name, pose.x, pose.y, pose.yaw)))
             elif role == "approach":
@@ -386,13 +383,6 @@ class Writer:
     def _set_time(self, tick: int, t: float) -> None:
         self.rec.set_time(TICK, sequence=tick)
         self.rec.set_time(TIME, timestamp=t)
-
-    def _waypoint(self, x: float, y: float, qz: float, qw: float) -> str:
-        for name, poi in self.site.pois.items():
-            if (abs(poi.x - x) < 1e-6 and abs(poi.y - y) < 1e-6
-                    and abs(poi.z - qz) < 1e-6 and abs(poi.w - qw) < 1e-6):
-                return name
-        return "goal"
 
     def _log_goal(self, tick: int, t: float, goal: Goal | None) -> None:
         rec = self.rec

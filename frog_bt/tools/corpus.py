@@ -34,9 +34,13 @@ class TourRow:
     replayed_node: str = ""
     signature: str = ""  # node + what differs, for grouping
     recovered: str = ""  # a file cut short: what was read of it
+    bad: int = 0  # messages of our own channels that did not decode (reported, skipped)
+    bad_first: str = ""  # the first one's reason
 
     def line(self) -> str:
         note = f" [{self.recovered}]" if self.recovered else ""
+        if self.bad:
+            note += f" [{self.bad} bad message(s): {self.bad_first}]"
         return self._line() + note
 
     def _line(self) -> str:
@@ -75,8 +79,9 @@ def replay_file(path: str, tree: str | None, site: Site) -> TourRow:
         reason = f"{type(exc).__name__}: {exc}".splitlines()[0][:200]
         return TourRow(path, "unreadable", reason=reason)
     div = result.divergence
+    bad = {"bad": result.bad_count, "bad_first": result.bad[0] if result.bad else ""}
     if div is None:
-        return TourRow(path, "identical", recovered=recovered)
+        return TourRow(path, "identical", recovered=recovered, **bad)
     diff = differences(div.expected, div.got, site)
     recorded = div.expected.node if div.expected else ""
     replayed = div.got.node if div.got else ""
@@ -84,7 +89,7 @@ def replay_file(path: str, tree: str | None, site: Site) -> TourRow:
     return TourRow(path, "diverged", at=div.t - result.start, number=div.number,
                    differs=diff, recorded_node=recorded, replayed_node=replayed,
                    signature=f"{node}: {what_differs(div.expected, div.got, site)}",
-                   recovered=recovered)
+                   recovered=recovered, **bad)
 
 
 def replay_corpus(files: list[Path], tree: Path | None, site: Site,

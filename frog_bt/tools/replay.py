@@ -35,20 +35,30 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from frog_bt import channels
+from frog_bt.channels import BLAME, OPERATOR, PRIMER, TICK
 from frog_bt.config import Site, parse_hostport
 from frog_bt.errors import DecodeError, FrogError
 from frog_bt.frontend.messages import EVENTS, FrontendMessage, message_fields
 from frog_bt.frontend.protocol import Endpoint
 from frog_bt.kernel import keys
 from frog_bt.kernel.clock import SITE_TZ, ManualClock
-from frog_bt.observers.recording import BLAME, FRONTEND_IN, FRONTEND_OUT, PRIMER, TICK, from_ns
+from frog_bt.observers.recording import FRONTEND_IN, FRONTEND_OUT, from_ns
 from frog_bt.rosbridge.msgs import ROS_TYPES
-from frog_bt.runtime.core import Core
+from frog_bt.runtime.core import Core, Taps
+from frog_bt.runtime.operator import Command as OperatorCommand
 from frog_bt.tools.mcapfile import RecordingError, RecordingFile, open_recording
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
+
+if TYPE_CHECKING:
+    from frog_bt.observers.links import Links
+    from frog_bt.runtime.executive import WireTaps
+
+
+BAD_KEPT = 20  # reasons of bad messages kept in a result (all are counted)
 
 
 class ReplayError(FrogError):
@@ -97,6 +107,9 @@ class ReplayResult:
     divergence: Divergence | None = None
     wall: float = 0.0  # seconds the replay took
     recovered: list[str] = field(default_factory=list)  # files cut short, what was read
+    bad: list[str] = field(default_factory=list)  # our own messages that did not decode: why
+    bad_count: int = 0  # all of them (``bad`` keeps the first few)
+    operator_commands: int = 0  # recorded operator commands, applied again
 
     @property
     def identical(self) -> bool:
@@ -137,9 +150,13 @@ def _without_stamp(msg: Any) -> Any:
 class Replay:
     """One replay of ``path`` with ``site`` and ``tree``; see the module docstring.
 
-    Raises :class:`ReplayError` when the file is no frog-bt recording. Attach
-    observers (telemetry) to :attr:`core` before :meth:`run`.
+    Raises :class:`ReplayError` when the file is no frog-bt recording. A replay is an
+    :class:`~frog_bt.observers.Host` without raw traffic or links: attach observers
+    (telemetry) to it before :meth:`run`.
     """
+
+    wire: WireTaps | None = None  # no raw traffic in a replay
+    links: Links | None = None  # and no links
 
     def __init__(self, path: Path, site: Site, tree: LoadedTree) -> None:
         self.path = Path(path)
@@ -176,6 +193,10 @@ class Replay:
         self._next_tick = 0.0
         self.result = ReplayResult(self.start, self.end, self.start, exact=self.exact,
                                    recovered=self.recovered)
+
+    @property
+    def taps(self) -> Taps:
+        return self.core.taps
 
     # ------------------------------------------------------------ outputs of the replayed tree
 
@@ -250,14 +271,16 @@ class Replay:
         elif topic == FRONTEND_IN:
             self._on_datagram(data)
         elif topic == TICK:
-            if self.exact:
+            if self._own(topic, t, data) is not None and self.exact:
                 self._tick()
         elif topic == FRONTEND_OUT:
             self._expect_datagram(t, data)
         elif topic == BLAME:
-            self._blame(data)
+            self._blame(self._own(topic, t, data))
         elif topic == PRIMER:
-            self._prime(data)
+            self._prime(self._own(topic, t, data))
+        elif topic == OPERATOR:
+            self._operator(t, self._own(topic, t, data))
         elif topic in self.outputs:
             self.result.ros_commands += 1
             self._last_expected = Command(t, topic, _without_stamp(json.loads(data)))
@@ -298,46 +321,70 @@ class Replay:
         self._expected.append(self._last_expected)
         self._compare()
 
-    def _prime(self, data: bytes) -> None:
+    def _own(self, topic: str, t: float, data: bytes) -> Any:
+        """A message of one of our channels, decoded by its Struct; None for a bad one,
+        counted and reported with its reason (never dropped silently)."""
+        try:
+            return channels.decode(topic, data)
+        except DecodeError as exc:
+            self._bad(topic, t, str(exc))
+            return None
+
+    def _bad(self, topic: str, t: float, reason: str) -> None:
+        result = self.result
+        result.bad_count += 1
+        if len(result.bad) < BAD_KEPT:
+            result.bad.append(f"{topic} at +{t - self.start:.1f} s: {reason}")
+
+    def _prime(self, primer: channels.Primer | None) -> None:
         """A recorded ``/frog_bt/primer``: what the live executive carried into this file
         from before it (:mod:`frog_bt.observers.rotation`)."""
-        try:
-            primer = json.loads(data)
-        except ValueError:
+        if primer is None:
             return
-        for entry in primer.get("inputs", ()):
-            topic = entry.get("topic")
-            inp = self.core.table.get(topic)
-            codec = ROS_TYPES.get(self.types.get(topic, "")) if inp is not None else None
+        for entry in primer.inputs:
+            inp = self.core.table.get(entry.topic)
+            codec = ROS_TYPES.get(self.types.get(entry.topic, "")) if inp is not None else None
             if inp is None or codec is None:
                 continue
             try:
-                value = codec.decode(json.dumps(entry.get("msg")).encode())
+                value = codec.decode(bytes(entry.msg))
             except DecodeError:
-                continue
-            self.core.inputs.add(inp, value, float(entry.get("t", self.clock.now())))
-        if primer.get("frontend_ready"):
+                continue  # live, the client drops a malformed message before the core
+            self.core.inputs.add(inp, value, entry.t)
+        if primer.frontend_ready:
             self.core.board.set(keys.FRONTEND_READY, True)
-        for raw in primer.get("frontend_in", ()):  # seen live: their resends are duplicates
+        for raw in primer.frontend_in:  # seen live: their resends are duplicates
             self.endpoint.receive(raw.encode(), self._peer, self.clock.now())
-        self._seqs.update(primer.get("frontend_out_seqs", ()))
+        self._seqs.update(primer.frontend_out_seqs)
 
-    def _blame(self, data: bytes) -> None:
+    def _blame(self, blame: channels.Blame | None) -> None:
         """A recorded ``/frog_bt/blame``: the node that sent the command just recorded."""
-        try:
-            obj = json.loads(data)
-        except ValueError:
-            return
         last = self._last_expected
-        if last is None or not isinstance(obj, dict):
+        if last is None or blame is None:
             return
-        channel = obj.get("channel")
-        if channel == last.channel or (last.channel == FRONTEND_OUT
-                                       and last.payload.get("type") == channel):
-            last.node = str(obj.get("node", ""))
-            reads = obj.get("reads")
-            if isinstance(reads, dict):
-                last.reads = {str(k): str(v) for k, v in reads.items()}
+        if blame.channel == last.channel or (last.channel == FRONTEND_OUT
+                                             and last.payload.get("type") == blame.channel):
+            last.node = blame.node
+            last.reads = dict(blame.reads)
+
+    def _operator(self, t: float, recorded: channels.Operator | None) -> None:
+        """A recorded operator command: applied again here, between the same two ticks; a
+        different answer is a divergence like a different command."""
+        if recorded is None:
+            return
+        try:
+            command = OperatorCommand(recorded.command)
+        except ValueError:
+            self._bad(OPERATOR, t, f"unknown command {recorded.command!r}")
+            return
+        self.result.operator_commands += 1
+        answer = self.core.command(command)
+        self._last_expected = Command(t, OPERATOR, {"command": recorded.command,
+                                                   "ok": recorded.ok, "did": recorded.text})
+        self._expected.append(self._last_expected)
+        self._got.append(Command(self.clock.now(), OPERATOR, {
+            "command": command.value, "ok": answer.ok, "did": answer.text}))
+        self._compare()
 
     # ------------------------------------------------------------ time and ticks
 

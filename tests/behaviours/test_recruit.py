@@ -159,7 +159,7 @@ def test_a_person_whose_approach_always_fails_is_approached_once_a_minute(tmp_pa
     assert all(60 < b - a <= 60.3 for a, b in itertools.pairwise(times))
     assert {(topic, data) for _, topic, data in sent} == {("/ApproachPeopleFar", 7)}
     assert "approach of visitor 7 aborted: seek again (not them for 60 s)" in [
-        text for _, text in bench.core.journal.notes]
+        note.text for note in bench.core.journal.notes]
 
 
 def test_lost_finish_introduction_asks_the_visitor_after_the_timeout(tmp_path):

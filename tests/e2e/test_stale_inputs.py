@@ -15,7 +15,7 @@ async def _laser_drops_out_on_arrival() -> tuple[list[str], list[str], int]:
         run.sim.drop("/PeopleUPO", 3600)  # the laser tracker dies on the way to POI1
         run.sim.drop("/UvA_PersonDetectionAndPose", 3600)
         outcome = await run.finish(90)
-        notes = [text for _, text in run.executive.core.journal.notes]
+        notes = [note.text for note in run.executive.core.journal.notes]
         return commands_after(run, goal.t), notes, outcome.code
 
 
@@ -37,7 +37,7 @@ async def _pose_drops_out_near_the_shop() -> tuple[list[int], list[str]]:
         run.sim.drop("/FROG_pose", 60)  # no pose while leaving the shop zone
         start = await run.sim.wait_for(is_("start_poi", poi="POI1", part="a"), 90)
         volumes = [r.payload["percent"] for r in run.sim.received("volume") if r.t <= start.t]
-        notes = [text for _, text in run.executive.core.journal.notes]
+        notes = [note.text for note in run.executive.core.journal.notes]
         return volumes, notes
 
 

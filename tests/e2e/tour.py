@@ -82,9 +82,9 @@ class Running(Rehearsal):
                          **executive_kwargs)
 
     def _prepare(self, executive: Executive) -> None:
-        self.summary.attach(executive.taps)
+        self.summary.attach(executive)
         executive.taps.frontend_out.append(lambda t, _type, m: self.sent.append((t, m)))
-        executive.taps.ros_out.append(lambda t, topic, _m: self.published.append((t, topic)))
+        executive.taps.ros_out.append(lambda t, out: self.published.append((t, out.topic)))
 
     def tour(self) -> Tour:
         return Tour(self.sim, self.executive, self.executive.outcome, self.summary, self.site,

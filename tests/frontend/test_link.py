@@ -156,9 +156,10 @@ def test_commands_delivered_and_acked_between_two_links() -> None:
                 assert front.stats.received == 2 and front.stats.foreign == 0
                 # The front end acked to the executive's socket, never to its own "peer".
                 assert [json.loads(d)["type"] for d in front_tap.outbound] == ["ack", "ack"]
-                # Acked: advancing the clock resends nothing.
+                # Acked: nothing waits for an ack, so no time on the clock resends anything.
+                assert executive.next_resend is None
                 clock.advance(10)
-                await asyncio.sleep(0)
+                assert executive.next_resend is None
                 assert executive.stats.resent == 0 and len(exec_tap.outbound) == 2
 
     run(main)
@@ -220,9 +221,12 @@ def test_resends_driven_by_the_clock(drop: int) -> None:
                 first, _ = await within(peer.datagrams.get())
                 assert first == {"type": "follow_me", "seq": 1, "on": True}
                 for n in range(drop):
-                    # Not due yet: a little less than 0.25 s resends nothing...
+                    # Not due yet: a little less than 0.25 s after the last send, the next
+                    # resend is still ahead on the clock...
+                    due = link.next_resend
+                    assert due is not None
                     clock.advance(0.2)
-                    await asyncio.sleep(0)
+                    assert link.next_resend == due > clock.now()
                     assert link.stats.resent == n
                     # ...and reaching 0.25 s since the last send resends it once.
                     clock.advance(0.05)

@@ -24,10 +24,10 @@ from frog_bt.observers.recording import (
     DATAGRAM_TYPE,
     FRONTEND_IN,
     FRONTEND_OUT,
-    SCHEMAS,
     TICK,
     Recorder,
     from_ns,
+    schema_for,
     to_ns,
 )
 from frog_bt.runtime.core import Taps
@@ -93,11 +93,11 @@ def test_a_recorded_tour_has_every_channel_typed_and_stamped(tour: RecordedTour)
         if channel.topic in types:
             assert schema.name == types[channel.topic], channel.topic
         assert channel.message_encoding == "json" and schema.encoding == "jsonschema"
-        assert json.loads(schema.data) == SCHEMAS[schema.name]
+        assert json.loads(schema.data) == schema_for(schema.name)
         assert message.publish_time == message.log_time >= last
         last = message.log_time
         assert tour.start <= from_ns(message.log_time) <= tour.end
-        assert conforms(json.loads(message.data), SCHEMAS[schema.name]), (channel.topic,
+        assert conforms(json.loads(message.data), schema_for(schema.name)), (channel.topic,
                                                                          message.data)
     assert set(types) <= set(counts), set(types) - set(counts)  # every channel had traffic
     assert counts[TICK] == tour.executive.core.ticks
@@ -122,7 +122,7 @@ def fake_executive() -> Any:
     site = load_site()
     taps = Taps()
     return SimpleNamespace(site=site, sim_time=True, clock=SimClock(), wire=WireTaps(),
-                           taps=taps)
+                           taps=taps, core=SimpleNamespace(tree=None), links=None)
 
 
 def test_what_arrives_before_the_first_clock_is_stamped_with_it(tmp_path: Path) -> None:

@@ -55,9 +55,9 @@ class TourRun(Rehearsal):
                          sim_secret=sim_secret, secret=secret, prepare=self._prepare)
 
     def _prepare(self, exe: Executive) -> None:
-        self.summary.attach(exe.taps)
+        self.summary.attach(exe)
         exe.taps.ros_out.append(
-            lambda t, topic, msg: self._add(Published(t, topic, msg, exe.client.link.connected)))
+            lambda t, out: self._add(Published(t, out.topic, out.msg, exe.client.link.connected)))
         on_link = exe.client.on_link
 
         def link_changed(state: LinkState) -> None:

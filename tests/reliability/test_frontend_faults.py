@@ -49,7 +49,8 @@ def short_timeouts(tmp_path: Path, content: float, **per_stop: float) -> Site:
 
 
 def content_timeouts(run: TourRun) -> list[str]:
-    return [text for _, text in run.executive.core.journal.notes if "no content_done" in text]
+    notes = run.executive.core.journal.notes
+    return [note.text for note in notes if "no content_done" in note.text]
 
 
 def tour_states(run: TourRun) -> list[str]:

@@ -34,8 +34,7 @@ def test_an_outage_and_a_silent_front_end_show_as_link_states(tmp_path: Path) ->
         async with TourRun({"speed": 200}) as run:
             sim, exe = run.sim, run.executive
             telemetry = Telemetry.open(f"save:{rrd}", exe.site, exe.core.tree)
-            telemetry.attach(exe.core)
-            telemetry.attach_links(exe)
+            telemetry.attach(exe)
 
             def on_links(t: float, links: Links) -> None:
                 seen.append((t, links))

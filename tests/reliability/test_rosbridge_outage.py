@@ -99,7 +99,7 @@ def test_tour_survives_three_rosbridge_outages() -> None:
                                            "TEMP", "END", "SHOP"]
 
             # Nothing timed out, failed or was skipped because the link was down.
-            notes = [text for _, text in exe.core.journal.notes]
+            notes = [note.text for note in exe.core.journal.notes]
             assert not [n for n in notes if TROUBLE.search(n)], notes
             assert run.commands("tour") == ["tour started", "tour ended"]
 

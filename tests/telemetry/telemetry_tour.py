@@ -63,7 +63,7 @@ async def _run_tour(path: Path) -> Recorded:
     tree = load_tree(site=site)
     telemetry = Telemetry.open(f"save:{path}", site, tree)
     rehearsal = Rehearsal(fast(), site=site, tree=tree,
-                          prepare=lambda executive: telemetry.attach(executive.core))
+                          prepare=lambda executive: telemetry.attach(executive))
     try:
         async with rehearsal:
             outcome = await rehearsal.finish(60.0)

@@ -9,6 +9,7 @@ import pytest
 from bench import Bench, write_tree
 
 from frog_bt.frontend.messages import FrontendIdle
+from frog_bt.kernel.outcomes import IncidentKind, Level
 from frog_bt.telemetry import Telemetry
 from frog_bt.telemetry.layout import TreeIndex
 from frog_bt.telemetry.rows import Rows
@@ -55,7 +56,7 @@ def test_rows_belong_to_the_tick_that_consumes_or_produces_them(bench: Bench):
     assert rows.batch.events == [(3, t0 + 0.1, "frontend_idle", FrontendIdle())]
     [(tick, t, side, topic, _)] = rows.batch.outputs
     assert (tick, t, side, topic) == (3, t3, "ros", bench.site.topic("goto"))
-    assert rows.batch.notes == [(3, t3, "go to POI0")]
+    assert rows.batch.notes == [(3, t3, "go to POI0", Level.INFO)]
     bench.ros("response", 2)
     assert rows.batch.inputs[-1][:3] == (4, t3, "response")
     batch = rows.drain()
@@ -74,7 +75,20 @@ def test_notes_are_taken_once_even_when_the_list_is_trimmed(bench: Bench):
     ctx.note("g")
     bench.tick()
     # "b" was trimmed before any tick saw it; nothing is taken twice
-    assert [text for _, _, text in rows.batch.notes] == ["a", "c", "d", "e", "f", "g"]
+    assert [note[2] for note in rows.batch.notes] == ["a", "c", "d", "e", "f", "g"]
+
+
+def test_a_notes_level_comes_from_its_incident_kind_not_its_words(bench: Bench):
+    rows = rows_on(bench)
+    journal = bench.core.journal
+    journal.note("the visitor's umbrella failed to open")  # words of failure, no incident
+    journal.note("approach of visitor 7 timed out", IncidentKind.APPROACH_FAILED)
+    journal.note("resuming the tour at POI2", IncidentKind.RESUMED)
+    journal.note("giving up: undock failed", IncidentKind.GAVE_UP)
+    bench.tick()
+    assert [(note[2][:9], note[3]) for note in rows.batch.notes] == [
+        ("the visit", Level.INFO), ("approach ", Level.WARN), ("resuming ", Level.INFO),
+        ("giving up", Level.ERROR)]
 
 
 def test_rows_ask_to_be_written_every_batch_ticks_and_stop_after_detach(bench: Bench):
@@ -97,7 +111,7 @@ def test_telemetry_over_a_core_ticked_by_hand(bench: Bench, tmp_path: Path):
 
     path = tmp_path / "hand.rrd"
     telemetry = Telemetry.open(f"save:{path}", bench.site, bench.core.tree)
-    telemetry.attach(bench.core)
+    telemetry.attach(bench)
     bench.pose(104.0, 32.0)
     bench.tick(2)
     bench.event(FrontendIdle())
