@@ -190,6 +190,32 @@ class OperatorCfg(_Model):
     pause_max: Positive = 300.0  # seconds an operator's pause may last; then the tour ends
 
 
+class AlertsCfg(_Model):
+    battery_below: Annotated[float, Field(ge=0, le=100)] = 25.0  # percent: ask for help below
+    rosbridge_down_after: Positive = 60.0  # seconds without the robot before an alert
+    frontend_silent_after: Positive = 60.0  # seconds of a silent front end before an alert
+    no_visitor_after: Positive = 900.0  # seconds of searching for a visitor before an alert
+    webhooks: list[str] = []  # http(s) URLs: each alert change is POSTed there as JSON
+    webhook_timeout: Positive = 5.0  # seconds one POST may take
+    webhook_attempts: Annotated[int, Field(ge=1, le=20)] = 5  # tries per alert and URL
+    webhook_backoff: Positive = 1.0  # seconds before the 2nd try, doubling after each
+
+    @field_validator("webhooks")
+    @classmethod
+    def _urls(cls, urls: list[str]) -> list[str]:
+        for url in urls:
+            parts = urlsplit(url)
+            if parts.scheme not in ("http", "https") or not parts.hostname:
+                raise ValueError(f"expected an http:// or https:// URL, got {url!r}")
+        return urls
+
+
+class ConsoleCfg(_Model):
+    commands_per_second: Positive = 2.0  # more from all clients together: 429
+    max_body: Annotated[int, Field(ge=64, le=1_000_000)] = 4096  # bytes of a request body
+    push_every: Positive = 0.3  # seconds between pushed states (at once on a new phase)
+
+
 class Recording(_Model):
     max_bytes: Annotated[int, Field(gt=0)] = 20_000_000_000  # --record DIR: disk budget
 
@@ -239,6 +265,8 @@ class Site(_Model):
     checkpoint: Checkpoint = Checkpoint()
     recording: Recording = Recording()
     operator: OperatorCfg = OperatorCfg()
+    alerts: AlertsCfg = AlertsCfg()
+    console: ConsoleCfg = ConsoleCfg()
     topics: dict[Literal[tuple(INPUTS) + tuple(OUTPUTS)], str] = {}  # type: ignore[valid-type]
 
     @model_validator(mode="after")

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import time
-
 from frog_bt.observers.status import link_line
 from frog_bt.rosbridge.link import LinkState
 
@@ -11,8 +9,8 @@ from frog_bt.rosbridge.link import LinkState
 def test_unreachable_rosbridge_is_named_with_attempt_delay_and_plain_reason():
     down = LinkState(connected=False, since=0.0, last_error="ConnectionRefusedError: [Errno 111] "
                      "Connect call failed ('127.0.0.1', 9090)", attempt=4,
-                     retry_at=time.monotonic() + 2.04)
-    line = link_line("ws://frog:9090", down)
+                     retry_at=100.0 + 2.04)
+    line = link_line("ws://frog:9090", down, now=100.0)  # the countdown's clock, given
     assert line == ("rosbridge: connecting to ws://frog:9090 (attempt 4, next in 2.0 s): "
                     "connection refused")
 

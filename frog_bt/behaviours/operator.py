@@ -24,7 +24,7 @@ class OperatorSkip(FrogDecorator):
 
     Reads ``/skip`` (optional: the operator's skip requests this tour). When the count
     grows while the child runs, the child is stopped (content ends, navigation is
-    cancelled, scopes switch off) and this returns SUCCESS, noting a ``stop skipped``
+    cancelled, scopes switch off) and this returns SUCCESS, noting a ``stop left``
     incident; otherwise it returns the child's status.
     """
 
@@ -49,7 +49,7 @@ class OperatorSkip(FrogDecorator):
     def update(self) -> Status:
         if self._requested:
             self.ctx.note(f"skipped {self.params.poi}: the operator asked",
-                          incident=IncidentKind.STOP_SKIPPED, subject=self.params.poi)
+                          incident=IncidentKind.STOP_LEFT, subject=self.params.poi)
             return SUCCESS
         return self.decorated.status
 

@@ -60,7 +60,8 @@ class VisitorFollows(Leaf):
             return SUCCESS
         if now - self.started >= self.grace:
             if not fresh:
-                self.ctx.note("laser tracking or pose stale: assuming the visitor follows")
+                self.ctx.note("laser tracking or pose stale: assuming the visitor follows",
+                              incident=IncidentKind.STALE_INPUT)
                 return SUCCESS
             self.ctx.note(f"nobody within {self.radius:g} m for {self.grace:g} s: "
                           "visitor lost, back to recruit", incident=IncidentKind.VISITOR_LOST)

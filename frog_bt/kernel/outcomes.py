@@ -34,7 +34,8 @@ class IncidentKind(enum.StrEnum):
 
     DOCKING_FAILED = "docking failed"
     NAVIGATION_FAILED = "navigation failed"
-    STOP_SKIPPED = "stop skipped"
+    STOP_SKIPPED = "stop skipped"  # navigation kept failing: the robot gave the stop up
+    STOP_LEFT = "stop left"  # an operator asked to skip it
     APPROACH_FAILED = "approach failed"
     VISITOR_DECLINED = "visitor declined"
     VISITOR_LOST = "visitor lost"
@@ -46,6 +47,7 @@ class IncidentKind(enum.StrEnum):
     RESUMED = "resumed"
     MISSING_VALUE = "missing value"
     LINK_LOST = "link lost"
+    STALE_INPUT = "stale input"  # decided without fresh data (benefit of the doubt)
     OPERATOR = "operator"  # an operator command changed the tour
 
     @property
@@ -54,6 +56,7 @@ class IncidentKind(enum.StrEnum):
 
 
 _LEVELS = {IncidentKind.RESUMED: Level.INFO, IncidentKind.OPERATOR: Level.INFO,
+           IncidentKind.STOP_LEFT: Level.INFO,
            IncidentKind.GAVE_UP: Level.ERROR}
 
 

@@ -14,12 +14,13 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Callable
-from typing import Any, TextIO
+from typing import TextIO
 
 import py_trees
 
 from frog_bt.kernel import keys
 from frog_bt.observers import Host
+from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.core import Core
 
 
@@ -39,12 +40,15 @@ def phase(core: Core) -> str:
         node = child
 
 
-def link_line(url: str, link: Any, clock_ready: bool = True) -> str | None:
-    """What the rosbridge link is doing, while it keeps the tree from running; else None."""
+def link_line(url: str, link: LinkState, clock_ready: bool = True,
+              now: float | None = None) -> str | None:
+    """What the rosbridge link is doing, while it keeps the tree from running; else None.
+    ``now``: the monotonic time the countdown is counted from (default: now)."""
     if link.connected:
         return None if clock_ready else f"rosbridge: connected to {url}, waiting for /clock"
-    attempt = getattr(link, "attempt", 0)
-    retry_in = getattr(link, "retry_in", None)
+    attempt = link.attempt
+    now = time.monotonic() if now is None else now
+    retry_in = None if link.retry_at is None else max(0.0, link.retry_at - now)
     detail = ", ".join(part for part in (
         f"attempt {attempt}" if attempt else "",
         f"next in {retry_in:.1f} s" if retry_in is not None else "") if part)

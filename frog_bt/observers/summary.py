@@ -86,7 +86,7 @@ class TourSummary:
         if journal.incident_total != self._seen_incidents:
             for incident in journal.incidents[self._seen_incidents - journal.incident_total:]:
                 self.incidents.append(incident)
-                if incident.kind is IncidentKind.STOP_SKIPPED:
+                if incident.kind in (IncidentKind.STOP_SKIPPED, IncidentKind.STOP_LEFT):
                     self.skipped.append(incident.subject)
             self._seen_incidents = journal.incident_total
         resumed = board.get(keys.RESUMED)
@@ -135,7 +135,7 @@ class TourSummary:
         ]
         if self.resumed:
             out.append(f"resumed:   {self.resumed}")
-        counts = Counter(i.kind for i in self.incidents if i.kind != "resumed")
+        counts = Counter(i.kind for i in self.incidents if i.kind is not IncidentKind.RESUMED)
         if frontend is not None and frontend.peer_restarts:
             counts["front end restarted"] = frontend.peer_restarts
         if frontend is not None and frontend.unacked:

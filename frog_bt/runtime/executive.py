@@ -35,6 +35,7 @@ from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
 from frog_bt.runtime.core import Core
+from frog_bt.runtime.staff import Staff
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.warning_limit import WarningLimiter
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
@@ -42,6 +43,7 @@ from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
 FRONTEND_DRAIN = 1.2  # wall seconds for the last commands' acks (of a 2 s shutdown budget)
+ROSBRIDGE_FLUSH = 0.5  # wall seconds for the last frames to the robot (of the same budget)
 
 
 @dataclass(slots=True)
@@ -100,6 +102,8 @@ class Executive:
         self.was_connected = False  # to rosbridge, at some point: a loss is a reconnect
         self._link_states = states(self)
         self.swaps = 0
+        self.staff = Staff(self)  # operator commands and alerts
+        self._seekers = self._find_seekers()
 
     # ------------------------------------------------------------ I/O callbacks (cache only)
 
@@ -134,6 +138,18 @@ class Executive:
         self.check_links()
         self._wake.set()
 
+    def wake(self) -> None:
+        """Tick soon (a queued operator command waits for the next tick)."""
+        self._wake.set()
+
+    def _find_seekers(self) -> list[py_trees.behaviour.Behaviour]:
+        return [n for n in self.core.root.iterate() if type(n).__name__ == "SeekVisitor"]
+
+    @property
+    def seekers(self) -> list[py_trees.behaviour.Behaviour]:
+        """The tree's searches for a visitor (an alert when one runs too long)."""
+        return self._seekers
+
     @property
     def links(self) -> Links:
         """Each link's state as of the latest check."""
@@ -146,6 +162,7 @@ class Executive:
             self._link_states = now_states
             links = self.links
             now = self.clock.now() if self.clock.ready else 0.0
+            self.staff.links_changed(now)
             for tap in self.wire.links:
                 tap(now, links)
 
@@ -183,9 +200,12 @@ class Executive:
         return self.outcome
 
     def status_text(self) -> str:
-        """The live status: the rosbridge link while it keeps the tree waiting, else the tree."""
-        return (link_line(self.client.url, self.client.link, self.clock.ready)
+        """The live status: the rosbridge link while it keeps the tree waiting, else the tree;
+        then the alerts not yet acknowledged."""
+        line = (link_line(self.client.url, self.client.link, self.clock.ready)
                 or f"{status_line(self.core)} | {self.links.text()}")
+        alerts = [a.kind for a in self.staff.book.shown() if a.state == "raised"]
+        return line + (f" | ALERT: {', '.join(alerts)}" if alerts else "")
 
     async def _until_stopped(self, awaitable: Any) -> bool:
         """Await ``awaitable`` unless stop() comes first; True when it completed."""
@@ -251,6 +271,7 @@ class Executive:
             core.board.set(key, old.board.get(key))  # the executive's view of the tours
         core.setup()
         self.core, self.site, self.swaps = core, site, self.swaps + 1
+        self._seekers = self._find_seekers()
         nodes = sum(1 for _ in tree.nodes())
         log.warning("tree reloaded at an idle point: %s (%d nodes)", tree.file, nodes)
         core.ctx.note(f"tree reloaded: {tree.file}")
@@ -263,7 +284,9 @@ class Executive:
         if restarts != self._peer_restarts:
             self._peer_restarts = restarts
             self.core.ctx.note("front end restarted", incident=IncidentKind.FRONTEND_RESTARTED)
+        self.staff.before_tick()
         status = self.core.tick()
+        self.staff.after_tick()
         progress = self.core.board.get(keys.PROGRESS) or EMPTY
         if self.checkpoint is not None and progress != self._saved:
             self._saved = progress
@@ -305,7 +328,7 @@ class Executive:
                 self.client.unsubscribe(topic)
             for topic in list(self.client.session.advertised):
                 self.client.unadvertise(topic)
-        await self.client.flush(0.5)
+        await self.client.flush(ROSBRIDGE_FLUSH)
         await self.client.close()
         self.link.close()
         await self.link.wait_closed()

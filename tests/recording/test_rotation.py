@@ -152,11 +152,16 @@ def test_a_killed_writers_file_is_recovered_by_replay_and_numbering_goes_on(
                 return goals[0] >= 4
 
             await sim.wait_for(fourth_goal, timeout=60)
-            for _ in range(200):
+            # The file system cannot be waited on: poll it, bounded, and fail loudly when
+            # the tour file never grows past its first flushed chunks.
+            deadline = asyncio.get_running_loop().time() + 60.0
+            while True:
                 tours = [p for _, p in numbered(day) if "-tour" in p.name]
                 if tours and tours[-1].stat().st_size > 50_000:
                     break
-                await asyncio.sleep(0.05)  # polling the file system, bounded: 10 s
+                assert asyncio.get_running_loop().time() < deadline, (
+                    f"no tour file past 50 kB within 60 s: {[p.name for p in tours]}")
+                await asyncio.sleep(0.05)
             os.kill(proc.pid, signal.SIGKILL)
             await proc.wait()
         finally:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import socket
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -64,6 +65,23 @@ def test_importing_telemetry_does_not_import_rerun():
     assert result.returncode == 0, result.stdout + result.stderr
 
 
+def listening(port: int) -> set[str]:
+    """The local addresses (hex, as the kernel lists them) listening on TCP ``port``."""
+    found = set()
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        try:
+            lines = Path(table).read_text().splitlines()[1:]
+        except OSError:
+            continue
+        for line in lines:
+            local, state = line.split()[1], line.split()[3]
+            address, hex_port = local.rsplit(":", 1)
+            if state == "0A" and int(hex_port, 16) == port:  # 0A: LISTEN
+                found.add(address)
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="needs Linux's /proc/net/tcp")
 def test_serve_listens_on_loopback_only():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -73,6 +91,9 @@ def test_serve_listens_on_loopback_only():
     try:
         with socket.create_connection(("127.0.0.1", port), timeout=5):
             pass
+        # The kernel's own table: bound to 127.0.0.1 (0100007F), not to every address
+        # (00000000 or ::) — checked without sending anything anywhere else.
+        assert listening(port) == {"0100007F"}
     finally:
         telemetry.close()
         telemetry.close()  # idempotent

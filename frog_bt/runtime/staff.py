@@ -1,0 +1,147 @@
+"""The executive's side of the people around the robot: operator commands and alerts.
+
+Commands from the console or ``frog-bt ctl`` are queued (:meth:`Staff.submit`, from any
+task) and applied at the next tick boundary (:meth:`Staff.before_tick`): tree commands
+through :meth:`~frog_bt.runtime.core.Core.command` (recorded, replayed), ``ack_alert`` to
+the alert book. A command the executive cannot apply within ``APPLY_WITHIN`` seconds
+(the tree does not tick while rosbridge is unreachable) is refused and changes nothing.
+
+After each tick (:meth:`Staff.after_tick`) the alert conditions are checked against what
+the executive knows now (:class:`~frog_bt.console.alerts.Facts`).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from frog_bt.console.alerts import AlertBook, Facts
+from frog_bt.kernel import keys
+from frog_bt.kernel.outcomes import IncidentKind, TourState
+from frog_bt.observers.links import LinkStatus
+from frog_bt.runtime.operator import Answer, Command
+
+if TYPE_CHECKING:
+    from frog_bt.runtime.executive import Executive
+
+log = logging.getLogger(__name__)
+APPLY_WITHIN = 5.0  # wall seconds a queued command waits for a tick before it is refused
+
+
+@dataclass(slots=True)
+class Queued:
+    command: Command
+    alert_id: str
+    answer: asyncio.Future[Answer]
+
+
+@dataclass
+class Staff:
+    executive: Executive
+    book: AlertBook = field(init=False)
+    link_since: dict[str, tuple[LinkStatus, float]] = field(default_factory=dict)
+    _queue: list[Queued] = field(default_factory=list)
+    _seeking_since: float | None = None
+    _given_up: list[str] = field(default_factory=list)  # stops given up this tour
+    _incidents_seen: int = 0
+    _pause_ran_out: bool = False
+    _touring: bool = False
+
+    def __post_init__(self) -> None:
+        self.book = AlertBook(self.executive.site.alerts)
+
+    # ------------------------------------------------------------ commands
+
+    async def submit(self, command: Command, alert_id: str = "") -> Answer:
+        """Queue ``command``; its answer once applied at the next tick (or refused)."""
+        answer: asyncio.Future[Answer] = asyncio.get_running_loop().create_future()
+        queued = Queued(command, alert_id, answer)
+        self._queue.append(queued)
+        self.executive.wake()
+        try:
+            return await asyncio.wait_for(asyncio.shield(answer), APPLY_WITHIN)
+        except TimeoutError:
+            if queued in self._queue:
+                self._queue.remove(queued)
+                return Answer(False, "the executive is not ticking now (is the robot "
+                                     "reachable?): nothing was changed")
+            return await answer  # applied meanwhile
+
+    def before_tick(self) -> None:
+        """Apply what was queued, in order, between two ticks."""
+        queue, self._queue = self._queue, []
+        core = self.executive.core
+        for queued in queue:
+            if queued.command is Command.ACK_ALERT:
+                ack = self.book.acknowledge(queued.alert_id, core.clock.now())
+                answer = (Answer(True, f"alert {ack.id} acknowledged") if ack is not None
+                          else Answer(False, f"no alert {queued.alert_id!r} to acknowledge"))
+                core.journal.note(f"operator: ack_alert {queued.alert_id}: {answer.text}")
+            else:
+                answer = core.command(queued.command)
+            log.info("operator %s: %s%s", queued.command, "" if answer.ok else "refused: ",
+                     answer.text)
+            if not queued.answer.done():
+                queued.answer.set_result(answer)
+
+    # ------------------------------------------------------------ links and alerts
+
+    def links_changed(self, now: float) -> None:
+        """Note when each link entered its state (the console shows for how long)."""
+        for name, state in self.executive.links.items():
+            seen = self.link_since.get(name)
+            if seen is None or seen[0] is not state:
+                self.link_since[name] = (state, now)
+
+    def after_tick(self) -> None:
+        self.check(self.executive.core.clock.now())
+
+    def check(self, now: float) -> None:
+        """Raise or clear alerts from what the executive knows now (also between ticks:
+        a robot out of reach does not tick)."""
+        self.links_changed(now)
+        self.book.update(self.facts(now))
+
+    def facts(self, now: float) -> Facts:
+        exe = self.executive
+        core = exe.core
+        board = core.board
+        touring = board.get(keys.TOUR_STATE) is TourState.STARTED
+        if touring and not self._touring:  # a new tour: its one-offs start afresh
+            self._given_up.clear()
+            self._pause_ran_out = False
+        self._touring = touring
+        journal = core.journal
+        if journal.incident_total != self._incidents_seen:
+            new = journal.incidents[self._incidents_seen - journal.incident_total:]
+            self._given_up += [i.subject for i in new if i.kind is IncidentKind.STOP_SKIPPED]
+            self._incidents_seen = journal.incident_total
+        if core.pause_ran_out is not None:
+            self._pause_ran_out = True
+        seeking = any(n.status.name == "RUNNING" for n in exe.seekers)
+        if seeking and self._seeking_since is None:
+            self._seeking_since = now
+        elif not seeking:
+            self._seeking_since = None
+        site = exe.site
+        diagnostics = board.get(keys.DIAGNOSTICS)
+        fresh = (diagnostics.value if diagnostics is not None
+                 and diagnostics.age(now) <= site.safety.diagnostics_max_age else None)
+        gave_up = board.get(keys.GAVE_UP)
+        rosbridge = self.link_since.get("rosbridge")
+        frontend = self.link_since.get("frontend")
+        return Facts(
+            now=now,
+            battery=fresh.battery if fresh is not None else None,
+            faults=tuple(fresh.faults) if fresh is not None else (),
+            rosbridge_down_since=(rosbridge[1] if rosbridge is not None
+                                  and rosbridge[0] is not LinkStatus.CONNECTED else None),
+            frontend_silent_since=(frontend[1] if frontend is not None
+                                   and frontend[0] is LinkStatus.SILENT else None),
+            seeking_since=self._seeking_since,
+            gave_up=gave_up.text if gave_up is not None else "",
+            docking_gave_up=gave_up is not None and gave_up.kind is IncidentKind.DOCKING_FAILED,
+            stops_given_up=tuple(self._given_up),  # one-offs: until the next tour starts
+            pause_ran_out=self._pause_ran_out)
