@@ -21,6 +21,7 @@ COMMANDS = {
     "schema": ("frog_bt.commands.schema", "print the JSON Schema of tree files or the site"),
     "replay": ("frog_bt.commands.replay", "re-run a recorded tour offline"),
     "init": ("frog_bt.commands.init", "write an editable copy of the tour and the site config"),
+    "ctl": ("frog_bt.commands.ctl", "send an operator command to a running console"),
 }
 
 

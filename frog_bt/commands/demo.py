@@ -19,9 +19,14 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from frog_bt.commands.console_options import (
+    add_console_arguments,
+    console_settings,
+    start_people,
+)
 from frog_bt.commands.options import add_tree_and_config
 from frog_bt.config import Site, load_site
-from frog_bt.errors import DefinitionError, error_lines
+from frog_bt.errors import DefinitionError, UsageError, error_lines
 from frog_bt.tree.loader import LoadedTree, load_tree
 
 if TYPE_CHECKING:
@@ -40,6 +45,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--rerun", default="save:frog-demo.rrd", metavar="SPEC",
                    help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve | off "
                    "(default: save:frog-demo.rrd)")
+    add_console_arguments(p)
     p.add_argument("--quiet", action="store_true", help="no live status line")
 
 
@@ -51,7 +57,8 @@ def run(args: argparse.Namespace) -> int:
         site = load_site(args.config)
         tree = load_tree(args.tree, site)
         scenario = load_scenario(args.scenario)
-    except DefinitionError as exc:
+        console_settings(args)
+    except (DefinitionError, UsageError) as exc:
         for line in error_lines(exc):
             print(f"frog-bt: {line}", file=sys.stderr)
         return 2
@@ -81,8 +88,16 @@ async def _demo(site: Site, tree: LoadedTree, scenario: Scenario,
     wall0 = time.monotonic()
     rehearsal = Rehearsal(scenario, site=site, tree=tree, prepare=prepare)
     sim0 = rehearsal.sim.clock.now()
+    people = None
     try:
         async with rehearsal:
+            try:
+                people = await start_people(rehearsal.executive, console_settings(args),
+                                            observers)
+            except UsageError as exc:
+                print(f"frog-bt: {exc}", file=sys.stderr)
+                rehearsal.executive.stop(str(exc), 2)
+                return 2
             try:
                 outcome = await rehearsal.finish(args.timeout)
             except TimeoutError:
@@ -90,6 +105,8 @@ async def _demo(site: Site, tree: LoadedTree, scenario: Scenario,
                 outcome.code, outcome.reason = 1, (f"no docked finish within {args.timeout:g} s "
                                                    "of wall time")
     finally:
+        if people is not None:
+            await people.close()
         close_all(observers)
     clock = rehearsal.executive.clock
     wall, simulated = time.monotonic() - wall0, rehearsal.sim.clock.now() - sim0

@@ -23,6 +23,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from frog_bt import __version__
+from frog_bt.commands.console_options import (
+    ConsoleSettings,
+    add_console_arguments,
+    console_settings,
+    start_people,
+)
 from frog_bt.commands.options import add_tree_and_config, read_secret, rerun_spec, writable_file
 from frog_bt.config import DEFAULT_CONFIG, Site, check_ws_url, load_site, parse_hostport
 from frog_bt.errors import FrogError, UsageError, error_lines
@@ -66,6 +72,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="re-check the tree and config files when they change; a valid change "
                    "takes over when the robot is docked and idle, a bad one is reported and "
                    "the running tree stays")
+    add_console_arguments(p)
     p.add_argument("--quiet", action="store_true", help="no live status line")
     p.add_argument("-v", "--verbose", action="store_true", help="log at debug level")
 
@@ -172,6 +179,7 @@ def run(args: argparse.Namespace) -> int:
         if args.watch and settings.rerun:
             raise UsageError("--watch", "", "cannot be combined with --rerun (the viewer's "
                              "tree layout is fixed when it starts)")
+        console = console_settings(args)
         lock = claim_checkpoint(settings.checkpoint) if settings.checkpoint else None
     except FrogError as exc:
         for line in error_lines(exc):
@@ -179,17 +187,21 @@ def run(args: argparse.Namespace) -> int:
         return 2
     print("\n".join(banner(args, settings)), flush=True)
     try:
-        return asyncio.run(_main(args, site, tree, settings))
+        return asyncio.run(_main(args, site, tree, settings, console))
     except AddressError as exc:  # the listen port is taken, the front end's host unknown
         option = "--listen" if exc.which == "listen" else "--frontend"
         print(f"frog-bt: {option} {exc}", file=sys.stderr)
+        return 2
+    except UsageError as exc:  # the console's port is taken
+        print(f"frog-bt: {exc}", file=sys.stderr)
         return 2
     finally:
         if lock is not None:
             lock.close()
 
 
-async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Settings) -> int:
+async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Settings,
+                console: ConsoleSettings | None = None) -> int:
     from frog_bt.runtime.executive import Executive
     from frog_bt.runtime.memory import pin_malloc_thresholds
 
@@ -216,6 +228,11 @@ async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Setti
         # the line must still say what the executive is waiting for.
         refresher = asyncio.create_task(_refresh(status))
     observers = attach_observers(executive, record=settings.record, rerun=settings.rerun)
+    try:
+        people = await start_people(executive, console, observers)
+    except UsageError:
+        close_all(observers)
+        raise
     watcher = None
     if args.watch:
         from frog_bt.runtime.watch import Watch
@@ -229,6 +246,7 @@ async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Setti
             watcher.cancel()
         if refresher is not None:
             refresher.cancel()
+        await people.close()
         close_all(observers)
         if status is not None:
             status.close()

@@ -141,12 +141,14 @@ class Console:
     # ------------------------------------------------------------ guard
 
     def _authorised(self, request: web.Request) -> bool:
+        """The bearer token, compared in constant time (a page's reads, whose WebSocket
+        cannot send a header, may give it as ``?token=`` instead)."""
         if self.token is None:
             return False
-        given = request.headers.get("Authorization", "")
-        scheme, _, value = given.partition(" ")
-        return scheme.lower() == "bearer" and hmac.compare_digest(
-            value.strip().encode(), self.token.encode())
+        scheme, _, value = request.headers.get("Authorization", "").partition(" ")
+        if scheme.lower() != "bearer" and request.method == "GET":
+            value = request.query.get("token", "")
+        return hmac.compare_digest(value.strip().encode(), self.token.encode())
 
     @web.middleware
     async def _guard(self, request: web.Request, handler: Handler) -> web.StreamResponse:

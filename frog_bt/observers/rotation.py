@@ -38,6 +38,7 @@ from typing import Any
 
 import py_trees
 
+from frog_bt.channels import Alert
 from frog_bt.kernel import keys
 from frog_bt.kernel.clock import SITE_TZ
 from frog_bt.kernel.outcomes import TourState
@@ -99,6 +100,11 @@ class RecordingDir:
         self.files.append(path)
         self.recorder.attach(host)
         host.taps.tick.append(self.on_tick)  # after the recorder's: the tick is in
+
+    def on_alert(self, t: float, alert: Alert) -> None:
+        """An alert change, into the file being written now."""
+        if self.recorder is not None:
+            self.recorder.on_alert(t, alert)
 
     def on_tick(self, core: Any) -> None:
         """Between ticks: a tour started, or the tree's run ended."""

@@ -89,7 +89,10 @@ class Staff:
     # ------------------------------------------------------------ links and alerts
 
     def links_changed(self, now: float) -> None:
-        """Note when each link entered its state (the console shows for how long)."""
+        """Note when each link entered its state (the console shows for how long); on the
+        project clock, so not before it has a time."""
+        if not self.executive.clock.ready:
+            return
         for name, state in self.executive.links.items():
             seen = self.link_since.get(name)
             if seen is None or seen[0] is not state:

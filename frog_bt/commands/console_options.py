@@ -1,0 +1,110 @@
+"""``--console HOST:PORT`` and ``--console-token-file FILE`` (run and demo, CONTRACT §5):
+checked up front, and the console started and stopped around the executive."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from frog_bt.config import parse_hostport
+from frog_bt.errors import UsageError
+
+if TYPE_CHECKING:
+    from frog_bt.console.server import Console
+    from frog_bt.console.webhooks import Webhooks
+    from frog_bt.runtime.executive import Executive
+
+DEFAULT_HOST = "127.0.0.1"
+
+
+def add_console_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--console", metavar="HOST:PORT",
+                   help="serve the operator's console (HTTP; PORT alone: on 127.0.0.1)")
+    p.add_argument("--console-token-file", metavar="FILE", type=Path,
+                   help="the staff token for commands (required off loopback)")
+
+
+@dataclass(frozen=True, slots=True)
+class ConsoleSettings:
+    host: str
+    port: int
+    token: str | None
+
+
+def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
+    """The console's address and token, checked: UsageError (one line) for a bad address, a
+    token file that cannot be read or is empty, or a non-loopback address without one."""
+    if not args.console:
+        if args.console_token_file is not None:
+            raise UsageError("--console-token-file", args.console_token_file,
+                             "given without --console")
+        return None
+    from frog_bt.console.server import is_loopback
+
+    text = str(args.console)
+    if text.isdigit() or text.startswith(":"):
+        text = f"{DEFAULT_HOST}:{text.lstrip(':')}"
+    host, port = parse_hostport(text, "--console")
+    token = None
+    if args.console_token_file is not None:
+        path = args.console_token_file
+        try:
+            token = path.read_text(encoding="utf-8").strip()
+        except (OSError, UnicodeDecodeError) as exc:
+            raise UsageError("--console-token-file", path,
+                             f"cannot read it: {getattr(exc, 'strerror', None) or exc}") from None
+        if len(token) < 8:
+            raise UsageError("--console-token-file", path,
+                             "expected a token of at least 8 characters")
+    if token is None and not is_loopback(host):
+        raise UsageError("--console", args.console, f"{host} is not loopback: anyone on the "
+                         "network could steer the robot; give --console-token-file")
+    return ConsoleSettings(host, port, token)
+
+
+async def start_console(executive: Executive, settings: ConsoleSettings) -> Console:
+    """The console for ``executive``, listening; UsageError when the port cannot be bound."""
+    from frog_bt.console.server import Console
+
+    console = Console(executive, settings.host, settings.port, settings.token)
+    console.attach()
+    try:
+        await console.start()
+    except OSError as exc:
+        await console.close()
+        raise UsageError("--console", f"{settings.host}:{settings.port}",
+                         f"cannot listen there: {exc.strerror or exc}") from None
+    return console
+
+
+@dataclass
+class People:
+    """What is started for the people around the robot: the console (if asked for) and
+    the webhooks, with the alerts told to them and to the recorders."""
+
+    console: Console | None
+    webhooks: Webhooks
+
+    async def close(self) -> None:
+        if self.console is not None:
+            await self.console.close()
+        await self.webhooks.close(1.0)
+
+
+async def start_people(executive: Executive, settings: ConsoleSettings | None,
+                       observers: Sequence[object]) -> People:
+    from frog_bt.console.webhooks import Webhooks
+
+    book = executive.staff.book
+    webhooks = Webhooks(executive.site.alerts)
+    book.listeners.append(webhooks.notify)
+    webhooks.start()
+    for observer in observers:  # the recording: every alert change, on /frog_bt/alert
+        on_alert = getattr(observer, "on_alert", None)
+        if on_alert is not None:
+            book.listeners.append(on_alert)
+    console = await start_console(executive, settings) if settings is not None else None
+    return People(console, webhooks)

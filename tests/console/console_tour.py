@@ -1,0 +1,39 @@
+"""A simulated tour with its console on 127.0.0.1 (a free port), for the console's tests."""
+
+from __future__ import annotations
+
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
+from typing import Any
+
+import aiohttp
+from tour import Running
+
+from frog_bt.commands.console_options import ConsoleSettings, People, start_people
+
+TOKEN = "staff-token-0123"
+
+
+@asynccontextmanager
+async def console_tour(scenario: dict[str, Any] | None = None, *, token: str | None = TOKEN,
+                       once: bool = True, **kwargs: Any
+                       ) -> AsyncIterator[tuple[Running, People, str]]:
+    """The rehearsal, what was started for the people around it, and the console's URL."""
+    async with Running(scenario or {}, once=once, **kwargs) as run:
+        people = await start_people(run.executive, ConsoleSettings("127.0.0.1", 0, token), [])
+        try:
+            assert people.console is not None
+            yield run, people, f"http://127.0.0.1:{people.console.bound_port}"
+        finally:
+            await people.close()
+
+
+def auth(token: str = TOKEN) -> dict[str, str]:
+    return {"Authorization": f"Bearer {token}"}
+
+
+async def command(session: aiohttp.ClientSession, url: str, body: Any,
+                  headers: dict[str, str] | None = None) -> tuple[int, dict[str, Any]]:
+    async with session.post(f"{url}/api/command", json=body,
+                            headers=auth() if headers is None else headers) as r:
+        return r.status, await r.json()
