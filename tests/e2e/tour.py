@@ -8,6 +8,7 @@ front end with its own clock's times.
 from __future__ import annotations
 
 import asyncio
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -89,6 +90,25 @@ class Running(Rehearsal):
     def tour(self) -> Tour:
         return Tour(self.sim, self.executive, self.executive.outcome, self.summary, self.site,
                     self.sent, self.published)
+
+    async def executive_ticks_until(self, condition: Callable[[], bool], wall: float = 60.0
+                                    ) -> None:
+        """Wait, tick by tick (a tap on the executive's ticks, no polling), until
+        ``condition()`` holds; ``wall`` seconds only catch a hang."""
+        if condition():
+            return
+        held = asyncio.Event()
+
+        def check(_core: object) -> None:
+            if condition():
+                held.set()
+
+        taps = self.executive.taps.tick
+        taps.append(check)
+        try:
+            await asyncio.wait_for(held.wait(), wall)
+        finally:
+            taps.remove(check)
 
     def published_at(self, topic: str) -> list[float]:
         """When (by the executive's clock) the executive published on ``topic``."""

@@ -1,0 +1,79 @@
+"""The console in a real browser: Debian's Chromium, headless, driven by Selenium with
+Debian's chromium-driver. It opens the console of a running simulated tour, sees the stop
+change, presses "Send home" with the token, and the simulated robot docks with
+``tour aborted`` and the reason ``operator``.
+
+Skipped (and saying why) where Chromium is not installed, except in CI (``CI=true``),
+where ``.ci/run`` installs it and the test must run.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import shutil
+
+import pytest
+from console_tour import TOKEN, console_tour
+from test_faults import is_
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+DRIVER = shutil.which("chromedriver")
+if not (CHROMIUM and DRIVER) and os.environ.get("CI") != "true":
+    pytest.skip("Debian's chromium and chromium-driver are not installed "
+                "(apt-get install chromium chromium-driver)", allow_module_level=True)
+
+from selenium import webdriver  # noqa: E402 - only where a browser can run it
+from selenium.webdriver.chrome.service import Service  # noqa: E402
+from selenium.webdriver.common.by import By  # noqa: E402
+from selenium.webdriver.support import expected_conditions  # noqa: E402
+from selenium.webdriver.support.ui import WebDriverWait  # noqa: E402
+
+WAIT = 60.0  # seconds any one thing may take to show in the page (a bound, not a pace)
+
+
+def browser() -> webdriver.Chrome:
+    options = webdriver.ChromeOptions()
+    options.binary_location = CHROMIUM or "chromium"
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                "--window-size=1280,1600", "--no-proxy-server"):
+        options.add_argument(arg)
+    return webdriver.Chrome(service=Service(DRIVER or "chromedriver"), options=options)
+
+
+def drive(url: str) -> tuple[list[str], str]:
+    """In the browser: the stops seen, in order, then Send home; the answer shown."""
+    driver = browser()
+    try:
+        wait = WebDriverWait(driver, WAIT, poll_frequency=0.05)
+        driver.get(url)
+        stop = driver.find_element(By.ID, "stop")
+        wait.until(lambda d: stop.text.startswith("POI1"))
+        seen = [stop.text]
+        wait.until(lambda d: stop.text.startswith("POI2"))  # the stop changes in the page
+        seen.append(stop.text)
+        driver.find_element(By.CSS_SELECTOR, "button[data-command=home]").click()
+        prompt = wait.until(expected_conditions.alert_is_present())
+        prompt.send_keys(TOKEN)
+        prompt.accept()
+        answer = driver.find_element(By.ID, "answer")
+        wait.until(lambda d: answer.text.startswith(("Done", "Not done")))
+        return seen, answer.text
+    finally:
+        driver.quit()
+
+
+def test_send_home_from_the_console_in_chromium() -> None:
+    async def main() -> tuple[list[str], str, str, str, str]:
+        # slow enough for a person (and a browser) to follow: a stop lasts a few seconds
+        async with console_tour({"speed": 20.0}, once=True) as (run, _people, url):
+            seen, answer = await asyncio.to_thread(drive, url)
+            aborted = await run.sim.wait_for(is_("tour", state="aborted"), 60)
+            outcome = await run.finish()
+            return seen, answer, aborted.payload["reason"], outcome.reason, \
+                run.sim.world.docking_state
+
+    seen, answer, reason, outcome, docking = asyncio.run(main())
+    assert seen == ["POI1 (POI1a)", "POI2 (POI2a)"]
+    assert answer == "Done: ending the tour: the robot goes home and docks"
+    assert (reason, outcome, docking) == ("operator", "tour aborted: operator", "docked")
