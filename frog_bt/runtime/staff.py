@@ -81,8 +81,9 @@ class Staff:
                 core.journal.note(f"operator: ack_alert {queued.alert_id}: {answer.text}")
             else:
                 answer = core.command(queued.command)
-            log.info("operator %s: %s%s", queued.command, "" if answer.ok else "refused: ",
-                     answer.text)
+            # a person steered the robot: always in the log (warning level reaches it)
+            log.warning("operator %s: %s%s", queued.command, "" if answer.ok else "refused: ",
+                        answer.text)
             if not queued.answer.done():
                 queued.answer.set_result(answer)
 
