@@ -42,7 +42,11 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
             raise UsageError("--console-token-file", args.console_token_file,
                              "given without --console")
         return None
-    from frog_bt.console.server import is_loopback
+    try:
+        from frog_bt.console.server import is_loopback
+    except ImportError as exc:
+        raise UsageError("--console", args.console, f"needs the console extra ({exc.name} is "
+                         "missing): pip install 'frog-bt[console]'") from None
 
     text = str(args.console)
     if text.isdigit() or text.startswith(":"):
