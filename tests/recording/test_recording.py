@@ -87,17 +87,20 @@ def test_a_recorded_tour_has_every_channel_typed_and_stamped(tour: RecordedTour)
     types |= {FRONTEND_IN: DATAGRAM_TYPE, FRONTEND_OUT: DATAGRAM_TYPE}
     counts: dict[str, int] = {}
     last = 0
+    schemas: dict[str, dict[str, object]] = {}
     for schema, channel, message in messages:
+        if schema.name not in schemas:
+            schemas[schema.name] = schema_for(schema.name)
+        expected = schemas[schema.name]
         counts[channel.topic] = counts.get(channel.topic, 0) + 1
         if channel.topic in types:
             assert schema.name == types[channel.topic], channel.topic
         assert channel.message_encoding == "json" and schema.encoding == "jsonschema"
-        assert json.loads(schema.data) == schema_for(schema.name)
+        assert json.loads(schema.data) == expected
         assert message.publish_time == message.log_time >= last
         last = message.log_time
         assert tour.start <= from_ns(message.log_time) <= tour.end
-        assert conforms(json.loads(message.data), schema_for(schema.name)), (channel.topic,
-                                                                         message.data)
+        assert conforms(json.loads(message.data), expected), (channel.topic, message.data)
     assert set(types) <= set(counts), set(types) - set(counts)  # every channel had traffic
     assert counts[TICK] == tour.executive.core.ticks
 
