@@ -49,6 +49,10 @@ def main(argv: list[str] | None = None) -> int:
                            formatter_class=argparse.RawDescriptionHelpFormatter)
         mod.add_arguments(p)
         args = parser.parse_args(argv)
+        if name != "init":
+            from frog_bt.commands import site_folder
+
+            site_folder.apply(args)
         return int(mod.run(args) or 0)
     build_parser().parse_args(argv)  # prints usage or help and exits
     return 2
