@@ -33,3 +33,44 @@ def test_connected_link_leaves_the_line_to_the_tree_unless_waiting_for_clock():
     assert link_line("ws://frog:9090", up) is None
     assert link_line("ws://frog:9090", up, clock_ready=False) == (
         "rosbridge: connected to ws://frog:9090, waiting for /clock")
+
+
+def test_a_ten_minute_outage_in_a_journal_is_a_few_dozen_lines() -> None:
+    """Not a terminal: the status line prints states, not the countdown. A 10-minute
+    outage (the client's own backoff, redrawn every 0.5 s as frog-bt run does) is driven
+    on a clock the test moves; the lines are counted."""
+    import io
+
+    from frog_bt.observers.status import StatusLine
+    from frog_bt.rosbridge.client import backoff_delays
+
+    out = io.StringIO()
+    t, attempt, retry_at = 0.0, 0, 0.0
+    delays = backoff_delays(0.25, 5.0)
+
+    def source() -> str:
+        link = LinkState(connected=False, since=0.0, attempt=attempt, retry_at=retry_at,
+                         last_error="ConnectionRefusedError: [Errno 111] Connect call failed")
+        return link_line("ws://frog:9090", link, now=t, countdown=False) or ""
+
+    status = StatusLine(out, source=source)
+    assert not status.tty
+    while t < 600.0:
+        if t >= retry_at:  # another attempt failed: the next one after the backoff
+            attempt += 1
+            retry_at = t + next(delays)
+        status.update()
+        t += 0.5
+    lines = out.getvalue().splitlines()
+    assert attempt > 100  # the client kept trying all along
+    assert 5 <= len(lines) <= 36, lines
+    assert lines[-1] == ("rosbridge: connecting to ws://frog:9090 (100+ attempts): "
+                         "connection refused")
+    assert not [line for line in lines if "next in" in line]
+
+
+def test_attempt_counts_grow_in_steps() -> None:
+    from frog_bt.observers.status import milestone
+
+    assert [milestone(n) for n in (0, 1, 2, 3, 4, 5, 9, 10, 19, 20, 49, 50, 99, 100, 201)] == [
+        0, 1, 2, 2, 2, 5, 5, 10, 10, 20, 20, 50, 50, 100, 200]

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import logging
 import os
 import signal
 import sys
@@ -23,6 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from frog_bt import __version__
+from frog_bt.commands import logs
 from frog_bt.commands.console_options import (
     ConsoleSettings,
     add_console_arguments,
@@ -75,6 +75,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_console_arguments(p)
     p.add_argument("--quiet", action="store_true", help="no live status line")
     p.add_argument("-v", "--verbose", action="store_true", help="log at debug level")
+    p.add_argument("--log-format", choices=("text", "json"), default="text",
+                   help="text (levels as syslog prefixes under systemd) or one JSON object "
+                   "per line (default: text)")
 
 
 @dataclass(frozen=True, slots=True)
@@ -170,8 +173,7 @@ def attach_observers(executive: Executive, *, record: Path | None, rerun: str | 
 
 
 def run(args: argparse.Namespace) -> int:
-    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING,
-                        format="%(levelname)s %(name)s: %(message)s")
+    logs.setup(args.verbose, args.log_format)
     try:
         site = load_site(args.config)
         tree = load_tree(args.tree, site)
@@ -220,7 +222,9 @@ async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Setti
     summary = TourSummary(site) if args.once else None
     if summary is not None:
         summary.attach(executive)
-    status = None if args.quiet else StatusLine(source=executive.status_text)
+    status = None
+    if not args.quiet:  # on a terminal a countdown; in a journal, states only
+        status = StatusLine(source=lambda: executive.status_text(countdown=status.tty))
     refresher = None
     if status is not None:
         status.attach(executive)

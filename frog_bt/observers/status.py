@@ -40,17 +40,36 @@ def phase(core: Core) -> str:
         node = child
 
 
+MILESTONES = (1, 2, 5)  # x 10^n: the attempt counts a journal hears of
+
+
+def milestone(attempt: int) -> int:
+    """The last of 1, 2, 5, 10, 20, 50, 100, ... at or below ``attempt`` (0 for 0)."""
+    if attempt < 1:
+        return 0
+    scale, last = 1, 1
+    while True:
+        for m in MILESTONES:
+            if m * scale > attempt:
+                return last
+            last = m * scale
+        scale *= 10
+
+
 def link_line(url: str, link: LinkState, clock_ready: bool = True,
-              now: float | None = None) -> str | None:
+              now: float | None = None, countdown: bool = True) -> str | None:
     """What the rosbridge link is doing, while it keeps the tree from running; else None.
-    ``now``: the monotonic time the countdown is counted from (default: now)."""
+    ``now``: the monotonic time the countdown is counted from (default: now). Without
+    ``countdown`` (a journal, not a terminal) the line is a state: no "next in", and the
+    attempt count only at growing steps (1, 2, 5, 10, 20, 50, ...)."""
     if link.connected:
         return None if clock_ready else f"rosbridge: connected to {url}, waiting for /clock"
-    attempt = link.attempt
+    attempt = link.attempt if countdown else milestone(link.attempt)
     now = time.monotonic() if now is None else now
-    retry_in = None if link.retry_at is None else max(0.0, link.retry_at - now)
+    retry_in = (None if link.retry_at is None or not countdown
+                else max(0.0, link.retry_at - now))
     detail = ", ".join(part for part in (
-        f"attempt {attempt}" if attempt else "",
+        (f"attempt {attempt}" if countdown else f"{attempt}+ attempts") if attempt else "",
         f"next in {retry_in:.1f} s" if retry_in is not None else "") if part)
     error = _plain_error(link.last_error) if link.last_error else ""
     return (f"rosbridge: connecting to {url}" + (f" ({detail})" if detail else "")

@@ -199,10 +199,11 @@ class Executive:
             await self._shutdown()
         return self.outcome
 
-    def status_text(self) -> str:
+    def status_text(self, countdown: bool = True) -> str:
         """The live status: the rosbridge link while it keeps the tree waiting, else the tree;
-        then the alerts not yet acknowledged."""
-        line = (link_line(self.client.url, self.client.link, self.clock.ready)
+        then the alerts not yet acknowledged (``countdown``: a terminal's, see link_line)."""
+        line = (link_line(self.client.url, self.client.link, self.clock.ready,
+                          countdown=countdown)
                 or f"{status_line(self.core)} | {self.links.text()}")
         alerts = [a.kind for a in self.staff.book.shown() if a.state == "raised"]
         return line + (f" | ALERT: {', '.join(alerts)}" if alerts else "")
