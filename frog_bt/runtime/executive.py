@@ -13,6 +13,7 @@ With ``--sim-time`` nothing is timed before the first ``/clock``.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -35,6 +36,7 @@ from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
 from frog_bt.runtime.core import Core
+from frog_bt.runtime.notify import Notifier
 from frog_bt.runtime.staff import Staff
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.warning_limit import WarningLimiter
@@ -103,6 +105,7 @@ class Executive:
         self._link_states = states(self)
         self.swaps = 0
         self.staff = Staff(self)  # operator commands and alerts
+        self.notifier = Notifier.from_env()  # systemd: READY, STATUS, watchdog pings
         self._seekers = self._find_seekers()
 
     # ------------------------------------------------------------ I/O callbacks (cache only)
@@ -191,13 +194,30 @@ class Executive:
         self.setup_wire()
         await self.link.start()
         self.client.start()
+        self.notifier.ready(f"frog-bt: rosbridge {self.client.url}")
         try:
-            if await self._until_stopped(self.clock.wait_ready()):
+            if await self._until_stopped(self._ready_or_alive()):
                 self.core.setup()
                 await self._loop()
         finally:
+            self.notifier.stopping()
             await self._shutdown()
+            self.notifier.close()
         return self.outcome
+
+    def _alive(self) -> float:
+        """One turn of the loop: the watchdog's ping, the status line for systemd; how
+        long the loop may wait before its next turn."""
+        self.notifier.alive()
+        self.notifier.status(lambda: self.status_text(countdown=False))
+        return self.notifier.ping_every or 1.0
+
+    async def _ready_or_alive(self) -> None:
+        """Wait for the clock (under sim time, the first /clock), pinging meanwhile."""
+        while not self.clock.ready:
+            wait = self._alive()
+            with contextlib.suppress(TimeoutError):
+                await asyncio.wait_for(self.clock.wait_ready(), wait)
 
     def status_text(self, countdown: bool = True) -> str:
         """The live status: the rosbridge link while it keeps the tree waiting, else the tree;
@@ -227,7 +247,11 @@ class Executive:
         periodic = asyncio.create_task(self._periodic())
         try:
             while not self._stopping.is_set():
-                await self._wake.wait()
+                wait = self._alive()  # from the loop itself: a wedged loop stops the pings
+                try:
+                    await asyncio.wait_for(self._wake.wait(), wait)
+                except TimeoutError:
+                    continue
                 self._wake.clear()
                 if not self._stopping.is_set():
                     self.tick()
