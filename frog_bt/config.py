@@ -247,6 +247,26 @@ class Executive(_Model):
     tick_hz: Positive = 10.0
 
 
+class RunCfg(_Model):
+    """``frog-bt run`` options kept in the site configuration (``run:``): the command line
+    wins over ``FROG_BT_<OPTION>`` in the environment, which wins over these."""
+
+    rosbridge: str | None = None
+    frontend: str | None = None
+    listen: str | None = None
+    sim_time: bool | None = None
+    record: str | None = None
+    rerun: str | None = None
+    checkpoint: str | None = None
+    once: bool | None = None
+    fresh: bool | None = None
+    watch: bool | None = None
+    quiet: bool | None = None
+    console: str | None = None
+    console_token_file: str | None = None
+    log_format: Literal["text", "json"] | None = None
+
+
 class Site(_Model):
     pois: dict[str, Poi]
     variants: dict[str, list[Variant]] = {}
@@ -265,6 +285,7 @@ class Site(_Model):
     checkpoint: Checkpoint = Checkpoint()
     recording: Recording = Recording()
     operator: OperatorCfg = OperatorCfg()
+    run: RunCfg = RunCfg()
     alerts: AlertsCfg = AlertsCfg()
     console: ConsoleCfg = ConsoleCfg()
     topics: dict[Literal[tuple(INPUTS) + tuple(OUTPUTS)], str] = {}  # type: ignore[valid-type]

@@ -8,6 +8,12 @@ it cannot go on.
 Example, against the built-in simulator (frog-bt sim) on sim time:
 
   frog-bt run --sim-time --once
+
+Every option may also come from the environment (FROG_BT_ROSBRIDGE=ws://frog:9090,
+FROG_BT_SIM_TIME=1, FROG_BT_CONSOLE=8080, ...: FROG_BT_ and the option's name) or from
+the site configuration's run: section (run: {rosbridge: ws://frog:9090, quiet: true}).
+The command line wins, then the environment, then run:, then the defaults below.
+--tree and --config may come from FROG_BT_TREE and FROG_BT_CONFIG.
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ from frog_bt.commands.console_options import (
     start_people,
 )
 from frog_bt.commands.options import add_tree_and_config, read_secret, rerun_spec, writable_file
+from frog_bt.commands.settings import fill, tree_and_config
 from frog_bt.config import DEFAULT_CONFIG, Site, check_ws_url, load_site, parse_hostport
 from frog_bt.errors import FrogError, UsageError, error_lines
 from frog_bt.frontend.link import AddressError
@@ -52,7 +59,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="where the front end listens (default: 127.0.0.1:5005)")
     p.add_argument("--listen", metavar="HOST:PORT",
                    help="where the executive listens for the front end (default: 127.0.0.1:5006)")
-    p.add_argument("--sim-time", action="store_true",
+    p.add_argument("--sim-time", action="store_true", default=None,
                    help="take time from /clock (ROS use_sim_time); nothing is timed before it")
     p.add_argument("--record", metavar="FILE.mcap|DIR", type=Path,
                    help="record every message in and out: to one MCAP file (FILE.mcap), or "
@@ -61,21 +68,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--rerun", metavar="SPEC",
                    help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve "
                    "(default: off)")
-    p.add_argument("--once", action="store_true",
+    p.add_argument("--once", action="store_true", default=None,
                    help="exit 0 after one tour ends docked; non-zero when it cannot go on")
     p.add_argument("--checkpoint", type=Path, metavar="FILE",
                    help=f"tour progress, so that a restart resumes the tour (default: one file "
                    f"per site config and listen address in {STATE_DIR}); 'none' disables it")
-    p.add_argument("--fresh", action="store_true",
+    p.add_argument("--fresh", action="store_true", default=None,
                    help="ignore the checkpoint: start a fresh tour")
-    p.add_argument("--watch", action="store_true",
+    p.add_argument("--watch", action="store_true", default=None,
                    help="re-check the tree and config files when they change; a valid change "
                    "takes over when the robot is docked and idle, a bad one is reported and "
                    "the running tree stays")
     add_console_arguments(p)
-    p.add_argument("--quiet", action="store_true", help="no live status line")
+    p.add_argument("--quiet", action="store_true", default=None, help="no live status line")
     p.add_argument("-v", "--verbose", action="store_true", help="log at debug level")
-    p.add_argument("--log-format", choices=("text", "json"), default="text",
+    p.add_argument("--log-format", choices=("text", "json"), default=None,
                    help="text (levels as syslog prefixes under systemd) or one JSON object "
                    "per line (default: text)")
 
@@ -173,9 +180,12 @@ def attach_observers(executive: Executive, *, record: Path | None, rerun: str | 
 
 
 def run(args: argparse.Namespace) -> int:
-    logs.setup(args.verbose, args.log_format)
+    tree_and_config(args)
+    logs.setup(args.verbose, os.environ.get("FROG_BT_LOG_FORMAT") or args.log_format or "text")
     try:
         site = load_site(args.config)
+        fill(args, site.run)
+        logs.setup(args.verbose, args.log_format)  # run: may have chosen it
         tree = load_tree(args.tree, site)
         settings = resolve(args, site)
         if args.watch and settings.rerun:

@@ -1,0 +1,41 @@
+"""Each run option from the command line, else the environment, else the site config's
+run: section, else its default."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import pytest
+
+from frog_bt.commands import run as run_command
+from frog_bt.commands.settings import fill
+from frog_bt.config import RunCfg
+from frog_bt.errors import UsageError
+
+
+def parse(*argv: str) -> argparse.Namespace:
+    p = argparse.ArgumentParser()
+    run_command.add_arguments(p)
+    return p.parse_args(argv)
+
+
+def test_the_command_line_wins_then_the_environment_then_the_site() -> None:
+    site = RunCfg(rosbridge="ws://site:9090", frontend="10.0.0.1:5005", quiet=True,
+                  record="/srv/frog/recordings", log_format="json")
+    env = {"FROG_BT_ROSBRIDGE": "ws://env:9090", "FROG_BT_SIM_TIME": "yes",
+           "FROG_BT_LISTEN": "127.0.0.1:6000"}
+    args = parse("--rosbridge", "ws://cli:9090")
+    sources = fill(args, site, env)
+    assert args.rosbridge == "ws://cli:9090"  # given: the command line's
+    assert (args.listen, args.sim_time) == ("127.0.0.1:6000", True)  # the environment's
+    assert (args.frontend, args.quiet, args.log_format) == ("10.0.0.1:5005", True, "json")
+    assert args.record == Path("/srv/frog/recordings")
+    assert (args.once, args.fresh, args.watch, args.console) == (False, False, False, None)
+    assert sources == {"listen": "env", "sim_time": "env", "frontend": "site",
+                       "record": "site", "quiet": "site", "log_format": "site"}
+
+
+def test_a_bad_flag_in_the_environment_names_the_variable() -> None:
+    with pytest.raises(UsageError, match="FROG_BT_ONCE maybe: expected 1/true/yes/on"):
+        fill(parse(), RunCfg(), {"FROG_BT_ONCE": "maybe"})
