@@ -248,8 +248,9 @@ class Executive:
         try:
             while not self._stopping.is_set():
                 wait = self._alive()  # from the loop itself: a wedged loop stops the pings
-                try:
-                    await asyncio.wait_for(self._wake.wait(), wait)
+                try:  # (a timeout, not wait_for: no extra task between a wake and its tick)
+                    async with asyncio.timeout(wait):
+                        await self._wake.wait()
                 except TimeoutError:
                     continue
                 self._wake.clear()
