@@ -184,6 +184,9 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
         if record.side != "frontend" or record.direction != "in" or record.channel != "tour":
             return
         what = record.payload.get("state")
+        if report.completed + report.aborted >= tours:
+            return  # the soak is over: a tour the executive starts before it is stopped is
+            # not one of the soak's (it would count as stranded, a race at the end)
         if what == "started":
             if state["open"]:
                 if killed_during_open[0]:
