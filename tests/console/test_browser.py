@@ -66,7 +66,7 @@ def drive(url: str) -> tuple[list[str], str]:
 def test_send_home_from_the_console_in_chromium() -> None:
     async def main() -> tuple[list[str], str, str, str, str]:
         # slow enough for a person (and a browser) to follow: a stop lasts a few seconds
-        async with console_tour({"speed": 20.0}, once=True) as (run, _people, url):
+        async with console_tour({"speed": 40.0}, once=True) as (run, _people, url):
             seen, answer = await asyncio.to_thread(drive, url)
             aborted = await run.sim.wait_for(is_("tour", state="aborted"), 60)
             outcome = await run.finish()
