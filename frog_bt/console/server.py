@@ -43,6 +43,7 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 Handler = Callable[[web.Request], Awaitable[web.StreamResponse]]
 SEND_TIMEOUT = 2.0  # seconds a pushed state may take to reach one page; then it is dropped
+CLOSE_TIMEOUT = 1.0  # seconds the server waits for open requests when it stops
 
 
 def is_loopback(host: str) -> bool:
@@ -118,7 +119,8 @@ class Console:
         app.router.add_post("/api/command", self._command)
         self._runner = web.AppRunner(app, access_log=None, handle_signals=False)
         await self._runner.setup()
-        site = web.TCPSite(self._runner, self.host, self.port)
+        site = web.TCPSite(self._runner, self.host, self.port,
+                           shutdown_timeout=CLOSE_TIMEOUT)  # bounded, with pages still open
         await site.start()
         server = site._server  # the bound port, when 0 was asked for
         sockets = getattr(server, "sockets", None) or ()
@@ -134,7 +136,7 @@ class Console:
                 await self._pusher
         for ws in list(self._sockets):
             with contextlib.suppress(Exception):
-                await asyncio.wait_for(ws.close(), 1.0)
+                await asyncio.wait_for(ws.close(), CLOSE_TIMEOUT)
         if self._runner is not None:
             await self._runner.cleanup()
 
