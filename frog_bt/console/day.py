@@ -77,9 +77,7 @@ class Day:
 
     def _tick(self, core: Core) -> None:
         journal = core.journal
-        if journal.incident_total == self._incidents_seen:
-            return
-        new = journal.incidents[self._incidents_seen - journal.incident_total:]
+        new = journal.incidents_since(self._incidents_seen)
         self._incidents_seen = journal.incident_total
         for incident in new:
             if incident.kind in (IncidentKind.STOP_SKIPPED, IncidentKind.STOP_LEFT):

@@ -57,5 +57,12 @@ class Journal:
     def last_note(self) -> str:
         return self.notes[-1].text if self.notes else ""
 
+    def incidents_since(self, seen: int) -> list[Incident]:
+        """The incidents recorded after the first ``seen`` of all time (those the list
+        still keeps): how a reader takes each once, counting with :attr:`incident_total`."""
+        if seen >= self.incident_total:
+            return []
+        return self.incidents[seen - self.incident_total:]
+
     def last_incident(self) -> Incident | None:
         return self.incidents[-1] if self.incidents else None

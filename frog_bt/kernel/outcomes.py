@@ -46,7 +46,6 @@ class IncidentKind(enum.StrEnum):
     GAVE_UP = "gave up"
     RESUMED = "resumed"
     MISSING_VALUE = "missing value"
-    LINK_LOST = "link lost"
     STALE_INPUT = "stale input"  # decided without fresh data (benefit of the doubt)
     OPERATOR = "operator"  # an operator command changed the tour
 

@@ -83,12 +83,11 @@ class TourSummary:
             self._last_decision = decision
             self.decisions.append(decision)
         journal = core.journal
-        if journal.incident_total != self._seen_incidents:
-            for incident in journal.incidents[self._seen_incidents - journal.incident_total:]:
-                self.incidents.append(incident)
-                if incident.kind in (IncidentKind.STOP_SKIPPED, IncidentKind.STOP_LEFT):
-                    self.skipped.append(incident.subject)
-            self._seen_incidents = journal.incident_total
+        for incident in journal.incidents_since(self._seen_incidents):
+            self.incidents.append(incident)
+            if incident.kind in (IncidentKind.STOP_SKIPPED, IncidentKind.STOP_LEFT):
+                self.skipped.append(incident.subject)
+        self._seen_incidents = journal.incident_total
         resumed = board.get(keys.RESUMED)
         if resumed and self.resumed is None:
             self.resumed = resumed

@@ -118,10 +118,9 @@ class Staff:
             self._pause_ran_out = False
         self._touring = touring
         journal = core.journal
-        if journal.incident_total != self._incidents_seen:
-            new = journal.incidents[self._incidents_seen - journal.incident_total:]
-            self._given_up += [i.subject for i in new if i.kind is IncidentKind.STOP_SKIPPED]
-            self._incidents_seen = journal.incident_total
+        new = journal.incidents_since(self._incidents_seen)
+        self._incidents_seen = journal.incident_total
+        self._given_up += [i.subject for i in new if i.kind is IncidentKind.STOP_SKIPPED]
         if core.pause_ran_out is not None:
             self._pause_ran_out = True
         seeking = any(n.status.name == "RUNNING" for n in exe.seekers)

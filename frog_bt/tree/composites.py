@@ -32,12 +32,15 @@ class _Composite(Observed):
 
     @classmethod
     def build(cls, name: str, params: Any, children: list[Behaviour]) -> Behaviour:
-        raise NotImplementedError
+        """The node for a tree file's entry: py_trees' composite, starting its scope."""
+        node = cls._make(name, params, children)
+        if params.scope is not None:
+            node.scope = Scope[params.scope.upper()]
+        return node
 
-
-def _scoped(node: Observed, params: Any) -> None:
-    if params.scope is not None:
-        node.scope = Scope[params.scope.upper()]
+    @classmethod
+    def _make(cls, name: str, params: Any, children: list[Behaviour]) -> _Composite:
+        return cls(name, memory=params.memory, children=children)  # type: ignore[call-arg]
 
 
 class Sequence(_Composite, py_trees.composites.Sequence):
@@ -49,12 +52,6 @@ class Sequence(_Composite, py_trees.composites.Sequence):
                                          "re-check every child each tick")
         scope: ScopeName | None = Field(None, description=SCOPE_DOC)
 
-    @classmethod
-    def build(cls, name: str, params: Any, children: list[Behaviour]) -> Behaviour:
-        node = cls(name, memory=params.memory, children=children)
-        _scoped(node, params)
-        return node
-
 
 class Selector(_Composite, py_trees.composites.Selector):
     """Tries its children in order; SUCCESS at the first that succeeds, FAILURE when all
@@ -64,12 +61,6 @@ class Selector(_Composite, py_trees.composites.Selector):
         memory: bool = Field(description="true: resume at the running child; false: try "
                                          "from the first each tick")
         scope: ScopeName | None = Field(None, description=SCOPE_DOC)
-
-    @classmethod
-    def build(cls, name: str, params: Any, children: list[Behaviour]) -> Behaviour:
-        node = cls(name, memory=params.memory, children=children)
-        _scoped(node, params)
-        return node
 
 
 class Parallel(_Composite, py_trees.composites.Parallel):
@@ -83,12 +74,10 @@ class Parallel(_Composite, py_trees.composites.Parallel):
         scope: ScopeName | None = Field(None, description=SCOPE_DOC)
 
     @classmethod
-    def build(cls, name: str, params: Any, children: list[Behaviour]) -> Behaviour:
+    def _make(cls, name: str, params: Any, children: list[Behaviour]) -> _Composite:
         policy = (py_trees.common.ParallelPolicy.SuccessOnAll(synchronise=params.synchronise)
                   if params.policy == "all" else py_trees.common.ParallelPolicy.SuccessOnOne())
-        node = cls(name, policy=policy, children=children)
-        _scoped(node, params)
-        return node
+        return cls(name, policy=policy, children=children)
 
 
 COMPOSITES: dict[str, type[_Composite]] = {

@@ -5,16 +5,14 @@ from __future__ import annotations
 
 import asyncio
 import shutil
-from collections.abc import Callable
 from pathlib import Path
 
-from tour import Running
+from tour import Running, after_ticks
 
 from frog_bt import resources
 from frog_bt.config import load_site
 from frog_bt.kernel import keys
 from frog_bt.kernel.outcomes import TourState
-from frog_bt.runtime.executive import Executive
 from frog_bt.runtime.watch import Watch
 from frog_bt.tree.loader import load_tree
 
@@ -28,25 +26,6 @@ def copy_trees(tmp_path: Path) -> Path:
 
 def names(tree) -> set[str]:
     return {n.name for n in tree.nodes()}
-
-
-async def after_ticks(exe: Executive, condition: Callable[[], bool], timeout: float = 60.0
-                      ) -> None:
-    """Wait, tick by tick (a tap on the executive's ticks, no polling), until
-    ``condition()`` holds; ``timeout`` only catches a hang."""
-    if condition():
-        return
-    held = asyncio.Event()
-
-    def check(_core: object) -> None:
-        if condition():
-            held.set()
-
-    exe.taps.tick.append(check)
-    try:
-        await asyncio.wait_for(held.wait(), timeout)
-    finally:
-        exe.taps.tick.remove(check)
 
 
 def test_a_valid_change_takes_over_when_idle_and_a_bad_one_is_refused(tmp_path: Path) -> None:

@@ -24,7 +24,8 @@ from frog_bt.tree.loader import LoadedTree
 # High speed and short content: a whole tour takes a few seconds of wall time.
 FAST: dict[str, Any] = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
 
-__all__ = ["FAST", "Running", "Tour", "describe", "fast", "free_udp_port", "tour"]
+__all__ = ["FAST", "Running", "Tour", "after_ticks", "describe", "fast", "free_udp_port",
+           "tour"]
 
 
 def fast(overrides: dict[str, Any] | None = None) -> Scenario:
@@ -54,6 +55,25 @@ class Tour:
         """Front-end commands, only of ``types`` when given."""
         return [c for c in self.commands() if not c.startswith("/")
                 and (not types or c.split()[0] in types)]
+
+
+async def after_ticks(exe: Executive, condition: Callable[[], bool], wall: float = 60.0
+                      ) -> None:
+    """Wait, tick by tick (a tap on the executive's ticks, no polling), until
+    ``condition()`` holds; ``wall`` seconds only catch a hang."""
+    if condition():
+        return
+    held = asyncio.Event()
+
+    def check(_core: object) -> None:
+        if condition():
+            held.set()
+
+    exe.taps.tick.append(check)
+    try:
+        await asyncio.wait_for(held.wait(), wall)
+    finally:
+        exe.taps.tick.remove(check)
 
 
 def describe(record: Record, summary: TourSummary) -> str:
@@ -93,22 +113,7 @@ class Running(Rehearsal):
 
     async def executive_ticks_until(self, condition: Callable[[], bool], wall: float = 60.0
                                     ) -> None:
-        """Wait, tick by tick (a tap on the executive's ticks, no polling), until
-        ``condition()`` holds; ``wall`` seconds only catch a hang."""
-        if condition():
-            return
-        held = asyncio.Event()
-
-        def check(_core: object) -> None:
-            if condition():
-                held.set()
-
-        taps = self.executive.taps.tick
-        taps.append(check)
-        try:
-            await asyncio.wait_for(held.wait(), wall)
-        finally:
-            taps.remove(check)
+        await after_ticks(self.executive, condition, wall)
 
     def published_at(self, topic: str) -> list[float]:
         """When (by the executive's clock) the executive published on ``topic``."""
