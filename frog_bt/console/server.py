@@ -132,8 +132,9 @@ class Console:
         logging.getLogger("frog_bt").removeHandler(self.logs)
         if self._pusher is not None:
             self._pusher.cancel()
-            with contextlib.suppress(asyncio.CancelledError):
-                await self._pusher
+            with contextlib.suppress(asyncio.CancelledError, TimeoutError):
+                async with asyncio.timeout(CLOSE_TIMEOUT):  # bounded, come what may
+                    await self._pusher
         for ws in list(self._sockets):
             with contextlib.suppress(Exception):
                 await asyncio.wait_for(ws.close(), CLOSE_TIMEOUT)
@@ -217,8 +218,11 @@ class Console:
         a page that does not take it within :data:`SEND_TIMEOUT` is dropped."""
         last = ""
         while True:
+            # asyncio.timeout, not wait_for: on Python 3.11 wait_for can swallow a cancel
+            # that meets the event being set, and close() would then wait for ever
             with contextlib.suppress(TimeoutError):
-                await asyncio.wait_for(self._changed.wait(), self.push_every)
+                async with asyncio.timeout(self.push_every):
+                    await self._changed.wait()
             self._changed.clear()
             if not self._sockets:
                 continue
@@ -228,7 +232,8 @@ class Console:
             last = text
             for ws in list(self._sockets):
                 try:
-                    await asyncio.wait_for(ws.send_str(text), SEND_TIMEOUT)
+                    async with asyncio.timeout(SEND_TIMEOUT):
+                        await ws.send_str(text)
                 except (TimeoutError, ConnectionError, RuntimeError):
                     self._sockets.discard(ws)
                     with contextlib.suppress(Exception):

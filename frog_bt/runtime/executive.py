@@ -217,7 +217,8 @@ class Executive:
         while not self.clock.ready:
             wait = self._alive()
             with contextlib.suppress(TimeoutError):
-                await asyncio.wait_for(self.clock.wait_ready(), wait)
+                async with asyncio.timeout(wait):  # not wait_for: 3.11 may swallow a cancel
+                    await self.clock.wait_ready()
 
     def status_text(self, countdown: bool = True) -> str:
         """The live status: the rosbridge link while it keeps the tree waiting, else the tree;

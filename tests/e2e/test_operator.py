@@ -130,8 +130,10 @@ async def _pause_runs_out() -> tuple[list[str], str, float, float]:
         core = run.executive.core
         core.operator.pause_max = 30.0
         await run.sim.wait_for(is_("start_poi", poi="POI1", part="a"), 60)
-        paused_at = run.sim.clock.now()
         assert core.command(Command.PAUSE).ok
+        # the executive's own clock at the pause (the sim's may be ahead of it under load)
+        paused_at = core.operator.paused_since
+        assert paused_at is not None
         outcome = await run.finish()
         aborted = next(r for r in run.sim.received("tour") if r.payload["state"] == "aborted")
         return commands_after(run, paused_at), outcome.reason, paused_at, aborted.t
