@@ -52,6 +52,7 @@ SOAK_SCENARIO: dict[str, Any] = {
     "battery": {"start": 95, "charge_per_hour": 300},
     "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0, "loss": 0.15},
 }
+DEFAULT_SCRIPTS = Path(__file__).resolve().parents[2] / "shared" / "real-rosbridge"
 PERCEPTION = ("persons", "people", "pose")  # wire roles that go stale together
 KINDS = ("rosbridge", "frontend", "stale", "battery", "kill")
 
@@ -104,6 +105,13 @@ class Report:
     wall_s: float = 0.0
     sim_s: float = 0.0
     timed_out: bool = False
+    # with --via-rosbridge: the real server between the executive and the robot
+    server: str | None = None
+    server_restarts: int = 0
+    server_restart_wall_s: list[float] = field(default_factory=list)
+    robot_connections: int = 0  # times the simulated robot connected to the server
+    restarts_answered: int = 0  # restarts after which the robot got a command again
+    content_started_twice: int = 0  # a (stop, part) started again in one tour, new seq
 
     def lines(self) -> list[str]:
         reasons = ", ".join(f"{n} {r}" for r, n in self.abort_reasons.items()) or "none"
@@ -119,15 +127,21 @@ class Report:
             f"{self.rss_kb[-1] if self.rss_kb else 0} kB ({growth}); "
             f"{self.sim_s / 3600:.1f} h simulated in {self.wall_s:.0f} s wall"
             + ("; TIMED OUT" if self.timed_out else ""),
-        ]
+        ] + ([
+            f"  via {self.server}: {self.server_restarts} server restarts, the robot "
+            f"connected {self.robot_connections} times, {self.restarts_answered} restarts "
+            f"followed by commands reaching the robot; content parts started twice "
+            f"{self.content_started_twice}",
+        ] if self.server else [])
 
 
 class Executive:
     """``frog-bt run`` in a child process; started again after a kill."""
 
-    def __init__(self, argv: list[str], logs: Path) -> None:
+    def __init__(self, argv: list[str], logs: Path, env: dict[str, str] | None = None) -> None:
         self.argv = argv
         self.logs = logs
+        self.env = {**os.environ, **(env or {})}
         self.proc: asyncio.subprocess.Process | None = None
         self.starts = 0
 
@@ -135,7 +149,7 @@ class Executive:
         self.starts += 1
         log = open(self.logs / f"executive-{self.starts}.log", "wb")  # noqa: SIM115
         self.proc = await asyncio.create_subprocess_exec(
-            *self.argv, stdin=asyncio.subprocess.DEVNULL, stdout=log, stderr=log)
+            *self.argv, stdin=asyncio.subprocess.DEVNULL, stdout=log, stderr=log, env=self.env)
         log.close()
 
     async def kill(self) -> None:
@@ -157,8 +171,40 @@ class Executive:
         return memory_kb(self.proc.pid).get("rss_kb", 0) if self.proc else 0
 
 
+class RealServer:
+    """A real rosbridge_suite on loopback, restarted with its own scripts (``stop.sh PORT``,
+    ``start.sh PORT`` of ../shared/real-rosbridge): the ROS master goes with it."""
+
+    def __init__(self, scripts: Path, port: int) -> None:
+        self.scripts = scripts
+        self.port = port
+        self.restarts = 0
+        self.restart_wall: list[float] = []  # seconds each stop+start took
+
+    async def _sh(self, name: str) -> None:
+        proc = await asyncio.create_subprocess_exec(
+            "bash", str(self.scripts / name), str(self.port),
+            stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.PIPE)
+        _, err = await proc.communicate()
+        if proc.returncode != 0:
+            raise RuntimeError(f"{name} {self.port}: exit {proc.returncode}: "
+                               f"{err.decode(errors='replace').strip()[-300:]}")
+
+    async def restart(self) -> None:
+        t0 = time.monotonic()
+        await self._sh("stop.sh")
+        await asyncio.sleep(2.0)  # the server is away for 2 s of wall time, as in the sim
+        await self._sh("start.sh")
+        self.restarts += 1
+        self.restart_wall.append(time.monotonic() - t0)
+
+
 async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
-               faults: list[Fault] | None = None, wall_timeout: float = 3600.0) -> Report:
+               faults: list[Fault] | None = None, wall_timeout: float = 3600.0,
+               via: str | None = None, server: RealServer | None = None,
+               secret: str | None = None) -> Report:
+    """``via``: the rosbridge server (a real one) between the executive and the simulated
+    robot; ``server`` restarts it for each ``rosbridge`` fault; ``secret``: its rosauth."""
     from frog_bt.config import load_site
     from frog_bt.sim import Simulator, scenario_from
     from frog_bt.sim.traffic import Record
@@ -167,22 +213,39 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
     plan = faults if faults is not None else schedule(tours, seed)
     listen = (LOOPBACK, free_port())
     sim = Simulator(scenario_from("default", {**SOAK_SCENARIO, "speed": speed, "seed": seed}),
-                    host=LOOPBACK, rosbridge_port=0, frontend_port=0, executive=listen)
+                    host=LOOPBACK, rosbridge_port=0, frontend_port=0, executive=listen,
+                    via=via, secret=secret)
     await sim.start()
     record_dir = workdir / "recordings"
     argv = [str(FROG_BT), "run", "--sim-time", "--quiet", "--record", str(record_dir),
             "--checkpoint", str(workdir / "checkpoint.json"),
-            "--rosbridge", f"ws://{LOOPBACK}:{sim.rosbridge_port}",
+            "--rosbridge", via or f"ws://{LOOPBACK}:{sim.rosbridge_port}",
             "--frontend", f"{LOOPBACK}:{sim.frontend_port}",
             "--listen", f"{LOOPBACK}:{listen[1]}"]
-    executive = Executive(argv, workdir)
+    executive = Executive(argv, workdir, {"FROG_ROSBRIDGE_SECRET": secret} if secret else {})
     report = Report(tours)
     state = {"tour": 0, "open": False, "started_at": 0.0}
     ended = asyncio.Event()
     changed = asyncio.Event()
     killed_during_open = [False]
 
+    started_parts: dict[tuple[str, str], object] = {}  # this tour's content parts -> seq
+    since_restart = [True]  # a command reached the robot since the last server restart
+
     def on_record(record: Record) -> None:
+        if record.side == "ros" and record.direction == "in":
+            if not since_restart[0]:
+                since_restart[0] = True
+                report.restarts_answered += 1
+            return
+        if record.side == "frontend" and record.direction == "in" \
+                and record.channel == "start_poi":
+            part = (str(record.payload.get("poi")), str(record.payload.get("part")))
+            seq = record.payload.get("seq")
+            if part in started_parts and started_parts[part] != seq:
+                report.content_started_twice += 1
+            started_parts[part] = seq
+            return
         if record.side != "frontend" or record.direction != "in" or record.channel != "tour":
             return
         what = record.payload.get("state")
@@ -204,6 +267,7 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
                 return
             else:
                 state["tour"] += 1
+                started_parts.clear()
             state["open"], state["started_at"] = True, record.t
             report.started += 1
             changed.set()
@@ -235,7 +299,9 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
                    and sim.clock.now() - state["started_at"] >= f.delay]
             for fault in due:
                 pending.remove(fault)
-                await inject(fault, sim, site, executive, killed_during_open)
+                await inject(fault, sim, site, executive, killed_during_open, server)
+                if fault.kind == "rosbridge" and server is not None:
+                    since_restart[0] = False
                 fault.done_at = sim.clock.now()
                 report.faults[fault.kind] = report.faults.get(fault.kind, 0) + 1
             if executive.proc is not None and executive.proc.returncode is not None:
@@ -247,6 +313,11 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
         await executive.stop()
         await sim.stop()
     report.restarts = executive.starts - 1
+    if server is not None:
+        report.server = via
+        report.server_restarts = server.restarts
+        report.server_restart_wall_s = [round(w, 1) for w in server.restart_wall]
+        report.robot_connections = sim._rosbridge.connections
     report.wall_s = time.monotonic() - wall0
     report.sim_s = sim.clock.now() - sim0
     if state["open"]:
@@ -260,8 +331,10 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
 
 
 async def inject(fault: Fault, sim: Any, site: Any, executive: Executive,
-                 killed_during_open: list[bool]) -> None:
-    if fault.kind == "rosbridge":
+                 killed_during_open: list[bool], server: RealServer | None = None) -> None:
+    if fault.kind == "rosbridge" and server is not None:
+        await server.restart()
+    elif fault.kind == "rosbridge":
         await sim.stop_rosbridge()
         await asyncio.sleep(2.0)  # the server is away for 2 s of wall time
         await sim.start_rosbridge()
@@ -325,11 +398,37 @@ def main() -> None:
     p.add_argument("--speed", type=float, default=200.0, help="sim-time speed factor")
     p.add_argument("--keep", type=Path, help="keep the recordings and logs in this directory")
     p.add_argument("--out", help="write the report as JSON here")
+    p.add_argument("--via-rosbridge", metavar="URL",
+                   help="a real rosbridge_suite server (ws://127.0.0.1:PORT) between the "
+                        "executive and the simulated robot (frog-bt sim --via); each "
+                        "rosbridge fault restarts it with --server-scripts' stop.sh/start.sh")
+    p.add_argument("--server-scripts", type=Path, default=DEFAULT_SCRIPTS, metavar="DIR",
+                   help=f"the real server's start.sh and stop.sh (default {DEFAULT_SCRIPTS})")
+    p.add_argument("--server-restarts", type=int, default=20, metavar="N",
+                   help="with --via-rosbridge: restart the server at least N times, in as "
+                        "many tours (default 20)")
+    p.add_argument("--secret-file", type=Path, metavar="FILE",
+                   help="with --via-rosbridge: the server's rosauth secret (first line), for "
+                        "the executive and the robot (start.sh's FROG_RB_AUTH_SECRET_FILE)")
     args = p.parse_args()
+    server = secret = faults = None
+    if args.via_rosbridge:
+        port = int(args.via_rosbridge.rstrip("/").rsplit(":", 1)[1])
+        server = RealServer(args.server_scripts, port)
+        if args.secret_file:
+            secret = args.secret_file.read_text().splitlines()[0].strip()
+        faults = schedule(args.tours, args.seed, rosbridge=0.0)
+        # a server restart in each of the first N tours (a tour may well hold two)
+        rng = random.Random(args.seed)
+        faults += [Fault(1 + i % args.tours, "rosbridge", rng.uniform(5.0, 40.0))
+                   for i in range(args.server_restarts)]
+        faults.sort(key=lambda f: (f.tour, f.delay))
     with tempfile.TemporaryDirectory(prefix="frog-soak-") as tmp:
         workdir = args.keep or Path(tmp)
         workdir.mkdir(parents=True, exist_ok=True)
-        report = asyncio.run(soak(args.tours, args.seed, workdir, speed=args.speed))
+        report = asyncio.run(soak(args.tours, args.seed, workdir, speed=args.speed,
+                                  faults=faults, via=args.via_rosbridge, server=server,
+                                  secret=secret))
     print("\n".join(report.lines()), file=sys.stderr)
     emit(asdict(report), args.out)
 

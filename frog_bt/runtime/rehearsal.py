@@ -69,7 +69,8 @@ class Rehearsal:
         if self.own_sim:
             await self.sim.start()
         self.executive = Executive(self.site, self.tree, SimClock(),
-                                   rosbridge_url=f"ws://{HOST}:{self.sim.rosbridge_port}",
+                                   rosbridge_url=self.sim.via
+                                   or f"ws://{HOST}:{self.sim.rosbridge_port}",
                                    frontend=(HOST, self.sim.frontend_port), listen=self.listen,
                                    sim_time=True, **self.executive_kwargs)
         if self.prepare is not None:

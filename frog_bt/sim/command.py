@@ -6,6 +6,13 @@ Point the executive at it and run it on simulated time:
     frog-bt sim --scenario default --speed 50
     frog-bt run --rosbridge ws://127.0.0.1:9090 --sim-time
 
+Or put a rosbridge server between them (a real rosbridge_suite; or `frog-bt sim
+--relay`, a server with no robot inside): the simulated robot is then a client of it.
+
+    frog-bt sim --relay --rosbridge 127.0.0.1:9190          # or a real rosbridge_suite
+    frog-bt sim --via ws://127.0.0.1:9190 --speed 10
+    frog-bt run --rosbridge ws://127.0.0.1:9190 --sim-time
+
 Time: the simulator is the master clock. It publishes /clock, starting at the
 scenario's start_time, and runs `speed` times faster than real time (--speed
 overrides the scenario; 50 = 50x). When the machine cannot keep up, simulated
@@ -133,7 +140,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="site configuration with the POI table (default: the packaged "
                         "config/site.yaml; 'frog-bt init DIR' copies it to edit)")
     parser.add_argument("--secret", default=None,
-                        help="require rosbridge clients to authenticate with this secret")
+                        help="rosauth secret: clients of the simulator's server must "
+                             "authenticate with it; with --via, the simulator does")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--via", default=None, metavar="ws://HOST:PORT",
+                       help="serve no rosbridge: be the robot as a client of this rosbridge "
+                            "server (a real rosbridge_suite, say); the executive connects "
+                            "to the same server")
+    where.add_argument("--relay", action="store_true",
+                       help="only a rosbridge server with no robot inside, on --rosbridge: "
+                            "publishes from one client go to the others' subscriptions "
+                            "(a stand-in for rosbridge_suite, for --via)")
     parser.add_argument("--log", action="store_true",
                         help="print every message as it is sent or received, one line each")
 
@@ -153,7 +170,17 @@ def run(args: argparse.Namespace) -> int:
         return 2
     if args.speed is not None:
         scenario = scenario.model_copy(update={"speed": args.speed})
+    if args.via is not None:
+        from websockets.exceptions import InvalidURI
+        from websockets.uri import parse_uri
+        try:
+            parse_uri(args.via)
+        except InvalidURI:
+            print(f"frog-bt sim: --via {args.via!r}: expected ws://HOST:PORT", file=sys.stderr)
+            return 2
     try:
+        if args.relay:
+            return asyncio.run(_relay(args))
         return asyncio.run(_serve(args, scenario, pois))
     except ConfigError as exc:
         print(f"frog-bt sim: {exc}", file=sys.stderr)
@@ -165,7 +192,7 @@ async def _serve(args: argparse.Namespace, scenario: Scenario, pois: dict) -> in
 
     sim = Simulator(scenario, host=args.rosbridge[0], rosbridge_port=args.rosbridge[1],
                     frontend_host=args.frontend[0], frontend_port=args.frontend[1],
-                    executive=args.executive, pois=pois, secret=args.secret)
+                    executive=args.executive, pois=pois, secret=args.secret, via=args.via)
     if args.log:
         sim.log.add_listener(lambda record: print(describe(record), flush=True))
     try:
@@ -173,16 +200,13 @@ async def _serve(args: argparse.Namespace, scenario: Scenario, pois: dict) -> in
     except OSError as exc:
         print(f"frog-bt sim: cannot listen: {exc}", file=sys.stderr)
         return 1
-    print(f"frog-bt sim: rosbridge ws://{args.rosbridge[0]}:{sim.rosbridge_port}, "
+    bridge = (f"robot via rosbridge {args.via}" if args.via is not None
+              else f"rosbridge ws://{args.rosbridge[0]}:{sim.rosbridge_port}")
+    print(f"frog-bt sim: {bridge}, "
           f"front end udp {args.frontend[0]}:{sim.frontend_port} -> executive "
           f"{args.executive[0]}:{args.executive[1]}, scenario {sim.scenario.name or '?'}, "
           f"{sim.speed:g}x from {sim.scenario.start_time.isoformat()}", flush=True)
-    stop = asyncio.Event()
-    loop = asyncio.get_running_loop()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        with contextlib.suppress(NotImplementedError):
-            loop.add_signal_handler(sig, stop.set)
-    stopping = asyncio.create_task(stop.wait())
+    stopping = _stop_on_signals()
     clock = asyncio.create_task(sim.wait_clock_stopped())
     await asyncio.wait([stopping, clock], return_when=asyncio.FIRST_COMPLETED)
     stopping.cancel()
@@ -194,4 +218,31 @@ async def _serve(args: argparse.Namespace, scenario: Scenario, pois: dict) -> in
         return 1
     print(f"frog-bt sim: stopped at {sim.clock.local_time().isoformat(timespec='seconds')}",
           flush=True)
+    return 0
+
+
+def _stop_on_signals() -> asyncio.Task[bool]:
+    """A task that ends on SIGINT or SIGTERM."""
+    stop = asyncio.Event()
+    loop = asyncio.get_running_loop()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        with contextlib.suppress(NotImplementedError):
+            loop.add_signal_handler(sig, stop.set)
+    return asyncio.create_task(stop.wait())
+
+
+async def _relay(args: argparse.Namespace) -> int:
+    from frog_bt.sim.rosbridge_server import RosbridgeServer
+
+    server = RosbridgeServer.relay(args.rosbridge[0], args.rosbridge[1], args.secret)
+    try:
+        await server.start()
+    except OSError as exc:
+        print(f"frog-bt sim: cannot listen: {exc}", file=sys.stderr)
+        return 1
+    print(f"frog-bt sim: relaying rosbridge ws://{args.rosbridge[0]}:{server.port} "
+          f"(no robot inside{'; clients authenticate' if args.secret else ''})", flush=True)
+    await _stop_on_signals()
+    await server.stop()
+    print("frog-bt sim: stopped", flush=True)
     return 0

@@ -13,6 +13,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -46,6 +47,12 @@ class RosbridgeServer:
         self.dropped = 0
         self._server: Server | None = None
         self._connections: dict[int, _Connection] = {}
+
+    @classmethod
+    def relay(cls, host: str, port: int, secret: str | None = None) -> RosbridgeServer:
+        """A server with no robot inside (``frog-bt sim --relay``): a publish from one
+        client goes to every client subscribed to its topic, as in rosbridge_suite."""
+        return cls(BridgeServer(secret), host, port, lambda _incoming: None, time.time)
 
     @property
     def listening(self) -> bool:

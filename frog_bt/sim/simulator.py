@@ -34,6 +34,7 @@ from frog_bt.sim.frontend import FrontendModel
 from frog_bt.sim.frontend_udp import Address, FrontendSocket
 from frog_bt.sim.rosbridge_protocol import BridgeServer, Incoming
 from frog_bt.sim.rosbridge_server import RosbridgeServer
+from frog_bt.sim.rosbridge_via import RosbridgeVia
 from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.site import PoiPose, load_pois
 from frog_bt.sim.traffic import MessageLog, Predicate, Record
@@ -54,7 +55,8 @@ class Simulator:
                  rosbridge_port: int = 9090, frontend_port: int = 5005,
                  executive: tuple[str, int] = ("127.0.0.1", 5006),
                  pois: Mapping[str, PoiPose] | None = None,
-                 secret: str | None = None, frontend_host: str | None = None) -> None:
+                 secret: str | None = None, frontend_host: str | None = None,
+                 via: str | None = None) -> None:
         self.scenario = scenario
         self.speed = scenario.speed
         self._follow: Callable[[], float | None] | None = None
@@ -67,8 +69,16 @@ class Simulator:
         self.log = MessageLog()
         types = {t.name: t.type for t in (*INPUTS.values(), *OUTPUTS.values(), CLOCK)}
         self.bridge = BridgeServer(secret, types)
-        self._rosbridge = RosbridgeServer(self.bridge, host, rosbridge_port, self._on_incoming,
-                                          self.clock.now)
+        self.via = via
+        self._rosbridge: RosbridgeServer | RosbridgeVia
+        if via is None:
+            self._rosbridge = RosbridgeServer(self.bridge, host, rosbridge_port,
+                                              self._on_incoming, self.clock.now)
+        else:  # the robot as a client of an existing server (secret: to authenticate)
+            robot = {t.name: t.type for t in (*INPUTS.values(), CLOCK)}
+            commands = {t.name: t.type for t in OUTPUTS.values()}
+            self._rosbridge = RosbridgeVia(via, robot, commands, self._on_incoming,
+                                           secret=secret)
         self.frontend = FrontendModel(scenario, executive[0], self._visitor_says_yes,
                                       self._on_frontend_traffic)
         self._udp = FrontendSocket(frontend_host or host, frontend_port,
@@ -129,7 +139,11 @@ class Simulator:
         self._udp.close()
 
     async def stop_rosbridge(self) -> None:
-        """Drop all rosbridge clients and stop listening; the world keeps running."""
+        """Drop all rosbridge clients and stop listening; the world keeps running.
+        (Only for the simulator's own server: ``via`` a server, restart that server.)"""
+        if self.via is not None:
+            raise RuntimeError("the simulator serves no rosbridge: it is a client of "
+                               f"{self.via}")
         await self._rosbridge.stop()
 
     async def start_rosbridge(self) -> None:
@@ -177,8 +191,9 @@ class Simulator:
                 while self._waiting():
                     if self._wait_until is not None and not self._paused:
                         target = self.world.now - self._lead
-                        try:
-                            await asyncio.wait_for(self._wait_until(target), REPUBLISH_AFTER)
+                        try:  # asyncio.timeout: a cancel is never swallowed (3.11 wait_for)
+                            async with asyncio.timeout(REPUBLISH_AFTER):
+                                await self._wait_until(target)
                         except TimeoutError:
                             waited = REPUBLISH_AFTER
                     else:

@@ -91,3 +91,60 @@ def test_the_help_example_is_a_valid_scenario(tmp_path: Path, pois: dict) -> Non
     assert scenario.visitors[0].wander_off is not None
     assert scenario.navigation.failures[1].poi == "POI2"
     World(scenario, pois)
+
+
+def test_a_tour_through_a_relay_with_the_robot_via_it(tmp_path: Path) -> None:
+    """Three commands, as a deployer would try --via: a relaying server, the robot as its
+    client, and `frog-bt run --once` against the server."""
+    scenario = tmp_path / "fast.yaml"
+    scenario.write_text("extends: default\ncontent: {default: 10, introduction: 8}\n")
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        listen = probe.getsockname()[1]  # the executive's front-end port, free right now
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    procs: list[subprocess.Popen[str]] = []
+
+    def start(*argv: str) -> subprocess.Popen[str]:
+        proc = subprocess.Popen([sys.executable, "-m", "frog_bt", *argv],
+                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                                env=env)
+        procs.append(proc)
+        return proc
+
+    try:
+        relay = start("sim", "--relay", "--rosbridge", "127.0.0.1:0")
+        port = re.search(r"relaying rosbridge ws://127\.0\.0\.1:(\d+)", read_line(relay, 15))
+        assert port, "no relay banner"
+        url = f"ws://127.0.0.1:{port.group(1)}"
+        robot = start("sim", "--via", url, "--scenario", str(scenario), "--speed", "100",
+                      "--frontend", "127.0.0.1:0", "--executive", f"127.0.0.1:{listen}")
+        banner = read_line(robot, 15)
+        assert f"robot via rosbridge {url}" in banner
+        frontend = re.search(r"front end udp 127\.0\.0\.1:(\d+)", banner)
+        assert frontend, banner
+        run = subprocess.run(
+            [sys.executable, "-m", "frog_bt", "run", "--sim-time", "--once", "--quiet",
+             "--checkpoint", "none", "--rosbridge", url,
+             "--frontend", f"127.0.0.1:{frontend.group(1)}", "--listen", f"127.0.0.1:{listen}"],
+            capture_output=True, text=True, timeout=120, env=env)
+        assert run.returncode == 0, run.stderr[-2000:]
+        assert "  outcome:   tour ended docked, every stop visited" in run.stdout.splitlines()
+    finally:
+        for proc in procs:
+            proc.send_signal(signal.SIGINT)
+        codes = [proc.wait(timeout=15) for proc in procs]
+    assert codes == [0, 0]
+
+
+@pytest.mark.parametrize(("argv", "line"), [
+    (["--via", "localhost:9090"], "--via 'localhost:9090': expected ws://HOST:PORT"),
+    (["--via", "ws://127.0.0.1:1", "--relay"], "not allowed with argument"),
+])
+def test_via_mistakes_are_one_line_and_exit_2(argv: list[str], line: str,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    try:
+        code = main(["sim", *argv])
+    except SystemExit as exc:  # argparse's own usage errors
+        code = exc.code
+    assert code == 2
+    assert line in capsys.readouterr().err
