@@ -20,6 +20,7 @@ import time
 from typing import Any
 
 import aiohttp
+from bench_support import emit
 
 from frog_bt.commands.console_options import ConsoleSettings, start_people
 from frog_bt.config import load_site
@@ -75,7 +76,7 @@ async def one(clients: int) -> dict[str, Any]:
             "latency_ms": [round(1000 * s, 1) for s in seen]}
 
 
-async def main(clients: int, runs: int) -> None:
+async def main(clients: int, runs: int, out: str | None = None) -> None:
     off, on, latency = [], [], []
     for _ in range(runs):  # alternate, so that load drifts hit both alike
         off.append((await one(0))["tick_p50_us"])
@@ -90,11 +91,17 @@ async def main(clients: int, runs: int) -> None:
         latency.sort()
         print(f"new phase to page: p50 {statistics.median(latency):.1f} ms, "
               f"max {latency[-1]:.1f} ms over {len(latency)} deliveries")
+    emit({"clients": clients, "runs": runs, "tick_p50_off_us": p50_off,
+          "tick_p50_on_us": p50_on, "overhead_pct": 100 * (p50_on / p50_off - 1),
+          "latency_p50_ms": statistics.median(latency) if latency else None,
+          "latency_max_ms": latency[-1] if latency else None,
+          "deliveries": len(latency)}, out)
 
 
 if __name__ == "__main__":
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--clients", type=int, default=10)
     p.add_argument("--runs", type=int, default=3)
+    p.add_argument("--out", help="write the figures as JSON here")
     a = p.parse_args()
-    asyncio.run(main(a.clients, a.runs))
+    asyncio.run(main(a.clients, a.runs, a.out))

@@ -23,7 +23,7 @@ from typing import Any
 
 from bench_support import SCRIPTS
 
-SECTIONS = ("startup", "ticks", "reaction", "ingest", "replay", "memory")
+SECTIONS = ("startup", "ticks", "reaction", "ingest", "replay", "memory", "console")
 PHASES = ("waiting", "undocking", "recruiting", "driving", "content", "returning", "other")
 
 
@@ -40,6 +40,7 @@ def plan(quick: bool) -> dict[str, list[tuple[str, list[str]]]]:
         "replay": [("replay", ["--minutes", "10" if quick else "60"])],
         "memory": [("off", ["--tours", "10" if quick else "100"])]
         + ([] if quick else [("on", ["--tours", "30", "--telemetry", "on"])]),
+        "console": [("console", ["--clients", "10", "--runs", "1" if quick else "3"])],
     }
 
 
@@ -158,6 +159,12 @@ def budgets(results: dict[str, Any]) -> list[dict[str, Any]]:
         rows.add(f"RSS growth with telemetry, tour 1 -> {mem_on['tours']} "
                  f"({mem_on['rss_first_kb'] / 1024:.1f} -> {mem_on['rss_last_kb'] / 1024:.1f}"
                  " MiB)", mem_on["growth_pct"], " %", "≤ 5 %", lambda v: v <= 5, "{:.1f}")
+    console = get(results, "console", "console") or {}
+    if "overhead_pct" in console:
+        rows.add(f"console overhead on tick p50, {console['clients']} pages",
+                 console["overhead_pct"], " %", "≤ 5 %", lambda v: v <= 5, "{:.1f}")
+        rows.add("console: a new phase reaches every page, max", console["latency_max_ms"],
+                 " ms", "≤ 500 ms", lambda v: v <= 500, "{:.1f}")
     return rows.rows
 
 

@@ -273,6 +273,8 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
             changed.set()
         elif what in ("ended", "aborted") and state["open"]:
             state["open"] = False
+            if killed_during_open[0]:
+                report.resumed += 1  # carried on to its end by the restarted executive
             killed_during_open[0] = False
             if what == "ended":
                 report.completed += 1
@@ -295,8 +297,10 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
             if time.monotonic() > deadline:
                 report.timed_out = True
                 break
-            due = [f for f in pending if f.tour == state["tour"] and state["open"]
-                   and sim.clock.now() - state["started_at"] >= f.delay]
+            due = [f for f in pending if state["open"] and (
+                (f.tour == state["tour"] and sim.clock.now() - state["started_at"] >= f.delay)
+                # a real server's restart whose tour ended first goes into the next one
+                or (server is not None and f.kind == "rosbridge" and f.tour < state["tour"]))]
             for fault in due:
                 pending.remove(fault)
                 await inject(fault, sim, site, executive, killed_during_open, server)

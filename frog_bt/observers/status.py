@@ -32,7 +32,14 @@ def phase(core: Core) -> str:
         if isinstance(node, py_trees.decorators.Decorator):
             node = node.decorated
             continue
-        child = next((c for c in getattr(node, "children", ()) if c.status == running), None)
+        # A sequence's or selector's running child is its current_child (no scan of its
+        # children: this runs after every tick when the console is on); a parallel's is
+        # whichever of them runs.
+        child = getattr(node, "current_child", None)
+        if child is None or child.status != running \
+                or isinstance(node, py_trees.composites.Parallel):
+            child = next((c for c in getattr(node, "children", ()) if c.status == running),
+                         None)
         if child is None:
             return node.status.value.lower()
         if isinstance(node, py_trees.composites.Sequence):
