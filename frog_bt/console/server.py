@@ -6,7 +6,7 @@ aiohttp serves (``web.AppRunner`` + ``TCPSite``):
 * ``GET /api/state`` — the state (:func:`frog_bt.console.state.state`);
 * ``GET /api/site`` — the static map; ``GET /api/tree`` — the whole tree, with statuses;
 * ``GET /api/stream`` — a WebSocket pushing the state at most every ``console.push_every``
-  seconds, and at once when the phase changes;
+  seconds, and within 50 ms of a new phase or a command;
 * ``POST /api/command`` — ``{"command": C}`` (``"id"`` with ``ack_alert``), with
   ``Authorization: Bearer TOKEN``: 200 ``{"ok": true, "did"}`` once applied at the next
   tick, 409 ``{"ok": false, "reason"}`` when the tour cannot do it now, 400 malformed or
@@ -35,6 +35,7 @@ from aiohttp import WSMsgType, web
 
 from frog_bt.console.day import Day
 from frog_bt.console.state import LogLines, StopClock, site_map, state, tree
+from frog_bt.observers.status import phase
 from frog_bt.runtime.operator import Command
 
 if TYPE_CHECKING:
@@ -43,6 +44,7 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 Handler = Callable[[web.Request], Awaitable[web.StreamResponse]]
 SEND_TIMEOUT = 2.0  # seconds a pushed state may take to reach one page; then it is dropped
+PHASE_POLL = 0.05  # wall seconds between looks at the phase (a new one is pushed at once)
 CLOSE_TIMEOUT = 1.0  # seconds the server waits for open requests when it stops
 
 
@@ -106,7 +108,6 @@ class Console:
     def attach(self) -> None:
         """The day's tally and the phase watch on the executive's taps; the log lines."""
         self.day.attach(self.executive)
-        self.executive.taps.tick.append(self._on_tick)
         logging.getLogger("frog_bt").addHandler(self.logs)
 
     async def start(self) -> None:
@@ -192,14 +193,6 @@ class Console:
 
     # ------------------------------------------------------------ pushed state
 
-    def _on_tick(self, core: object) -> None:
-        from frog_bt.observers.status import phase
-
-        now_phase = phase(self.executive.core)
-        if now_phase != self._phase:
-            self._phase = now_phase
-            self._changed.set()  # a new phase: push at once
-
     async def _stream(self, request: web.Request) -> web.WebSocketResponse:
         ws = web.WebSocketResponse(heartbeat=30.0)
         await ws.prepare(request)
@@ -214,18 +207,26 @@ class Console:
         return ws
 
     async def _push(self) -> None:
-        """Every ``push_every`` seconds (sooner on a new phase), the state to every page;
-        a page that does not take it within :data:`SEND_TIMEOUT` is dropped."""
-        last = ""
+        """The state to every page every ``push_every`` seconds, and within
+        :data:`PHASE_POLL` of a new phase or a command; a page that does not take it within
+        :data:`SEND_TIMEOUT` is dropped. The phase is looked at here, between ticks, not
+        after each tick: the console costs the tick nothing."""
+        loop = asyncio.get_running_loop()
+        last, last_at = "", 0.0
         while True:
             # asyncio.timeout, not wait_for: on Python 3.11 wait_for can swallow a cancel
             # that meets the event being set, and close() would then wait for ever
             with contextlib.suppress(TimeoutError):
-                async with asyncio.timeout(self.push_every):
+                async with asyncio.timeout(PHASE_POLL):
                     await self._changed.wait()
+            now_phase = phase(self.executive.core)
+            due = (self._changed.is_set() or now_phase != self._phase
+                   or loop.time() - last_at >= self.push_every)
             self._changed.clear()
-            if not self._sockets:
+            self._phase = now_phase
+            if not due or not self._sockets:
                 continue
+            last_at = loop.time()
             text = json.dumps(self.snapshot())
             if text == last:
                 continue
