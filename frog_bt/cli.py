@@ -20,6 +20,7 @@ COMMANDS = {
     "leaves": ("frog_bt.commands.leaves", "list every node type: parameters, keys, docs"),
     "schema": ("frog_bt.commands.schema", "print the JSON Schema of tree files or the site"),
     "replay": ("frog_bt.commands.replay", "re-run a recorded tour offline"),
+    "report": ("frog_bt.commands.report", "what recorded tours tell: rows, totals, plots"),
     "init": ("frog_bt.commands.init", "write an editable copy of the tour and the site config"),
     "ctl": ("frog_bt.commands.ctl", "send an operator command to a running console"),
 }

@@ -23,7 +23,8 @@ from typing import Any
 
 from bench_support import SCRIPTS
 
-SECTIONS = ("startup", "ticks", "reaction", "ingest", "replay", "memory", "console")
+SECTIONS = ("startup", "ticks", "reaction", "ingest", "replay", "memory", "console",
+            "report")
 PHASES = ("waiting", "undocking", "recruiting", "driving", "content", "returning", "other")
 
 
@@ -41,6 +42,8 @@ def plan(quick: bool) -> dict[str, list[tuple[str, list[str]]]]:
         "memory": [("off", ["--tours", "10" if quick else "100"])]
         + ([] if quick else [("on", ["--tours", "30", "--telemetry", "on"])]),
         "console": [("console", ["--clients", "10", "--runs", "1" if quick else "3"])],
+        "report": [("report", ["--tours", "20" if quick else "100", "--runs", "1" if quick
+                               else "2"])],
     }
 
 
@@ -165,6 +168,13 @@ def budgets(results: dict[str, Any]) -> list[dict[str, Any]]:
                  console["overhead_pct"], " %", "≤ 5 %", lambda v: v <= 5, "{:.1f}")
         rows.add("console: a new phase reaches every page, max", console["latency_max_ms"],
                  " ms", "≤ 500 ms", lambda v: v <= 500, "{:.1f}")
+    rep = get(results, "report", "report") or {}
+    if "report_vs_plain_read" in rep:
+        rows.add(f"report throughput vs reading every message with mcap ({rep['tours']} "
+                 "tours)", 100 * rep["report_vs_plain_read"], " %", "≥ 50 %",
+                 lambda v: v >= 50, "{:.0f}")
+        rows.add("report --jobs 2 vs one job", rep["two_jobs_speedup"], " x", "≥ 1.6 x",
+                 lambda v: v >= 1.6, "{:.2f}")
     return rows.rows
 
 

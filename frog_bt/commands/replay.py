@@ -16,7 +16,8 @@ differently on the same inputs:
 Batch what-if over a corpus (several files, or directories of *.mcap): one line
 per tour (identical, diverged with its first divergence, or unreadable and
 skipped), then a summary grouping the divergences by node and what differs;
---jobs N replays N files at a time (processes), --report FILE writes it as JSON.
+--jobs N replays N files at a time (processes), --scheduler ADDRESS on a
+dask.distributed cluster instead, --report FILE writes it as JSON.
 Exit 0 only when every tour replays identically.
 
   frog-bt replay recordings/ --config what-if/site.yaml --jobs 2 --report out.json
@@ -55,6 +56,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="corpus: recordings replayed at a time, in processes (default 1)")
     p.add_argument("--report", type=Path, metavar="FILE.json",
                    help="corpus: write every tour's row and the summary as JSON")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="corpus: run on this dask.distributed scheduler (tcp://HOST:PORT) "
+                        "instead of local processes (pip install 'frog-bt[fleet]')")
 
 
 class Progress:
@@ -87,18 +91,17 @@ class Progress:
 
 
 def run(args: argparse.Namespace) -> int:
-    if len(args.files) > 1 or args.files[0].is_dir() or args.report or args.jobs != 1:
+    if (len(args.files) > 1 or args.files[0].is_dir() or args.report or args.jobs != 1
+            or args.scheduler):
         return run_corpus(args)
     args.file = args.files[0]
     return run_one(args)
 
 
 def run_corpus(args: argparse.Namespace) -> int:
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
     from frog_bt.tools import replay as _replay  # noqa: F401 - imported once, before the fork
     from frog_bt.tools.corpus import recordings, replay_corpus, summary, summary_line
+    from frog_bt.tools.executors import ExecutorError, executor
 
     if args.rerun:
         print("frog-bt replay: --rerun takes one recording", file=sys.stderr)
@@ -118,18 +121,19 @@ def run_corpus(args: argparse.Namespace) -> int:
         print("frog-bt replay: no recordings (*.mcap) found", file=sys.stderr)
         return 2
     bar = None if args.quiet or not sys.stderr.isatty() else CountBar(sys.stderr)
-    # Forked workers start with the modules already imported (~0.5 s each otherwise);
-    # where fork is unavailable, the platform's default start method. The site goes
-    # with each task.
-    methods = multiprocessing.get_all_start_methods()
-    context = multiprocessing.get_context("fork" if "fork" in methods else None)
-    with ProcessPoolExecutor(max_workers=args.jobs, mp_context=context) as pool:
-        rows = []
-        for row in replay_corpus(files, args.tree, site, pool, bar):
-            rows.append(row)
-            if bar is not None:
-                bar.clear()
-            print(row.line(), flush=True)
+    # Processes (forked: workers start with the modules imported), or a dask cluster;
+    # the site goes with each task.
+    rows = []
+    try:
+        with executor(args.jobs, args.scheduler) as pool:
+            for row in replay_corpus(files, args.tree, site, pool, bar):
+                rows.append(row)
+                if bar is not None:
+                    bar.clear()
+                print(row.line(), flush=True)
+    except ExecutorError as exc:
+        print(f"frog-bt replay: {exc}", file=sys.stderr)
+        return 2
     if bar is not None:
         bar.clear()
     totals = summary(rows)
@@ -171,12 +175,14 @@ def report(result: Any, site: Any) -> dict[str, Any]:
 class CountBar:
     """A one-line progress bar over the corpus, on a terminal."""
 
-    def __init__(self, out: TextIO) -> None:
+    def __init__(self, out: TextIO, label: str = "replay", unit: str = "tours") -> None:
         self.out = out
+        self.label, self.unit = label, unit
 
     def __call__(self, done: int, total: int) -> None:
         filled = round(done / max(total, 1) * BAR)
-        self.out.write(f"\rreplay [{'#' * filled}{'-' * (BAR - filled)}] {done}/{total} tours")
+        self.out.write(f"\r{self.label} [{'#' * filled}{'-' * (BAR - filled)}] "
+                       f"{done}/{total} {self.unit}")
         self.out.flush()
 
     def clear(self) -> None:

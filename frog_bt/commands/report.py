@@ -1,0 +1,116 @@
+"""What the recorded tours tell: one row per tour, totals and rates, plots.
+
+Reads MCAP recordings (files, or directories of *.mcap, as `frog-bt run --record DIR`
+writes them) without re-running the tree, joins the pieces of a tour cut by a
+restart, and writes:
+
+  -o FILE.html    the report: summary, plots and every tour, in one self-contained
+                  file (no network needed to open it)
+  --csv FILE      one row per tour, for pandas or R
+  --parquet FILE  the same rows as Parquet
+
+A file that is not a recording, or is damaged beyond reading, is reported and
+skipped; one cut short (kill -9) is read up to the cut. --jobs N reads N files at a
+time (processes); --scheduler ADDRESS runs the same work on a dask.distributed
+cluster. The plots and Parquet need the `report` extra (matplotlib, pyarrow), the
+cluster the `fleet` extra (dask.distributed). Columns and figures: docs/REPORT.md.
+
+  frog-bt report recordings/ -o season.html --csv season.csv --jobs 2
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from frog_bt.commands.options import add_tree_and_config
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("files", type=Path, nargs="+", metavar="FILE_OR_DIR",
+                   help="recordings: MCAP files, or directories of them")
+    add_tree_and_config(p, tree=False)
+    p.add_argument("-o", "--output", type=Path, metavar="FILE.html",
+                   help="write the HTML report here")
+    p.add_argument("--csv", type=Path, metavar="FILE", help="write the rows as CSV")
+    p.add_argument("--parquet", type=Path, metavar="FILE", help="write the rows as Parquet")
+    p.add_argument("--json", type=Path, metavar="FILE",
+                   help="write the totals and the rows as JSON")
+    p.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="files read at a time, in processes (default 1)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on this dask.distributed scheduler (tcp://HOST:PORT) instead")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def run(args: argparse.Namespace) -> int:
+    from frog_bt.commands.replay import CountBar
+    from frog_bt.config import load_site
+    from frog_bt.errors import DefinitionError, error_lines
+    from frog_bt.report import outputs
+    from frog_bt.report.corpus import read_corpus
+    from frog_bt.report.rows import rows as tour_rows
+    from frog_bt.report.totals import totals
+    from frog_bt.tools.corpus import recordings
+    from frog_bt.tools.executors import ExecutorError, executor
+
+    if args.jobs < 1:
+        print(f"frog-bt report: --jobs {args.jobs}: expected 1 or more", file=sys.stderr)
+        return 2
+    try:
+        site = load_site(args.config)
+    except DefinitionError as exc:
+        for line in error_lines(exc):
+            print(f"frog-bt report: {line}", file=sys.stderr)
+        return 2
+    missing = [str(f) for f in args.files if not f.exists()]
+    if missing:
+        print(f"frog-bt report: no such file or directory: {', '.join(missing)}",
+              file=sys.stderr)
+        return 2
+    files = recordings(args.files)
+    if not files:
+        print("frog-bt report: no recordings (*.mcap) found", file=sys.stderr)
+        return 2
+    bar = None if args.quiet or not sys.stderr.isatty() else CountBar(sys.stderr, "report",
+                                                                       "files")
+    try:
+        with executor(args.jobs, args.scheduler) as pool:
+            facts = read_corpus(files, site, pool, bar)
+    except ExecutorError as exc:
+        print(f"frog-bt report: {exc}", file=sys.stderr)
+        return 2
+    if bar is not None:
+        bar.clear()
+    skipped = [f"{f.file}: {f.error}" for f in facts if f.error]
+    for line in skipped:
+        print(f"frog-bt report: skipped {line}", file=sys.stderr)
+    for f in facts:
+        if f.recovered and not f.error:
+            print(f"frog-bt report: {f.file}: {f.recovered}", file=sys.stderr)
+    rows = tour_rows([f for f in facts if not f.error], site)
+    face_stops = [s.poi for s in site.tour.stops if s.face_stream]
+    t = totals(rows, face_stops, unreadable=len(skipped))
+    rate = t["completion_rate"]
+    print(f"frog-bt report: {len(files)} files, {t['tours']} tours, {t['completed']} "
+          f"completed ({'-' if rate is None else f'{100 * rate:.1f} %'}), "
+          f"{t['resumed']} resumed, {len(skipped)} skipped")
+    try:
+        if args.csv:
+            outputs.write_csv(rows, args.csv)
+        if args.parquet:
+            outputs.write_parquet(rows, args.parquet)
+        if args.json:
+            args.json.write_text(json.dumps({"totals": t, "tours": [r.as_dict() for r in rows],
+                                             "skipped": skipped}, indent=1) + "\n")
+        if args.output:
+            outputs.write_html(rows, t, args.output, "FROG tours: what they tell", skipped)
+    except outputs.MissingExtra as exc:
+        print(f"frog-bt report: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"frog-bt report: cannot write: {exc}", file=sys.stderr)
+        return 2
+    return 0

@@ -1,0 +1,183 @@
+"""`frog-bt report` over a seeded corpus of real recorded tours (scripts/corpus): the
+figures against what the corpus was seeded with, the three outputs, the executor seam
+(processes and a local dask cluster), and files that are cut short, foreign or pieces
+of a resumed tour."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+import sys
+from datetime import datetime
+from html.parser import HTMLParser
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from frog_bt.cli import main
+from frog_bt.config import load_site
+from frog_bt.report.facts import FileFacts, Piece, StopFacts
+from frog_bt.report.rows import join, rows
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+from corpus_run import make
+
+SEED = 6  # one day: engaged, declines, wander_off, fault, wander_off, bored; 4 afternoon
+
+
+@pytest.fixture(scope="module")
+def corpus(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    out = tmp_path_factory.mktemp("season")
+    return out, make(out, days=1, per_day=6, seed=SEED, jobs=2)
+
+
+def report(tmp_path: Path, *args: str) -> dict[str, Any]:
+    target = tmp_path / "out.json"
+    assert main(["report", *args, "--json", str(target), "--quiet"]) == 0
+    return json.loads(target.read_text())
+
+
+def test_the_figures_are_those_the_corpus_was_seeded_with(corpus, tmp_path) -> None:
+    directory, manifest = corpus
+    seeded = manifest["tours"]
+    kinds = [t["kind"] for t in seeded]
+    got = report(tmp_path, str(directory))
+    t, tours = got["totals"], got["tours"]
+    assert t["tours"] == len(seeded) == 6
+    assert t["tours_per_day"] == {"2026-06-01": 6}
+    hours: dict[str, int] = {}
+    for s in seeded:
+        hour = str(datetime.fromisoformat(s["start"]).hour)
+        hours[hour] = hours.get(hour, 0) + 1
+    assert t["tours_per_hour"] == hours
+    # the fault aborts its tour; every other kind completes
+    assert t["completed"] == len(seeded) - kinds.count("fault")
+    assert [r["ended"] for r in tours] == ["aborted" if k == "fault" else "ended"
+                                           for k in kinds]
+    assert t["failure_causes"] == {
+        "aborted: electronics fault: motors: motor driver overheated": 1,
+        "fault: motors: motor driver overheated": 1}
+    # one invitation each; a second after a decline or a visitor who wandered off
+    assert t["invitations"] == 6 + kinds.count("declines") + kinds.count("wander_off")
+    assert t["invitations_declined"] == kinds.count("declines")
+    assert [r["introduction"] for r in tours] == ["accepted"] * 6
+    # the engagement gate: part b for every visitor but the bored one
+    assert t["part_b_rate"] == {"POI1": 5 / 6, "POI2": 5 / 6}
+    for r, kind in zip(tours, kinds, strict=True):
+        engagement = json.loads(r["engagement"])
+        assert engagement["POI1"]["decision"] == ("a only" if kind == "bored" else "b")
+        assert engagement["POI1"]["samples"] > 0
+    # the time-of-day variant the site picks for the tour's start
+    site = load_site()
+    for r, s in zip(tours, seeded, strict=True):
+        at = datetime.fromisoformat(s["start"]).time()
+        assert r["variants"].split(";")[0] == site.waypoint_for("POI1", at)
+    assert t["distance_m"] > 0 and all(r["distance_m"] > 100 for r in tours)
+    assert t["resumed"] == 0
+
+
+def test_csv_parquet_and_a_self_contained_html(corpus, tmp_path) -> None:
+    pq = pytest.importorskip("pyarrow.parquet")
+    directory, _ = corpus
+    out = tmp_path / "r.html"
+    assert main(["report", str(directory), "-o", str(out), "--csv", str(tmp_path / "r.csv"),
+                 "--parquet", str(tmp_path / "r.parquet"), "--quiet"]) == 0
+    with open(tmp_path / "r.csv", newline="") as f:
+        table = list(csv.DictReader(f))
+    assert len(table) == 6 and table[0]["day"] == "2026-06-01"
+    parquet = pq.read_table(tmp_path / "r.parquet").to_pylist()
+    assert [r["tour"] for r in parquet] == [int(r["tour"]) for r in table]
+    assert [r["ended"] for r in parquet] == [r["ended"] for r in table]
+
+    class Page(HTMLParser):
+        def __init__(self) -> None:
+            super().__init__()
+            self.images: list[str] = []
+            self.links: list[str] = []
+            self.in_totals = False
+            self.totals = ""
+
+        def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+            a = dict(attrs)
+            if tag == "img":
+                self.images.append(a.get("src") or "")
+            for key in ("src", "href"):
+                if a.get(key) and tag != "img":
+                    self.links.append(a[key] or "")
+            self.in_totals = tag == "script" and a.get("id") == "totals"
+
+        def handle_data(self, data: str) -> None:
+            if self.in_totals:
+                self.totals += data
+
+    page = Page()
+    page.feed(out.read_text())
+    assert len(page.images) >= 5
+    assert all(src.startswith("data:image/png;base64,") for src in page.images)
+    assert page.links == []  # nothing to fetch: it opens offline
+    assert json.loads(page.totals)["tours"] == 6
+
+
+def test_two_jobs_and_a_dask_cluster_give_the_same_rows(corpus, tmp_path) -> None:
+    distributed = pytest.importorskip("distributed")
+    directory, _ = corpus
+    one = report(tmp_path, str(directory))
+    two = report(tmp_path, str(directory), "--jobs", "2")
+    assert two == one
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  protocol="tcp://", host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        fleet = report(tmp_path, str(directory), "--scheduler", cluster.scheduler_address)
+        first = sorted(directory.glob("*.mcap"))[0]
+        assert main(["replay", str(first), "--scheduler", cluster.scheduler_address,
+                     "--quiet"]) == 0  # batch replay through the same seam: identical
+    assert fleet == one
+
+
+def test_a_cut_file_is_read_to_the_cut_and_a_foreign_one_is_skipped(corpus, tmp_path,
+                                                                     capsys) -> None:
+    directory, _ = corpus
+    files = sorted(directory.glob("*.mcap"))
+    work = tmp_path / "mixed"
+    work.mkdir()
+    shutil.copy(files[0], work / files[0].name)
+    data = files[1].read_bytes()
+    (work / files[1].name).write_bytes(data[: len(data) // 2])  # killed half-way
+    (work / "notes.mcap").write_text("not a recording")
+    got = report(tmp_path, str(work))
+    err = capsys.readouterr().err
+    assert "skipped " in err and "notes.mcap: not an MCAP file" in err
+    assert "cut short" in err
+    assert got["totals"]["tours"] == 2 and got["totals"]["unreadable_files"] == 1
+    assert [r["ended"] for r in got["tours"]] == ["ended", "cut"]
+
+
+def test_the_pieces_of_a_resumed_tour_are_joined_into_one() -> None:
+    site = load_site()
+    before = Piece("a.mcap", first_seq=1, started=100.0, t0=100.0, t1=400.0,
+                   stops=[StopFacts("POI1", "POI1a", "ab", 200.0, 220.0)], distance=50.0)
+    after = Piece("b.mcap", first_seq=1, started=None, t0=420.0, t1=900.0, ended="ended",
+                  stops=[StopFacts("POI2", "POI2a", "a", 450.0, 460.0)], distance=70.0)
+    after_rotation = Piece("c.mcap", first_seq=40, started=None, t0=1000.0, t1=1100.0,
+                           ended="ended", stops=[StopFacts("POI1", "POI1a", "a", 1010.0,
+                                                           1020.0)])
+    opened = Piece("c0.mcap", first_seq=39, started=990.0, t0=990.0, t1=990.0)
+    tours = join([FileFacts("b.mcap", [after]), FileFacts("a.mcap", [before]),
+                  FileFacts("c.mcap", [after_rotation]), FileFacts("c0.mcap", [opened])])
+    assert [len(t.pieces) for t in tours] == [2, 2]
+    assert [t.resumed for t in tours] == [True, False]  # a new executive, then a rotation
+    first = rows([FileFacts("a.mcap", [before]), FileFacts("b.mcap", [after])], site)[0]
+    assert (first.files, first.stops_visited, first.distance_m, first.ended,
+            first.duration_s) == ("a.mcap;b.mcap", "POI1;POI2", 120.0, "ended", 800.0)
+
+
+def test_mistakes_are_one_line_and_exit_2(tmp_path, capsys) -> None:
+    assert main(["report", str(tmp_path / "nowhere")]) == 2
+    assert "no such file or directory" in capsys.readouterr().err
+    assert main(["report", str(tmp_path)]) == 2
+    assert "no recordings (*.mcap) found" in capsys.readouterr().err
+    (tmp_path / "x.mcap").write_text("x")
+    assert main(["report", str(tmp_path), "--jobs", "0"]) == 2
+    assert "--jobs 0: expected 1 or more" in capsys.readouterr().err
