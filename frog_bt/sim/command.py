@@ -13,6 +13,13 @@ Or put a rosbridge server between them (a real rosbridge_suite; or `frog-bt sim
     frog-bt sim --via ws://127.0.0.1:9190 --speed 10
     frog-bt run --rosbridge ws://127.0.0.1:9190 --sim-time
 
+Or play a recorded tour (the seed's recorded-data simulator), open loop: its robot-side
+inputs over rosbridge on the recording's own clock (--speed, default 1x), its front-end
+events over UDP; the commands of the executive run against it are held against the
+recorded ones, and the first difference is printed in replay's terms:
+
+    frog-bt sim --play recordings/20260601-103012-tour0003.mcap --speed 10 [--loop]
+
 Time: the simulator is the master clock. It publishes /clock, starting at the
 scenario's start_time, and runs `speed` times faster than real time (--speed
 overrides the scenario; 50 = 50x). When the machine cannot keep up, simulated
@@ -147,10 +154,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                        help="serve no rosbridge: be the robot as a client of this rosbridge "
                             "server (a real rosbridge_suite, say); the executive connects "
                             "to the same server")
+    where.add_argument("--play", type=Path, metavar="FILE.mcap",
+                       help="serve a recorded tour's robot-side inputs on the recording's own "
+                            "clock, and its front-end events over UDP, open loop; say where a "
+                            "new executive's commands differ from the recorded ones")
     where.add_argument("--relay", action="store_true",
                        help="only a rosbridge server with no robot inside, on --rosbridge: "
                             "publishes from one client go to the others' subscriptions "
                             "(a stand-in for rosbridge_suite, for --via)")
+    parser.add_argument("--loop", action="store_true",
+                        help="with --play: play the recording again from its start, for ever "
+                             "(the clock goes on forward)")
     parser.add_argument("--log", action="store_true",
                         help="print every message as it is sent or received, one line each")
 
@@ -179,6 +193,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"frog-bt sim: --via {args.via!r}: expected ws://HOST:PORT", file=sys.stderr)
             return 2
     try:
+        if args.play is not None:
+            return asyncio.run(_play(args))
         if args.relay:
             return asyncio.run(_relay(args))
         return asyncio.run(_serve(args, scenario, pois))
@@ -245,4 +261,54 @@ async def _relay(args: argparse.Namespace) -> int:
     await _stop_on_signals()
     await server.stop()
     print("frog-bt sim: stopped", flush=True)
+    return 0
+
+
+async def _play(args: argparse.Namespace) -> int:
+    from frog_bt.config import load_site
+    from frog_bt.sim.play import Player, PlayError, load
+
+    site = load_site(args.config)
+    try:
+        played = load(args.play, site)
+    except PlayError as exc:
+        print(f"frog-bt sim: --play: {exc}", file=sys.stderr)
+        return 2
+    speed = args.speed or 1.0
+
+    def differ(text: str) -> None:
+        print(f"frog-bt sim: the executive parted from the recording {text}", flush=True)
+
+    player = Player(played, site, host=args.rosbridge[0], rosbridge_port=args.rosbridge[1],
+                    frontend_host=args.frontend[0], frontend_port=args.frontend[1],
+                    executive=args.executive, speed=speed, loop=args.loop,
+                    secret=args.secret, on_difference=differ)
+    try:
+        await player.start()
+    except OSError as exc:
+        print(f"frog-bt sim: cannot listen: {exc}", file=sys.stderr)
+        return 1
+    print(f"frog-bt sim: playing {', '.join(played.files)} ({len(played.inputs)} inputs, "
+          f"{len(played.events)} front-end events, {played.end - played.start:.0f} s) at "
+          f"{speed:g}x{' in a loop' if args.loop else ''}: rosbridge "
+          f"ws://{args.rosbridge[0]}:{player.rosbridge.port}, front end udp "
+          f"{args.frontend[0]}:{player.udp.port} -> executive "
+          f"{args.executive[0]}:{args.executive[1]}; it starts when an executive subscribes "
+          "to /clock", flush=True)
+    stopping = _stop_on_signals()
+    over = asyncio.create_task(player.over.wait())
+    clock = asyncio.create_task(player.wait())
+    await asyncio.wait([stopping, over, clock], return_when=asyncio.FIRST_COMPLETED)
+    if over.done() and not stopping.done():
+        print(f"frog-bt sim: the recording is over; {player.comparison.line()}; the clock "
+              "goes on until interrupted", flush=True)
+        await asyncio.wait([stopping, clock], return_when=asyncio.FIRST_COMPLETED)
+    for task in (stopping, over, clock):
+        task.cancel()
+    try:
+        await player.stop()
+    except Exception as exc:  # the time loop died of a bug; it was logged
+        print(f"frog-bt sim: play failed: {exc!r}", file=sys.stderr)
+        return 1
+    print(f"frog-bt sim: stopped; {player.comparison.line()}", flush=True)
     return 0
