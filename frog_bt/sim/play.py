@@ -47,6 +47,7 @@ DT = 0.1  # simulated seconds per step of the time loop (a /clock each)
 WAIT_POLL = 0.01  # wall seconds between looks for an executive's /clock subscription
 SUBSCRIBE_GRACE = 0.3  # wall seconds for its other subscriptions, after /clock's
 SEQ_PER_PASS = 1_000_000  # --loop: front-end seqs of pass n are the recorded ones + n x this
+PASS_TAIL = 5.0  # recording seconds of /clock after its end before a pass counts as over
 METER_TOLERANCE = 0.1  # engagement meter levels this close are the same reading
 
 
@@ -138,9 +139,20 @@ class Comparison:
     first: str = ""  # the first difference, in domain terms
     _expected: dict[str, deque[Command]] = field(default_factory=dict)
 
+    missed: int = 0  # recorded commands of earlier passes (--loop) never received
+    beyond: int = 0  # received when the recording had no more of their stream
+
     def __post_init__(self) -> None:
+        self.next_pass(0.0)
+
+    def next_pass(self, offset: float) -> None:
+        """Expect the recorded commands (again, ``offset`` seconds later: ``--loop``); what
+        the last pass still expected was not received."""
+        self.missed += self.missing
+        self._expected = {}
         for command in self.recorded:
-            self._expected.setdefault(_stream(command), deque()).append(command)
+            later = Command(command.t + offset, command.channel, command.payload)
+            self._expected.setdefault(_stream(command), deque()).append(later)
 
     def got(self, command: Command) -> str | None:
         """Take one command received; the description of the difference when it differs."""
@@ -152,7 +164,10 @@ class Comparison:
             self.meter_differ += not (expected is not None and _same(expected, command))
             return None
         self.received += 1
-        if expected is not None and _same(expected, command):
+        if expected is None:
+            self.beyond += 1  # the recording has no more of these: nothing to hold it to
+            return None
+        if _same(expected, command):
             return None
         self.differ += 1
         text = differences(expected, command, self.site)
@@ -167,8 +182,10 @@ class Comparison:
 
     def line(self) -> str:
         text = f"commands: {self.received} received, {self.differ} differ from the recording"
-        if self.missing:
-            text += f", {self.missing} recorded not received"
+        if self.missing + self.missed:
+            text += f", {self.missing + self.missed} recorded not received"
+        if self.beyond:
+            text += f", {self.beyond} past the recorded ones"
         if self.first:
             text += f"; first difference {self.first}"
         if self.meter:
@@ -255,7 +272,7 @@ class Player:
         loop = asyncio.get_running_loop()
         played = self.played
         offset = 0.0  # each pass of --loop runs later: the clock never goes back
-        length = played.end - played.start + DT
+        length = played.end - played.start + PASS_TAIL + DT
         while True:
             i = j = 0
             t = played.start
@@ -272,7 +289,7 @@ class Player:
                     self.udp.send(self._numbered(played.events[j][1]))
                     self.events_sent += 1
                     j += 1
-                if t > played.end:
+                if t > played.end + PASS_TAIL:
                     break
                 t += DT
                 deadline += DT / self.speed
@@ -287,6 +304,7 @@ class Player:
                 await self._clock_on(t + offset)
                 return
             offset += length  # the next pass starts where this one ended
+            self.comparison.next_pass(offset)
 
     def _numbered(self, data: bytes) -> bytes:
         """A front-end event of a later pass numbered after the earlier ones (the same seq
