@@ -49,7 +49,7 @@ def test_run_once_against_a_played_tour_reaches_its_end(recorded: Path) -> None:
         listen = probe.getsockname()[1]
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
     player = subprocess.Popen(
-        [sys.executable, "-m", "frog_bt", "sim", "--play", str(recorded), "--speed", "30",
+        [sys.executable, "-m", "frog_bt", "sim", "--play", str(recorded), "--speed", "60",
          "--rosbridge", "127.0.0.1:0", "--frontend", "127.0.0.1:0",
          "--executive", f"127.0.0.1:{listen}"],
         stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
