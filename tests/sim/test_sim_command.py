@@ -97,7 +97,9 @@ def test_a_tour_through_a_relay_with_the_robot_via_it(tmp_path: Path) -> None:
     """Three commands, as a deployer would try --via: a relaying server, the robot as its
     client, and `frog-bt run --once` against the server."""
     scenario = tmp_path / "fast.yaml"
-    scenario.write_text("extends: default\ncontent: {default: 10, introduction: 8}\n")
+    scenario.write_text("extends: default\ncontent: {default: 10, introduction: 8}\n"
+                        "navigation: {speed: 3.0, approach_time: 1.0}\n"
+                        "docking: {undock_time: 2, dock_time: 3}\n")
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         probe.bind(("127.0.0.1", 0))
         listen = probe.getsockname()[1]  # the executive's front-end port, free right now
