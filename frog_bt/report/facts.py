@@ -49,6 +49,7 @@ class StopFacts:
     edge_engaged: int = 0
     edge_total: int = 0
     face_stream: bool = False
+    a_end: float | None = None  # the front end said part a was done
 
     @property
     def seconds(self) -> float | None:
@@ -185,7 +186,8 @@ class _Reader:
         """The face samples stored since the stop's start, and the edge vote over them."""
         if not stop.face_stream or stop.start is None:
             return
-        levels = [level for ts, level in self.samples if ts <= t]  # since the stream began
+        end = stop.a_end if stop.a_end is not None else t
+        levels = [level for ts, level in self.samples if ts <= end]  # since the stream began
         stop.samples = len(levels)
         if levels:
             d = decide(np.asarray(levels), self.edge)
@@ -193,6 +195,10 @@ class _Reader:
 
     def frontend_in(self, t: float, msg: dict[str, Any]) -> None:
         kind = msg.get("type")
+        if kind == "content_done" and msg.get("part") == "a":
+            stop = self._stop(str(msg.get("poi")))
+            if stop is not None and stop.a_end is None:
+                stop.a_end = t  # the decision counts the samples up to here
         if kind in ("user_positive", "user_negative") and self.piece is not None \
                 and self.asked:
             self.asked = False
