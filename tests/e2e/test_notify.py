@@ -96,9 +96,14 @@ def test_the_executive_is_ready_pings_and_a_stopped_loop_stops_the_pings(
             await sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 60)
             running = heard[:] + await until_pings(3)
             proc.send_signal(signal.SIGSTOP)  # the loop can turn no more
-            await asyncio.sleep(0.3)  # what was in flight when it stopped arrives
+            deadline = loop.time() + 10.0
+            while not _stopped(proc.pid):  # the kernel has stopped it: nothing more is sent
+                assert loop.time() < deadline
+                await asyncio.sleep(0.01)
+            heard.extend(drain(sock))  # every ping sent before it stopped, now
             mark = len(heard)
-            await asyncio.sleep(1.0)  # ten intervals
+            await asyncio.sleep(1.0)  # the window watched: ten ping intervals
+            heard.extend(drain(sock))
             stopped = heard[mark:]
             proc.send_signal(signal.SIGCONT)
             resumed = await until_pings(2)
@@ -116,6 +121,12 @@ def test_the_executive_is_ready_pings_and_a_stopped_loop_stops_the_pings(
     assert any(line.startswith("STATUS=") for line in running)
     assert "WATCHDOG=1" not in stopped  # systemd would restart it now
     assert resumed.count("WATCHDOG=1") >= 2
+
+
+def _stopped(pid: int) -> bool:
+    """Is the process stopped (state T in /proc/PID/stat)?"""
+    with open(f"/proc/{pid}/stat") as f:
+        return f.read().rsplit(")", 1)[1].split()[0] in ("T", "t")
 
 
 def test_init_service_writes_a_notify_unit_with_a_watchdog_for_that_folder(
