@@ -21,6 +21,7 @@ cluster the `fleet` extra (dask.distributed). Columns and figures: docs/REPORT.m
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import sys
 from pathlib import Path
@@ -56,6 +57,10 @@ def run(args: argparse.Namespace) -> int:
     from frog_bt.tools.corpus import recordings
     from frog_bt.tools.executors import ExecutorError, executor
 
+    for wanted, module in ((args.output, "matplotlib"), (args.parquet, "pyarrow")):
+        if wanted is not None and importlib.util.find_spec(module) is None:
+            print(f"frog-bt report: {wanted} needs {module}: {outputs.EXTRA}", file=sys.stderr)
+            return 2  # said before reading anything
     if args.jobs < 1:
         print(f"frog-bt report: --jobs {args.jobs}: expected 1 or more", file=sys.stderr)
         return 2

@@ -181,3 +181,17 @@ def test_mistakes_are_one_line_and_exit_2(tmp_path, capsys) -> None:
     (tmp_path / "x.mcap").write_text("x")
     assert main(["report", str(tmp_path), "--jobs", "0"]) == 2
     assert "--jobs 0: expected 1 or more" in capsys.readouterr().err
+
+
+def test_without_the_report_extra_it_says_which_before_reading(corpus, tmp_path, capsys,
+                                                               monkeypatch) -> None:
+    import importlib.util
+
+    directory, _ = corpus
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == "matplotlib" else real(name, *a))
+    out, table = tmp_path / "r.html", tmp_path / "r.csv"
+    assert main(["report", str(directory), "-o", str(out), "--csv", str(table)]) == 2
+    assert "needs matplotlib: pip install 'frog-bt[report]'" in capsys.readouterr().err
+    assert not out.exists() and not table.exists()  # nothing half-written
