@@ -294,7 +294,7 @@ async def _play(args: argparse.Namespace) -> int:
           f"ws://{args.rosbridge[0]}:{player.rosbridge.port}, front end udp "
           f"{args.frontend[0]}:{player.udp.port} -> executive "
           f"{args.executive[0]}:{args.executive[1]}; it starts when an executive subscribes "
-          "to /clock", flush=True)
+          "(at most a minute from now)", flush=True)
     stopping = _stop_on_signals()
     over = asyncio.create_task(player.over.wait())
     clock = asyncio.create_task(player.wait())

@@ -44,8 +44,9 @@ from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 log = logging.getLogger(__name__)
 
 DT = 0.1  # simulated seconds per step of the time loop (a /clock each)
-WAIT_POLL = 0.01  # wall seconds between looks for an executive's /clock subscription
-SUBSCRIBE_GRACE = 0.3  # wall seconds for its other subscriptions, after /clock's
+WAIT_POLL = 0.01  # wall seconds between looks for an executive's first subscription
+SUBSCRIBE_GRACE = 0.3  # wall seconds for its other subscriptions, after the first
+WAIT_MAX = 60.0  # wall seconds waiting for a rosbridge client before playing anyway
 SEQ_PER_PASS = 1_000_000  # --loop: front-end seqs of pass n are the recorded ones + n x this
 PASS_TAIL = 5.0  # recording seconds of /clock after its end before a pass counts as over
 METER_TOLERANCE = 0.1  # engagement meter levels this close are the same reading
@@ -219,8 +220,10 @@ class Player:
     def __init__(self, played: Played, site: Site, *, host: str, rosbridge_port: int,
                  frontend_host: str, frontend_port: int, executive: Address,
                  speed: float = 1.0, loop: bool = False, secret: str | None = None,
-                 on_difference: Callable[[str], None] | None = None) -> None:
+                 on_difference: Callable[[str], None] | None = None,
+                 wait_max: float = WAIT_MAX) -> None:
         self.played = played
+        self.wait_max = wait_max
         self.speed = speed
         self.loop = loop
         self.now = played.start
@@ -260,11 +263,19 @@ class Player:
             await asyncio.shield(self._task)
 
     async def _wait_for_executive(self) -> None:
-        """Until a client subscribes to ``/clock`` (then a moment for its other
-        subscriptions): the recording starts for an executive, not before it."""
-        while not self.rosbridge.protocol.subscribers(CLOCK.name):
+        """Until a client subscribes to a topic it serves (then a moment for its other
+        subscriptions): the recording starts for an executive, not before it; after
+        ``wait_max`` wall seconds it starts anyway (a front end alone, say)."""
+        loop = asyncio.get_running_loop()
+        give_up = loop.time() + self.wait_max
+        protocol = self.rosbridge.protocol
+        while not any(protocol.subscribers(topic) for topic in self.played.types):
+            if loop.time() >= give_up:
+                log.warning("no rosbridge client after %.0f s: playing anyway", self.wait_max)
+                break
             await asyncio.sleep(WAIT_POLL)
-        await asyncio.sleep(SUBSCRIBE_GRACE)
+        else:
+            await asyncio.sleep(SUBSCRIBE_GRACE)
         self.executive_seen.set()
 
     async def _run(self) -> None:

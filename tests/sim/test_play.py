@@ -98,3 +98,37 @@ def test_a_file_that_is_no_recording_is_one_line_and_exit_2(tmp_path, capsys) ->
     bad.write_text("hello")
     assert main(["sim", "--play", str(bad)]) == 2
     assert f"frog-bt sim: --play: {bad}: not an MCAP file" in capsys.readouterr().err
+
+
+def test_with_no_client_it_plays_anyway_after_its_bound(recorded: Path) -> None:
+    import asyncio
+
+    from frog_bt.sim.play import Player
+
+    site = load_site()
+    played = load(recorded, site)
+
+    async def main() -> tuple[int, int, int]:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as front_end_peer:
+            front_end_peer.bind(("127.0.0.1", 0))
+            front_end_peer.setblocking(False)
+            player = Player(played, site, host="127.0.0.1", rosbridge_port=0,
+                            frontend_host="127.0.0.1", frontend_port=0,
+                            executive=front_end_peer.getsockname(), speed=2000.0,
+                            wait_max=0.1)
+            await player.start()
+            try:
+                await asyncio.wait_for(player.over.wait(), 30)  # a bound, not a pace
+            finally:
+                await player.stop()
+            got = 0
+            while True:
+                try:
+                    front_end_peer.recv(65536)
+                except BlockingIOError:
+                    break
+                got += 1
+            return player.inputs_sent, player.events_sent, got
+
+    inputs, events, received = asyncio.run(main())
+    assert inputs == len(played.inputs) and events == len(played.events) == received
