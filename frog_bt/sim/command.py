@@ -19,6 +19,14 @@ events over UDP; the commands of the executive run against it are held against t
 recorded ones, and the first difference is printed in replay's terms:
 
     frog-bt sim --play recordings/20260601-103012-tour0003.mcap --speed 10 [--loop]
+    frog-bt run --rosbridge ws://127.0.0.1:9090 --sim-time --once
+
+It starts when the executive subscribes (or after a minute without one), plays a
+tour file of --record DIR after the idle file it continues, acks the executive's
+front-end commands (the protocol, not a reaction), and keeps /clock going after the
+recording's end until interrupted; --loop plays it again, later (the clock never goes
+back). The counts are printed at the end and on exit. A file that is not a recording,
+or has no robot-side input, is exit 2. More in docs/RECORDING.md.
 
 Time: the simulator is the master clock. It publishes /clock, starting at the
 scenario's start_time, and runs `speed` times faster than real time (--speed
@@ -182,6 +190,9 @@ def run(args: argparse.Namespace) -> int:
     except ConfigError as exc:
         print(f"frog-bt sim: {exc}", file=sys.stderr)
         return 2
+    if args.loop and args.play is None:
+        print("frog-bt sim: --loop goes with --play FILE.mcap", file=sys.stderr)
+        return 2
     if args.speed is not None:
         scenario = scenario.model_copy(update={"speed": args.speed})
     if args.via is not None:
@@ -300,8 +311,8 @@ async def _play(args: argparse.Namespace) -> int:
     clock = asyncio.create_task(player.wait())
     await asyncio.wait([stopping, over, clock], return_when=asyncio.FIRST_COMPLETED)
     if over.done() and not stopping.done():
-        print(f"frog-bt sim: the recording is over; {player.comparison.line()}; the clock "
-              "goes on until interrupted", flush=True)
+        print(f"frog-bt sim: the recording is over; {player.summary()}; the clock goes on "
+              "until interrupted", flush=True)
         await asyncio.wait([stopping, clock], return_when=asyncio.FIRST_COMPLETED)
     for task in (stopping, over, clock):
         task.cancel()
@@ -310,5 +321,5 @@ async def _play(args: argparse.Namespace) -> int:
     except Exception as exc:  # the time loop died of a bug; it was logged
         print(f"frog-bt sim: play failed: {exc!r}", file=sys.stderr)
         return 1
-    print(f"frog-bt sim: stopped; {player.comparison.line()}", flush=True)
+    print(f"frog-bt sim: stopped; {player.summary()}", flush=True)
     return 0

@@ -2,17 +2,21 @@
 tour's robot-side inputs served over rosbridge on the recording's own clock, and its
 front-end events sent over UDP, open loop.
 
-:func:`load` reads a recording (after its lead-in file, as replay does: a tour file of
-``--record DIR`` continues the idle file before it) into a :class:`Played`: the inputs
-(every topic the executive subscribes to), the front end's events (``/frontend/in``
-without its acks) and the commands the recorded executive sent. :class:`Comparison`
-(sans-I/O) holds the commands a new executive sends against the recorded ones, each
-stream in its own order (ROS topics; the front end's messages, resends dropped by seq;
-the engagement meter apart, told as readings off by more than :data:`METER_TOLERANCE`:
-where its 2 s windows fall moves with the executive's tick timing), and
-describes the first difference in replay's domain terms. :class:`Player` is the I/O:
-the built-in rosbridge server, the front end's UDP socket (it acks every command, as a
-front end does: an ack is the protocol, not the content) and the time loop.
+:func:`load` reads a recording into a :class:`Played`: the inputs (every topic the
+executive subscribes to), the front end's events (``/frontend/in`` without its acks) and
+the commands the recorded executive sent (ROS outputs; ``/frontend/out`` without acks
+and resends). A tour file of ``--record DIR`` is read after the idle file it continues
+(its ``lead_in``, as replay does); a first file that starts with a ``/frog_bt/primer``
+(an idle file of ``--record DIR``) gives its inputs first, at its start: the latest
+message of each input from before the file, which a robot that publishes on change
+would not send again. The primer's datagrams are not played (the live executive had
+them; a new one never asked for them).
+
+:class:`Player` is the I/O: the built-in rosbridge server, the front end's UDP socket
+(it acks every command, as a front end does: an ack is the protocol, not the content)
+and the time loop. The commands received go to a
+:class:`~frog_bt.sim.comparison.Comparison` (sans-I/O), which holds them against the
+recorded ones and tells the first difference in replay's domain terms.
 
 Open loop: nothing reacts to the commands. A new executive that acts as the recorded
 one did sees the same world; one that acts otherwise sees it anyway (a goal it sends
@@ -26,19 +30,21 @@ import asyncio
 import contextlib
 import json
 import logging
-from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from frog_bt import channels
 from frog_bt.config import Site
+from frog_bt.errors import DecodeError, FrogError
 from frog_bt.observers.recording import FRONTEND_IN, FRONTEND_OUT
 from frog_bt.sim import msgs
+from frog_bt.sim.comparison import Comparison
 from frog_bt.sim.frontend_udp import Address, FrontendSocket
 from frog_bt.sim.rosbridge_protocol import BridgeServer, Incoming
 from frog_bt.sim.rosbridge_server import RosbridgeServer
-from frog_bt.tools.replay import Command, chain, differences
+from frog_bt.tools.replay import Command, chain, without_stamp
 from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 log = logging.getLogger(__name__)
@@ -49,23 +55,18 @@ SUBSCRIBE_GRACE = 0.3  # wall seconds for its other subscriptions, after the fir
 WAIT_MAX = 60.0  # wall seconds waiting for a rosbridge client before playing anyway
 SEQ_PER_PASS = 1_000_000  # --loop: front-end seqs of pass n are the recorded ones + n x this
 PASS_TAIL = 5.0  # recording seconds of /clock after its end before a pass counts as over
-METER_TOLERANCE = 0.1  # engagement meter levels this close are the same reading
 
 
-class PlayError(Exception):
-    """The file cannot be played (not a recording, nothing of the robot in it)."""
-
-
-def _without_stamp(msg: Any) -> Any:
-    header = msg.get("header") if isinstance(msg, dict) else None
-    if isinstance(header, dict) and "stamp" in header:
-        msg = {**msg, "header": {k: v for k, v in header.items() if k != "stamp"}}
-    return msg
+class PlayError(FrogError):
+    """The file cannot be played (not a recording, its lead-in gone, nothing of the robot
+    in it)."""
 
 
 @dataclass
 class Played:
-    files: list[str]
+    """A recording as the player serves it; times are the recording's, in seconds."""
+
+    files: list[str]  # the files read, the lead-in first
     start: float
     end: float
     inputs: list[tuple[float, str, dict[str, Any]]]  # (t, topic, msg), in time order
@@ -75,15 +76,12 @@ class Played:
 
 
 def load(path: Path, site: Site) -> Played:
-    """The recording at ``path`` (and its lead-in) as inputs, events and commands."""
-    from frog_bt.tools.mcapfile import RecordingError
-
+    """The recording at ``path`` (after its lead-in) as inputs, events and commands;
+    PlayError when it is not a recording, its lead-in is gone or it has no input."""
     try:
         recordings = chain(Path(path))
-    except (RecordingError, OSError) as exc:
-        raise PlayError(str(exc)) from None
-    except Exception as exc:  # ReplayError: the lead-in is gone
-        raise PlayError(str(exc)) from None
+    except (FrogError, OSError) as exc:  # not a recording; its lead-in is gone
+        raise PlayError(str(exc)) from exc
     served = {site.topic(role): t.type for role, t in INPUTS.items()}
     commands_on = {site.topic(role) for role in OUTPUTS}
     inputs: list[tuple[float, str, dict[str, Any]]] = []
@@ -96,6 +94,10 @@ def load(path: Path, site: Site) -> Played:
             t = ns / 1e9
             start = t if start is None else start
             end = t
+            if topic == channels.PRIMER:
+                if recording is recordings[0] and not inputs:
+                    inputs.extend((t, name, msg) for name, msg in _primed(data, served))
+                continue
             if topic in served or topic in commands_on or topic in (FRONTEND_IN,
                                                                     FRONTEND_OUT):
                 try:
@@ -107,7 +109,7 @@ def load(path: Path, site: Site) -> Played:
                 if topic in served:
                     inputs.append((t, topic, msg))
                 elif topic in commands_on:
-                    commands.append(Command(t, topic, _without_stamp(msg)))
+                    commands.append(Command(t, topic, without_stamp(msg)))
                 elif msg.get("type") == "ack":
                     continue
                 elif topic == FRONTEND_IN:
@@ -120,98 +122,29 @@ def load(path: Path, site: Site) -> Played:
                     commands.append(Command(t, FRONTEND_OUT, msg))
     if not inputs or start is None or end is None:
         raise PlayError(f"{path}: no robot-side inputs in it (is it a frog-bt recording?)")
-    types = {topic: type_ for topic, type_ in served.items()}
+    types = dict(served)
     types[CLOCK.name] = CLOCK.type
     return Played([str(r.path) for r in recordings], start, end, inputs, events, commands,
                   types)
 
 
-@dataclass
-class Comparison:
-    """The commands received against the recorded ones, per stream, in order."""
-
-    site: Site
-    recorded: list[Command]
-    start: float = 0.0
-    received: int = 0  # commands but the engagement meter's
-    differ: int = 0
-    meter: int = 0  # engagement meter readings received
-    meter_differ: int = 0  # ... off by more than METER_TOLERANCE (or one too many)
-    first: str = ""  # the first difference, in domain terms
-    _expected: dict[str, deque[Command]] = field(default_factory=dict)
-
-    missed: int = 0  # recorded commands of earlier passes (--loop) never received
-    beyond: int = 0  # received when the recording had no more of their stream
-
-    def __post_init__(self) -> None:
-        self.next_pass(0.0)
-
-    def next_pass(self, offset: float) -> None:
-        """Expect the recorded commands (again, ``offset`` seconds later: ``--loop``); what
-        the last pass still expected was not received."""
-        self.missed += self.missing
-        self._expected = {}
-        for command in self.recorded:
-            later = Command(command.t + offset, command.channel, command.payload)
-            self._expected.setdefault(_stream(command), deque()).append(later)
-
-    def got(self, command: Command) -> str | None:
-        """Take one command received; the description of the difference when it differs."""
-        stream = _stream(command)
-        queue = self._expected.get(stream)
-        expected = queue.popleft() if queue else None
-        if stream == "meter":  # a display, told apart: its windows move with tick timing
-            self.meter += 1
-            self.meter_differ += not (expected is not None and _same(expected, command))
-            return None
-        self.received += 1
-        if expected is None:
-            self.beyond += 1  # the recording has no more of these: nothing to hold it to
-            return None
-        if _same(expected, command):
-            return None
-        self.differ += 1
-        text = differences(expected, command, self.site)
-        if not self.first:
-            self.first = f"at +{command.t - self.start:.1f} s: {text}"
-        return text
-
-    @property
-    def missing(self) -> int:
-        """Recorded commands (but meter readings) not received (yet)."""
-        return sum(len(q) for s, q in self._expected.items() if s != "meter")
-
-    def line(self) -> str:
-        text = f"commands: {self.received} received, {self.differ} differ from the recording"
-        if self.missing + self.missed:
-            text += f", {self.missing + self.missed} recorded not received"
-        if self.beyond:
-            text += f", {self.beyond} past the recorded ones"
-        if self.first:
-            text += f"; first difference {self.first}"
-        if self.meter:
-            text += (f"; engagement meter: {self.meter} readings, {self.meter_differ} off by "
-                     f"more than {METER_TOLERANCE:g} (its windows move with tick timing)")
-        return text
-
-
-def _stream(command: Command) -> str:
-    """Commands are compared in order within their stream: ROS topics; the front end's
-    engagement meter (one per window of face data: how many depends on where the windows
-    fall, which the executive's tick timing moves); the other front-end messages."""
-    if command.channel != FRONTEND_OUT:
-        return "ros"
-    return "meter" if command.payload.get("type") == "engagement" else "frontend"
-
-
-def _same(expected: Command, got: Command) -> bool:
-    if (expected.channel, expected.payload) == (got.channel, got.payload):
-        return True
-    if _stream(expected) == _stream(got) == "meter":  # a level, within the tolerance
-        a, b = expected.payload.get("level"), got.payload.get("level")
-        return (isinstance(a, int | float) and isinstance(b, int | float)
-                and abs(a - b) <= METER_TOLERANCE)
-    return False
+def _primed(data: bytes, served: dict[str, str]) -> list[tuple[str, dict[str, Any]]]:
+    """A ``/frog_bt/primer``'s inputs on served topics, as (topic, msg); none when it is
+    malformed (the file's own inputs follow anyway)."""
+    try:
+        primer = channels.decode(channels.PRIMER, bytes(data))
+    except DecodeError:
+        log.warning("a malformed /frog_bt/primer: played without it")
+        return []
+    primed = []
+    for entry in primer.inputs:
+        try:
+            msg = json.loads(bytes(entry.msg))
+        except ValueError:
+            continue
+        if entry.topic in served and isinstance(msg, dict):
+            primed.append((entry.topic, msg))
+    return primed
 
 
 class Player:
@@ -262,6 +195,12 @@ class Player:
         if self._task is not None:
             await asyncio.shield(self._task)
 
+    def summary(self) -> str:
+        """``played 3893 inputs and 11 front-end events; commands: ...`` (so far)."""
+        passes = f" ({self.passes} whole passes)" if self.loop else ""
+        return (f"played {self.inputs_sent} inputs and {self.events_sent} front-end "
+                f"events{passes}; {self.comparison.line()}")
+
     async def _wait_for_executive(self) -> None:
         """Until a client subscribes to a topic it serves (then a moment for its other
         subscriptions): the recording starts for an executive, not before it; after
@@ -293,7 +232,7 @@ class Player:
                 self.rosbridge.publish(CLOCK.name, msgs.clock(self.now))
                 while i < len(played.inputs) and played.inputs[i][0] <= t:
                     _, topic, msg = played.inputs[i]
-                    self.rosbridge.publish(topic, msg)
+                    self.rosbridge.publish(topic, restamped(msg, offset))
                     self.inputs_sent += 1
                     i += 1
                 while j < len(played.events) and played.events[j][0] <= t:
@@ -340,7 +279,7 @@ class Player:
             await asyncio.sleep(max(0.0, deadline - loop.time()))
 
     def _on_incoming(self, incoming: Incoming) -> None:
-        command = Command(self.now, incoming.topic, _without_stamp(incoming.msg))
+        command = Command(self.now, incoming.topic, without_stamp(incoming.msg))
         self._take(command)
 
     def _on_datagram(self, data: bytes, addr: Address) -> None:
@@ -353,12 +292,29 @@ class Player:
         seq = msg.pop("seq", None)
         if isinstance(seq, int):
             self.udp.send(json.dumps({"type": "ack", "seq": seq}).encode())
-        if seq in self._seqs:
-            return  # a resend: acked again, compared once
-        self._seqs.add(seq)
+            if seq in self._seqs:
+                return  # a resend: acked again, compared once
+            self._seqs.add(seq)
         self._take(Command(self.now, FRONTEND_OUT, msg))
 
     def _take(self, command: Command) -> None:
         text = self.comparison.got(command)
         if text is not None and self.comparison.differ == 1 and self.on_difference:
             self.on_difference(self.comparison.first)
+
+
+def restamped(msg: dict[str, Any], offset: float) -> dict[str, Any]:
+    """``msg`` with its header's stamp ``offset`` seconds later, in the same shape
+    (``--loop``: a later pass keeps its stamps in step with its ``/clock``); ``msg``
+    itself when there is nothing to move."""
+    header = msg.get("header")
+    stamp = header.get("stamp") if isinstance(header, dict) else None
+    if not offset or not isinstance(stamp, dict):
+        return msg
+    for secs, nsecs in (("secs", "nsecs"), ("sec", "nanosec")):  # ROS 1, ROS 2
+        s, n = stamp.get(secs), stamp.get(nsecs)
+        if isinstance(s, int) and isinstance(n, int):
+            ns = s * 1_000_000_000 + n + round(offset * 1e9)
+            moved = {**stamp, secs: ns // 1_000_000_000, nsecs: ns % 1_000_000_000}
+            return {**msg, "header": {**header, "stamp": moved}}
+    return msg

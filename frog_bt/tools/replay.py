@@ -140,7 +140,9 @@ def _plain(value: Any) -> Any:
     return json.loads(json.dumps(value))
 
 
-def _without_stamp(msg: Any) -> Any:
+def without_stamp(msg: Any) -> Any:
+    """A ROS message without its header's stamp (the time it was sent, which differs
+    between two runs of the same commands; the rest is what is compared)."""
     header = msg.get("header") if isinstance(msg, dict) else None
     if isinstance(header, dict) and "stamp" in header:
         msg = {**msg, "header": {k: v for k, v in header.items() if k != "stamp"}}
@@ -201,7 +203,7 @@ class Replay:
     # ------------------------------------------------------------ outputs of the replayed tree
 
     def _publish(self, topic: str, msg: dict[str, Any]) -> None:
-        self._got.append(Command(self.clock.now(), topic, _without_stamp(_plain(msg)),
+        self._got.append(Command(self.clock.now(), topic, without_stamp(_plain(msg)),
                                  self.core.blamed, self.core.blamed_reads))
         self._compare()
 
@@ -283,7 +285,7 @@ class Replay:
             self._operator(t, self._own(topic, t, data))
         elif topic in self.outputs:
             self.result.ros_commands += 1
-            self._last_expected = Command(t, topic, _without_stamp(json.loads(data)))
+            self._last_expected = Command(t, topic, without_stamp(json.loads(data)))
             self._expected.append(self._last_expected)
             self._compare()
 

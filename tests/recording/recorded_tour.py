@@ -1,4 +1,6 @@
-"""A whole simulated tour on sim time, in one event loop, recorded to MCAP."""
+"""Recorded simulated tours on sim time, in one event loop: one whole tour to an MCAP file
+(:func:`record_tour`), or tours back to back into a directory as `--record DIR` does
+(:func:`record_day`)."""
 
 from __future__ import annotations
 
@@ -9,6 +11,7 @@ from typing import Any
 
 from frog_bt.config import Site, load_site
 from frog_bt.observers.recording import Recorder
+from frog_bt.observers.rotation import RecordingDir
 from frog_bt.runtime.executive import Executive, Outcome
 from frog_bt.runtime.rehearsal import Rehearsal
 from frog_bt.sim import scenario_from
@@ -54,3 +57,38 @@ def record_tour(path: Path, data: dict[str, Any] | None = None, *, site: Site | 
                 tree: LoadedTree | None = None, wall_timeout: float = 60.0) -> RecordedTour:
     """Run one tour of the default scenario (with ``data`` on top) and record it to ``path``."""
     return asyncio.run(_record(path, data, site, tree, wall_timeout))
+
+
+# Tours back to back: a fast robot, short content, a visitor who comes back.
+FAST_TOURS: dict[str, Any] = {
+    "speed": 400.0, "navigation": {"speed": 3.0, "approach_time": 1.0},
+    "docking": {"undock_time": 2.0, "dock_time": 3.0},
+    "content": {"default": 4, "introduction": 3},
+    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0}}
+
+
+def record_day(directory: Path, tours: int, max_bytes: int) -> RecordingDir:
+    """Run the executive (not ``once``) until ``tours`` tours have ended, recording to DIR
+    as ``frog-bt run --record DIR`` does: an idle and a tour file per tour."""
+    recordings = RecordingDir(directory, max_bytes)
+
+    async def run() -> None:
+        enough = asyncio.Event()
+
+        def prepare(executive: Any) -> None:
+            recordings.attach(executive)
+            executive.taps.tick.append(
+                lambda _core: executive.outcome.tours >= tours and enough.set())
+
+        rehearsal = Rehearsal(scenario_from("default", FAST_TOURS), site=load_site(),
+                              prepare=prepare, once=False)
+        async with rehearsal:
+            await asyncio.wait_for(enough.wait(), 60)
+            rehearsal.executive.stop("enough")
+            await rehearsal.finish()
+
+    try:
+        asyncio.run(run())
+    finally:
+        recordings.close()
+    return recordings

@@ -13,48 +13,17 @@ from typing import Any
 
 import pytest
 from mcap.reader import make_reader
+from recorded_tour import FAST_TOURS, record_day
 
 from frog_bt.cli import main
 from frog_bt.config import load_site
 from frog_bt.observers.rotation import RecordingDir, numbered
-from frog_bt.runtime.rehearsal import Rehearsal, free_udp_port
+from frog_bt.runtime.rehearsal import free_udp_port
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.tools.replay import Replay, ReplayError
 from frog_bt.tree.loader import load_tree
 
 ROOT = Path(__file__).resolve().parents[2]
-# Tours back to back: a fast robot, short content, a visitor who comes back.
-FAST_TOURS: dict[str, Any] = {
-    "speed": 400.0, "navigation": {"speed": 3.0, "approach_time": 1.0},
-    "docking": {"undock_time": 2.0, "dock_time": 3.0},
-    "content": {"default": 4, "introduction": 3},
-    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0}}
-
-
-def record_day(directory: Path, tours: int, max_bytes: int) -> RecordingDir:
-    """Run the executive (not ``once``) until ``tours`` tours have ended, recording to DIR."""
-    recordings = RecordingDir(directory, max_bytes)
-
-    async def run() -> None:
-        enough = asyncio.Event()
-
-        def prepare(executive: Any) -> None:
-            recordings.attach(executive)
-            executive.taps.tick.append(
-                lambda _core: executive.outcome.tours >= tours and enough.set())
-
-        rehearsal = Rehearsal(scenario_from("default", FAST_TOURS), site=load_site(),
-                              prepare=prepare, once=False)
-        async with rehearsal:
-            await asyncio.wait_for(enough.wait(), 60)
-            rehearsal.executive.stop("enough")
-            await rehearsal.finish()
-
-    try:
-        asyncio.run(run())
-    finally:
-        recordings.close()
-    return recordings
 
 
 def metadata(path: Path) -> dict[str, str]:
