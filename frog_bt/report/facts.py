@@ -61,7 +61,7 @@ class Piece:
     """One tour, or the part of one that a file holds."""
 
     file: str
-    first_seq: int  # the first front-end seq of the executive in this file (1: a new one)
+    first_seq: int  # the first new front-end seq of the executive in this file
     started: float | None = None  # `tour started` (None: the file opens mid-tour)
     started_seq: int = 0  # its front-end seq: a resend of it in the next file is no new tour
     t0: float = 0.0  # first event of the piece
@@ -89,6 +89,7 @@ class FileFacts:
     error: str = ""  # unreadable: why (the file is reported and skipped)
     recovered: str = ""  # a file cut short: what was read of it
     start: float = 0.0  # first message, seconds
+    new_executive: list[float] = field(default_factory=list)  # when one began numbering
 
 
 class _Reader:
@@ -107,13 +108,15 @@ class _Reader:
         self.stream_on = False
         self.samples: list[tuple[float, float]] = []  # (t, level) while the stream is on
         self.seen: set[int] = set()  # front-end seqs sent (a resend has the same one)
+        self.numbered_from_1: list[float] = []  # when a seq 1 went out: a new executive
         self.face_stops = {s.poi for s in site.tour.stops if s.face_stream}
         self.near = site.engagement.near
         self.edge = site.engagement.edge
 
     def _open(self, t: float, started: bool) -> Piece:
         if self.piece is None:
-            self.piece = Piece(self.path, self.first_seq, t if started else None, t, t)
+            self.piece = Piece(self.path, first_seq=self.first_seq,
+                               started=t if started else None, t0=t, t1=t)
             self.out.append(self.piece)
         return self.piece
 
@@ -137,6 +140,7 @@ class _Reader:
             return
         if seq == 1:
             self.seen.clear()  # a new executive numbers from 1 again
+            self.numbered_from_1.append(t)
         elif seq in self.seen:
             return  # a resend (datagram loss): not a new command
         self.seen.add(seq)
@@ -312,7 +316,8 @@ def read_file(path: str, site: Site) -> FileFacts:
                 reader.ros(t, topic, msg)
             else:
                 reader.own(t, topic, msg)
-        return FileFacts(path, reader.out, recovered=recording.recovered, start=start or 0.0)
+        return FileFacts(path, reader.out, recovered=recording.recovered, start=start or 0.0,
+                         new_executive=reader.numbered_from_1)
     except RecordingError as exc:
         return FileFacts(path, error=str(exc).replace(f"{path}: ", ""))
     except Exception as exc:  # a damaged file must not stop the corpus

@@ -37,6 +37,9 @@ class Tour:
 def join(files: list[FileFacts]) -> list[Tour]:
     """The tours of the corpus, in time order."""
     pieces = sorted((p for f in files for p in f.pieces), key=lambda p: (p.t0, p.file))
+    # when an executive began numbering its front-end messages from 1 (it started; its
+    # first file may hold no tour event: a resumed tour rotates into a file of its own)
+    starts = sorted(t for f in files for t in f.new_executive)
     tours: list[Tour] = []
     for piece in pieces:
         prev = tours[-1] if tours else None
@@ -46,9 +49,9 @@ def join(files: list[FileFacts]) -> list[Tour]:
             continue
         if piece.started is None:
             if prev is not None and not prev.last.ended:
+                if any(prev.last.t1 < t <= piece.t0 for t in starts):
+                    prev.resumed = True  # another executive took the tour over
                 prev.pieces.append(piece)
-                if piece.first_seq == 1:  # a new executive took the tour over
-                    prev.resumed = True
                 continue
             if not piece.stops:
                 continue  # the end of a tour already ended (said again): nothing new

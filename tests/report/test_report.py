@@ -164,11 +164,13 @@ def test_the_pieces_of_a_resumed_tour_are_joined_into_one() -> None:
                            ended="ended", stops=[StopFacts("POI1", "POI1a", "a", 1010.0,
                                                            1020.0)])
     opened = Piece("c0.mcap", first_seq=39, started=990.0, t0=990.0, t1=990.0)
-    tours = join([FileFacts("b.mcap", [after]), FileFacts("a.mcap", [before]),
+    restarted = FileFacts("b.mcap", [after], new_executive=[410.0])  # numbering from 1
+    tours = join([restarted, FileFacts("a.mcap", [before]),
                   FileFacts("c.mcap", [after_rotation]), FileFacts("c0.mcap", [opened])])
     assert [len(t.pieces) for t in tours] == [2, 2]
     assert [t.resumed for t in tours] == [True, False]  # a new executive, then a rotation
-    first = rows([FileFacts("a.mcap", [before]), FileFacts("b.mcap", [after])], site)[0]
+    first = rows([FileFacts("a.mcap", [before]), restarted], site)[0]
+    assert first.resumed
     assert (first.files, first.stops_visited, first.distance_m, first.ended,
             first.duration_s) == ("a.mcap;b.mcap", "POI1;POI2", 120.0, "ended", 800.0)
 
