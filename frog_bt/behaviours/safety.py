@@ -131,13 +131,16 @@ class ConfirmResume(Leaf):
     Only a robot that reports itself away from the dock (``/docking`` not
     ``docked``) within ``checkpoint.confirm`` seconds resumes; otherwise the
     checkpoint is dropped (``/resume`` and ``/progress`` cleared) and a fresh tour
-    starts. Reads ``/docking``, ``/now``, ``/resume``; writes ``/resumed`` (how, in
-    words). SUCCESS once decided (at once without a checkpoint).
+    starts. A resumed tour is a started tour (``/tour_state`` ``started``, as the
+    executive before told the front end): an abort, the operator's ``home`` and the
+    recording's rotation see it as one. Reads ``/docking``, ``/now``, ``/resume``;
+    writes ``/resumed`` (how, in words) and ``/tour_state``. SUCCESS once decided (at
+    once without a checkpoint).
     """
 
     reads = (keys.DOCKING, keys.NOW)
     optional_reads = (keys.RESUME,)
-    writes = (keys.RESUME, keys.RESUMED, keys.PROGRESS)
+    writes = (keys.RESUME, keys.RESUMED, keys.PROGRESS, keys.TOUR_STATE)
 
     def initialise(self) -> None:
         self.started = self.ctx.clock.now()
@@ -150,6 +153,7 @@ class ConfirmResume(Leaf):
         if state is not None and state.value not in ("docked", "docking"):
             announce = resume.announce([stop.poi for stop in self.ctx.site.tour.stops])
             self.set(keys.RESUMED, announce)
+            self.set(keys.TOUR_STATE, TourState.STARTED)  # no new `tour started` is sent
             self.ctx.note(f"{announce} ({resume.describe()})", incident=IncidentKind.RESUMED)
             log.warning("%s", announce)
             return SUCCESS

@@ -139,6 +139,32 @@ def test_a_restarted_executive_resumes_the_tour_at_the_current_stop(tmp_path):
     assert not (tmp_path / "checkpoint.json").exists()  # cleared when the tour ended
 
 
+async def _battery_low_after_resume(tmp_path) -> tuple[list[str], int, str]:
+    checkpoint = tmp_path / "checkpoint.json"
+    async with Running({}, checkpoint=checkpoint) as first:
+        sim, listen = first.sim, first.listen
+        await sim.wait_for(is_("start_poi", poi="POI2", part="a"), 60)
+        first.own_sim = False
+    async with Running({}, sim=sim, listen=listen, checkpoint=checkpoint, once=True) as second:
+        await sim.wait_for(is_("start_poi", poi="POI3", part="a"), 60)
+        sim.world.battery.percentage = 12.0
+        t = sim.clock.now()
+        outcome = await second.finish()
+        after = commands_after(second, t)
+    await sim.stop()
+    return after, outcome.code, outcome.reason
+
+
+def test_a_resumed_tour_is_a_tour_a_low_battery_aborts(tmp_path):
+    # the restarted executive sends no new `tour started`, but the tour it carries on is
+    # one: the abort guard (and the operator's home) act on it as on any other
+    after, code, reason = asyncio.run(_battery_low_after_resume(tmp_path))
+    assert "tour aborted battery 12% below 20%" in after
+    assert [c for c in after if c.startswith("/GotoWayPoint")] == ["/GotoWayPoint SHOP"]
+    assert not [c for c in after if c.startswith("start_poi")]
+    assert (code, reason) == (1, "tour aborted: battery 12% below 20%")
+
+
 async def _fresh_ignores(tmp_path) -> list[str]:
     checkpoint = tmp_path / "checkpoint.json"
     checkpoint.write_text(json.dumps({"version": 1, "done": ["start", "recruit", "stop 0"],
