@@ -70,7 +70,7 @@ class Row:
     hour: int
     duration_s: float
     distance_m: float
-    stops_visited: str  # ';'-separated, in order
+    stops_visited: str  # ";"-separated, in order, each once (a resumed stop starts again)
     stops_skipped: str  # 'POI2: navigation failed; ...'
     time_at_stops: str  # JSON {poi: seconds from part a to finish_poi}
     approaches: int
@@ -138,7 +138,7 @@ def row(number: int, tour: Tour, site: Site) -> Row:
         day=f"{local:%Y-%m-%d}", start=local.isoformat(timespec="seconds"), hour=local.hour,
         duration_s=round(tour.last.t1 - start_t, 1),
         distance_m=round(sum(p.distance for p in pieces), 1),
-        stops_visited=";".join(visited), stops_skipped="; ".join(skipped),
+        stops_visited=";".join(dict.fromkeys(visited)), stops_skipped="; ".join(skipped),
         time_at_stops=json.dumps({s.poi: round(s.seconds, 1) for s in stops
                                   if s.seconds is not None}),
         approaches=sum(p.approaches for p in pieces),

@@ -197,3 +197,41 @@ def test_without_the_report_extra_it_says_which_before_reading(corpus, tmp_path,
     assert main(["report", str(directory), "-o", str(out), "--csv", str(table)]) == 2
     assert "needs matplotlib: pip install 'frog-bt[report]'" in capsys.readouterr().err
     assert not out.exists() and not table.exists()  # nothing half-written
+
+
+def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) -> None:
+    import asyncio
+
+    from frog_bt.observers.rotation import RecordingDir
+    from frog_bt.runtime.rehearsal import Rehearsal
+    from frog_bt.sim import scenario_from
+
+    day, checkpoint = tmp_path / "day", tmp_path / "checkpoint.json"
+    scenario = scenario_from("default", {"speed": 400.0, "content": {"default": 10,
+                                                                     "introduction": 8}})
+
+    async def run() -> None:
+        first_files = RecordingDir(day, 10**9)
+        first = Rehearsal(scenario, site=load_site(), prepare=first_files.attach,
+                          checkpoint=checkpoint, once=False)
+        async with first:
+            await first.sim.wait_for(lambda r: r.channel == "start_poi"
+                                     and r.payload.get("poi") == "POI2", 60)
+            first.own_sim = False  # the robot goes on; this executive stops (as if killed)
+        first_files.close()
+        second_files = RecordingDir(day, 10**9)
+        try:
+            async with Rehearsal(None, site=load_site(), sim=first.sim, listen=first.listen,
+                                 prepare=second_files.attach, checkpoint=checkpoint) as second:
+                outcome = await second.finish()
+                assert outcome.code == 0, outcome.reason
+        finally:
+            second_files.close()
+            await first.sim.stop()
+
+    asyncio.run(run())
+    got = report(tmp_path, str(day))
+    assert got["totals"]["tours"] == 1 and got["totals"]["resumed"] == 1
+    (row,) = got["tours"]
+    assert row["resumed"] and row["ended"] == "ended" and len(row["files"].split(";")) >= 3
+    assert row["stops_visited"] == "POI1;POI2;POI3;POI4;POI5;END"  # POI2 once: resumed there
