@@ -14,6 +14,10 @@ ROS command and a datagram sent in the same tick carries no meaning):
   than :data:`METER_TOLERANCE` (or one too many) are counted on their own line, never
   as differences. The decisions the meter feeds (part b or not) are in ``frontend``.
 
+Two commands recorded within :data:`REORDER_WINDOW` of each other may arrive swapped
+(a location-awareness volume and an arrival's follow_me off, say: whether they fall in
+one tick or two moves with the executive's timing): that is no difference.
+
 A command received when the recording has no more of its stream is counted as past the
 recorded ones (an executive that goes on after the recording's end is not wrong for it).
 """
@@ -28,6 +32,7 @@ from frog_bt.observers.recording import FRONTEND_OUT
 from frog_bt.tools.replay import Command, differences
 
 METER_TOLERANCE = 0.1  # engagement meter levels this close are the same reading
+REORDER_WINDOW = 1.0  # recorded seconds within which two commands may come swapped
 
 
 @dataclass
@@ -77,6 +82,14 @@ class Comparison:
             self.beyond += 1  # the recording has no more of these: nothing to hold it to
             return None
         if same(expected, command):
+            return None
+        assert queue is not None
+        swapped = next((i for i, later in enumerate(queue)
+                        if later.t - expected.t <= REORDER_WINDOW and same(later, command)),
+                       None)
+        if swapped is not None:  # the same command, a moment earlier than recorded: the
+            del queue[swapped]  # one it passed is still to come
+            queue.appendleft(expected)
             return None
         self.differ += 1
         text = differences(expected, command, self.site)

@@ -112,3 +112,19 @@ def test_each_pass_is_held_against_the_recording_afresh(site: Site) -> None:
         == "state started → ended"
     assert comparison.first == "at +202.0 s: state started → ended"
     assert "11 recorded not received" in comparison.line()  # 6 + 5
+
+
+def test_two_commands_recorded_a_moment_apart_may_come_swapped() -> None:
+    from frog_bt.config import load_site
+    from frog_bt.observers.recording import FRONTEND_OUT
+    from frog_bt.sim.comparison import Comparison
+    from frog_bt.tools.replay import Command
+
+    volume = Command(10.0, FRONTEND_OUT, {"type": "volume", "percent": 80})
+    follow = Command(10.4, FRONTEND_OUT, {"type": "follow_me", "on": False})
+    later = Command(30.0, FRONTEND_OUT, {"type": "finish_poi", "poi": "POI1"})
+    c = Comparison(load_site(), [volume, follow, later])
+    assert c.got(follow) is None and c.got(volume) is None  # swapped: no difference
+    assert c.got(later) is None and c.differ == 0 and c.missing == 0
+    far = Comparison(load_site(), [volume, later])
+    assert far.got(later) is not None  # 20 s apart: a difference
