@@ -211,7 +211,14 @@ class _Reader:
                     piece.end_seq = seq
                     if state == "aborted":
                         self.back = piece  # the robot returns to its dock: still this tour's
-                self.piece, self.opening = None, False
+                if piece is not None and self.opening:
+                    # A tour file has no primer: this may be the tour before's end, resent
+                    # (rows.join tells by its seq); what follows goes into a new opening
+                    # piece, in case it is the open tour's.
+                    self.piece = Piece(self.path, None, 0, t, t)
+                    self.out.append(self.piece)
+                else:
+                    self.piece, self.opening = None, False
             return
         piece = self._current(t)
         if piece is None:
@@ -279,7 +286,8 @@ class _Reader:
                 piece.declined += 1
 
     def ros(self, t: float, role: str, msg: dict[str, Any]) -> None:
-        piece = self.piece or self.back  # the drive back after an abort is the tour's too
+        # the drive back after an abort is the aborted tour's
+        piece = self.back if self.back is not None else self.piece
         if role == "pose":
             p = msg.get("pose", {}).get("position", {})
             x, y = p.get("x"), p.get("y")

@@ -18,7 +18,7 @@ import pytest
 
 from frog_bt.cli import main
 from frog_bt.config import load_site
-from frog_bt.report.facts import FileFacts, Piece, StopFacts
+from frog_bt.report.facts import FileFacts, Piece, StopFacts, _Reader
 from frog_bt.report.rows import join, rows
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
@@ -194,6 +194,31 @@ def test_the_pieces_of_a_tour_are_joined_into_one() -> None:
             first.ended, first.duration_s, first.resumed) == (
         "a", "1.mcap;2.mcap", "POI1;POI2", "POI1 ab; POI2 ab", 120.0, "ended", 800.0, True)
     assert json.loads(first.time_at_stops) == {"POI1": 20.0, "POI2": 50.0}  # 20 + 30
+
+
+def test_a_tour_file_opening_with_the_tour_befores_end_resent_is_read_whole() -> None:
+    """The idle file between two tours was short: the tour before's `tour ended` (seq 5)
+    is still being resent when the next tour's file opens, after its `tour started`
+    (seq 7, acked at once). What follows in that file is the new tour's."""
+    site = load_site()
+    idle = _Reader("r/1-idle.mcap", site)
+    idle.first(100.0)
+    idle.own(100.0, "/frog_bt/primer", {"frontend_out_seqs": [4, 5, 6]})
+    idle.frontend_out(101.0, {"type": "tour", "seq": 7, "state": "started"})
+    tour = _Reader("r/2-tour.mcap", site)
+    tour.first(101.1)
+    tour.frontend_out(101.2, {"type": "tour", "seq": 5, "state": "ended", "reason": ""})
+    tour.frontend_out(130.0, {"type": "ask_tour", "seq": 9, "engaged": True})
+    tour.frontend_in(131.0, {"type": "user_positive", "seq": 3})
+    tour.frontend_out(150.0, {"type": "start_poi", "seq": 10, "poi": "POI1",
+                              "waypoint": "POI1a", "part": "a"})
+    tour.frontend_out(170.0, {"type": "finish_poi", "seq": 11, "poi": "POI1"})
+    tour.frontend_out(300.0, {"type": "tour", "seq": 20, "state": "ended", "reason": ""})
+    files = [FileFacts("r/1-idle.mcap", idle.finish(), restarts=[]),
+             FileFacts("r/2-tour.mcap", tour.finish())]
+    (row,) = rows(files, site)
+    assert (row.invitations, row.invitations_accepted, row.stops_visited, row.ended,
+            row.duration_s, row.resumed) == (1, 1, "POI1", "ended", 199.0, False)
 
 
 def test_mistakes_are_one_line_and_exit_2(tmp_path, capsys) -> None:
