@@ -91,13 +91,19 @@ def main() -> int:
           n + kinds.count("declines") + kinds.count("wander_off"))
     check("invitations declined", t["invitations_declined"], kinds.count("declines"))
     for poi, rate in t["part_b_rate"].items():
-        check(f"part b at {poi}", round(rate * t["part_a_played"][poi]),
-              t["part_a_played"][poi] - kinds.count("bored"))
+        check(f"part b at {poi}", round(rate * t["gate_decisions"][poi]),
+              t["gate_decisions"][poi] - kinds.count("bored"))
     check("tours per day", sorted(t["tours_per_day"].values()),
           [manifest["tours_per_day"]] * manifest["days"])
     near("completion rate vs seeding", t["completion_rate"], 1 - weights["fault"], n)
+    # a visitor who wanders off on the way to POI2 has heard POI1, and the next one
+    # hears it again: one more (engaged) visit of POI1 per wanderer
+    check("visits of POI1 (the gate's decisions)", t["gate_decisions"]["POI1"],
+          t["gate_decisions"]["POI2"] + kinds.count("wander_off"))
     for poi, rate in t["part_b_rate"].items():
-        near(f"part-b rate at {poi} vs seeding", rate, 1 - weights["bored"], n)
+        extra = weights["wander_off"] if poi == "POI1" else 0.0
+        near(f"part-b rate at {poi} vs seeding", rate, 1 - weights["bored"] / (1 + extra),
+             t["gate_decisions"][poi])
     asked = 1 + weights["declines"] + weights["wander_off"]
     near("invitation acceptance vs seeding", t["invitation_acceptance"],
          1 - weights["declines"] / asked, t["invitations"])

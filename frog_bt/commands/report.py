@@ -1,19 +1,20 @@
 """What the recorded tours tell: one row per tour, totals and rates, plots.
 
 Reads MCAP recordings (files, or directories of *.mcap, as `frog-bt run --record DIR`
-writes them) without re-running the tree, joins the pieces of a tour cut by a
-restart, and writes:
+writes them) without re-running the tree, joins the pieces of a tour (rotated files, a
+restart that resumed it), and writes:
 
   -o FILE.html    the report: summary, plots and every tour, in one self-contained
                   file (no network needed to open it)
   --csv FILE      one row per tour, for pandas or R
   --parquet FILE  the same rows as Parquet
 
-A file that is not a recording, or is damaged beyond reading, is reported and
-skipped; one cut short (kill -9) is read up to the cut. --jobs N reads N files at a
-time (processes); --scheduler ADDRESS runs the same work on a dask.distributed
-cluster. The plots and Parquet need the `report` extra (matplotlib, pyarrow), the
-cluster the `fleet` extra (dask.distributed). Columns and figures: docs/REPORT.md.
+The recordings in one directory are one robot's: give each robot its own. A file that
+is not a recording, or is damaged beyond reading, is reported and skipped; one cut
+short (kill -9) is read up to the cut. --jobs N reads N files at a time (processes);
+--scheduler ADDRESS runs the same work on a dask.distributed cluster. The plots and
+Parquet need the `report` extra (matplotlib, pyarrow), the cluster the `fleet` extra
+(dask.distributed). Columns and figures: docs/REPORT.md.
 
   frog-bt report recordings/ -o season.html --csv season.csv --jobs 2
 """

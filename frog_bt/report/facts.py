@@ -2,18 +2,30 @@
 
 :func:`read_file` runs in a worker (a process, or a dask worker): it takes a path and the
 site, reads the channels it needs in time order and returns a :class:`FileFacts`, plain
-picklable data: the tour pieces found in the file (:class:`Piece`), or the reason the
-file could not be read. A piece begins at ``tour started`` or, in a file that opens
-mid-tour (a restarted executive resuming from its checkpoint, or a file rotated at the
-start of a tour), at the first tour event; it ends at ``tour ended``/``aborted`` or at
-the end of the file. :mod:`frog_bt.report.rows` joins the pieces into tours.
+picklable data: the tour pieces found in the file (:class:`Piece`), the times an
+executive started in it, or the reason the file could not be read. An executive
+starts a file of its own (``--record DIR``: an idle file without a primer, the files it
+rotates into having one, or a tour's ``lead_in``; a file without frog-bt's metadata is
+one whole run).
+:mod:`frog_bt.report.rows` joins the pieces into tours.
+
+A piece begins at ``tour started``, or at the file's first message: a file may open
+inside a tour (``--record DIR`` rotates at the start of a tour, so the tour file opens
+just after its ``tour started``; a restarted executive carries on a tour from its
+checkpoint in a new file, without a new ``tour started``). Such an opening piece keeps
+everything up to the file's first ``tour started`` and is kept only when it holds
+something of a tour (content, an invitation, an approach, a goal, a tour's end): the
+opening of an idle file is no tour. A piece ends at ``tour ended`` (the robot is
+docked by then), or after ``tour aborted`` once the robot has driven back and docked
+(that drive is the tour's too), or at the end of the file.
 
 Channels read: ``/frontend/out`` (tour, start_poi, finish_poi, ask_tour),
 ``/frontend/in`` (user_positive/negative, content_done), ``/GotoWayPoint``,
-``/ApproachPeopleFar``, ``/FROG_response``, ``/ICL_command``, ``/ICL_FaceDataStream``,
-``/FROG_pose``, ``/diagnostic``, ``/frog_bt/operator``, ``/frog_bt/alert`` and
-``/frog_bt/primer`` (a rotated file: the front-end seqs sent just before it, so that a
-resend across the rotation is not taken for a new command).
+``/ApproachPeopleFar``, ``/FROG_response``, ``/docking/dock``, ``/docking/state``,
+``/ICL_command``, ``/ICL_FaceDataStream``, ``/FROG_pose``, ``/diagnostic``,
+``/frog_bt/operator``, ``/frog_bt/alert`` and ``/frog_bt/primer`` (a rotated file: the
+front-end seqs sent just before it, so that a resend across the rotation is not taken
+for a new command). Topic names are the site's.
 """
 
 from __future__ import annotations
@@ -32,15 +44,19 @@ from frog_bt.rosbridge.msgs import POSE
 from frog_bt.tools.mcapfile import RecordingError, open_recording
 from frog_bt.wire import SUCCEEDED
 
-SUCCESS = SUCCEEDED  # /FROG_response: the goal or approach succeeded
 ERROR_LEVEL = 2  # diagnostic_msgs/DiagnosticStatus ERROR
+JUMP = 10.0  # metres: a pose step this long is a relocalisation, not a drive
 OWN = frozenset({"/frontend/in", "/frontend/out", "/frog_bt/operator", "/frog_bt/alert",
                  "/frog_bt/primer"})
+ROS_ROLES = ("pose", "goto", "approach", "response", "dock", "docking_state", "icl", "faces",
+             "diagnostic")
 
 
 @dataclass
 class StopFacts:
-    poi: str
+    """One visit of a content stop: from its part a to its ``finish_poi``."""
+
+    poi: str  # the logical POI (POI1)
     waypoint: str = ""  # the time-of-day variant played (POI1a / POI1b)
     parts: str = ""  # "a", "ab"
     start: float | None = None  # part a started
@@ -50,10 +66,22 @@ class StopFacts:
     edge_total: int = 0
     face_stream: bool = False
     a_end: float | None = None  # the front end said part a was done
+    before_restart: float = 0.0  # seconds of this visit before a restart cut it (joined)
 
     @property
     def seconds(self) -> float | None:
-        return None if self.start is None or self.end is None else self.end - self.start
+        """Time at the stop: part a to ``finish_poi`` (and the time before a restart)."""
+        if self.start is None or self.end is None:
+            return None
+        return self.end - self.start + self.before_restart
+
+    @property
+    def decision(self) -> str:
+        """What the engagement gate did: ``b`` (part b played), ``a only`` (part a played
+        to its end, no part b) or ``none`` (part a was cut before the gate)."""
+        if "b" in self.parts:
+            return "b"
+        return "a only" if self.a_end is not None else "none"
 
 
 @dataclass
@@ -61,35 +89,55 @@ class Piece:
     """One tour, or the part of one that a file holds."""
 
     file: str
-    first_seq: int  # the first new front-end seq of the executive in this file
-    started: float | None = None  # `tour started` (None: the file opens mid-tour)
+    started: float | None = None  # `tour started` (None: the piece opens with the file)
     started_seq: int = 0  # its front-end seq: a resend of it in the next file is no new tour
     t0: float = 0.0  # first event of the piece
     t1: float = 0.0  # last event of the piece
     ended: str = ""  # "ended" | "aborted" | "" (the file ended first)
     reason: str = ""
+    end_seq: int = 0  # the front-end seq of its `tour ended`/`aborted`
     distance: float = 0.0
     stops: list[StopFacts] = field(default_factory=list)
-    goals: list[str] = field(default_factory=list)  # waypoint of each goal, in order
-    failed_goals: list[str] = field(default_factory=list)  # goals answered 3/4
+    goals: int = 0  # /GotoWayPoint sent
+    failed_goals: list[str] = field(default_factory=list)  # waypoints of goals answered 3/4
+    nav_retries: int = 0  # goals sent again to the waypoint whose goal had just failed
+    dock_retries: int = 0  # dock/undock sent again after /docking/state failed
     approaches: int = 0
     approaches_ok: int = 0
+    approached: list[int] = field(default_factory=list)  # person ids, in order
+    visitors: list[int] = field(default_factory=list)  # the approached who said yes
     invitations: int = 0
     accepted: int = 0
     declined: int = 0
     faults: list[str] = field(default_factory=list)
-    operator: list[str] = field(default_factory=list)  # "skip (ok)", "home (refused: ...)"
+    operator: list[str] = field(default_factory=list)  # "skip (ok)", "home (refused)"
+    operator_skips: list[str] = field(default_factory=list)  # stops the operator skipped
     alerts: list[str] = field(default_factory=list)  # kinds raised
+
+    def of_a_tour(self) -> bool:
+        """Something only a tour does happened in it."""
+        return bool(self.stops or self.invitations or self.approaches or self.goals
+                    or self.ended)
 
 
 @dataclass
 class FileFacts:
     file: str
     pieces: list[Piece] = field(default_factory=list)
+    restarts: list[float] = field(default_factory=list)  # an executive started here
     error: str = ""  # unreadable: why (the file is reported and skipped)
     recovered: str = ""  # a file cut short: what was read of it
     start: float = 0.0  # first message, seconds
-    new_executive: list[float] = field(default_factory=list)  # when one began numbering
+
+
+def stop_of(site: Site) -> dict[str, str]:
+    """Waypoint (a POI or one of its time-of-day variants) -> logical POI of the tour."""
+    out = {}
+    for stop in site.tour.stops:
+        out[stop.poi] = stop.poi
+        for variant in site.variants.get(stop.poi, ()):
+            out[variant.waypoint] = stop.poi
+    return out
 
 
 class _Reader:
@@ -100,30 +148,41 @@ class _Reader:
         self.path = path
         self.out: list[Piece] = []
         self.piece: Piece | None = None
-        self.first_seq = 0
+        self.back: Piece | None = None  # an aborted tour's piece until the robot docks
+        self.opening = True  # the piece open is the file's opening one (no `tour started`)
+        self.primed = False  # the file opens with a /frog_bt/primer (an idle rotation)
         self.pose: tuple[float, float] | None = None
-        self.goal: str | None = None
+        self.goal: str | None = None  # waypoint of the goal awaiting its response
+        self.failed: str | None = None  # waypoint whose goal failed last
         self.approach = False
+        self.dock: str | None = None  # the latest dock/undock command
+        self.dock_failed: str | None = None
         self.asked = False
         self.stream_on = False
         self.samples: list[tuple[float, float]] = []  # (t, level) while the stream is on
         self.seen: set[int] = set()  # front-end seqs sent (a resend has the same one)
-        self.numbered_from_1: list[float] = []  # when a seq 1 went out: a new executive
         self.face_stops = {s.poi for s in site.tour.stops if s.face_stream}
+        self.stop_of = stop_of(site)
         self.near = site.engagement.near
         self.edge = site.engagement.edge
+        self.topics = {site.topic(role): role for role in ROS_ROLES}
 
-    def _open(self, t: float, started: bool) -> Piece:
-        if self.piece is None:
-            self.piece = Piece(self.path, first_seq=self.first_seq,
-                               started=t if started else None, t0=t, t1=t)
-            self.out.append(self.piece)
+    def first(self, t: float) -> None:
+        """The file's first message: a piece opens, in case the file opens inside a tour."""
+        self.piece = Piece(self.path, None, 0, t, t)
+        self.out.append(self.piece)
+        self.opening = True
+
+    def finish(self) -> list[Piece]:
+        """The pieces, but an opening one that held nothing of a tour (an idle file's)."""
+        return [p for p in self.out if p.started is not None or p.of_a_tour()]
+
+    def _current(self, t: float) -> Piece | None:
+        """The piece open now (None between a tour's end and the next start), its last
+        event moved to ``t``."""
+        if self.piece is not None:
+            self.piece.t1 = t
         return self.piece
-
-    def _tour_event(self, t: float) -> Piece:
-        piece = self._open(t, started=False)
-        piece.t1 = t
-        return piece
 
     def _stop(self, poi: str) -> StopFacts | None:
         if self.piece is None:
@@ -138,31 +197,33 @@ class _Reader:
         seq = msg.get("seq")
         if kind == "ack" or not isinstance(seq, int):
             return
-        if seq == 1:
-            self.seen.clear()  # a new executive numbers from 1 again
-            self.numbered_from_1.append(t)
-        elif seq in self.seen:
+        if seq in self.seen:
             return  # a resend (datagram loss): not a new command
         self.seen.add(seq)
-        if not self.first_seq:
-            self.first_seq = seq
         if kind == "tour":
             state = msg.get("state")
             if state == "started":
-                if self.piece is not None and self.piece.started is None \
-                        and not self.piece.stops:
-                    self.piece.started = t  # a rotated file's opening events, then started
-                elif self.piece is not None:
-                    return  # said again (a resend taken anew): the same tour
-                piece = self._open(t, started=True)
-                piece.t1, piece.started_seq = t, seq
+                self._started(t, seq)
             elif state in ("ended", "aborted"):
-                piece = self._tour_event(t)
-                piece.ended, piece.reason = str(state), str(msg.get("reason") or "")
-                self.piece = None
+                piece = self._current(t)
+                if piece is not None:  # (None: said again after the tour's end)
+                    piece.ended, piece.reason = str(state), str(msg.get("reason") or "")
+                    piece.end_seq = seq
+                    if state == "aborted":
+                        self.back = piece  # the robot returns to its dock: still this tour's
+                if piece is not None and self.opening:
+                    # A tour file has no primer: this may be the tour before's end, resent
+                    # (rows.join tells by its seq); what follows goes into a new opening
+                    # piece, in case it is the open tour's.
+                    self.piece = Piece(self.path, None, 0, t, t)
+                    self.out.append(self.piece)
+                else:
+                    self.piece, self.opening = None, False
+            return
+        piece = self._current(t)
+        if piece is None:
             return
         if kind == "start_poi":
-            piece = self._tour_event(t)
             poi, part = str(msg.get("poi")), str(msg.get("part"))
             stop = self._stop(poi)
             if part == "a" or stop is None:
@@ -174,20 +235,30 @@ class _Reader:
                 stop.parts += part
             if part == "b":
                 self._engagement(stop, t)
-        elif kind == "finish_poi" and self.piece is not None:
+        elif kind == "finish_poi":
             stop = self._stop(str(msg.get("poi")))
             if stop is not None:
                 stop.end = t
                 if "b" not in stop.parts:
                     self._engagement(stop, t)
-            self.piece.t1 = t
-        elif kind == "ask_tour" and self.piece is not None:
+        elif kind == "ask_tour":
             self.asked = True
-            self.piece.invitations += 1
-            self.piece.t1 = t
+            piece.invitations += 1
+
+    def _started(self, t: float, seq: int) -> None:
+        piece = self.piece
+        if piece is not None and not self.opening:
+            return  # said again (a resend taken anew): the same tour
+        if piece is not None and not piece.of_a_tour():
+            self.out.remove(piece)  # an idle file's opening: no tour
+        self.back = None
+        self.piece = Piece(self.path, t, seq, t, t)
+        self.out.append(self.piece)
+        self.opening = False
 
     def _engagement(self, stop: StopFacts, t: float) -> None:
-        """The face samples stored since the stop's start, and the edge vote over them."""
+        """The face samples stored since the stop's start, and the edge vote over them
+        (:func:`frog_bt.maths.engagement.decide`, the executive's own rule)."""
         if not stop.face_stream or stop.start is None:
             return
         end = stop.a_end if stop.a_end is not None else t
@@ -206,82 +277,125 @@ class _Reader:
         if kind in ("user_positive", "user_negative") and self.piece is not None \
                 and self.asked:
             self.asked = False
+            piece = self.piece
             if kind == "user_positive":
-                self.piece.accepted += 1
+                piece.accepted += 1
+                if piece.approached:
+                    piece.visitors.append(piece.approached[-1])
             else:
-                self.piece.declined += 1
+                piece.declined += 1
 
-    def ros(self, t: float, topic: str, msg: dict[str, Any]) -> None:
-        site = self.site
-        if topic == site.topic("pose"):
+    def ros(self, t: float, role: str, msg: dict[str, Any]) -> None:
+        # the drive back after an abort is the aborted tour's
+        piece = self.back if self.back is not None else self.piece
+        if role == "pose":
             p = msg.get("pose", {}).get("position", {})
             x, y = p.get("x"), p.get("y")
             if isinstance(x, int | float) and isinstance(y, int | float):
-                if self.pose is not None and self.piece is not None:
+                if self.pose is not None and piece is not None:
                     step = math.hypot(x - self.pose[0], y - self.pose[1])
-                    if step < 10.0:  # a jump is a relocalisation, not a drive
-                        self.piece.distance += step
+                    if step < JUMP:
+                        piece.distance += step
                 self.pose = (x, y)
-        elif topic == site.topic("goto"):
-            self.goal, self.approach = _waypoint(site, msg), False
-            if self.piece is not None:
-                self.piece.goals.append(self.goal)
-        elif topic == site.topic("approach"):
-            self.approach = True
-            if self.piece is not None:
-                self.piece.approaches += 1
-        elif topic == site.topic("response"):
+        elif role == "goto":
+            goal, self.approach = _waypoint(self.site, msg), False
+            if piece is not None:
+                piece.goals += 1
+                piece.nav_retries += goal == self.failed
+                piece.t1 = t
+            self.goal, self.failed = goal, None
+        elif role == "approach":
+            self.approach, self.goal = True, None
+            piece = self.piece
+            if piece is not None:
+                piece.approaches += 1
+                person = msg.get("data")
+                if isinstance(person, int):
+                    piece.approached.append(person)
+                piece.t1 = t
+        elif role == "response":
             code = msg.get("data")
-            if self.piece is None or code not in (2, 3, 4):
+            if code not in (2, 3, 4):
                 return
             if self.approach:
                 self.approach = False
-                if code == SUCCESS:
-                    self.piece.approaches_ok += 1
+                if code == SUCCEEDED and piece is not None:
+                    piece.approaches_ok += 1
             elif self.goal is not None:
-                if code != SUCCESS:
-                    self.piece.failed_goals.append(self.goal)
+                if code != SUCCEEDED:
+                    self.failed = self.goal
+                    if piece is not None:
+                        piece.failed_goals.append(self.goal)
                 self.goal = None
-        elif topic == site.topic("icl"):
+        elif role == "dock":
+            command = msg.get("data")
+            if piece is not None and command == self.dock_failed:
+                piece.dock_retries += 1
+            self.dock, self.dock_failed = str(command), None
+        elif role == "docking_state":
+            state = msg.get("data")
+            if state in ("docking", "undocking"):  # what is under way (a file may open here)
+                self.dock = "dock" if state == "docking" else "undock"
+            elif state == "failed" and self.dock is not None:
+                self.dock_failed = self.dock
+            elif state == "docked" and self.back is not None:
+                self.back.t1, self.back = t, None  # home after the abort: the tour is over
+        elif role == "icl":
             on = msg.get("data") == "start"
             if on and not self.stream_on:
                 self.samples = []
             self.stream_on = on
-        elif topic == site.topic("faces") and self.stream_on:
+        elif role == "faces" and self.stream_on:
             for face in msg.get("faces") or ():
                 try:
                     if float(face["distance"]) <= self.near and face["facing"] is True:
                         self.samples.append((t, float(face["engagement"])))
                 except (KeyError, TypeError, ValueError):
                     continue
-        elif topic == site.topic("diagnostic") and self.piece is not None:
+        elif role == "diagnostic" and piece is not None:
             for status in msg.get("status") or ():
                 if isinstance(status, dict) and status.get("level") == ERROR_LEVEL:
                     name = f"{status.get('name')}: {status.get('message')}"
-                    if name not in self.piece.faults:
-                        self.piece.faults.append(name)
+                    if name not in piece.faults:
+                        piece.faults.append(name)
 
     def own(self, t: float, topic: str, msg: dict[str, Any]) -> None:
         if topic == "/frog_bt/primer":  # a rotated file: the seqs sent just before it
+            self.primed = True
             seqs = msg.get("frontend_out_seqs") or []
             self.seen.update(s for s in seqs if isinstance(s, int))
             return
-        if self.piece is None:
+        piece = self.piece
+        if piece is None:
             return
         if topic == "/frog_bt/operator":
-            done = "ok" if msg.get("ok") else "refused"
-            self.piece.operator.append(f"{msg.get('command')} ({done})")
+            command, ok = str(msg.get("command")), bool(msg.get("ok"))
+            piece.operator.append(f"{command} ({'ok' if ok else 'refused'})")
+            if command == "skip" and ok:
+                at = self._skipping()
+                if at is not None:
+                    piece.operator_skips.append(at)
         elif topic == "/frog_bt/alert" and msg.get("state") == "raised":
-            self.piece.alerts.append(str(msg.get("kind")))
+            piece.alerts.append(str(msg.get("kind")))
+
+    def _skipping(self) -> str | None:
+        """The stop an operator's skip leaves: the one playing, or the one driven to."""
+        assert self.piece is not None
+        stops = self.piece.stops
+        if stops and stops[-1].end is None:
+            return stops[-1].poi
+        return self.stop_of.get(self.goal) if self.goal is not None else None
 
 
 def _waypoint(site: Site, msg: dict[str, Any]) -> str:
+    """The POI a goal names (position and orientation, as TourSummary matches it)."""
     try:
         pose = POSE.convert(msg)
     except Exception:
         return "?"
     for name, poi in site.pois.items():
-        if abs(poi.x - pose.x) < 1e-3 and abs(poi.y - pose.y) < 1e-3:
+        if (abs(poi.x - pose.x) < 1e-3 and abs(poi.y - pose.y) < 1e-3
+                and abs(poi.z - pose.qz) < 1e-3 and abs(poi.w - pose.qw) < 1e-3):
             return name
     return f"({pose.x:.1f}, {pose.y:.1f})"
 
@@ -293,14 +407,15 @@ def read_file(path: str, site: Site) -> FileFacts:
         if "/frontend/out" not in recording.types:
             return FileFacts(path, error="not a frog-bt tour recording (no /frontend/out)")
         reader = _Reader(path, site)
-        ros_topics = {site.topic(r) for r in ("pose", "goto", "approach", "response", "icl",
-                                              "faces", "diagnostic")}
+        ros = reader.topics
         start = None
         for topic, ns, data in recording.messages():
             t = ns / 1e9
             if start is None:
                 start = t
-            if topic not in ros_topics and topic not in OWN:
+                reader.first(t)
+            role = ros.get(topic)
+            if role is None and topic not in OWN:
                 continue
             try:
                 msg = json.loads(data)
@@ -308,16 +423,21 @@ def read_file(path: str, site: Site) -> FileFacts:
                 continue
             if not isinstance(msg, dict):
                 continue
-            if topic == "/frontend/out":
+            if role is not None:
+                reader.ros(t, role, msg)
+            elif topic == "/frontend/out":
                 reader.frontend_out(t, msg)
             elif topic == "/frontend/in":
                 reader.frontend_in(t, msg)
-            elif topic in ros_topics:
-                reader.ros(t, topic, msg)
             else:
                 reader.own(t, topic, msg)
-        return FileFacts(path, reader.out, recovered=recording.recovered, start=start or 0.0,
-                         new_executive=reader.numbered_from_1)
+        # An executive's first file: neither a tour file nor an idle file it rotated into
+        # (those open with a primer); a file without our metadata is one whole run.
+        kind = recording.metadata.get("frog_bt", {}).get("kind")
+        restarts = [start] if start is not None and kind != "tour" and not reader.primed \
+            else []
+        return FileFacts(path, reader.finish(), restarts, recovered=recording.recovered,
+                         start=start or 0.0)
     except RecordingError as exc:
         return FileFacts(path, error=str(exc).replace(f"{path}: ", ""))
     except Exception as exc:  # a damaged file must not stop the corpus

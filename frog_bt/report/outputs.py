@@ -121,7 +121,8 @@ def write_html(rows: list[Row], t: dict[str, Any], path: Path, title: str,
         ("Invitation acceptance", f"{_pct(t['invitation_acceptance'])} of "
                                   f"{t['invitations']} invitations "
                                   f"({t['invitations_declined']} declined)"),
-        *((f"Part b at {poi}", f"{_pct(r)} of {t['part_a_played'][poi]} visits")
+        ("Visitors reached", f"{t['visitors']} (said yes to a tour)"),
+        *((f"Part b at {poi}", f"{_pct(r)} of {t['gate_decisions'][poi]} visits")
           for poi, r in t["part_b_rate"].items()),
         ("Tour length", f"median {tour_min.get('median', '-')} min "
                         f"(from {tour_min.get('min', '-')} to {tour_min.get('max', '-')})"),
@@ -132,8 +133,8 @@ def write_html(rows: list[Row], t: dict[str, Any], path: Path, title: str,
     ]
     causes = "".join(f"<tr><td>{e(c)}</td><td class=n>{n}</td></tr>"
                      for c, n in t["failure_causes"].items()) or "<tr><td>none</td></tr>"
-    cols = ["tour", "start", "duration_s", "distance_m", "stops_visited", "stops_skipped",
-            "introduction", "parts", "ended", "reason", "resumed"]
+    cols = ["tour", "robot", "start", "duration_s", "distance_m", "stops_visited",
+            "stops_skipped", "visitors", "introduction", "parts", "ended", "reason", "resumed"]
     body = "".join("<tr>" + "".join(f"<td>{e(str(getattr(r, c)))}</td>" for c in cols)
                    + "</tr>" for r in rows)
     data = json.dumps(t).replace("</", "<\\/")  # raw text inside <script>: no entities
@@ -150,6 +151,7 @@ table {{ border-collapse: collapse; }} td, th {{ padding: .25em .7em; text-align
 td.n {{ text-align: right; }} .figs {{ display: flex; flex-wrap: wrap; gap: 1em; }}
 figure {{ margin: 0; }} figcaption {{ font-weight: 600; }} img {{ max-width: 100%; }}
 .tours td {{ font-size: .85em; }} .skip {{ color: #8a4b00; }}
+.wide {{ overflow-x: auto; }}
 </style></head><body>
 <h1>{e(title)}</h1>
 <h2>Summary</h2>
@@ -161,7 +163,8 @@ figure {{ margin: 0; }} figcaption {{ font-weight: 600; }} img {{ max-width: 100
 <h2>Most frequent failure causes</h2>
 <table id="causes">{causes}</table>
 <h2>Tours</h2>
-<table class="tours" id="tours"><tr>{"".join(f"<th>{c}</th>" for c in cols)}</tr>{body}</table>
+<div class="wide"><table class="tours" id="tours"><tr>{"".join(f"<th>{c}</th>" for c in cols)}</tr>
+{body}</table></div>
 {"".join(f'<p class="skip">skipped: {e(s)}</p>' for s in skipped)}
 <script type="application/json" id="totals">{data}</script>
 </body></html>

@@ -21,16 +21,12 @@ def totals(rows: list[Row], face_stops: list[str], unreadable: int = 0) -> dict[
     approaches = sum(r.approaches for r in rows)
     asked = sum(r.invitations for r in rows)
     part_b: dict[str, float | None] = {}
-    played_a: dict[str, int] = {}
+    decided: dict[str, int] = {}
     for poi in face_stops:
-        a = b = 0
-        for r in rows:
-            e = json.loads(r.engagement).get(poi)
-            if e is not None:
-                a += 1
-                b += e["decision"] == "b"
-        played_a[poi] = a
-        part_b[poi] = _rate(b, a)
+        gate = [v["decision"] for r in rows for v in json.loads(r.engagement)
+                if v["poi"] == poi and v["decision"] != "none"]
+        decided[poi] = len(gate)
+        part_b[poi] = _rate(gate.count("b"), len(gate))
     per_stop: dict[str, list[float]] = {}
     for r in rows:
         for poi, s in json.loads(r.time_at_stops).items():
@@ -57,13 +53,14 @@ def totals(rows: list[Row], face_stops: list[str], unreadable: int = 0) -> dict[
         "resumed": sum(r.resumed for r in rows),
         "tours_per_day": dict(sorted(Counter(r.day for r in rows).items())),
         "tours_per_hour": dict(sorted(Counter(r.hour for r in rows).items())),
+        "visitors": sum(r.visitors for r in rows),
         "approaches": approaches,
         "approach_success": _rate(sum(r.approaches_accepted for r in rows), approaches),
         "invitations": asked,
         "invitation_acceptance": _rate(sum(r.invitations_accepted for r in rows), asked),
         "invitations_declined": sum(r.invitations_declined for r in rows),
         "part_b_rate": part_b,
-        "part_a_played": played_a,
+        "gate_decisions": decided,
         "tour_minutes": _spread([d / 60 for d in durations]),
         "stop_seconds": {poi: _spread(v) for poi, v in per_stop.items()},
         "distance_per_day_m": distance_per_day,

@@ -18,7 +18,7 @@ import pytest
 
 from frog_bt.cli import main
 from frog_bt.config import load_site
-from frog_bt.report.facts import FileFacts, Piece, StopFacts
+from frog_bt.report.facts import FileFacts, Piece, StopFacts, _Reader
 from frog_bt.report.rows import join, rows
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
@@ -63,12 +63,17 @@ def test_the_figures_are_those_the_corpus_was_seeded_with(corpus, tmp_path) -> N
     assert t["invitations"] == 6 + kinds.count("declines") + kinds.count("wander_off")
     assert t["invitations_declined"] == kinds.count("declines")
     assert [r["introduction"] for r in tours] == ["accepted"] * 6
-    # the engagement gate: part b for every visitor but the bored one
-    assert t["part_b_rate"] == {"POI1": 5 / 6, "POI2": 5 / 6}
+    # the engagement gate: part b for every visitor but the bored one; a visitor who
+    # wanders off on the way to POI2 has heard POI1, and so does the next one
+    lost = kinds.count("wander_off")
+    assert t["gate_decisions"] == {"POI1": 6 + lost, "POI2": 6}
+    assert t["part_b_rate"] == {"POI1": (5 + lost) / (6 + lost), "POI2": 5 / 6}
     for r, kind in zip(tours, kinds, strict=True):
         engagement = json.loads(r["engagement"])
-        assert engagement["POI1"]["decision"] == ("a only" if kind == "bored" else "b")
-        assert engagement["POI1"]["samples"] > 0
+        assert [e["poi"] for e in engagement] == (
+            ["POI1", "POI1", "POI2"] if kind == "wander_off" else ["POI1", "POI2"])
+        assert {e["decision"] for e in engagement} == {"a only" if kind == "bored" else "b"}
+        assert all(e["samples"] > 0 for e in engagement)
     # the time-of-day variant the site picks for the tour's start
     site = load_site()
     for r, s in zip(tours, seeded, strict=True):
@@ -154,25 +159,66 @@ def test_a_cut_file_is_read_to_the_cut_and_a_foreign_one_is_skipped(corpus, tmp_
     assert [r["ended"] for r in got["tours"]] == ["ended", "cut"]
 
 
-def test_the_pieces_of_a_resumed_tour_are_joined_into_one() -> None:
+def test_the_pieces_of_a_tour_are_joined_into_one() -> None:
     site = load_site()
-    before = Piece("a.mcap", first_seq=1, started=100.0, t0=100.0, t1=400.0,
-                   stops=[StopFacts("POI1", "POI1a", "ab", 200.0, 220.0)], distance=50.0)
-    after = Piece("b.mcap", first_seq=1, started=None, t0=420.0, t1=900.0, ended="ended",
-                  stops=[StopFacts("POI2", "POI2a", "a", 450.0, 460.0)], distance=70.0)
-    after_rotation = Piece("c.mcap", first_seq=40, started=None, t0=1000.0, t1=1100.0,
-                           ended="ended", stops=[StopFacts("POI1", "POI1a", "a", 1010.0,
-                                                           1020.0)])
-    opened = Piece("c0.mcap", first_seq=39, started=990.0, t0=990.0, t1=990.0)
-    restarted = FileFacts("b.mcap", [after], new_executive=[410.0])  # numbering from 1
-    tours = join([restarted, FileFacts("a.mcap", [before]),
-                  FileFacts("c.mcap", [after_rotation]), FileFacts("c0.mcap", [opened])])
-    assert [len(t.pieces) for t in tours] == [2, 2]
-    assert [t.resumed for t in tours] == [True, False]  # a new executive, then a rotation
-    first = rows([FileFacts("a.mcap", [before]), restarted], site)[0]
-    assert first.resumed
-    assert (first.files, first.stops_visited, first.distance_m, first.ended,
-            first.duration_s) == ("a.mcap;b.mcap", "POI1;POI2", 120.0, "ended", 800.0)
+    # robot a: killed during POI2 (the halt said finish_poi), restarted at 410 (a file
+    # of its own), the tour resumed at POI2
+    before = Piece("a/1.mcap", started=100.0, started_seq=1, t0=100.0, t1=400.0,
+                   stops=[StopFacts("POI1", "POI1a", "ab", 200.0, 220.0),
+                          StopFacts("POI2", "POI2a", "a", 380.0, 400.0)], distance=50.0)
+    after = Piece("a/2.mcap", t0=405.0, t1=900.0, ended="ended", end_seq=30,
+                  stops=[StopFacts("POI2", "POI2a", "ab", 450.0, 480.0)], distance=70.0)
+    # robot b, the same hours: a rotation (the tour file opens just after `tour started`,
+    # the end of the tour before resent into it), then a new executive whose first
+    # `tour started` has seq 1 again: a new tour
+    opened = Piece("b/1.mcap", started=390.0, started_seq=7, t0=390.0, t1=390.0)
+    resent = Piece("b/2.mcap", t0=391.0, t1=391.0, ended="ended", end_seq=5)
+    rotated = Piece("b/2.mcap", started=391.0, started_seq=7, t0=391.0, t1=600.0,
+                    ended="ended", end_seq=60,
+                    stops=[StopFacts("POI1", "POI1a", "a", 410.0, 420.0)])
+    fresh = Piece("b/3.mcap", started=700.0, started_seq=7, t0=700.0, t1=800.0,
+                  ended="aborted", reason="operator")
+    files = [FileFacts("a/2.mcap", [after], restarts=[405.0]),
+             FileFacts("b/3.mcap", [fresh], restarts=[650.0]),
+             FileFacts("a/1.mcap", [before], restarts=[90.0]),
+             FileFacts("b/2.mcap", [resent, rotated]),
+             FileFacts("b/1.mcap", [opened], restarts=[1.0])]
+    tours = join(files)
+    assert [(t.robot, [Path(p.file).name for p in t.pieces], t.resumed, t.last.ended)
+            for t in tours] == [
+        ("a", ["1.mcap", "2.mcap"], True, "ended"),
+        ("b", ["1.mcap", "2.mcap", "2.mcap"], False, "ended"),
+        ("b", ["3.mcap"], False, "aborted")]
+    first = rows(files, site)[0]
+    assert (first.robot, first.files, first.stops_visited, first.parts, first.distance_m,
+            first.ended, first.duration_s, first.resumed) == (
+        "a", "1.mcap;2.mcap", "POI1;POI2", "POI1 ab; POI2 ab", 120.0, "ended", 800.0, True)
+    assert json.loads(first.time_at_stops) == {"POI1": 20.0, "POI2": 50.0}  # 20 + 30
+
+
+def test_a_tour_file_opening_with_the_tour_befores_end_resent_is_read_whole() -> None:
+    """The idle file between two tours was short: the tour before's `tour ended` (seq 5)
+    is still being resent when the next tour's file opens, after its `tour started`
+    (seq 7, acked at once). What follows in that file is the new tour's."""
+    site = load_site()
+    idle = _Reader("r/1-idle.mcap", site)
+    idle.first(100.0)
+    idle.own(100.0, "/frog_bt/primer", {"frontend_out_seqs": [4, 5, 6]})
+    idle.frontend_out(101.0, {"type": "tour", "seq": 7, "state": "started"})
+    tour = _Reader("r/2-tour.mcap", site)
+    tour.first(101.1)
+    tour.frontend_out(101.2, {"type": "tour", "seq": 5, "state": "ended", "reason": ""})
+    tour.frontend_out(130.0, {"type": "ask_tour", "seq": 9, "engaged": True})
+    tour.frontend_in(131.0, {"type": "user_positive", "seq": 3})
+    tour.frontend_out(150.0, {"type": "start_poi", "seq": 10, "poi": "POI1",
+                              "waypoint": "POI1a", "part": "a"})
+    tour.frontend_out(170.0, {"type": "finish_poi", "seq": 11, "poi": "POI1"})
+    tour.frontend_out(300.0, {"type": "tour", "seq": 20, "state": "ended", "reason": ""})
+    files = [FileFacts("r/1-idle.mcap", idle.finish(), restarts=[]),
+             FileFacts("r/2-tour.mcap", tour.finish())]
+    (row,) = rows(files, site)
+    assert (row.invitations, row.invitations_accepted, row.stops_visited, row.ended,
+            row.duration_s, row.resumed) == (1, 1, "POI1", "ended", 199.0, False)
 
 
 def test_mistakes_are_one_line_and_exit_2(tmp_path, capsys) -> None:
@@ -235,3 +281,15 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
     (row,) = got["tours"]
     assert row["resumed"] and row["ended"] == "ended" and len(row["files"].split(";")) >= 3
     assert row["stops_visited"] == "POI1;POI2;POI3;POI4;POI5;END"  # POI2 once: resumed there
+
+
+def test_without_the_fleet_extra_scheduler_says_which(corpus, tmp_path, capsys,
+                                                      monkeypatch) -> None:
+    directory, _ = corpus
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed fails
+    for command in ("report", "replay"):
+        assert main([command, str(directory), "--scheduler", "tcp://127.0.0.1:1",
+                     "--quiet"]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert err == [f"frog-bt {command}: --scheduler needs dask.distributed: "
+                       "pip install 'frog-bt[fleet]'"]

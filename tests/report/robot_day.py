@@ -1,0 +1,203 @@
+"""Tours of different kinds, each a whole run of the real executive against the simulator
+(fast, sim time), recorded as `frog-bt run --record DIR` records them: rotating files,
+one idle and one tour file per tour, in one directory (one robot), one tour a day.
+
+:func:`record_day` runs them in worker processes and returns what the simulator
+received of each tour (the other side's account, to hold the report's rows against).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import math
+import multiprocessing
+from collections.abc import Awaitable, Callable
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from frog_bt.config import load_site
+from frog_bt.observers.rotation import RecordingDir
+from frog_bt.runtime.operator import Command
+from frog_bt.runtime.rehearsal import Rehearsal
+from frog_bt.sim import scenario_from
+from frog_bt.sim.traffic import Record
+
+# Tours in about 0.6 s of wall time: a fast robot, short content, quick answers.
+FAST: dict[str, Any] = {
+    "speed": 400.0, "navigation": {"speed": 3.0, "approach_time": 1.0},
+    "docking": {"undock_time": 2.0, "dock_time": 3.0},
+    "content": {"default": 4, "introduction": 3},
+    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0}}
+
+# kind -> (scenario, overrides, local start); one day each, so that no two overlap
+KINDS: dict[str, tuple[str, dict[str, Any], str]] = {
+    "afternoon": ("afternoon", {}, "2026-06-02T15:00:00"),
+    "bored": ("bored", {}, "2026-06-03T10:00:00"),
+    "declines": ("declines", {}, "2026-06-04T10:00:00"),
+    "declined_then_home": ("declines", {}, "2026-06-05T10:00:00"),
+    "nav_failure": ("nav_failure", {"navigation": {"failures": [
+        {"poi": "POI1", "times": 3, "result": "aborted", "after": 1.0}]}},
+        "2026-06-06T11:00:00"),
+    "fault": ("fault", {"faults": [{"at": 60, "name": "motors", "level": 2,
+                                    "message": "motor driver overheated"}]},
+              "2026-06-07T10:00:00"),
+    "operator_skips": ("default", {}, "2026-06-08T10:00:00"),
+    "undock_failure": ("undock_failure", {}, "2026-06-09T10:00:00"),
+    "wander_off": ("wander_off", {}, "2026-06-10T10:00:00"),
+    "resumed": ("default", {}, "2026-06-11T10:00:00"),
+    # a front end that never acks: every command sent 8 times, `tour started` again
+    # into the tour file after the rotation
+    "unacked": ("default", {"frontend": {"ack": False}}, "2026-06-12T10:00:00"),
+}
+
+
+@dataclass
+class Seen:
+    """What the simulator received from the executive during one tour."""
+
+    kind: str
+    code: int
+    reason: str
+    frontend: list[dict[str, Any]] = field(default_factory=list)  # commands, in order
+    ros: list[tuple[str, Any]] = field(default_factory=list)  # (topic, msg), in order
+    tour: list[float] = field(default_factory=list)  # times of `tour` started, ended/aborted
+    answers: list[str] = field(default_factory=list)  # user_positive / user_negative sent
+    docked: list[float] = field(default_factory=list)  # times /docking/state said docked
+    path_m: float = 0.0  # the robot's path, from the poses the simulator published
+
+    def of(self, type_: str) -> list[dict[str, Any]]:
+        return [m for m in self.frontend if m["type"] == type_]
+
+    @property
+    def duration(self) -> float:
+        """From `tour started` to `tour ended` (docked by then), or to docked again after
+        `tour aborted`."""
+        end = self.tour[-1]
+        if self.of("tour")[-1]["state"] == "aborted":
+            end = next(t for t in self.docked if t >= end)
+        return end - self.tour[0]
+
+
+def _merge(a: dict[str, Any], b: dict[str, Any]) -> dict[str, Any]:
+    out = dict(a)
+    for k, v in b.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def _is(channel: str, **fields: Any) -> Callable[[Record], bool]:
+    return lambda r: r.direction == "in" and r.channel == channel and all(
+        r.payload.get(k) == v for k, v in fields.items())
+
+
+async def _home_after_a_no(r: Rehearsal) -> None:
+    no = asyncio.Event()
+    r.executive.taps.frontend_in.append(
+        lambda _t, type_, _m: no.set() if type_ == "user_negative" else None)
+    await asyncio.wait_for(no.wait(), 60)  # the executive has the visitor's no
+    assert r.executive.core.command(Command.HOME).ok
+
+
+async def _skip_content_then_drive(r: Rehearsal) -> None:
+    await r.sim.wait_for(_is("start_poi", poi="POI3", part="a"), 60)
+    assert r.executive.core.command(Command.SKIP).ok  # during POI3's content
+    await r.sim.wait_for(lambda rec: rec.channel == "/GotoWayPoint"
+                         and rec.payload["pose"]["position"]["x"] == 51.7105, 60)
+    assert r.executive.core.command(Command.SKIP).ok  # during the drive to POI4
+
+
+ACTIONS: dict[str, Callable[[Rehearsal], Awaitable[None]]] = {
+    "declined_then_home": _home_after_a_no, "operator_skips": _skip_content_then_drive}
+
+
+def _seen(kind: str, code: int, reason: str, records: list[Record]) -> Seen:
+    """The simulator's log, for one tour. The simulated front end logs a command once,
+    however often it was sent."""
+    seen = Seen(kind, code, reason)
+    pose: tuple[float, float] | None = None
+    for rec in records:
+        if rec.direction == "in" and rec.side == "frontend" and rec.channel != "ack":
+            seen.frontend.append({"type": rec.channel, **rec.payload})
+            if rec.channel == "tour":
+                seen.tour.append(rec.t)
+        elif rec.direction == "in" and rec.side == "ros":
+            seen.ros.append((rec.channel, rec.payload))
+        elif rec.direction == "out" and rec.channel in ("user_positive", "user_negative"):
+            seen.answers.append(rec.channel)
+        elif rec.direction == "out" and rec.channel == "/docking/state" \
+                and rec.payload["data"] == "docked":
+            seen.docked.append(rec.t)
+        elif rec.direction == "out" and rec.channel == "/FROG_pose":
+            p = rec.payload["pose"]["position"]
+            if pose is not None:
+                seen.path_m += math.hypot(p["x"] - pose[0], p["y"] - pose[1])
+            pose = (p["x"], p["y"])
+    return seen
+
+
+async def _tour(directory: Path, kind: str) -> Seen:
+    name, overrides, start = KINDS[kind]
+    data = _merge(_merge(FAST, overrides), {"start_time": start + "+02:00"})
+    site = load_site()
+    recordings = RecordingDir(directory, 10**12)
+    run = Rehearsal(scenario_from(name, data), site=site, prepare=recordings.attach)
+    try:
+        async with run:
+            action = ACTIONS.get(kind)
+            if action is not None:
+                await action(run)
+            outcome = await run.finish(60)
+    finally:
+        recordings.close()
+    return _seen(kind, outcome.code, outcome.reason, list(run.sim.log))
+
+
+async def _resumed(directory: Path, checkpoint: Path) -> Seen:
+    """A tour whose executive stops during POI2's content (its files closed as SIGTERM
+    closes them) and a new executive that resumes it from the checkpoint."""
+    name, _, start = KINDS["resumed"]
+    site = load_site()
+    first = RecordingDir(directory, 10**12)
+    run = Rehearsal(scenario_from(name, _merge(FAST, {"start_time": start + "+02:00"})),
+                    site=site, prepare=first.attach, checkpoint=checkpoint, once=False)
+    try:
+        async with run:
+            sim, listen = run.sim, run.listen
+            await sim.wait_for(_is("start_poi", poi="POI2", part="a"), 60)
+            run.own_sim = False  # the simulator (the robot, the visitor) goes on
+    finally:
+        first.close()
+    second = RecordingDir(directory, 10**12)
+    again = Rehearsal(None, sim=sim, listen=listen, site=site, prepare=second.attach,
+                      checkpoint=checkpoint)
+    try:
+        async with again:
+            outcome = await again.finish(60)
+    finally:
+        second.close()
+        await sim.stop()
+    return _seen("resumed", outcome.code, outcome.reason, list(sim.log))
+
+
+def record(directory: str, kind: str) -> Seen:
+    """One tour of ``kind`` recorded into ``directory`` (in a worker process)."""
+    if kind == "resumed":
+        return asyncio.run(_resumed(Path(directory), Path(directory).parent / "checkpoint"))
+    return asyncio.run(_tour(Path(directory), kind))
+
+
+def record_day(directory: Path, kinds: list[str], jobs: int = 2) -> dict[str, Seen]:
+    """Every tour of ``kinds`` recorded into ``directory`` (one robot); kind -> Seen."""
+    directory.mkdir(parents=True, exist_ok=True)
+    context = multiprocessing.get_context("fork")
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
+        futures = {kind: pool.submit(record, str(directory / kind), kind) for kind in kinds}
+        seen = {kind: f.result() for kind, f in futures.items()}
+    # one robot's directory: every tour's files together, as one --record DIR holds them
+    for kind in kinds:
+        for path in (directory / kind).glob("*.mcap"):
+            path.rename(directory / path.name)
+        (directory / kind).rmdir()
+    return seen

@@ -1,0 +1,306 @@
+"""`frog-bt report` over one robot's `--record DIR` recordings of tours of every kind
+(tests/report/robot_day.py): each row held against what the simulator received during
+that tour and against what its kind of tour does; a resumed tour, resends across a
+rotation, cut and foreign files, two robots, and the three outputs read back."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+from collections import Counter
+from datetime import datetime
+from html.parser import HTMLParser
+from pathlib import Path
+from typing import Any
+
+import pytest
+from mcap.writer import Writer
+from robot_day import KINDS, Seen
+
+from frog_bt.cli import main
+from frog_bt.tools.mcapfile import open_recording
+
+STOPS = ["POI1", "POI2", "POI3", "POI4", "POI5", "END"]  # content stops, in order
+
+
+def report(tmp_path: Path, *args: str) -> dict[str, Any]:
+    target = tmp_path / "out.json"
+    assert main(["report", *args, "--json", str(target), "--quiet"]) == 0
+    return json.loads(target.read_text())
+
+
+def day_of(kind: str) -> str:
+    return KINDS[kind][2][:10]
+
+
+@pytest.fixture(scope="module")
+def by_kind(robot_day, tmp_path_factory) -> dict[str, dict[str, Any]]:
+    directory, _ = robot_day
+    got = report(tmp_path_factory.mktemp("report"), str(directory))
+    days = {day_of(kind): kind for kind in KINDS}
+    assert len(got["tours"]) == len(KINDS)  # one row per tour, whatever its files
+    return {days[r["day"]]: r for r in got["tours"]} | {"totals": got["totals"]}
+
+
+def visits(seen: Seen, restarted: bool = False) -> list[list[str]]:
+    """[poi, parts, waypoint] of each visit, as the simulator received them; a visit
+    a restart cut and the resumed executive played again is one."""
+    out: list[list[str]] = []
+    for m in seen.of("start_poi"):
+        if m["part"] == "b":
+            out[-1][1] += "b"
+        elif restarted and out and out[-1][0] == m["poi"]:
+            out[-1][2] = m["waypoint"]
+        else:
+            out.append([m["poi"], "a", m["waypoint"]])
+    return out
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_each_row_is_what_the_robot_was_told_and_did(robot_day, by_kind, kind) -> None:
+    _, seen_all = robot_day
+    seen, row = seen_all[kind], by_kind[kind]
+    v = visits(seen, restarted=kind == "resumed")
+    assert row["stops_visited"] == ";".join(poi for poi, _, _ in v)
+    assert row["parts"] == "; ".join(f"{poi} {parts}" for poi, parts, _ in v)
+    assert row["variants"] == ";".join(dict.fromkeys(wp for poi, _, wp in v if wp != poi))
+    assert row["approaches"] == sum(t == "/ApproachPeopleFar" for t, _ in seen.ros)
+    assert row["invitations"] == len(seen.of("ask_tour"))
+    assert row["invitations_accepted"] == seen.answers.count("user_positive")
+    assert row["invitations_declined"] == seen.answers.count("user_negative")
+    last = seen.of("tour")[-1]
+    assert (row["ended"], row["reason"]) == (last["state"], last["reason"])
+    start = datetime.fromisoformat(KINDS[kind][2])
+    assert (row["day"], row["hour"]) == (f"{start:%Y-%m-%d}", start.hour)
+    assert row["duration_s"] == pytest.approx(seen.duration, abs=0.5)
+    assert row["distance_m"] == pytest.approx(seen.path_m, rel=0.01, abs=1.0)
+    assert row["resumed"] is (kind == "resumed")
+    assert row["robot"] == "frog1"
+    seconds = json.loads(row["time_at_stops"])
+    assert list(seconds) == list(dict.fromkeys(poi for poi, _, _ in v))
+    assert all(s > 0 for s in seconds.values())
+
+
+def test_what_each_kind_of_tour_shows(by_kind) -> None:
+    def gate(kind: str) -> list[tuple[str, str]]:
+        return [(e["poi"], e["decision"]) for e in json.loads(by_kind[kind]["engagement"])]
+
+    # the time-of-day variants: after 13:00 the afternoon waypoints
+    assert by_kind["afternoon"]["variants"] == "POI1b;POI2b"
+    assert by_kind["bored"]["variants"] == "POI1a;POI2a"
+    # the engagement gate: part b for an engaged visitor, none for a bored one
+    assert gate("afternoon") == [("POI1", "b"), ("POI2", "b")]
+    assert gate("bored") == [("POI1", "a only"), ("POI2", "a only")]
+    for e in json.loads(by_kind["bored"]["engagement"]):
+        assert e["samples"] > 0 and e["edge_engaged"] == 0 and e["edge_votes"] > 0
+    for e in json.loads(by_kind["afternoon"]["engagement"]):
+        assert e["edge_engaged"] == e["edge_votes"] > 0
+    assert by_kind["bored"]["parts"] == "; ".join(f"{s} a" for s in STOPS)
+    # a visitor says no, another says yes: one tour, two invitations, one visitor
+    declines = by_kind["declines"]
+    assert (declines["approaches"], declines["approaches_accepted"], declines["visitors"],
+            declines["invitations"], declines["invitations_accepted"],
+            declines["invitations_declined"], declines["introduction"]) == (
+        2, 2, 1, 2, 1, 1, "accepted")
+    # a no, and the operator sends the robot home: declined, aborted, nothing visited
+    home = by_kind["declined_then_home"]
+    assert (home["introduction"], home["ended"], home["reason"], home["operator"],
+            home["stops_visited"], home["stops_skipped"], home["visitors"]) == (
+        "declined", "aborted", "operator", "home (ok)", "", "", 0)
+    # POI1 cannot be reached: three goals (two retries), skipped with its reason
+    nav = by_kind["nav_failure"]
+    assert nav["stops_skipped"] == "POI1: navigation failed"
+    assert nav["stops_visited"] == ";".join(STOPS[1:])
+    assert (nav["nav_retries"], nav["dock_retries"]) == (2, 0)
+    assert gate("nav_failure") == [("POI2", "b")]
+    # a motor fault on the way: the tour aborted with its reason, the fault listed
+    fault = by_kind["fault"]
+    assert (fault["ended"], fault["reason"], fault["faults"]) == (
+        "aborted", "electronics fault: motors: motor driver overheated",
+        "motors: motor driver overheated")
+    assert fault["stops_skipped"] == ""  # it never reached the stops after the abort
+    # the operator skips POI3 during its content and POI4 on the way there
+    skips = by_kind["operator_skips"]
+    assert skips["stops_skipped"] == "POI3: operator; POI4: operator"
+    assert skips["stops_visited"] == "POI1;POI2;POI3;POI5;END"
+    assert skips["operator"] == "skip (ok); skip (ok)"
+    # the first undock fails and is tried again
+    assert (by_kind["undock_failure"]["dock_retries"],
+            by_kind["undock_failure"]["nav_retries"]) == (1, 0)
+    # a visitor lost on the way: back to POI0, a second visitor, POI1 again for them
+    wander = by_kind["wander_off"]
+    assert (wander["visitors"], wander["approaches"], wander["invitations"]) == (2, 2, 2)
+    assert wander["stops_visited"] == "POI1;POI1;POI2;POI3;POI4;POI5;END"
+    assert json.loads(wander["time_at_stops"])["POI1"] > json.loads(
+        by_kind["afternoon"]["time_at_stops"])["POI1"] * 1.5  # both visits added
+    for kind in KINDS:
+        if kind != "undock_failure":
+            assert by_kind[kind]["dock_retries"] == 0, kind
+        if kind != "nav_failure":
+            assert by_kind[kind]["nav_retries"] == 0, kind
+
+
+def test_a_tour_resumed_after_a_restart_is_one_row(by_kind) -> None:
+    row = by_kind["resumed"]
+    # idle and tour file of the first executive, idle and tour file of the second
+    assert len(row["files"].split(";")) == 4
+    assert row["resumed"] is True and row["ended"] == "ended"
+    assert row["stops_visited"] == ";".join(STOPS)  # POI2, cut by the restart, once
+    assert row["parts"] == "; ".join(f"{s} {'ab' if s in ('POI1', 'POI2') else 'a'}"
+                                     for s in STOPS)
+    assert (row["approaches"], row["invitations"], row["visitors"]) == (1, 1, 1)
+    # POI2's time: its part a before the restart and the whole visit after it
+    others = [json.loads(by_kind[k]["time_at_stops"])["POI2"]
+              for k in ("afternoon", "declines", "undock_failure")]
+    assert json.loads(row["time_at_stops"])["POI2"] > max(others)
+    assert by_kind["totals"]["resumed"] == 1
+
+
+def test_resends_across_a_rotation_are_not_new_tours(robot_day, by_kind) -> None:
+    directory, _ = robot_day
+    tour_file = next(directory.glob(f"{day_of('unacked').replace('-', '')}-*-tour*.mcap"))
+    started = [json.loads(data) for topic, _, data in open_recording(tour_file).messages()
+               if topic == "/frontend/out" and b'"started"' in data]
+    assert started  # `tour started`, unacked, sent again after the rotation
+    row = by_kind["unacked"]
+    assert len(row["files"].split(";")) == 2 and row["ended"] == "ended"
+    assert row["resumed"] is False
+
+
+def test_the_totals_and_rates(robot_day, by_kind) -> None:
+    _, seen = robot_day
+    t = by_kind["totals"]
+    aborted = 2  # the fault, and the decliner sent home
+    assert t["tours"] == len(KINDS) and t["completed"] == len(KINDS) - aborted
+    assert t["completion_rate"] == pytest.approx((len(KINDS) - aborted) / len(KINDS))
+    assert t["tours_per_day"] == {day_of(kind): 1 for kind in KINDS}
+    assert t["tours_per_hour"] == {"10": len(KINDS) - 2, "11": 1, "15": 1}
+    answers = [a for s in seen.values() for a in s.answers]
+    assert t["invitations"] == len(answers)
+    assert t["invitation_acceptance"] == pytest.approx(
+        answers.count("user_positive") / len(answers))
+    assert t["approaches"] == sum(topic == "/ApproachPeopleFar" for s in seen.values()
+                                  for topic, _ in s.ros)
+    assert t["approach_success"] == 1.0  # every simulated approach reaches its person
+    # one each; none for the decliner sent home, two for the tour that lost its first
+    assert t["visitors"] == sum(by_kind[k]["visitors"] for k in KINDS) == len(KINDS)
+    for poi in ("POI1", "POI2"):
+        decided = [parts for k in KINDS for p, parts, _ in visits(seen[k], k == "resumed")
+                   if p == poi]
+        assert t["gate_decisions"][poi] == len(decided)
+        assert t["part_b_rate"][poi] == pytest.approx(
+            sum("b" in parts for parts in decided) / len(decided))
+    assert t["failure_causes"] == {
+        "stop skipped: operator": 2,
+        "aborted: operator": 1,
+        "stop skipped: navigation failed": 1,
+        "aborted: electronics fault: motors: motor driver overheated": 1,
+        "fault: motors: motor driver overheated": 1}
+    assert t["distance_m"] == pytest.approx(sum(s.path_m for s in seen.values()), rel=0.01)
+    played = Counter(wp for k in KINDS for wp in {wp for poi, _, wp in visits(seen[k])
+                                                  if wp != poi})
+    assert t["variants"] == dict(played) and played["POI1b"] == played["POI2b"] == 1
+
+
+def test_csv_and_parquet_read_back_as_the_rows(robot_day, tmp_path) -> None:
+    pq = pytest.importorskip("pyarrow.parquet")
+    directory, _ = robot_day
+    got = report(tmp_path, str(directory), "--csv", str(tmp_path / "r.csv"),
+                 "--parquet", str(tmp_path / "r.parquet"))
+    with open(tmp_path / "r.csv", newline="", encoding="utf-8") as f:
+        table = list(csv.DictReader(f))
+    assert table == [{k: str(v) for k, v in r.items()} for r in got["tours"]]
+    assert pq.read_table(tmp_path / "r.parquet").to_pylist() == got["tours"]
+
+
+class Page(HTMLParser):
+    def __init__(self) -> None:
+        super().__init__()
+        self.images: list[str] = []
+        self.links: list[str] = []
+        self.script: str | None = None
+        self.scripts: dict[str, str] = {}
+        self.text: list[str] = []
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        a = dict(attrs)
+        if tag == "img":
+            self.images.append(a.get("src") or "")
+        elif a.get("src") or a.get("href"):
+            self.links.append(a.get("src") or a.get("href") or "")
+        self.script = a.get("id") if tag == "script" else None
+
+    def handle_data(self, data: str) -> None:
+        if self.script:
+            self.scripts[self.script] = self.scripts.get(self.script, "") + data
+        self.text.append(data)
+
+
+def test_the_html_is_one_self_contained_page(robot_day, tmp_path) -> None:
+    pytest.importorskip("matplotlib")
+    directory, _ = robot_day
+    got = report(tmp_path, str(directory), "-o", str(tmp_path / "r.html"))
+    page = Page()
+    page.feed((tmp_path / "r.html").read_text(encoding="utf-8"))
+    assert len(page.images) == 6  # per day, per hour, part b, length, per stop, distance
+    assert all(src.startswith("data:image/png;base64,") for src in page.images)
+    assert page.links == []  # nothing fetched: it opens offline
+    assert json.loads(page.scripts["totals"]) == got["totals"]
+    text = " ".join(page.text)
+    rate = got["totals"]["completion_rate"]
+    assert f"{100 * rate:.1f} %" in text and "Most frequent failure causes" in text
+    assert "stop skipped: navigation failed" in text
+
+
+def test_cut_and_foreign_files_are_said_and_the_rest_is_read(robot_day, tmp_path,
+                                                             capsys) -> None:
+    directory, _ = robot_day
+    work = tmp_path / "frog1"
+    shutil.copytree(directory, work)
+    first_tour = sorted(work.glob(f"{day_of('resumed').replace('-', '')}-*-tour*.mcap"))[0]
+    data = first_tour.read_bytes()
+    first_tour.write_bytes(data[: len(data) * 2 // 3])  # killed: its last third is gone
+    idle = sorted(work.glob(f"{day_of('declined_then_home').replace('-', '')}-*-idle*"))[0]
+    idle.write_bytes(idle.read_bytes()[:40])  # nothing readable left: `tour started` lost
+    (work / "notes.mcap").write_text("not a recording")
+    foreign = work / "chatter.mcap"
+    with open(foreign, "wb") as f:
+        writer = Writer(f)
+        writer.start()
+        schema = writer.register_schema("std_msgs/String", "jsonschema", b"{}")
+        channel = writer.register_channel("/chatter", "json", schema)
+        writer.add_message(channel, 1, b'{"data": "hi"}', 1, 1)
+        writer.finish()
+    got = report(tmp_path, str(work))
+    err = capsys.readouterr().err
+    assert f"skipped {work / 'notes.mcap'}: not an MCAP file" in err
+    assert f"skipped {foreign}: not a frog-bt tour recording (no /frontend/out)" in err
+    assert f"skipped {idle}: damaged MCAP file, nothing readable in it" in err
+    assert f"{first_tour}: cut short (no summary or footer): recovered" in err
+    t = got["totals"]
+    assert t["tours"] == len(KINDS) and t["unreadable_files"] == 3
+    rows = {r["day"]: r for r in got["tours"]}
+    resumed = rows[day_of("resumed")]
+    assert resumed["resumed"] is True and resumed["ended"] == "ended"
+    assert resumed["stops_visited"].endswith("POI3;POI4;POI5;END")
+    home = rows[day_of("declined_then_home")]  # from its tour file alone
+    assert (home["ended"], home["introduction"], home["resumed"]) == (
+        "aborted", "declined", False)
+
+
+def test_two_robots_tours_at_the_same_time_stay_apart(robot_day, tmp_path) -> None:
+    directory, _ = robot_day
+    day = day_of("resumed").replace("-", "")
+    for robot in ("frog1", "frog2"):
+        (tmp_path / robot).mkdir()
+        for path in directory.glob(f"{day}-*.mcap"):
+            shutil.copy(path, tmp_path / robot / path.name)
+    got = report(tmp_path, str(tmp_path / "frog1"), str(tmp_path / "frog2"))
+    assert [(r["robot"], r["resumed"], r["stops_visited"]) for r in got["tours"]] == [
+        ("frog1", True, ";".join(STOPS)), ("frog2", True, ";".join(STOPS))]
+
+
+def test_one_job_two_jobs_alike(robot_day, tmp_path) -> None:
+    directory, _ = robot_day
+    assert report(tmp_path, str(directory), "--jobs", "2") == report(tmp_path, str(directory))
