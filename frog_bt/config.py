@@ -18,7 +18,14 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from frog_bt import resources
 from frog_bt.errors import ConfigError, UsageError
-from frog_bt.wire import DEFAULT_FRONTEND, DEFAULT_LISTEN, DEFAULT_ROSBRIDGE_URL, INPUTS, OUTPUTS
+from frog_bt.model.ros import Pose
+from frog_bt.model.wire import (
+    DEFAULT_FRONTEND,
+    DEFAULT_LISTEN,
+    DEFAULT_ROSBRIDGE_URL,
+    INPUTS,
+    OUTPUTS,
+)
 from frog_bt.yamlfile import PathError, load_yaml, validate
 
 DEFAULT_CONFIG = resources.site_dir() / resources.SITE_FILE
@@ -26,6 +33,8 @@ DEFAULT_CONFIG = resources.site_dir() / resources.SITE_FILE
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+WAYPOINT_TOLERANCE = 1e-3  # metres and quaternion units: a goal names a POI within it
 
 
 class _Model(BaseModel):
@@ -323,6 +332,17 @@ class Site(_Model):
             if variant.until is None or local <= variant.until:
                 return variant.waypoint
         return poi
+
+    def waypoint_of(self, pose: Pose) -> str:
+        """The POI a goal's pose names (position and orientation within
+        :data:`WAYPOINT_TOLERANCE`), or its position as ``(x, y)`` when none does: the one
+        waypoint match (summary, replay, report)."""
+        for name, poi in self.pois.items():
+            near = (abs(poi.x - pose.x), abs(poi.y - pose.y), abs(poi.z - pose.qz),
+                    abs(poi.w - pose.qw))
+            if max(near) < WAYPOINT_TOLERANCE:
+                return name
+        return f"({pose.x:.1f}, {pose.y:.1f})"
 
     def topic(self, role: str) -> str:
         default = INPUTS.get(role) or OUTPUTS[role]

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from frog_bt.yamlmarks import line_of
+
 
 class FrogError(Exception):
     """Base class of every error frog-bt raises on purpose."""
@@ -43,8 +45,6 @@ class DefinitionError(FrogError):
         self.file = str(file)
         self.path = tuple(path)
         self.detail = message
-        from frog_bt.yamlfile import line_of  # errors.py imports nothing of ours at load
-
         self.line = line_of(self.file, self.path) if self.path else None
         at = f"{self.file}:{self.line[0]}:{self.line[1]}" if self.line else self.file
         where = f"{format_path(self.path)}: " if self.path else ""

@@ -16,11 +16,11 @@ import yaml
 from pydantic import BaseModel, ValidationError
 
 from frog_bt.errors import DefinitionError
+from frog_bt.yamlmarks import Marks, mark_paths
 
 M = TypeVar("M", bound=BaseModel)
 
 
-Marks = dict[tuple[str | int, ...], tuple[int, int]]  # path in a file -> (line, column)
 
 
 def load_yaml(path: str | Path, error: type[DefinitionError]) -> Any:
@@ -44,41 +44,8 @@ def load_yaml_marked(path: str | Path, error: type[DefinitionError]) -> tuple[An
         raise error(str(path), (), f"not valid YAML: {where}{problem}") from exc
     marks: Marks = {}
     if node is not None:
-        _marks(node, (), marks)
+        mark_paths(node, (), marks)
     return data, marks
-
-
-def _marks(node: yaml.Node, path: tuple[str | int, ...],
-           out: dict[tuple[str | int, ...], tuple[int, int]]) -> None:
-    out[path] = (node.start_mark.line + 1, node.start_mark.column + 1)
-    if isinstance(node, yaml.MappingNode):
-        for key, value in node.value:
-            if isinstance(key, yaml.ScalarNode):
-                _marks(value, (*path, key.value), out)
-    elif isinstance(node, yaml.SequenceNode):
-        for i, item in enumerate(node.value):
-            _marks(item, (*path, i), out)
-
-
-def line_of(file: str, path: tuple[str | int, ...], marks: Marks | None = None
-            ) -> tuple[int, int] | None:
-    """(line, column) of ``path`` in ``file``, or of its nearest ancestor there: from
-    ``marks`` when given, else the file is read again (errors only: nothing is kept)."""
-    if marks is None:
-        try:
-            node = yaml.compose(Path(file).read_text(encoding="utf-8"), Loader=yaml.SafeLoader)
-        except (OSError, UnicodeDecodeError, yaml.YAMLError):
-            return None
-        marks = {}
-        if node is not None:
-            _marks(node, (), marks)
-    if not marks:
-        return None
-    for n in range(len(path), -1, -1):
-        found = marks.get(tuple(path[:n]))
-        if found is not None:
-            return found
-    return None
 
 
 class PathError(ValueError):

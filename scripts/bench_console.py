@@ -24,8 +24,8 @@ from bench_support import emit
 
 from frog_bt.commands.console_options import ConsoleSettings, start_people
 from frog_bt.config import load_site
-from frog_bt.observers.status import phase
-from frog_bt.runtime.rehearsal import Rehearsal
+from frog_bt.rehearsal import Rehearsal
+from frog_bt.runtime.status import phase
 from frog_bt.sim import scenario_from
 
 

@@ -36,12 +36,12 @@ def say(event: str, **fields: Any) -> None:
 
 
 async def serve(args: argparse.Namespace) -> None:
+    from frog_bt.behaviours import load_tree
+    from frog_bt.clock import SimClock, WallClock
     from frog_bt.commands.run import attach_observers
     from frog_bt.config import load_site, parse_hostport
-    from frog_bt.kernel.clock import SimClock, WallClock
     from frog_bt.runtime.executive import Executive
     from frog_bt.runtime.memory import pin_malloc_thresholds
-    from frog_bt.tree.loader import load_tree
 
     pin_malloc_thresholds()  # as frog-bt run does
     site = load_site(args.config)

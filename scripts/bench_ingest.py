@@ -121,8 +121,8 @@ async def one_flood(server: FakeRosbridge, child: Child, kind: str,
 
 
 async def measure(seconds: float, kinds: list[str]) -> dict[str, Any]:
-    from frog_bt.frontend.messages import FrontendIdle
-    from frog_bt.wire import INPUTS
+    from frog_bt.model.frontend import FrontendIdle
+    from frog_bt.model.wire import INPUTS
 
     result: dict[str, Any] = {"seconds": seconds}
 

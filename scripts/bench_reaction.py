@@ -52,7 +52,7 @@ class Director:
     """The fake robot and front end: answers every command the way the loop needs."""
 
     def __init__(self, site: Any, trials: int) -> None:
-        from frog_bt.frontend import messages as fm
+        from frog_bt.model import frontend as fm
 
         self.fm = fm
         self.site = site
@@ -172,7 +172,7 @@ class Director:
 
 async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]:
     from frog_bt.config import load_site
-    from frog_bt.wire import INPUTS
+    from frog_bt.model.wire import INPUTS
 
     plain = {"content": True, "face_stream": False, "projector": False, "check_follower": True}
     site_path = synthetic_site(7, workdir, flags=plain, over={"follow": {"grace": 0.0},

@@ -2,7 +2,7 @@
 
 First records: the simulator and the executive in this process, on sim time as fast
 as they go, tours back to back on the default scenario (real content lengths), with
-``--record``'s :class:`~frog_bt.observers.recording.Recorder`, until ``--minutes`` of simulated
+``--record``'s :class:`~frog_bt.live.recording.Recorder`, until ``--minutes`` of simulated
 time have passed. Then times ``frog-bt replay FILE.mcap`` in a fresh process, without
 and with ``--rerun save:FILE.rrd``: the whole command (start-up included) and the
 replay's own figure.
@@ -37,12 +37,12 @@ REPLAYED = re.compile(r"replayed ([\d.]+) of ([\d.]+) s recorded in ([\d.]+) s w
 
 
 async def record(path: Path, minutes: float, speed: float) -> dict[str, Any]:
+    from frog_bt.behaviours import load_tree
+    from frog_bt.clock import SimClock
     from frog_bt.config import load_site
-    from frog_bt.kernel.clock import SimClock
-    from frog_bt.observers.recording import Recorder
+    from frog_bt.live.recording import Recorder
     from frog_bt.runtime.executive import Executive
     from frog_bt.sim import Simulator
-    from frog_bt.tree.loader import load_tree
 
     site = load_site()
     listen = (LOOPBACK, free_port())

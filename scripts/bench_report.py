@@ -23,10 +23,10 @@ from bench_support import emit
 from mcap.reader import make_reader
 
 from frog_bt.config import load_site
-from frog_bt.report.corpus import read_corpus
-from frog_bt.report.rows import rows
-from frog_bt.tools.corpus import recordings
-from frog_bt.tools.executors import executor
+from frog_bt.offline.corpus import recordings
+from frog_bt.offline.executors import executor
+from frog_bt.offline.report.corpus import read_corpus
+from frog_bt.offline.report.rows import rows
 
 YEAR = 2400  # tours of one robot in a year
 

@@ -25,7 +25,7 @@ def main() -> None:
     args = p.parse_args()
     import roslibpy
 
-    from frog_bt.wire import INPUTS
+    from frog_bt.model.wire import INPUTS
 
     received = 0
     lock = threading.Lock()

@@ -35,7 +35,7 @@ from bench_support import (
 
 
 async def startup_runs(runs: int, extra: list[str]) -> dict[str, Any]:
-    from frog_bt.wire import INPUTS
+    from frog_bt.model.wire import INPUTS
 
     server = FakeRosbridge(expect_subscriptions=len(INPUTS))
     await server.start()
@@ -66,8 +66,8 @@ async def startup_runs(runs: int, extra: list[str]) -> dict[str, Any]:
 
 def import_time() -> float:
     """Seconds for a fresh interpreter to import what ``frog-bt run`` needs."""
-    code = ("import frog_bt.commands.run, frog_bt.runtime.executive, frog_bt.observers.status; "
-            "from frog_bt.config import load_site; from frog_bt.tree.loader import load_tree; "
+    code = ("import frog_bt.commands.run, frog_bt.runtime.executive, frog_bt.runtime.status; "
+            "from frog_bt.config import load_site; from frog_bt.behaviours import load_tree; "
             "load_tree(site=load_site())")
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-c", code], check=True)

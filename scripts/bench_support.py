@@ -234,8 +234,8 @@ class FakeFrontend(asyncio.DatagramProtocol):
 
     def __init__(self, executive: tuple[str, int],
                  on_command: Callable[[Any, int], None] | None = None) -> None:
-        from frog_bt.frontend.messages import COMMANDS
         from frog_bt.frontend.protocol import Endpoint
+        from frog_bt.model.frontend import COMMANDS
 
         self.executive = executive
         self.on_command = on_command

@@ -68,12 +68,12 @@ def phase_of(node: Any, dock: str, recruit_at: str) -> str:
 
 
 async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
+    from frog_bt.behaviours import load_tree
+    from frog_bt.clock import SimClock
     from frog_bt.config import load_site
-    from frog_bt.kernel.clock import SimClock
     from frog_bt.runtime.executive import Executive
     from frog_bt.sim import Simulator
     from frog_bt.sim.site import load_pois
-    from frog_bt.tree.loader import load_tree
 
     site_path = synthetic_site(stops, workdir)
     site = load_site(site_path)

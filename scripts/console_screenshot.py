@@ -22,7 +22,7 @@ from selenium.webdriver.support.ui import WebDriverWait
 
 from frog_bt.commands.console_options import ConsoleSettings, start_people
 from frog_bt.config import load_site
-from frog_bt.runtime.rehearsal import Rehearsal
+from frog_bt.rehearsal import Rehearsal
 from frog_bt.sim import scenario_from
 
 

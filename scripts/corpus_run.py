@@ -82,8 +82,8 @@ def plan(days: int, per_day: int, seed: int) -> list[Seeded]:
 def record(tour: Seeded, directory: str) -> dict[str, Any]:
     """Run and record one tour (in a worker process); what happened, in brief."""
     from frog_bt.config import load_site
-    from frog_bt.observers.recording import Recorder
-    from frog_bt.runtime.rehearsal import Rehearsal
+    from frog_bt.live.recording import Recorder
+    from frog_bt.rehearsal import Rehearsal
     from frog_bt.sim import scenario_from
 
     path = Path(directory) / tour.file

@@ -359,9 +359,9 @@ def lost_commands(record_dir: Path) -> tuple[int, int]:
     """(front-end commands sent, never acked), from the recordings in order: a command's
     seq is taken once (resends are not new), an ack with its seq settles it; when the
     numbering starts again (a restarted executive), what is open is lost."""
-    from frog_bt.observers.recording import FRONTEND_IN, FRONTEND_OUT
-    from frog_bt.observers.rotation import numbered
-    from frog_bt.tools.mcapfile import RecordingError, open_recording
+    from frog_bt.live.rotation import numbered
+    from frog_bt.model.channels import FRONTEND_IN, FRONTEND_OUT
+    from frog_bt.recordings.mcapfile import RecordingError, open_recording
 
     sent = lost = 0
     open_seqs: set[int] = set()

@@ -8,10 +8,12 @@ from typing import Any
 
 import py_trees
 
+from frog_bt.behaviours import load_tree
+from frog_bt.clock import ManualClock
 from frog_bt.config import Site, load_site
-from frog_bt.frontend.messages import FrontendMessage
-from frog_bt.kernel.clock import ManualClock
-from frog_bt.rosbridge.msgs import (
+from frog_bt.engine.core import Core, Taps
+from frog_bt.model.frontend import FrontendMessage
+from frog_bt.model.ros import (
     PersonDetection,
     PersonDetections,
     Point,
@@ -19,8 +21,7 @@ from frog_bt.rosbridge.msgs import (
     TrackedPeople,
     TrackedPerson,
 )
-from frog_bt.runtime.core import Core, Taps
-from frog_bt.tree.loader import LoadedTree, load_tree
+from frog_bt.tree.loader import LoadedTree
 
 MORNING = 1780302600.0  # 2026-06-01 10:30 Europe/Madrid
 AFTERNOON = MORNING + 4 * 3600  # 14:30

@@ -1,4 +1,4 @@
-"""Test shorthands for the ROS codecs of :mod:`frog_bt.rosbridge.msgs`: decoders of
+"""Test shorthands for the ROS codecs of :mod:`frog_bt.model.ros`: decoders of
 ``msg`` objects (or raw JSON) by name, and encoders with the old positional forms."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from typing import Any
 
 import msgspec
 
-from frog_bt.rosbridge.msgs import (
+from frog_bt.model.ros import (
     CLOCK,
     DIAGNOSTICS,
     FACES,

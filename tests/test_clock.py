@@ -6,7 +6,7 @@ import asyncio
 
 import pytest
 
-from frog_bt.kernel.clock import ManualClock, SimClock, WallClock
+from frog_bt.clock import ManualClock, SimClock, WallClock
 
 
 def test_manual_clock_wakes_sleepers_in_deadline_order_and_never_rewinds():

@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from frog_bt.maths.engagement import Samples, decide, edge_indices, meter, qualifies
-from frog_bt.rosbridge.msgs import Face
+from frog_bt.model.ros import Face
 
 
 def test_meter_is_the_mean_of_the_majority_side():

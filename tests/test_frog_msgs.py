@@ -7,7 +7,7 @@ arrays) and checks, field by field, that
 * they are CONTRACT's definitions, comments included;
 * the simulator's JSON (:mod:`frog_bt.sim.msgs`) has every field, no other
   field, and JSON types matching the ROS types;
-* the executive's decoders (:mod:`frog_bt.rosbridge.msgs`) accept a message built from
+* the executive's decoders (:mod:`frog_bt.model.ros`) accept a message built from
   the definition and read every field;
 * ``package.xml`` and ``CMakeLists.txt`` build the package with catkin.
 """
@@ -27,7 +27,7 @@ import pytest
 import rosmsgs
 
 from frog_bt.errors import DecodeError
-from frog_bt.rosbridge import msgs as messages
+from frog_bt.model import ros as messages
 
 PACKAGE = Path(__file__).resolve().parents[1] / "ros" / "frog_msgs"
 MSG_DIR = PACKAGE / "msg"

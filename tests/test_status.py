@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from frog_bt.observers.status import link_line
 from frog_bt.rosbridge.link import LinkState
+from frog_bt.runtime.status import link_line
 
 
 def test_unreachable_rosbridge_is_named_with_attempt_delay_and_plain_reason():
@@ -41,8 +41,8 @@ def test_a_ten_minute_outage_in_a_journal_is_a_few_dozen_lines() -> None:
     on a clock the test moves; the lines are counted."""
     import io
 
-    from frog_bt.observers.status import StatusLine
     from frog_bt.rosbridge.client import backoff_delays
+    from frog_bt.runtime.status import StatusLine
 
     out = io.StringIO()
     t, attempt, retry_at = 0.0, 0, 0.0
@@ -70,7 +70,7 @@ def test_a_ten_minute_outage_in_a_journal_is_a_few_dozen_lines() -> None:
 
 
 def test_attempt_counts_grow_in_steps() -> None:
-    from frog_bt.observers.status import milestone
+    from frog_bt.runtime.status import milestone
 
     assert [milestone(n) for n in (0, 1, 2, 3, 4, 5, 9, 10, 19, 20, 49, 50, 99, 100, 201)] == [
         0, 1, 2, 2, 2, 5, 5, 10, 10, 20, 20, 50, 50, 100, 200]

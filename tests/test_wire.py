@@ -1,8 +1,8 @@
 """The wire table is the one place an input is declared.
 
 A made-up input (a lidar that says whether the corridor ahead is clear, and how wide it
-is) of a made-up ROS type is registered in :data:`frog_bt.wire.INPUTS` alone, with its
-type in :data:`frog_bt.rosbridge.msgs.ROS_TYPES` and a leaf that reads its key; nothing
+is) of a made-up ROS type is registered in :data:`frog_bt.model.wire.INPUTS` alone, with its
+type in :data:`frog_bt.model.ros.ROS_TYPES` and a leaf that reads its key; nothing
 else is touched. It is then subscribed to by the executive, decoded from rosbridge's
 JSON, snapshotted onto the blackboard for the leaf, given a JSON schema in recordings
 and encoded by the simulator's codec.
@@ -18,21 +18,21 @@ import msgspec
 import pytest
 from bench import Bench, write_tree
 
+from frog_bt.behaviours import FACTORY, load_tree
+from frog_bt.clock import WallClock
 from frog_bt.codec import Finite
 from frog_bt.config import load_site
 from frog_bt.errors import DecodeError
-from frog_bt.kernel.clock import WallClock
-from frog_bt.kernel.key import Reading
-from frog_bt.observers.recording import schema_for
-from frog_bt.rosbridge.msgs import ROS_TYPES, RosType
+from frog_bt.model.channels import schema_for
+from frog_bt.model.key import Reading
+from frog_bt.model.ros import ROS_TYPES, RosType
+from frog_bt.model.wire import INPUTS, Input, input_key
 from frog_bt.runtime.executive import Executive
-from frog_bt.tree.leaf import LEAVES, RUNNING, SUCCESS, Leaf, Status
-from frog_bt.tree.loader import load_tree
-from frog_bt.wire import INPUTS, Input, input_key
+from frog_bt.tree.leaf import RUNNING, SUCCESS, Leaf, Status
 
 
 class Corridor(msgspec.Struct, frozen=True):
-    """The made-up message (in frog_bt/rosbridge/msgs.py it would sit beside the others)."""
+    """The made-up message (in frog_bt/model/ros.py it would sit beside the others)."""
 
     ros_type: ClassVar[str] = "frog_msgs/Corridor"
     clear: bool
@@ -47,7 +47,7 @@ class Corridor(msgspec.Struct, frozen=True):
 
 
 CORRIDOR_TYPE: RosType[tuple[bool, float]] = RosType(Corridor)
-# In frog_bt/wire.py, beside its topic: the input's key (its type is the value's Reading)
+# In frog_bt/model/wire.py, beside its topic: the input's key (its type is the value's Reading)
 CORRIDOR = input_key("/corridor", Reading[tuple[bool, float]],
                      "whether the corridor ahead is clear, and its width")
 
@@ -67,7 +67,7 @@ def corridor(monkeypatch: pytest.MonkeyPatch) -> Iterator[Input]:
     entry = Input("/lidar/corridor", CORRIDOR_TYPE, CORRIDOR)  # the one table entry
     monkeypatch.setitem(ROS_TYPES, CORRIDOR_TYPE.name, CORRIDOR_TYPE)  # its new type
     monkeypatch.setitem(INPUTS, "corridor", entry)
-    monkeypatch.setitem(LEAVES, "CorridorClear", CorridorClear)  # and its leaf
+    monkeypatch.setitem(FACTORY.leaves, "CorridorClear", CorridorClear)  # and its leaf
     yield entry
 
 
@@ -106,6 +106,6 @@ def test_a_new_input_is_subscribed_recorded_and_simulated(corridor: Input,
 def test_a_leaf_reading_a_key_no_input_writes_is_refused(tmp_path: Path,
                                                          monkeypatch: pytest.MonkeyPatch
                                                          ) -> None:
-    monkeypatch.setitem(LEAVES, "CorridorClear", CorridorClear)
+    monkeypatch.setitem(FACTORY.leaves, "CorridorClear", CorridorClear)
     with pytest.raises(Exception, match="uses /corridor, which no key declaration knows"):
         load_tree(write_tree(tmp_path, "root: {type: CorridorClear}"), load_site())

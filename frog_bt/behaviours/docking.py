@@ -6,9 +6,10 @@ from typing import Literal
 
 from pydantic import Field
 
-from frog_bt.kernel import keys
-from frog_bt.kernel.outcomes import IncidentKind
-from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
+from frog_bt.behaviours.registry import register
+from frog_bt.model import keys
+from frog_bt.model.outcomes import IncidentKind
+from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
 
 TARGET = {"dock": "docked", "undock": "undocked"}
 BUSY = {"dock": "docking", "undock": "undocking"}

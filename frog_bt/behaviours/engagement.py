@@ -14,11 +14,12 @@ from collections.abc import Iterator
 import py_trees
 from pydantic import Field
 
-from frog_bt.frontend.messages import Engagement
-from frog_bt.kernel import keys
+from frog_bt.behaviours.registry import register, register_decorator
 from frog_bt.maths.engagement import Decision, Samples, decide, meter, qualifies
-from frog_bt.tree.decorators import FrogDecorator, register_decorator
-from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
+from frog_bt.model import keys
+from frog_bt.model.frontend import Engagement
+from frog_bt.tree.decorators import FrogDecorator
+from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
 
 
 @register_decorator

@@ -17,13 +17,14 @@ from __future__ import annotations
 import math
 
 from frog_bt.behaviours.navigation import PoiParams
+from frog_bt.behaviours.registry import register_decorator
 from frog_bt.config import ZoneShape
-from frog_bt.frontend.messages import FollowMe, SpecialContent, Volume
-from frog_bt.kernel import keys
-from frog_bt.kernel.key import Reading
 from frog_bt.maths.zones import Membership, Shape
-from frog_bt.rosbridge.msgs import Pose
-from frog_bt.tree.decorators import FrogDecorator, register_decorator
+from frog_bt.model import keys
+from frog_bt.model.frontend import FollowMe, SpecialContent, Volume
+from frog_bt.model.key import Reading
+from frog_bt.model.ros import Pose
+from frog_bt.tree.decorators import FrogDecorator
 from frog_bt.tree.leaf import Status
 
 

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 from pydantic import Field, ValidationInfo, field_validator
 
-from frog_bt.kernel import keys
-from frog_bt.kernel.actions import Goal
-from frog_bt.kernel.outcomes import IncidentKind
-from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
-from frog_bt.wire import SUCCEEDED
+from frog_bt.behaviours.registry import register
+from frog_bt.model import keys
+from frog_bt.model.goals import Goal
+from frog_bt.model.outcomes import IncidentKind
+from frog_bt.model.wire import SUCCEEDED
+from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status
 
 
 def goal_state(sent: Goal, latest: Goal | None) -> Goal | None:

@@ -1,4 +1,4 @@
-"""Where the tour tree handles the operator's commands (:mod:`frog_bt.runtime.operator`).
+"""Where the tour tree handles the operator's commands (:mod:`frog_bt.engine.operator`).
 
 ``home`` is ``MustAbort``'s business (the same polite abort as a low battery); ``pause``
 holds ``Navigate`` and ``PlayContent`` before they start; the two below handle ``skip``
@@ -12,10 +12,11 @@ from collections.abc import Iterator
 import py_trees
 
 from frog_bt.behaviours.navigation import PoiParams
-from frog_bt.kernel import keys
-from frog_bt.kernel.outcomes import IncidentKind
-from frog_bt.tree.decorators import FrogDecorator, register_decorator
-from frog_bt.tree.leaf import RUNNING, SUCCESS, Leaf, Status, register
+from frog_bt.behaviours.registry import register, register_decorator
+from frog_bt.model import keys
+from frog_bt.model.outcomes import IncidentKind
+from frog_bt.tree.decorators import FrogDecorator
+from frog_bt.tree.leaf import RUNNING, SUCCESS, Leaf, Status
 
 
 @register_decorator

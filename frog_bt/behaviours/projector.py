@@ -14,9 +14,10 @@ import math
 from collections import deque
 
 from frog_bt.behaviours.navigation import PoiParams
-from frog_bt.frontend.messages import Projector as ProjectorCommand
-from frog_bt.kernel import keys
-from frog_bt.tree.decorators import FrogDecorator, register_decorator
+from frog_bt.behaviours.registry import register_decorator
+from frog_bt.model import keys
+from frog_bt.model.frontend import Projector as ProjectorCommand
+from frog_bt.tree.decorators import FrogDecorator
 from frog_bt.tree.leaf import Status
 
 

@@ -7,15 +7,16 @@ import math
 from pydantic import Field
 
 from frog_bt.behaviours.navigation import goal_state
-from frog_bt.frontend.messages import AskTour as AskTourCommand
-from frog_bt.frontend.messages import StartIntroduction as StartIntroductionCommand
-from frog_bt.frontend.messages import UserNegative, UserPositive
-from frog_bt.kernel import keys
-from frog_bt.kernel.actions import Goal
-from frog_bt.kernel.outcomes import IncidentKind
-from frog_bt.rosbridge.msgs import PersonDetection, Pose
-from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
-from frog_bt.wire import SUCCEEDED
+from frog_bt.behaviours.registry import register
+from frog_bt.model import keys
+from frog_bt.model.frontend import AskTour as AskTourCommand
+from frog_bt.model.frontend import StartIntroduction as StartIntroductionCommand
+from frog_bt.model.frontend import UserNegative, UserPositive
+from frog_bt.model.goals import Goal
+from frog_bt.model.outcomes import IncidentKind
+from frog_bt.model.ros import PersonDetection, Pose
+from frog_bt.model.wire import SUCCEEDED
+from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status
 
 Timeout = Field(None, gt=0, allow_inf_nan=False,
                 description="seconds before it fails (default: the site's timeouts entry)")

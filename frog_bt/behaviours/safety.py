@@ -8,20 +8,21 @@ from collections.abc import Iterator
 import py_trees
 from pydantic import Field
 
-from frog_bt.frontend.messages import Tour
-from frog_bt.kernel import keys
-from frog_bt.kernel.key import Reading
-from frog_bt.kernel.outcomes import (
+from frog_bt.behaviours.registry import register, register_decorator
+from frog_bt.model import keys
+from frog_bt.model.frontend import Tour
+from frog_bt.model.key import Reading
+from frog_bt.model.outcomes import (
     AbortCause,
     AbortReason,
     Incident,
     IncidentKind,
     TourState,
 )
-from frog_bt.kernel.progress import EMPTY, Progress
-from frog_bt.rosbridge.msgs import Diagnostics
-from frog_bt.tree.decorators import FrogDecorator, register_decorator
-from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
+from frog_bt.model.progress import EMPTY, Progress
+from frog_bt.model.ros import Diagnostics
+from frog_bt.tree.decorators import FrogDecorator
+from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
 
 log = logging.getLogger(__name__)
 
@@ -42,7 +43,7 @@ class MustAbort(Leaf):
     Reads ``/home`` (optional: the operator's request, with its reason), ``/diagnostics``
     (only when fresher than ``safety.diagnostics_max_age``), ``/now``, ``/tour_state``
     (optional) and ``/abort_reason`` (optional). Writes ``/abort_reason`` (an
-    :class:`~frog_bt.kernel.outcomes.AbortReason`). SUCCESS while an abort is under way
+    :class:`~frog_bt.model.outcomes.AbortReason`). SUCCESS while an abort is under way
     (the reason is latched until :class:`ClearAbort`); FAILURE otherwise.
     """
 

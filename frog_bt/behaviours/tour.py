@@ -6,12 +6,13 @@ from typing import Annotated, Literal
 
 from pydantic import Field
 
+from frog_bt.behaviours.registry import register
 from frog_bt.config import Timeouts
-from frog_bt.frontend.messages import EVENTS, Tour
-from frog_bt.kernel import keys
-from frog_bt.kernel.outcomes import IncidentKind, TourState
-from frog_bt.kernel.progress import EMPTY
-from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status, register
+from frog_bt.model import keys
+from frog_bt.model.frontend import EVENTS, Tour
+from frog_bt.model.outcomes import IncidentKind, TourState
+from frog_bt.model.progress import EMPTY
+from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
 
 
 @register

@@ -8,12 +8,13 @@ from typing import Literal
 from pydantic import Field
 
 from frog_bt.behaviours.navigation import PoiParams
-from frog_bt.frontend.messages import ContentDone, FrontendIdle, StartPoi
-from frog_bt.frontend.messages import FinishPoi as FinishPoiCommand
-from frog_bt.kernel import keys
-from frog_bt.kernel.outcomes import IncidentKind
-from frog_bt.rosbridge.msgs import Pose, TrackedPeople
-from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status, register
+from frog_bt.behaviours.registry import register
+from frog_bt.model import keys
+from frog_bt.model.frontend import ContentDone, FrontendIdle, StartPoi
+from frog_bt.model.frontend import FinishPoi as FinishPoiCommand
+from frog_bt.model.outcomes import IncidentKind
+from frog_bt.model.ros import Pose, TrackedPeople
+from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status
 
 
 def someone_within(people: TrackedPeople, pose: Pose, radius: float) -> bool:

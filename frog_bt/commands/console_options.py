@@ -13,8 +13,8 @@ from frog_bt.config import parse_hostport
 from frog_bt.errors import UsageError
 
 if TYPE_CHECKING:
-    from frog_bt.console.server import Console
-    from frog_bt.console.webhooks import Webhooks
+    from frog_bt.live.console.server import Console
+    from frog_bt.live.console.webhooks import Webhooks
     from frog_bt.runtime.executive import Executive
 
 DEFAULT_HOST = "127.0.0.1"
@@ -43,7 +43,7 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
                              "given without --console")
         return None
     try:
-        from frog_bt.console.server import is_loopback
+        from frog_bt.live.console.server import is_loopback
     except ImportError as exc:
         raise UsageError("--console", args.console, f"needs the console extra ({exc.name} is "
                          "missing): pip install 'frog-bt[console]'") from None
@@ -71,7 +71,7 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
 
 async def start_console(executive: Executive, settings: ConsoleSettings) -> Console:
     """The console for ``executive``, listening; UsageError when the port cannot be bound."""
-    from frog_bt.console.server import Console
+    from frog_bt.live.console.server import Console
 
     console = Console(executive, settings.host, settings.port, settings.token)
     console.attach()
@@ -100,7 +100,7 @@ class People:
 
 async def start_people(executive: Executive, settings: ConsoleSettings | None,
                        observers: Sequence[object]) -> People:
-    from frog_bt.console.webhooks import Webhooks
+    from frog_bt.live.console.webhooks import Webhooks
 
     book = executive.staff.book
     webhooks = Webhooks(executive.site.alerts)

@@ -18,7 +18,7 @@ import urllib.error
 import urllib.request
 from pathlib import Path
 
-from frog_bt.runtime.operator import Command
+from frog_bt.engine.operator import Command
 
 DEFAULT_CONSOLE = "http://127.0.0.1:8080"
 

@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from frog_bt.behaviours import load_tree
 from frog_bt.commands.console_options import (
     add_console_arguments,
     console_settings,
@@ -27,7 +28,7 @@ from frog_bt.commands.console_options import (
 from frog_bt.commands.options import add_tree_and_config
 from frog_bt.config import Site, load_site
 from frog_bt.errors import DefinitionError, UsageError, error_lines
-from frog_bt.tree.loader import LoadedTree, load_tree
+from frog_bt.tree.loader import LoadedTree
 
 if TYPE_CHECKING:
     from frog_bt.sim.scenario import Scenario
@@ -70,11 +71,11 @@ def run(args: argparse.Namespace) -> int:
 async def _demo(site: Site, tree: LoadedTree, scenario: Scenario,
                 args: argparse.Namespace) -> int:
     from frog_bt.commands.run import attach_observers
-    from frog_bt.observers import Observer, attach_all, close_all
-    from frog_bt.observers.status import StatusLine
-    from frog_bt.observers.summary import TourSummary
+    from frog_bt.live.summary import TourSummary
+    from frog_bt.rehearsal import Rehearsal
     from frog_bt.runtime.executive import Executive
-    from frog_bt.runtime.rehearsal import Rehearsal
+    from frog_bt.runtime.observer import Observer, attach_all, close_all
+    from frog_bt.runtime.status import StatusLine
 
     summary = TourSummary(site)
     status = None if args.quiet else StatusLine()

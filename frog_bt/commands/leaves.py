@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from frog_bt.behaviours import FACTORY
 from frog_bt.tree.catalogue import as_json, as_markdown, catalogue
 
 
@@ -24,6 +25,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    nodes = catalogue()
+    nodes = catalogue(FACTORY)
     sys.stdout.write(as_json(nodes) if args.format == "json" else as_markdown(nodes))
     return 0

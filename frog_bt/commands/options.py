@@ -48,8 +48,8 @@ def tree_argument(args: argparse.Namespace) -> Path | None:
 def load_tree_argument(args: argparse.Namespace) -> tuple[Path | None, Site, Any]:
     """The tree given as TREE or --tree, the site config and the loaded tree; raises
     UsageError (both given) or DefinitionError (a bad file) for the command to report."""
+    from frog_bt.behaviours import load_tree
     from frog_bt.config import load_site
-    from frog_bt.tree.loader import load_tree
 
     path = tree_argument(args)
     site = load_site(args.config)

@@ -26,9 +26,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from frog_bt.behaviours import FACTORY
 from frog_bt.commands.options import add_tree_argument, load_tree_argument
 from frog_bt.errors import DefinitionError, UsageError, error_lines
-from frog_bt.tools import render
+from frog_bt.tree import render
 
 FORMATS = ("ascii", "unicode", "dot", "svg", "png", "mermaid", "btcpp")
 
@@ -51,7 +52,7 @@ def btcpp_xml(path: Path | None, site: Any) -> str:
     from frog_bt.tree.btcpp import tree_xml
     from frog_bt.tree.loader import DEFAULT_TREE
 
-    return tree_xml(path or DEFAULT_TREE, site)
+    return tree_xml(path or DEFAULT_TREE, site, FACTORY)
 
 
 def draw(root: render.Node, fmt: str, *, keys: bool = False, rankdir: str = "LR") -> bytes:

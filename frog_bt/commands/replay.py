@@ -33,10 +33,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TextIO
 
+from frog_bt.behaviours import load_tree
 from frog_bt.commands.options import add_tree_and_config
 from frog_bt.config import load_site
 from frog_bt.errors import DefinitionError, error_lines
-from frog_bt.tree.loader import load_tree
 
 REDRAW = 0.1  # wall seconds between progress-bar redraws
 BAR = 30
@@ -99,9 +99,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def run_corpus(args: argparse.Namespace) -> int:
-    from frog_bt.tools import replay as _replay  # noqa: F401 - imported once, before the fork
-    from frog_bt.tools.corpus import recordings, replay_corpus, summary, summary_line
-    from frog_bt.tools.executors import ExecutorError, executor
+    from frog_bt.offline import replay as _replay  # noqa: F401 - imported once, before the fork
+    from frog_bt.offline.corpus import recordings, replay_corpus, summary, summary_line
+    from frog_bt.offline.executors import ExecutorError, executor
 
     if args.rerun:
         print("frog-bt replay: --rerun takes one recording", file=sys.stderr)
@@ -146,7 +146,7 @@ def run_corpus(args: argparse.Namespace) -> int:
 
 def report(result: Any, site: Any) -> dict[str, Any]:
     """One replay as JSON: identical or the first divergence, in domain terms."""
-    from frog_bt.tools.replay import differences, what_differs
+    from frog_bt.recordings.commands import differences, what_differs
 
     div = result.divergence
     out: dict[str, Any] = {
@@ -191,7 +191,8 @@ class CountBar:
 
 
 def run_one(args: argparse.Namespace) -> int:
-    from frog_bt.tools.replay import Replay, ReplayError, differences, local_time
+    from frog_bt.offline.replay import Replay
+    from frog_bt.recordings.commands import ReplayError, differences, local_time
 
     try:
         site = load_site(args.config)
@@ -202,7 +203,7 @@ def run_one(args: argparse.Namespace) -> int:
         return 2
     telemetry: Any = None
     if args.rerun:
-        from frog_bt.telemetry import Telemetry
+        from frog_bt.live.telemetry import Telemetry
 
         try:
             telemetry = Telemetry.open(args.rerun, site, tree)
@@ -210,7 +211,7 @@ def run_one(args: argparse.Namespace) -> int:
             print(f"frog-bt replay: {exc}", file=sys.stderr)
             return 2
         telemetry.attach(replay)
-        from frog_bt.telemetry.compare import compare_lanes
+        from frog_bt.commands.rerun_compare import compare_lanes
 
         compare_lanes(telemetry.rec, replay, site)
     progress = None

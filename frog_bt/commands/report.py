@@ -51,12 +51,12 @@ def run(args: argparse.Namespace) -> int:
     from frog_bt.commands.replay import CountBar
     from frog_bt.config import load_site
     from frog_bt.errors import DefinitionError, error_lines
-    from frog_bt.report import outputs
-    from frog_bt.report.corpus import read_corpus
-    from frog_bt.report.rows import rows as tour_rows
-    from frog_bt.report.totals import totals
-    from frog_bt.tools.corpus import recordings
-    from frog_bt.tools.executors import ExecutorError, executor
+    from frog_bt.offline.corpus import recordings
+    from frog_bt.offline.executors import ExecutorError, executor
+    from frog_bt.offline.report import outputs
+    from frog_bt.offline.report.corpus import read_corpus
+    from frog_bt.offline.report.rows import rows as tour_rows
+    from frog_bt.offline.report.totals import totals
 
     for wanted, module in ((args.output, "matplotlib"), (args.parquet, "pyarrow")):
         if wanted is not None and importlib.util.find_spec(module) is None:

@@ -28,6 +28,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from frog_bt import __version__
+from frog_bt.behaviours import load_tree
+from frog_bt.clock import SimClock, WallClock
 from frog_bt.commands import logs
 from frog_bt.commands.console_options import (
     ConsoleSettings,
@@ -40,12 +42,11 @@ from frog_bt.commands.settings import fill, tree_and_config
 from frog_bt.config import DEFAULT_CONFIG, Site, check_ws_url, load_site, parse_hostport
 from frog_bt.errors import FrogError, UsageError, error_lines
 from frog_bt.frontend.link import AddressError
-from frog_bt.kernel.clock import SimClock, WallClock
-from frog_bt.observers import Observer, attach_all, close_all
 from frog_bt.runtime.checkpoint import STATE_DIR
 from frog_bt.runtime.checkpoint import claim as claim_checkpoint
 from frog_bt.runtime.checkpoint import default_path as default_checkpoint
-from frog_bt.tree.loader import DEFAULT_TREE, load_tree
+from frog_bt.runtime.observer import Observer, attach_all, close_all
+from frog_bt.tree.loader import DEFAULT_TREE
 
 if TYPE_CHECKING:
     from frog_bt.runtime.executive import Executive
@@ -158,18 +159,18 @@ __all__ = ["add_arguments", "attach_observers", "read_secret", "run"]
 def attach_observers(executive: Executive, *, record: Path | None, rerun: str | None
                      ) -> list[Observer]:
     """Recorder and telemetry, each imported only when asked for, attached; the caller
-    closes them (:func:`~frog_bt.observers.close_all`)."""
+    closes them (:func:`~frog_bt.runtime.observer.close_all`)."""
     observers: list[Observer] = []
     if record is not None and record.suffix == ".mcap" and not record.is_dir():
-        from frog_bt.observers.recording import Recorder
+        from frog_bt.live.recording import Recorder
 
         observers.append(Recorder(record))
     elif record is not None:
-        from frog_bt.observers.rotation import RecordingDir
+        from frog_bt.live.rotation import RecordingDir
 
         observers.append(RecordingDir(record, executive.site.recording.max_bytes))
     if rerun:
-        from frog_bt.telemetry import Telemetry, process
+        from frog_bt.live.telemetry import Telemetry, process
 
         if process.available():  # rerun in a process of its own: off the tick, its memory
             observers.append(process.TelemetryProcess(rerun, executive.site,
@@ -218,8 +219,8 @@ async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Setti
     from frog_bt.runtime.memory import pin_malloc_thresholds
 
     pin_malloc_thresholds()  # all day without creeping up
-    from frog_bt.observers.status import StatusLine
-    from frog_bt.observers.summary import TourSummary
+    from frog_bt.live.summary import TourSummary
+    from frog_bt.runtime.status import StatusLine
 
     clock = SimClock() if args.sim_time else WallClock()
     executive = Executive(site, tree, clock, rosbridge_url=settings.url,

@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from frog_bt.behaviours import FACTORY
 from frog_bt.tree.schema import dumps, site_schema, tree_schema
 
 
@@ -23,5 +24,5 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    sys.stdout.write(dumps(tree_schema() if args.which == "tree" else site_schema()))
+    sys.stdout.write(dumps(tree_schema(FACTORY) if args.which == "tree" else site_schema()))
     return 0

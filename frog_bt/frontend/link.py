@@ -5,7 +5,7 @@ originates to ``peer`` from that socket and answers every datagram with an ack
 sent back to the datagram's source address. All protocol decisions (numbering,
 acks, resends, duplicates, foreign hosts, malformed datagrams) are the
 :class:`~frog_bt.frontend.protocol.Endpoint`'s; this module only moves bytes and
-turns the injected :class:`~frog_bt.kernel.clock.Clock` into resend wake-ups.
+turns the injected :class:`~frog_bt.clock.Clock` into resend wake-ups.
 
 The same class serves both sides:
 
@@ -28,9 +28,9 @@ import logging
 import socket
 from collections.abc import Callable
 
-from frog_bt.frontend.messages import EVENTS, FrontendMessage
+from frog_bt.clock import Clock
 from frog_bt.frontend.protocol import MAX_DATAGRAM, Endpoint, LinkStats
-from frog_bt.kernel.clock import Clock
+from frog_bt.model.frontend import EVENTS, FrontendMessage
 from frog_bt.warning_limit import WarningLimiter
 
 log = logging.getLogger(__name__)
@@ -71,8 +71,8 @@ class FrontendLink:
     ``listen`` is the local address to bind (port 0 picks a free port, see
     :attr:`listen_port`); ``peer`` is where originated messages go, and its host
     is the only one whose datagrams are accepted. ``inbound`` is the table of
-    message types this side acts on: :data:`~frog_bt.frontend.messages.EVENTS`
-    for the executive, :data:`~frog_bt.frontend.messages.COMMANDS` for the front
+    message types this side acts on: :data:`~frog_bt.model.frontend.EVENTS`
+    for the executive, :data:`~frog_bt.model.frontend.COMMANDS` for the front
     end. ``on_message`` is called with every accepted, non-duplicate message, on
     the event loop, after its ack has been sent. ``on_datagram`` (optional) sees
     every datagram received from the peer host (``"in"``, malformed and duplicate

@@ -25,7 +25,7 @@ from typing import Any
 
 from frog_bt.codec import encode
 from frog_bt.errors import DecodeError
-from frog_bt.frontend.messages import (
+from frog_bt.model.frontend import (
     DatagramDecoder,
     Envelope,
     FrontendMessage,

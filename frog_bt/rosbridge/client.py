@@ -3,7 +3,7 @@
 The :class:`~frog_bt.rosbridge.protocol.Session` decides what to send and
 when; this module only moves frames between it and a WebSocket
 (``websockets.asyncio.client``), reconnects, and turns inbound ``publish`` ops
-into typed values with :data:`frog_bt.rosbridge.msgs.ROS_TYPES`.
+into typed values with :data:`frog_bt.model.ros.ROS_TYPES`.
 
 * ``advertise``/``subscribe``/``publish``/... are plain synchronous calls, O(1)
   and never blocking, so behaviour-tree leaves may call them inside a tick.
@@ -37,8 +37,8 @@ from websockets.exceptions import ConnectionClosed, InvalidURI, WebSocketExcepti
 from websockets.uri import parse_uri
 
 from frog_bt.errors import DecodeError
+from frog_bt.model.ros import ROS_TYPES
 from frog_bt.rosbridge.link import ClientStats, LinkState
-from frog_bt.rosbridge.msgs import ROS_TYPES
 from frog_bt.rosbridge.protocol import (
     MAX_FRAME_BYTES,
     OtherOp,

@@ -1,6 +1,6 @@
 """Tour progress, checkpointed to a small file so a restarted executive resumes the tour.
 
-:class:`~frog_bt.kernel.progress.Progress` (on the blackboard) is the ordered list of
+:class:`~frog_bt.model.progress.Progress` (on the blackboard) is the ordered list of
 checkpoints completed in the current tour, and the visitor being guided. The executive
 writes the file
 atomically (write a temporary file, fsync, rename) whenever progress changes,
@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import IO
 
 from frog_bt.errors import UsageError
-from frog_bt.kernel.progress import VERSION, Progress, Resume
+from frog_bt.model.progress import VERSION, Progress, Resume
 
 STATE_DIR = Path(os.environ.get("XDG_STATE_HOME", Path.home() / ".local" / "state")) / "frog-bt"
 

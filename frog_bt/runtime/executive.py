@@ -1,4 +1,4 @@
-"""The online executive: rosbridge and UDP links around a :class:`~frog_bt.runtime.core.Core`.
+"""The online executive: rosbridge and UDP links around a :class:`~frog_bt.engine.core.Core`.
 
 Ticks are event-driven — a tick follows any relevant input (a navigation
 response, a docking state, a front-end event, detections, diagnostics, a link
@@ -22,25 +22,25 @@ from typing import Any
 
 import py_trees
 
+from frog_bt.clock import Clock, ManualClock
 from frog_bt.config import Site
+from frog_bt.engine.core import Core
 from frog_bt.frontend.link import FrontendLink
-from frog_bt.frontend.messages import EVENTS, FrontendMessage
-from frog_bt.kernel import keys
-from frog_bt.kernel.clock import Clock, ManualClock
-from frog_bt.kernel.outcomes import IncidentKind, TourState
-from frog_bt.kernel.progress import EMPTY, Progress
-from frog_bt.observers.links import Links, states
-from frog_bt.observers.status import link_line, status_line
+from frog_bt.model import keys
+from frog_bt.model.frontend import EVENTS, FrontendMessage
+from frog_bt.model.links import Links, states
+from frog_bt.model.outcomes import IncidentKind, TourState
+from frog_bt.model.progress import EMPTY, Progress
+from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
-from frog_bt.runtime.core import Core
 from frog_bt.runtime.notify import Notifier
 from frog_bt.runtime.staff import Staff
+from frog_bt.runtime.status import link_line, status_line
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.warning_limit import WarningLimiter
-from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status

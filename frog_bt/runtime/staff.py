@@ -2,12 +2,12 @@
 
 Commands from the console or ``frog-bt ctl`` are queued (:meth:`Staff.submit`, from any
 task) and applied at the next tick boundary (:meth:`Staff.before_tick`): tree commands
-through :meth:`~frog_bt.runtime.core.Core.command` (recorded, replayed), ``ack_alert`` to
+through :meth:`~frog_bt.engine.core.Core.command` (recorded, replayed), ``ack_alert`` to
 the alert book. A command the executive cannot apply within ``APPLY_WITHIN`` seconds
 (the tree does not tick while rosbridge is unreachable) is refused and changes nothing.
 
 After each tick (:meth:`Staff.after_tick`) the alert conditions are checked against what
-the executive knows now (:class:`~frog_bt.console.alerts.Facts`).
+the executive knows now (:class:`~frog_bt.runtime.alerts.Facts`).
 """
 
 from __future__ import annotations
@@ -17,11 +17,11 @@ import logging
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from frog_bt.console.alerts import AlertBook, Facts
-from frog_bt.kernel import keys
-from frog_bt.kernel.outcomes import IncidentKind, TourState
-from frog_bt.observers.links import LinkStatus
-from frog_bt.runtime.operator import Answer, Command
+from frog_bt.engine.operator import Answer, Command
+from frog_bt.model import keys
+from frog_bt.model.links import LinkStatus
+from frog_bt.model.outcomes import IncidentKind, TourState
+from frog_bt.runtime.alerts import AlertBook, Facts
 
 if TYPE_CHECKING:
     from frog_bt.runtime.executive import Executive

@@ -18,9 +18,10 @@ import logging
 from collections.abc import Callable
 from pathlib import Path
 
+from frog_bt.behaviours import load_tree
 from frog_bt.config import DEFAULT_CONFIG, Site, load_site
 from frog_bt.errors import DefinitionError, error_lines
-from frog_bt.tree.loader import DEFAULT_TREE, LoadedTree, load_tree
+from frog_bt.tree.loader import DEFAULT_TREE, LoadedTree
 
 log = logging.getLogger(__name__)
 Stamp = tuple[int, int] | None  # (mtime_ns, size), None: missing

@@ -99,7 +99,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from frog_bt.kernel.clock import SITE_TZ
+from frog_bt.clock import SITE_TZ
 
 if TYPE_CHECKING:
     from frog_bt.sim.scenario import Scenario

@@ -1,6 +1,6 @@
 """The commands a live executive sends held against a recording's (``frog-bt sim
 --play``), sans-I/O: commands in, counts and the first difference out, in replay's domain
-terms (:func:`frog_bt.tools.replay.differences`: ``waypoint POI1a → POI1b``).
+terms (:func:`frog_bt.offline.replay.differences`: ``waypoint POI1a → POI1b``).
 
 Commands are compared in order within their stream, not across streams (the order of a
 ROS command and a datagram sent in the same tick carries no meaning):
@@ -28,8 +28,8 @@ from collections import deque
 from dataclasses import dataclass, field
 
 from frog_bt.config import Site
-from frog_bt.observers.recording import FRONTEND_OUT
-from frog_bt.tools.replay import Command, differences
+from frog_bt.model.channels import FRONTEND_OUT
+from frog_bt.recordings.commands import Command, differences
 
 METER_TOLERANCE = 0.1  # engagement meter levels this close are the same reading
 REORDER_WINDOW = 1.0  # recorded seconds within which two commands may come swapped

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from frog_bt.rosbridge.msgs import DiagnosticStatus, KeyValue
+from frog_bt.model.ros import DiagnosticStatus, KeyValue
 from frog_bt.sim.scenario import BatterySpec, FaultSpec
 
 

@@ -17,7 +17,7 @@ import math
 import random
 from dataclasses import dataclass
 
-from frog_bt.rosbridge.msgs import Face
+from frog_bt.model.ros import Face
 
 NEAR_DISTANCE = 1.0  # metres
 FAR_DISTANCE = 3.5

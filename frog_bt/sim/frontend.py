@@ -33,8 +33,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from frog_bt.frontend import messages as fm
 from frog_bt.frontend.protocol import Endpoint
+from frog_bt.model import frontend as fm
 from frog_bt.sim.scenario import Scenario
 
 log = logging.getLogger(__name__)

@@ -1,10 +1,10 @@
 """The ``msg`` objects the simulated robot publishes, built by the wire codecs.
 
 Each builder returns the JSON a rosbridge server sends for that ROS message, as
-:mod:`frog_bt.rosbridge.msgs` encodes it (the executive decodes with the same
+:mod:`frog_bt.model.ros` encodes it (the executive decodes with the same
 classes, so ``decode(encode(x)) == x``). Items may be the element Structs
-(:class:`~frog_bt.rosbridge.msgs.PersonDetection`, :class:`~frog_bt.rosbridge.msgs.Face`,
-:class:`~frog_bt.rosbridge.msgs.TrackedPerson`, :class:`~frog_bt.rosbridge.msgs.DiagnosticStatus`)
+(:class:`~frog_bt.model.ros.PersonDetection`, :class:`~frog_bt.model.ros.Face`,
+:class:`~frog_bt.model.ros.TrackedPerson`, :class:`~frog_bt.model.ros.DiagnosticStatus`)
 or mappings with the same keys; a position may be an ``(x, y[, z])`` pair, and
 diagnostic ``values`` ``(key, value)`` pairs.
 """
@@ -15,7 +15,7 @@ from collections.abc import Iterable, Mapping
 from typing import Any, TypeVar
 
 from frog_bt.codec import convert
-from frog_bt.rosbridge.msgs import (
+from frog_bt.model.ros import (
     CLOCK,
     DIAGNOSTICS,
     FACES,

@@ -13,9 +13,9 @@ import logging
 import math
 from dataclasses import dataclass
 
+from frog_bt.model.wire import ABORTED, FAILED, SUCCEEDED
 from frog_bt.sim.scenario import NavFailure, NavigationSpec
 from frog_bt.sim.site import poi_matches
-from frog_bt.wire import ABORTED, FAILED, SUCCEEDED
 
 log = logging.getLogger(__name__)
 ARRIVAL_RADIUS = 0.05  # metres

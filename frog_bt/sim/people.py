@@ -27,7 +27,7 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from frog_bt.rosbridge.msgs import Face, PersonDetection, Point, TrackedPerson
+from frog_bt.model.ros import Face, PersonDetection, Point, TrackedPerson
 from frog_bt.sim.faces import EngagementScript
 from frog_bt.sim.navigation import RobotPose
 from frog_bt.sim.scenario import VisitorSpec

@@ -35,17 +35,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from frog_bt import channels
 from frog_bt.config import Site
 from frog_bt.errors import DecodeError, FrogError
-from frog_bt.observers.recording import FRONTEND_IN, FRONTEND_OUT
+from frog_bt.model import channels
+from frog_bt.model.channels import FRONTEND_IN, FRONTEND_OUT
+from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
+from frog_bt.recordings.commands import Command, chain, without_stamp
 from frog_bt.sim import msgs
 from frog_bt.sim.comparison import Comparison
 from frog_bt.sim.frontend_udp import Address, FrontendSocket
 from frog_bt.sim.rosbridge_protocol import BridgeServer, Incoming
 from frog_bt.sim.rosbridge_server import RosbridgeServer
-from frog_bt.tools.replay import Command, chain, without_stamp
-from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 log = logging.getLogger(__name__)
 

@@ -40,7 +40,7 @@ from typing import Any
 import msgspec
 
 from frog_bt.errors import DecodeError
-from frog_bt.rosbridge.msgs import encode_time
+from frog_bt.model.ros import encode_time
 from frog_bt.rosbridge.protocol import MAX_FRAME_BYTES, auth_mac, dumps
 
 log = logging.getLogger(__name__)

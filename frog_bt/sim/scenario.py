@@ -23,9 +23,9 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from frog_bt.clock import SITE_TZ
 from frog_bt.errors import ConfigError
-from frog_bt.frontend import messages as fm
-from frog_bt.kernel.clock import SITE_TZ
+from frog_bt.model import frontend as fm
 from frog_bt.yamlfile import PathError, load_yaml, validate
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]

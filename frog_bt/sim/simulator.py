@@ -1,7 +1,7 @@
 """The simulator: world, rosbridge server, front end and the clock, wired together.
 
 The simulator is the master of time. It owns a
-:class:`~frog_bt.kernel.clock.ManualClock` that starts at the scenario's
+:class:`~frog_bt.clock.ManualClock` that starts at the scenario's
 ``start_time``; each step advances the world by ``dt`` simulated seconds,
 publishes ``/clock`` and whatever is due, and lets the front end send what is
 due. The time loop paces steps to the wall clock by the speed factor
@@ -28,7 +28,8 @@ import random
 from collections.abc import Awaitable, Callable, Mapping
 from typing import Any
 
-from frog_bt.kernel.clock import ManualClock
+from frog_bt.clock import ManualClock
+from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.sim import msgs
 from frog_bt.sim.frontend import FrontendModel
 from frog_bt.sim.frontend_udp import Address, FrontendSocket
@@ -39,7 +40,6 @@ from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.site import PoiPose, load_pois
 from frog_bt.sim.traffic import MessageLog, Predicate, Record
 from frog_bt.sim.world import World
-from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 log = logging.getLogger(__name__)
 

@@ -28,7 +28,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from frog_bt.errors import ConfigError, DecodeError
-from frog_bt.rosbridge import msgs as ros
+from frog_bt.model import ros
+from frog_bt.model.wire import ABORTED, ACTIVE, FAILED, INPUTS, OUTPUTS, SUCCEEDED
 from frog_bt.sim import msgs
 from frog_bt.sim.diagnostics import Battery, active_faults
 from frog_bt.sim.docking import Docking
@@ -36,7 +37,6 @@ from frog_bt.sim.navigation import Navigator, RobotPose
 from frog_bt.sim.people import Crowd, Visitor
 from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.site import PoiPose, poi_matches, pois_at
-from frog_bt.wire import ABORTED, ACTIVE, FAILED, INPUTS, OUTPUTS, SUCCEEDED
 
 log = logging.getLogger(__name__)
 

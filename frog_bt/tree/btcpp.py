@@ -35,7 +35,7 @@ import yaml
 from frog_bt.config import Site
 from frog_bt.errors import TreeError
 from frog_bt.tree.catalogue import NodeType, catalogue
-from frog_bt.tree.decorators import DECORATORS
+from frog_bt.tree.factory import NodeFactory
 from frog_bt.yamlfile import load_yaml
 
 CONTROLS = {("Sequence", True): "Sequence", ("Sequence", False): "ReactiveSequence",
@@ -137,12 +137,12 @@ class _Exporter:
         return [element]
 
 
-def _model(types: set[str]) -> ET.Element:
+def _model(types: set[str], factory: NodeFactory) -> ET.Element:
     model = ET.Element("TreeNodesModel")
-    nodes: dict[str, NodeType] = {n.name: n for n in catalogue()}
+    nodes: dict[str, NodeType] = {n.name: n for n in catalogue(factory)}
     for name in sorted(types):
         node = nodes[name]
-        kind = "Decorator" if name in DECORATORS else "Action"
+        kind = "Decorator" if name in factory.decorators else "Action"
         element = ET.SubElement(model, kind, {"ID": RENAMED.get(name, name)})
         for param in node.params:
             port = ET.SubElement(element, "input_port", {"name": param.name})
@@ -155,7 +155,7 @@ def _model(types: set[str]) -> ET.Element:
     return model
 
 
-def to_xml(tree_path: Path, site: Site | None,
+def to_xml(tree_path: Path, site: Site | None, factory: NodeFactory,
            documents: dict[str, Any] | None = None) -> str:
     """The tree file at ``tree_path`` (and what it includes) as BT.CPP v4 XML; with
     ``documents`` (an imported XML's), those instead of the files."""
@@ -171,7 +171,7 @@ def to_xml(tree_path: Path, site: Site | None,
     root = ET.Element("root", {"BTCPP_format": "4", "main_tree_to_execute": main})
     for tree_id in sorted(exporter.trees, key=lambda t: (t != main, t)):
         root.append(exporter.trees[tree_id])
-    root.append(_model(exporter.used))
+    root.append(_model(exporter.used, factory))
     ET.indent(root)
     return ET.tostring(root, encoding="unicode") + "\n"
 
@@ -255,10 +255,10 @@ def read_xml(path: Path) -> tuple[dict[str, Any], str]:
     return documents, main
 
 
-def tree_xml(path: Path, site: Site | None) -> str:
+def tree_xml(path: Path, site: Site | None, factory: NodeFactory) -> str:
     """The tree file at ``path`` as BT.CPP v4 XML: exported from its YAML files, or
     re-exported from an XML file (the same XML)."""
     if path.suffix.lower() == ".xml":
         documents, main = read_xml(path)
-        return to_xml(path.parent / f"{main}.yaml", site, documents)
-    return to_xml(path, site)
+        return to_xml(path.parent / f"{main}.yaml", site, factory, documents)
+    return to_xml(path, site, factory)

@@ -1,8 +1,8 @@
 """The catalogue of every node type a tree file can name: parameters, keys, docstring.
 
-Built from the registries (:data:`~frog_bt.tree.leaf.LEAVES`,
-:data:`~frog_bt.tree.decorators.DECORATORS`, :data:`~frog_bt.tree.composites.COMPOSITES`)
-and the key declarations (:mod:`frog_bt.kernel.keys`), so it cannot drift from the code.
+Built from a node factory (:class:`~frog_bt.tree.factory.NodeFactory`: the tour's is
+:data:`frog_bt.behaviours.FACTORY`)
+and the key declarations (:mod:`frog_bt.model.keys`), so it cannot drift from the code.
 ``frog-bt leaves`` prints it as Markdown or JSON; the node reference in ``docs/TREES.md``
 is its Markdown (a test compares).
 """
@@ -19,12 +19,9 @@ from typing import Any
 from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
-import frog_bt.behaviours  # noqa: F401 - registers the leaf types
-from frog_bt.kernel.key import Key
-from frog_bt.kernel.keys import by_name
-from frog_bt.tree.composites import COMPOSITES
-from frog_bt.tree.decorators import DECORATORS
-from frog_bt.tree.leaf import LEAVES
+from frog_bt.model.key import Key
+from frog_bt.model.keys import by_name
+from frog_bt.tree.factory import NodeFactory
 
 
 @dataclass(frozen=True, slots=True)
@@ -83,11 +80,12 @@ def _node(cls: Any, kind: str) -> NodeType:
                     children)
 
 
-def catalogue() -> list[NodeType]:
-    """Every node type, composites first, then decorators and leaves by name."""
-    return [*(_node(COMPOSITES[n], "composite") for n in COMPOSITES),
-            *(_node(DECORATORS[n], "decorator") for n in sorted(DECORATORS)),
-            *(_node(LEAVES[n], "leaf") for n in sorted(LEAVES))]
+def catalogue(factory: NodeFactory) -> list[NodeType]:
+    """Every node type of ``factory``, composites first, then decorators and leaves by
+    name."""
+    return [*(_node(factory.composites[n], "composite") for n in factory.composites),
+            *(_node(factory.decorators[n], "decorator") for n in sorted(factory.decorators)),
+            *(_node(factory.leaves[n], "leaf") for n in sorted(factory.leaves))]
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,8 +142,8 @@ def as_markdown(nodes: list[NodeType]) -> str:
                 line = "; ".join(keys)
                 out.append(line[0].upper() + line[1:] + ".\n")
     out.append("### Keys\n")
-    out.append("Every value a tree reads or writes (`frog_bt/kernel/keys.py`, and the "
-               "robot's inputs in `frog_bt/wire.py`). A value lives as long as its scope: "
+    out.append("Every value a tree reads or writes (`frog_bt/model/keys.py`, and the "
+               "robot's inputs in `frog_bt/model/wire.py`). A value lives as long as its scope: "
                "starting a scope clears its keys and those of narrower scopes "
                "(tour > visitor > stop).\n")
     out.append("| key | type | written by | scope | meaning |")

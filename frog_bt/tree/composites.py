@@ -1,10 +1,10 @@
 """The composites a tree file can name, with their parameters declared once.
 
-Each is py_trees' own composite, observed (:mod:`frog_bt.tree.observed`), with a
+Each is py_trees' own composite, observed (:mod:`frog_bt.engine.observed`), with a
 ``Params`` model like a leaf's: the loader validates a tree file's entry with it, and
 ``frog-bt leaves``, the JSON Schema and docs/TREES.md read the same declaration.
 ``scope`` makes the composite start a scope: its keys are cleared each time it starts
-(:class:`~frog_bt.kernel.key.Scope`).
+(:class:`~frog_bt.model.key.Scope`).
 """
 
 from __future__ import annotations
@@ -14,9 +14,9 @@ from typing import Any, ClassVar, Literal
 import py_trees
 from pydantic import Field
 
-from frog_bt.kernel.key import Scope
+from frog_bt.engine.observed import Observed
+from frog_bt.model.key import Scope
 from frog_bt.tree.node import Params
-from frog_bt.tree.observed import Observed
 
 Behaviour = py_trees.behaviour.Behaviour
 ScopeName = Literal["tour", "visitor", "stop"]

@@ -1,8 +1,9 @@
 """Decorators of tour trees, and the project-clock ones every tree may use.
 
 A decorator declares parameters and blackboard keys like a leaf does (see
-:mod:`frog_bt.tree.leaf`) and is registered in :data:`DECORATORS` with
-:func:`register_decorator`; tree files name it by class name.
+:mod:`frog_bt.tree.leaf`); tree files name it by class name. The ones below are every
+tree's (:data:`DECORATORS`, which every :class:`~frog_bt.tree.factory.NodeFactory`
+starts with); a domain scope is registered into a factory.
 
 * :class:`Retry` — runs its child again after FAILURE, up to ``attempts`` runs in
   all (``None``: until it succeeds); the child starts afresh each time.
@@ -23,8 +24,8 @@ from typing import Any, TypeVar
 import py_trees
 from pydantic import BaseModel, Field
 
+from frog_bt.engine.observed import Observed
 from frog_bt.tree.node import FAILURE, RUNNING, Declared, Params, Status
-from frog_bt.tree.observed import Observed
 
 
 class FrogDecorator(Observed, Declared, py_trees.decorators.Decorator):
@@ -47,6 +48,7 @@ DECORATORS: dict[str, type[FrogDecorator]] = {}
 
 
 def register_decorator(cls: D) -> D:
+    """Class decorator: one of every tree's decorators (this module's own)."""
     if cls.__name__ in DECORATORS:
         raise ValueError(f"decorator type {cls.__name__} registered twice")
     DECORATORS[cls.__name__] = cls

@@ -20,7 +20,7 @@ every path that reaches it), and after it succeeds:
   ``writes`` once it succeeded;
 * a node that starts a *scope* (each tour stop of a ``foreach``, ``scope:`` in a tree
   file) starts without the keys of that scope and the narrower ones (each key declares
-  its :class:`~frog_bt.kernel.key.Scope`): a value left over from an earlier stop or
+  its :class:`~frog_bt.model.key.Scope`): a value left over from an earlier stop or
   from an earlier visitor's introduction is never this one's. At run time the same
   node clears those keys when it starts, so optional reads never see them either.
 
@@ -36,8 +36,8 @@ from typing import Any
 
 import py_trees
 
-from frog_bt.kernel.key import Key, Scope
-from frog_bt.kernel.keys import always
+from frog_bt.model.key import Key, Scope
+from frog_bt.model.keys import always
 
 Behaviour = py_trees.behaviour.Behaviour
 Keys = frozenset[Key[Any]]

@@ -9,7 +9,8 @@ mapping with a ``type``:
   scope);
 * decorators (:mod:`frog_bt.tree.decorators`: ``Retry``, ``Timeout``,
   ``FaceStream``), with ``child``;
-* leaves (:mod:`frog_bt.behaviours`), their parameters given inline.
+* leaves (a :class:`~frog_bt.tree.factory.NodeFactory`'s: the tour's are
+  :mod:`frog_bt.behaviours`'), their parameters given inline.
 
 Any node may have a ``name``, and ``when: VAR`` / ``when: not VAR`` to keep it
 only where a variable is true: a composite or a leaf is then left out with all
@@ -35,53 +36,31 @@ from __future__ import annotations
 import difflib
 import re
 from collections.abc import Iterator
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import py_trees
 from pydantic import BaseModel
 
-import frog_bt.behaviours  # noqa: F401 - registers the leaf types
 from frog_bt import resources
 from frog_bt.config import Site
+from frog_bt.engine.loaded import LoadedTree, Path_, Where
 from frog_bt.errors import TreeError, TreeErrors, format_path
-from frog_bt.kernel.key import Scope
-from frog_bt.kernel.keys import by_name
-from frog_bt.tree.composites import COMPOSITES
-from frog_bt.tree.decorators import DECORATORS
+from frog_bt.model.key import Scope
+from frog_bt.model.keys import by_name
 from frog_bt.tree.flow import Gap, gaps
-from frog_bt.tree.leaf import LEAVES
-from frog_bt.yamlfile import Marks, line_of, load_yaml_marked, validate
+from frog_bt.yamlfile import load_yaml_marked, validate
+from frog_bt.yamlmarks import Marks, line_of
+
+if TYPE_CHECKING:
+    from frog_bt.tree.factory import NodeFactory
 
 DEFAULT_TREE_DIR = resources.tree_dir()
 DEFAULT_TREE = DEFAULT_TREE_DIR / resources.TREE_FILE
 STRUCTURE = {"type", "name", "when"}
 _VAR = re.compile(r"\{(\w+)\}")
 
-Path_ = tuple[str | int, ...]
 Behaviour = py_trees.behaviour.Behaviour
-
-
-@dataclass(frozen=True, slots=True)
-class Where:
-    file: str
-    path: Path_
-    line: tuple[int, int] | None = None  # (line, column) in the file, where known
-
-
-@dataclass
-class LoadedTree:
-    """A built tree and where each node came from (for errors, render and telemetry)."""
-
-    root: Behaviour
-    file: str
-    description: str = ""
-    where: dict[int, Where] = field(default_factory=dict)  # id(node) -> file and path
-    scopes: dict[int, Scope] = field(default_factory=dict)  # id(node) -> scope it starts
-
-    def nodes(self) -> Iterator[Behaviour]:
-        yield from self.root.iterate()
 
 
 def site_variables(site: Site | None) -> dict[str, Any]:
@@ -92,8 +71,9 @@ def site_variables(site: Site | None) -> dict[str, Any]:
 
 
 class _Builder:
-    def __init__(self, site: Site | None) -> None:
+    def __init__(self, site: Site | None, factory: NodeFactory) -> None:
         self.site = site
+        self.factory = factory
         self.where: dict[int, Where] = {}
         self.scopes: dict[int, Scope] = {}  # id(node) -> the scope it starts
         self.errors: list[TreeError] = []  # found so far; the build goes on past each
@@ -156,7 +136,7 @@ class _Builder:
         if not isinstance(data, dict):
             raise TreeError(file, path, f"expected a node (a mapping), got {_short(data)}")
         if "when" in data and not self._when(data["when"], file, (*path, "when"), variables):
-            if data.get("type") in DECORATORS and "child" in data:
+            if data.get("type") in self.factory.decorators and "child" in data:
                 # a decorator is its own effect: without it, its child runs as it is
                 return self._collect(data["child"], file, (*path, "child"), variables)
             return []
@@ -170,14 +150,15 @@ class _Builder:
         if not isinstance(type_, str):
             raise TreeError(file, (*path, "type"), f"expected a type name, got {_short(type_)}")
         name = self._subst(data.get("name", ""), file, (*path, "name"), variables)
-        if type_ in COMPOSITES:
+        factory = self.factory
+        if type_ in factory.composites:
             behaviour = self._composite(type_, data, file, path, variables, name)
-        elif type_ in DECORATORS:
+        elif type_ in factory.decorators:
             behaviour = self._decorator(type_, data, file, path, variables, name)
-        elif type_ in LEAVES:
+        elif type_ in factory.leaves:
             behaviour = self._leaf(type_, data, file, path, variables, name)
         else:
-            known = [*COMPOSITES, *DECORATORS, *LEAVES]
+            known = factory.names()
             close = difflib.get_close_matches(type_, known, n=1)
             hint = f"; did you mean {close[0]!r}?" if close else f" (known: {', '.join(known)})"
             raise TreeError(file, (*path, "type"), f"unknown type {type_!r}{hint}")
@@ -189,7 +170,7 @@ class _Builder:
 
     def _composite(self, type_: str, data: dict[str, Any], file: str, path: Path_,
                    variables: dict[str, Any], name: str) -> Behaviour:
-        cls = COMPOSITES[type_]
+        cls = self.factory.composites[type_]
         raw = {k: v for k, v in data.items() if k not in STRUCTURE | {"children"}}
         if "memory" in cls.Params.model_fields:
             if "memory" not in raw:
@@ -213,7 +194,7 @@ class _Builder:
 
     def _decorator(self, type_: str, data: dict[str, Any], file: str, path: Path_,
                    variables: dict[str, Any], name: str) -> Behaviour | None:
-        cls = DECORATORS[type_]
+        cls = self.factory.decorators[type_]
         raw = {k: v for k, v in data.items() if k not in STRUCTURE | {"child"}}
         params = self._params(cls.Params, raw, file, path, variables)
         if "child" not in data:
@@ -227,7 +208,7 @@ class _Builder:
 
     def _leaf(self, type_: str, data: dict[str, Any], file: str, path: Path_,
               variables: dict[str, Any], name: str) -> Behaviour:
-        cls = LEAVES[type_]
+        cls = self.factory.leaves[type_]
         raw = {k: v for k, v in data.items() if k not in STRUCTURE}
         params = self._params(cls.Params, raw, file, path, variables)
         return cls(name or f"{type_}{_summary(params)}", params)
@@ -320,7 +301,7 @@ def _short(value: Any) -> str:
 
 
 def check_keys(tree: LoadedTree) -> None:
-    """Every key a node reads or writes is declared (:mod:`frog_bt.kernel.keys`), and every
+    """Every key a node reads or writes is declared (:mod:`frog_bt.model.keys`), and every
     key it reads is written before it on every path (:mod:`.flow`)."""
     errors: list[TreeError] = list(_undeclared(tree))
     for gap in gaps(tree.root):
@@ -347,7 +328,7 @@ def _undeclared(tree: LoadedTree) -> Iterator[TreeError]:
             if declared.get(key.name) is not key:
                 yield TreeError(where.file, where.path,
                                 f"{who} uses {key.name}, which no key declaration knows "
-                                "(frog_bt/kernel/keys.py, or an input of frog_bt/wire.py)")
+                                "(frog_bt/model/keys.py, or an input of frog_bt/model/wire.py)")
 
 
 def _gap_error(tree: LoadedTree, gap: Gap) -> TreeError:
@@ -377,10 +358,11 @@ def _at(tree: LoadedTree, node: Behaviour) -> str:
     return f"{type(node).__name__} {node.name!r} ({place})"
 
 
-def load_tree(path: str | Path | None = None, site: Site | None = None) -> LoadedTree:
-    """Load, expand, build and check a tree file (default ``trees/tour.yaml``)."""
+def load_tree(path: str | Path | None, site: Site | None, factory: NodeFactory) -> LoadedTree:
+    """Load, expand, build and check a tree file (default ``trees/tour.yaml``) whose node
+    types are ``factory``'s."""
     path = Path(path) if path is not None else DEFAULT_TREE
-    builder = _Builder(site)
+    builder = _Builder(site, factory)
     source = path
     if path.suffix.lower() == ".xml":  # BehaviorTree.CPP v4 (Groot2): its trees as documents
         from frog_bt.tree.btcpp import read_xml
@@ -396,6 +378,6 @@ def load_tree(path: str | Path | None = None, site: Site | None = None) -> Loade
         raise_all(builder.errors)
     if root is None:
         raise TreeError(str(path), ("root",), "the whole tree was left out by 'when'")
-    tree = LoadedTree(root, str(source), description, builder.where, builder.scopes)
+    tree = LoadedTree(root, str(source), description, builder.where, builder.scopes, factory)
     check_keys(tree)
     return tree

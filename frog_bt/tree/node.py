@@ -1,11 +1,11 @@
 """What every frog-bt leaf and decorator declares and reaches.
 
 A node type declares its parameters (``Params``, a pydantic model: unknown keys
-are errors) and the typed keys (:mod:`frog_bt.kernel.keys`) it reads (``reads``:
+are errors) and the typed keys (:mod:`frog_bt.model.keys`) it reads (``reads``:
 something must write them before; ``optional_reads``: None while nothing has) and
 writes. The loader checks a whole tree against these declarations before anything
 connects. At run time ``setup`` hands the node the
-:class:`~frog_bt.kernel.context.Context` (services), the core's board and trace;
+:class:`~frog_bt.engine.context.Context` (services), the core's board and trace;
 :meth:`Declared.get` and :meth:`Declared.set` reach the board, for declared keys only.
 """
 
@@ -17,13 +17,13 @@ from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 import py_trees
 from pydantic import BaseModel, ConfigDict
 
-from frog_bt.kernel.context import Context
-from frog_bt.kernel.key import Key, Source
-from frog_bt.kernel.outcomes import IncidentKind
+from frog_bt.engine.context import Context
+from frog_bt.model.key import Key, Source
+from frog_bt.model.outcomes import IncidentKind
 
 if TYPE_CHECKING:
-    from frog_bt.kernel.blackboard import Board
-    from frog_bt.tree.observed import Trace
+    from frog_bt.engine.blackboard import Board
+    from frog_bt.engine.observed import Trace
 
 Status = py_trees.common.Status
 SUCCESS, FAILURE, RUNNING, INVALID = Status.SUCCESS, Status.FAILURE, Status.RUNNING, Status.INVALID

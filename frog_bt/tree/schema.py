@@ -16,9 +16,7 @@ from typing import Any
 
 from frog_bt.config import Site
 from frog_bt.tree.catalogue import catalogue
-from frog_bt.tree.composites import COMPOSITES
-from frog_bt.tree.decorators import DECORATORS
-from frog_bt.tree.leaf import LEAVES
+from frog_bt.tree.factory import NodeFactory
 
 TREE_SCHEMA_FILE = "tree.schema.json"
 SITE_SCHEMA_FILE = "site.schema.json"
@@ -41,11 +39,11 @@ def _params(cls: Any, defs: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
     return props, list(schema.get("required", []))
 
 
-def tree_schema() -> dict[str, Any]:
+def tree_schema(factory: NodeFactory) -> dict[str, Any]:
     defs: dict[str, Any] = {}
     kinds: list[dict[str, Any]] = []
-    for node in catalogue():
-        cls = COMPOSITES.get(node.name) or DECORATORS.get(node.name) or LEAVES[node.name]
+    for node in catalogue(factory):
+        cls = factory.type_of(node.name)
         props, required = _params(cls, defs)
         if node.kind == "composite":
             props["children"] = {"type": "array", "items": NODE, "minItems": 1}

@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 from bench import Bench, write_tree
 
-from frog_bt.frontend.messages import ContentDone, Engagement, FinishPoi, StartPoi
-from frog_bt.kernel import keys
-from frog_bt.rosbridge.msgs import Face, FaceData
+from frog_bt.model import keys
+from frog_bt.model.frontend import ContentDone, Engagement, FinishPoi, StartPoi
+from frog_bt.model.ros import Face, FaceData
 
 TREE = """
 root:

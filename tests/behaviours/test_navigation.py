@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from bench import AFTERNOON, MORNING, Bench, write_tree
 
-from frog_bt.kernel import keys
+from frog_bt.model import keys
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS
 
 NAVIGATE = "root: {type: Navigate, poi: POI1, timeout: 30}"

@@ -8,7 +8,8 @@ import pytest
 from bench import Bench, write_tree
 
 from frog_bt.errors import TreeError
-from frog_bt.frontend.messages import (
+from frog_bt.model import keys
+from frog_bt.model.frontend import (
     AskTour,
     Engagement,
     FinishIntroduction,
@@ -16,7 +17,6 @@ from frog_bt.frontend.messages import (
     UserNegative,
     UserPositive,
 )
-from frog_bt.kernel import keys
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS
 
 SEEK = "root: {type: SeekVisitor}"

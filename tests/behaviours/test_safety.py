@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from bench import Bench, write_tree
 
-from frog_bt.frontend.messages import ContentDone, FrontendIdle, Tour, Volume
-from frog_bt.kernel import keys
-from frog_bt.rosbridge.msgs import Diagnostics
+from frog_bt.model import keys
+from frog_bt.model.frontend import ContentDone, FrontendIdle, Tour, Volume
+from frog_bt.model.ros import Diagnostics
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS
 
 GUARD = """

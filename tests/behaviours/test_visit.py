@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from bench import Bench, write_tree
 
-from frog_bt.frontend.messages import ContentDone, FinishPoi, StartPoi
+from frog_bt.model.frontend import ContentDone, FinishPoi, StartPoi
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS
 
 
@@ -79,7 +79,7 @@ def test_silent_front_end_content_times_out_and_the_tour_goes_on(tmp_path):
 
 
 def test_content_is_sent_again_when_the_front_end_restarts(tmp_path):
-    from frog_bt.frontend.messages import FrontendIdle
+    from frog_bt.model.frontend import FrontendIdle
 
     bench = Bench(write_tree(tmp_path, "root: {type: PlayContent, poi: POI4}"))
     bench.tick()

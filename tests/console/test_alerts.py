@@ -12,7 +12,7 @@ from console_tour import command, console_tour
 from test_faults import is_
 
 from frog_bt.config import AlertsCfg, load_site
-from frog_bt.console.alerts import AlertBook, Facts, conditions
+from frog_bt.runtime.alerts import AlertBook, Facts, conditions
 
 
 async def receiver(fail_first: int) -> tuple[web.AppRunner, str, list[dict[str, object]]]:

@@ -14,9 +14,9 @@ from console_tour import TOKEN, auth, command, console_tour
 from test_faults import is_
 
 from frog_bt.commands.console_options import console_settings
-from frog_bt.console.server import RateLimit
 from frog_bt.errors import UsageError
-from frog_bt.kernel import keys
+from frog_bt.live.console.server import RateLimit
+from frog_bt.model import keys
 
 
 def test_state_has_the_contract_fields_and_a_read_needs_no_token_on_loopback() -> None:

@@ -8,7 +8,7 @@ import math
 import pytest
 from tour import tour
 
-from frog_bt.frontend.messages import Engagement
+from frog_bt.model.frontend import Engagement
 
 VISITOR = {"id": 7, "position": [103.0, 36.0], "facing": True}
 

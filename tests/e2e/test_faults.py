@@ -10,8 +10,8 @@ import time
 from tour import Running, describe, fast
 
 from frog_bt.config import load_site
+from frog_bt.rehearsal import Rehearsal
 from frog_bt.runtime.checkpoint import load as load_checkpoint
-from frog_bt.runtime.rehearsal import Rehearsal
 
 
 def commands_after(run: Running, t: float) -> list[str]:

@@ -8,16 +8,16 @@ from pathlib import Path
 
 from tour import fast
 
-from frog_bt.observers import Observer, attach_all, close_all
-from frog_bt.observers.recording import Recorder
-from frog_bt.observers.rotation import RecordingDir
-from frog_bt.observers.status import StatusLine
-from frog_bt.observers.summary import TourSummary
+from frog_bt.behaviours import load_tree
+from frog_bt.live.recording import Recorder
+from frog_bt.live.rotation import RecordingDir
+from frog_bt.live.summary import TourSummary
+from frog_bt.live.telemetry import Telemetry
+from frog_bt.live.telemetry.process import TelemetryProcess
+from frog_bt.rehearsal import Rehearsal
 from frog_bt.runtime.executive import Executive
-from frog_bt.runtime.rehearsal import Rehearsal
-from frog_bt.telemetry import Telemetry
-from frog_bt.telemetry.process import TelemetryProcess
-from frog_bt.tree.loader import load_tree
+from frog_bt.runtime.observer import Observer, attach_all, close_all
+from frog_bt.runtime.status import StatusLine
 
 
 def test_every_observer_attaches_to_a_live_executive_and_closes(tmp_path: Path) -> None:

@@ -12,9 +12,9 @@ import asyncio
 from test_faults import commands_after, is_
 from tour import Running
 
-from frog_bt.kernel import keys
-from frog_bt.kernel.outcomes import IncidentKind
-from frog_bt.runtime.operator import Command
+from frog_bt.engine.operator import Command
+from frog_bt.model import keys
+from frog_bt.model.outcomes import IncidentKind
 
 
 def sent_(channel: str, **fields: object):

@@ -10,8 +10,8 @@ import asyncio
 
 from tour import Running
 
-from frog_bt.kernel import keys
-from frog_bt.kernel.outcomes import TourState
+from frog_bt.model import keys
+from frog_bt.model.outcomes import TourState
 
 
 async def _both() -> tuple[Running, Running]:
@@ -44,7 +44,7 @@ def test_building_another_core_leaves_a_running_one_alone() -> None:
     running one. The running core's values and nodes are untouched."""
     from bench import Bench
 
-    from frog_bt.tree.loader import load_tree
+    from frog_bt.behaviours import load_tree
 
     running = Bench(load_tree())
     running.tick()

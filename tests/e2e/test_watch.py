@@ -10,11 +10,11 @@ from pathlib import Path
 from tour import Running, after_ticks
 
 from frog_bt import resources
+from frog_bt.behaviours import load_tree
 from frog_bt.config import load_site
-from frog_bt.kernel import keys
-from frog_bt.kernel.outcomes import TourState
+from frog_bt.model import keys
+from frog_bt.model.outcomes import TourState
 from frog_bt.runtime.watch import Watch
-from frog_bt.tree.loader import load_tree
 
 WAIT = "Wait for the front end"
 

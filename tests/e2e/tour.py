@@ -1,6 +1,6 @@
 """Whole tours of the real executive against the built-in simulator, on sim time.
 
-Built on :class:`frog_bt.runtime.rehearsal.Rehearsal`; adds what tests assert on: the
+Built on :class:`frog_bt.rehearsal.Rehearsal`; adds what tests assert on: the
 commands the simulator received, compactly, and what the executive sent to the
 front end with its own clock's times.
 """
@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from frog_bt.config import Site, load_site
-from frog_bt.observers.summary import TourSummary
+from frog_bt.live.summary import TourSummary
+from frog_bt.rehearsal import Rehearsal, free_udp_port
 from frog_bt.runtime.executive import Executive, Outcome
-from frog_bt.runtime.rehearsal import Rehearsal, free_udp_port
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.traffic import Record

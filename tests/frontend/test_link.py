@@ -17,8 +17,10 @@ from typing import Any, TypeVar
 
 import pytest
 
+from frog_bt.clock import ManualClock
 from frog_bt.frontend.link import FrontendLink, log
-from frog_bt.frontend.messages import (
+from frog_bt.frontend.protocol import MAX_DATAGRAM
+from frog_bt.model.frontend import (
     COMMANDS,
     ContentDone,
     FollowMe,
@@ -26,8 +28,6 @@ from frog_bt.frontend.messages import (
     UserPositive,
     Volume,
 )
-from frog_bt.frontend.protocol import MAX_DATAGRAM
-from frog_bt.kernel.clock import ManualClock
 from frog_bt.warning_limit import WarningLimiter
 
 HOST = "127.0.0.1"

@@ -7,7 +7,7 @@ from typing import Any
 import pytest
 
 from frog_bt.errors import DecodeError
-from frog_bt.frontend.messages import (
+from frog_bt.model.frontend import (
     COMMANDS,
     EVENTS,
     AskTour,

@@ -12,7 +12,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from frog_bt.errors import DecodeError
-from frog_bt.frontend.messages import (
+from frog_bt.frontend.protocol import (
+    MAX_DATAGRAM,
+    Endpoint,
+    decode_datagram,
+    encode_datagram,
+)
+from frog_bt.model.frontend import (
     COMMANDS,
     EVENTS,
     ContentDone,
@@ -24,12 +30,6 @@ from frog_bt.frontend.messages import (
     Volume,
     decode_message,
     message_fields,
-)
-from frog_bt.frontend.protocol import (
-    MAX_DATAGRAM,
-    Endpoint,
-    decode_datagram,
-    encode_datagram,
 )
 
 PEER = "127.0.0.1"

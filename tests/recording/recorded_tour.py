@@ -10,10 +10,10 @@ from pathlib import Path
 from typing import Any
 
 from frog_bt.config import Site, load_site
-from frog_bt.observers.recording import Recorder
-from frog_bt.observers.rotation import RecordingDir
+from frog_bt.live.recording import Recorder
+from frog_bt.live.rotation import RecordingDir
+from frog_bt.rehearsal import Rehearsal
 from frog_bt.runtime.executive import Executive, Outcome
-from frog_bt.runtime.rehearsal import Rehearsal
 from frog_bt.sim import scenario_from
 from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.traffic import Record

@@ -13,14 +13,15 @@ from mcap.reader import make_reader
 from mcap.writer import Writer
 from recorded_tour import scenario
 
-from frog_bt import channels, resources
+from frog_bt import resources
+from frog_bt.behaviours import load_tree
 from frog_bt.cli import main
 from frog_bt.config import load_site
-from frog_bt.observers.recording import Recorder
-from frog_bt.runtime.operator import Command
-from frog_bt.runtime.rehearsal import Rehearsal
-from frog_bt.tools.replay import Replay
-from frog_bt.tree.loader import load_tree
+from frog_bt.engine.operator import Command
+from frog_bt.live.recording import Recorder
+from frog_bt.model import channels
+from frog_bt.offline.replay import Replay
+from frog_bt.rehearsal import Rehearsal
 
 
 def is_(channel: str, **fields: object):  # type: ignore[no-untyped-def]

@@ -17,23 +17,23 @@ from mcap.reader import make_reader
 from recorded_tour import RecordedTour, scenario
 from rosmsgs import encode_clock
 
+from frog_bt.clock import SimClock
 from frog_bt.config import load_site
-from frog_bt.kernel.clock import SimClock
-from frog_bt.observers.recording import (
+from frog_bt.engine.core import Taps
+from frog_bt.live.recording import Recorder
+from frog_bt.model.channels import (
     DATAGRAM_TYPE,
     FRONTEND_IN,
     FRONTEND_OUT,
     TICK,
-    Recorder,
     from_ns,
     schema_for,
     to_ns,
 )
-from frog_bt.runtime.core import Taps
+from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
+from frog_bt.rehearsal import free_udp_port
 from frog_bt.runtime.executive import WireTaps
-from frog_bt.runtime.rehearsal import free_udp_port
 from frog_bt.sim import Simulator
-from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 ROOT = Path(__file__).resolve().parents[2]
 JSON_TYPES: dict[str, Any] = {"object": dict, "array": list, "string": str, "boolean": bool,
@@ -155,7 +155,7 @@ def test_nanosecond_stamps_give_the_clock_time_back(t: float) -> None:
 def test_a_crash_still_leaves_valid_mcap(tmp_path: Path) -> None:
     path = tmp_path / "crash.mcap"
     code = ("import sys; from pathlib import Path\n"
-            "from frog_bt.observers.recording import Recorder\n"
+            "from frog_bt.live.recording import Recorder\n"
             "r = Recorder(Path(sys.argv[1]))\n"
             "r.on_datagram('out', b'{\"type\":\"tour\",\"seq\":1}', 1.0)\n"
             "raise RuntimeError('boom')\n")
@@ -207,7 +207,7 @@ def test_what_was_flushed_survives_a_kill(tmp_path: Path) -> None:
     """A chunk is handed to the OS at each flush (every second; here at every drain): a
     copy of the file taken while the recorder runs, as a kill -9 leaves it, has no
     footer, and every message flushed before it is recovered."""
-    from frog_bt.tools.mcapfile import open_recording
+    from frog_bt.recordings.mcapfile import open_recording
 
     path, copy = tmp_path / "live.mcap", tmp_path / "killed.mcap"
 

@@ -15,11 +15,12 @@ from mcap.writer import Writer
 from recorded_tour import RecordedTour, record_tour
 
 from frog_bt import resources
+from frog_bt.behaviours import FACTORY, load_tree
 from frog_bt.cli import main
 from frog_bt.commands.replay import Progress
 from frog_bt.config import DEFAULT_CONFIG, load_site
-from frog_bt.tools.replay import Replay, differences, local_time
-from frog_bt.tree.loader import load_tree
+from frog_bt.offline.replay import Replay
+from frog_bt.recordings.commands import differences, local_time
 
 
 def test_b_replaying_the_recorded_tour_is_identical(
@@ -259,7 +260,7 @@ def test_a_recording_carries_the_tree_that_ran(tour: RecordedTour) -> None:
         trees = [json.loads(m.data) for _, c, m in make_reader(f).iter_messages()
                  if c.topic == "/frog_bt/tree"]
     assert len(trees) == 1 and trees[0]["format"] == "BehaviorTree.CPP v4"
-    assert trees[0]["xml"] == tree_xml(DEFAULT_TREE, tour.site)
+    assert trees[0]["xml"] == tree_xml(DEFAULT_TREE, tour.site, FACTORY)
 
 
 def test_the_viewer_shows_recorded_and_replayed_commands_and_the_divergence(

@@ -15,13 +15,14 @@ import pytest
 from mcap.reader import make_reader
 from recorded_tour import FAST_TOURS, record_day
 
+from frog_bt.behaviours import load_tree
 from frog_bt.cli import main
 from frog_bt.config import load_site
-from frog_bt.observers.rotation import RecordingDir, numbered
-from frog_bt.runtime.rehearsal import free_udp_port
+from frog_bt.live.rotation import RecordingDir, numbered
+from frog_bt.offline.replay import Replay
+from frog_bt.recordings.commands import ReplayError
+from frog_bt.rehearsal import free_udp_port
 from frog_bt.sim import Simulator, scenario_from
-from frog_bt.tools.replay import Replay, ReplayError
-from frog_bt.tree.loader import load_tree
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -67,7 +68,7 @@ def test_the_budget_deletes_the_oldest_tours_first_and_logs_each(
     (day / "notes.mcap").write_bytes(b"x" * 5000)  # not ours: never counted nor deleted
     recordings = RecordingDir(day, 700)
     assert recordings.number == 4  # numbers go on after the highest in DIR
-    with caplog.at_level(logging.WARNING, logger="frog_bt.observers.rotation"):
+    with caplog.at_level(logging.WARNING, logger="frog_bt.live.rotation"):
         recordings.enforce_budget()
     assert sorted(p.name for p in day.iterdir()) == [
         "20260601-100000-idle0002.mcap", "20260601-100100-tour0002.mcap",

@@ -20,11 +20,11 @@ from typing import Any
 from rosmsgs import DECODERS
 
 from frog_bt.errors import DecodeError
-from frog_bt.frontend import messages as fm
 from frog_bt.frontend.protocol import MAX_DATAGRAM, decode_datagram, encode_datagram
+from frog_bt.model import frontend as fm
+from frog_bt.model.wire import CLOCK, INPUTS
 from frog_bt.rosbridge.protocol import MAX_FRAME_BYTES, OtherOp, Publish, Status, decode_frame
 from frog_bt.sim import msgs
-from frog_bt.wire import CLOCK, INPUTS
 
 T = 1_780_000_000.25
 TOPIC_TYPES = {t.name: t.type for t in (*INPUTS.values(), CLOCK)}

@@ -20,10 +20,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from frog_bt.config import Site, load_site
-from frog_bt.observers.summary import TourSummary
+from frog_bt.live.summary import TourSummary
+from frog_bt.rehearsal import Rehearsal
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.executive import Executive
-from frog_bt.runtime.rehearsal import Rehearsal
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.sim.traffic import Record
 

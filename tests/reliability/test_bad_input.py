@@ -39,15 +39,15 @@ from hypothesis import strategies as st
 from rosmsgs import DECODERS, encode_clock
 from websockets.asyncio.server import ServerConnection, serve
 
+from frog_bt.behaviours import load_tree
+from frog_bt.clock import SimClock
 from frog_bt.config import load_site
 from frog_bt.errors import DecodeError
-from frog_bt.frontend import messages as fm
 from frog_bt.frontend.protocol import Endpoint, decode_datagram, encode_datagram
-from frog_bt.kernel.clock import SimClock
+from frog_bt.model import frontend as fm
+from frog_bt.rehearsal import free_udp_port
 from frog_bt.rosbridge.protocol import Publish, decode_frame
 from frog_bt.runtime.executive import Executive
-from frog_bt.runtime.rehearsal import free_udp_port
-from frog_bt.tree.loader import load_tree
 
 ROS_FRAMES = 70_000  # through decode_frame and the message decoders
 ROS_MSGS = 20_000  # mutated msg objects straight into the decoders (NaN as a float)

@@ -28,8 +28,8 @@ import yaml
 from harness import TourRun, received
 
 from frog_bt.config import DEFAULT_CONFIG, Site, load_site
-from frog_bt.frontend import messages as fm
 from frog_bt.frontend.protocol import Endpoint
+from frog_bt.model import frontend as fm
 from frog_bt.sim.frontend import FrontendModel
 from frog_bt.sim.scenario import parse_scenario
 

@@ -8,8 +8,8 @@ from pathlib import Path
 
 from harness import TourRun
 
-from frog_bt.observers.links import Links, frontend_state
-from frog_bt.telemetry import Telemetry
+from frog_bt.live.telemetry import Telemetry
+from frog_bt.model.links import Links, frontend_state
 
 
 def test_front_end_state_needs_a_command_waiting_and_a_quiet_peer() -> None:

@@ -17,11 +17,11 @@ import pytest
 from harness import TourRun, arrived, received
 from rosmsgs import encode_pose, encode_string
 
+from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.sim.scenario import parse_scenario
 from frog_bt.sim.site import load_pois
 from frog_bt.sim.world import World
-from frog_bt.wire import CLOCK, INPUTS, OUTPUTS
 
 GOTO, DOCK = "/GotoWayPoint", "/docking/dock"
 # what the leaves note when they time out, fail, skip, abort or give up

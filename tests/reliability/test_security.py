@@ -27,13 +27,13 @@ from urllib.parse import urlparse
 import pytest
 from harness import TourRun
 
+from frog_bt.behaviours import load_tree
 from frog_bt.cli import main
 from frog_bt.commands.run import read_secret
 from frog_bt.config import Links, load_site, parse_hostport
 from frog_bt.errors import ConfigError, TreeError
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.sim import Simulator, load_scenario
-from frog_bt.tree.loader import load_tree
 
 SECRET = "s3cret-FROG-7f1c2a9e"
 WRONG = "wr0ng-FROG-41d0"

@@ -11,7 +11,7 @@ sys.path.insert(0, str(ROOT / "scripts"))
 
 from soak_run import Fault, lost_commands, schedule, soak  # noqa: E402
 
-from frog_bt.observers.rotation import numbered  # noqa: E402
+from frog_bt.live.rotation import numbered  # noqa: E402
 
 
 def test_the_schedule_is_seeded_and_has_every_kind() -> None:

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import pytest
 
+from frog_bt.behaviours import load_tree
 from frog_bt.cli import main
-from frog_bt.tools import render
-from frog_bt.tree.loader import load_tree
+from frog_bt.tree import render
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
@@ -136,8 +136,8 @@ def test_render_loads_neither_websockets_nor_rerun(tmp_path):
         import sys
         from frog_bt.commands import render
         from frog_bt.cli import main
-        from frog_bt.tools.render import outline
-        from frog_bt.tree.loader import load_tree
+        from frog_bt.tree.render import outline
+        from frog_bt.behaviours import load_tree
         root = outline(load_tree().root)
         for fmt in ("ascii", "unicode", "dot", "mermaid"):
             assert render.draw(root, fmt, keys=True)

@@ -18,9 +18,9 @@ from pathlib import Path
 from typing import Any
 
 from frog_bt.config import load_site
-from frog_bt.observers.rotation import RecordingDir
-from frog_bt.runtime.operator import Command
-from frog_bt.runtime.rehearsal import Rehearsal
+from frog_bt.engine.operator import Command
+from frog_bt.live.rotation import RecordingDir
+from frog_bt.rehearsal import Rehearsal
 from frog_bt.sim import scenario_from
 from frog_bt.sim.traffic import Record
 

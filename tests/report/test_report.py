@@ -18,8 +18,8 @@ import pytest
 
 from frog_bt.cli import main
 from frog_bt.config import load_site
-from frog_bt.report.facts import FileFacts, Piece, StopFacts, _Reader
-from frog_bt.report.rows import join, rows
+from frog_bt.offline.report.facts import FileFacts, Piece, StopFacts, _Reader
+from frog_bt.offline.report.rows import join, rows
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 from corpus_run import make
@@ -248,8 +248,8 @@ def test_without_the_report_extra_it_says_which_before_reading(corpus, tmp_path,
 def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) -> None:
     import asyncio
 
-    from frog_bt.observers.rotation import RecordingDir
-    from frog_bt.runtime.rehearsal import Rehearsal
+    from frog_bt.live.rotation import RecordingDir
+    from frog_bt.rehearsal import Rehearsal
     from frog_bt.sim import scenario_from
 
     day, checkpoint = tmp_path / "day", tmp_path / "checkpoint.json"

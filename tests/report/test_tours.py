@@ -19,7 +19,7 @@ from mcap.writer import Writer
 from robot_day import KINDS, Seen
 
 from frog_bt.cli import main
-from frog_bt.tools.mcapfile import open_recording
+from frog_bt.recordings.mcapfile import open_recording
 
 STOPS = ["POI1", "POI2", "POI3", "POI4", "POI5", "END"]  # content stops, in order
 

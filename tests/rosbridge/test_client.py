@@ -19,13 +19,13 @@ import pytest
 from rosmsgs import encode_int32, encode_pose, encode_string
 from websockets.asyncio.server import serve
 
+from frog_bt.model.ros import Pose
 from frog_bt.rosbridge.client import (
     FRAME_TOPIC,
     LinkState,
     RosbridgeClient,
     backoff_delays,
 )
-from frog_bt.rosbridge.msgs import Pose
 from frog_bt.warning_limit import WarningLimiter
 
 from .conftest import FakeRosbridge, free_port, run

@@ -6,8 +6,8 @@ import asyncio
 
 from rosmsgs import encode_pose
 
+from frog_bt.model.ros import Pose
 from frog_bt.rosbridge.client import RosbridgeClient
-from frog_bt.rosbridge.msgs import Pose
 from frog_bt.sim import Simulator, parse_scenario
 
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 import asyncio
 from typing import Any
 
+from frog_bt.behaviours import load_tree
+from frog_bt.clock import WallClock
 from frog_bt.config import load_site
-from frog_bt.kernel.clock import WallClock
+from frog_bt.model.wire import INPUTS, OUTPUTS
+from frog_bt.rehearsal import free_udp_port
 from frog_bt.runtime.executive import Executive
-from frog_bt.runtime.rehearsal import free_udp_port
-from frog_bt.tree.loader import load_tree
-from frog_bt.wire import INPUTS, OUTPUTS
 
 from .conftest import FakeRosbridge
 

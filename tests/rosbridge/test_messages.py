@@ -29,7 +29,7 @@ from rosmsgs import (
 
 from frog_bt.codec import convert
 from frog_bt.errors import DecodeError, format_path
-from frog_bt.rosbridge.msgs import (
+from frog_bt.model.ros import (
     ROS_TYPES,
     Diagnostics,
     Face,

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from frog_bt.errors import DecodeError
-from frog_bt.rosbridge.msgs import ROS_TYPES
+from frog_bt.model.ros import ROS_TYPES
 from frog_bt.rosbridge.protocol import (
     MAX_FRAME_BYTES,
     OtherOp,

@@ -9,8 +9,8 @@ from typing import Any
 
 from websockets.asyncio.client import ClientConnection, connect
 
-from frog_bt.frontend import messages as fm
 from frog_bt.frontend.protocol import Endpoint
+from frog_bt.model import frontend as fm
 
 HOST = "127.0.0.1"
 

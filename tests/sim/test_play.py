@@ -22,14 +22,14 @@ import pytest
 from mcap.writer import Writer
 from sim_clients import RosClient
 
-from frog_bt import channels
 from frog_bt.cli import main
 from frog_bt.config import load_site
-from frog_bt.observers.recording import FRONTEND_OUT
+from frog_bt.model import channels
+from frog_bt.model.channels import FRONTEND_OUT
+from frog_bt.recordings.commands import Command
+from frog_bt.recordings.mcapfile import open_recording
 from frog_bt.sim.comparison import Comparison
 from frog_bt.sim.play import DT, PASS_TAIL, SEQ_PER_PASS, Player, load, restamped
-from frog_bt.tools.mcapfile import open_recording
-from frog_bt.tools.replay import Command
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "recording"))
 from recorded_tour import record_day, record_tour

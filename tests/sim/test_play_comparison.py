@@ -8,9 +8,9 @@ from typing import Any
 import pytest
 
 from frog_bt.config import Site, load_site
-from frog_bt.observers.recording import FRONTEND_OUT
+from frog_bt.model.channels import FRONTEND_OUT
+from frog_bt.recordings.commands import Command
 from frog_bt.sim.comparison import Comparison
-from frog_bt.tools.replay import Command
 
 START = 1_780_302_600.0
 
@@ -116,9 +116,9 @@ def test_each_pass_is_held_against_the_recording_afresh(site: Site) -> None:
 
 def test_two_commands_recorded_a_moment_apart_may_come_swapped() -> None:
     from frog_bt.config import load_site
-    from frog_bt.observers.recording import FRONTEND_OUT
+    from frog_bt.model.channels import FRONTEND_OUT
+    from frog_bt.recordings.commands import Command
     from frog_bt.sim.comparison import Comparison
-    from frog_bt.tools.replay import Command
 
     volume = Command(10.0, FRONTEND_OUT, {"type": "volume", "percent": 80})
     follow = Command(10.4, FRONTEND_OUT, {"type": "follow_me", "on": False})

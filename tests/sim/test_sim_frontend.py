@@ -8,8 +8,8 @@ from typing import Any
 
 import pytest
 
-from frog_bt.frontend import messages as fm
 from frog_bt.frontend.protocol import Endpoint
+from frog_bt.model import frontend as fm
 from frog_bt.sim.frontend import FrontendModel
 from frog_bt.sim.scenario import Scenario
 

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
+from frog_bt.clock import SITE_TZ
 from frog_bt.errors import ConfigError
-from frog_bt.kernel.clock import SITE_TZ
 from frog_bt.sim import command
 from frog_bt.sim.scenario import (
     ContentParts,

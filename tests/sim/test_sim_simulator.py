@@ -14,7 +14,7 @@ from sim_clients import Executive, RosClient
 from websockets.asyncio.client import connect
 from websockets.exceptions import ConnectionClosed
 
-from frog_bt.frontend import messages as fm
+from frog_bt.model import frontend as fm
 from frog_bt.rosbridge.protocol import auth_frame
 from frog_bt.sim import Record, Simulator, load_scenario, parse_scenario
 from frog_bt.sim.scenario import Scenario

@@ -17,11 +17,12 @@ from typing import Any
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "e2e"))
 from tour import fast
 
+from frog_bt.behaviours import load_tree
 from frog_bt.config import Site, load_site
+from frog_bt.live.telemetry import Telemetry
+from frog_bt.rehearsal import Rehearsal
 from frog_bt.runtime.executive import Outcome
-from frog_bt.runtime.rehearsal import Rehearsal
-from frog_bt.telemetry import Telemetry
-from frog_bt.tree.loader import LoadedTree, load_tree
+from frog_bt.tree.loader import LoadedTree
 
 
 @dataclass

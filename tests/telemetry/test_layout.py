@@ -8,9 +8,9 @@ import py_trees
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from frog_bt.behaviours import load_tree
 from frog_bt.config import load_site
-from frog_bt.telemetry.layout import GAP, TreeIndex, label_width, node_key, tidy_layout
-from frog_bt.tree.loader import load_tree
+from frog_bt.live.telemetry.layout import GAP, TreeIndex, label_width, node_key, tidy_layout
 
 Behaviour = py_trees.behaviour.Behaviour
 

@@ -6,7 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from frog_bt.telemetry.process import _numbered
+from frog_bt.live.telemetry.process import _numbered
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -22,7 +22,7 @@ def test_a_tour_is_written_by_writers_that_take_turns(tmp_path: Path) -> None:
     fresh interpreter: the child is forked before rerun is imported anywhere): several
     files, one recording id, each with the static scene and rows of its own, and the
     link lanes carried into each new file."""
-    code = ("import sys, frog_bt.telemetry.process as p; p.RECYCLE_ROWS = 3000\n"
+    code = ("import sys, frog_bt.live.telemetry.process as p; p.RECYCLE_ROWS = 3000\n"
             "from frog_bt.cli import main\n"
             "sys.exit(main(['demo', '--quiet', '--speed', '300', '--rerun', "
             "'save:' + sys.argv[1], '--record', sys.argv[2]]))\n")

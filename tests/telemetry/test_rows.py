@@ -8,11 +8,11 @@ import py_trees
 import pytest
 from bench import Bench, write_tree
 
-from frog_bt.frontend.messages import FrontendIdle
-from frog_bt.kernel.outcomes import IncidentKind, Level
-from frog_bt.telemetry import Telemetry
-from frog_bt.telemetry.layout import TreeIndex
-from frog_bt.telemetry.rows import Rows
+from frog_bt.live.telemetry import Telemetry
+from frog_bt.live.telemetry.layout import TreeIndex
+from frog_bt.live.telemetry.rows import Rows
+from frog_bt.model.frontend import FrontendIdle
+from frog_bt.model.outcomes import IncidentKind, Level
 
 S = py_trees.common.Status
 TREE = """
@@ -137,7 +137,7 @@ def test_telemetry_over_a_core_ticked_by_hand(bench: Bench, tmp_path: Path):
 
 
 def test_rows_before_the_clock_has_a_time_take_the_first_ticks_time(tmp_path: Path):
-    from frog_bt.kernel.clock import SimClock
+    from frog_bt.clock import SimClock
 
     bench = Bench(write_tree(tmp_path, TREE))
     clock = SimClock()
@@ -152,7 +152,7 @@ def test_rows_before_the_clock_has_a_time_take_the_first_ticks_time(tmp_path: Pa
 
 
 def test_rows_that_never_got_a_time_are_dropped(tmp_path: Path):
-    from frog_bt.kernel.clock import SimClock
+    from frog_bt.clock import SimClock
 
     bench = Bench(write_tree(tmp_path, TREE))
     bench.core.clock = SimClock()

@@ -7,7 +7,7 @@ from datetime import time
 from types import SimpleNamespace
 
 from frog_bt.config import Variant, load_site
-from frog_bt.telemetry.site_map import circle_points, poi_marks, tour_routes, zone_outlines
+from frog_bt.live.telemetry.site_map import circle_points, poi_marks, tour_routes, zone_outlines
 
 
 def test_pois_sharing_a_spot_share_a_mark_with_both_headings():

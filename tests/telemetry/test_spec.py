@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from frog_bt.behaviours import load_tree
 from frog_bt.config import load_site
-from frog_bt.telemetry import Telemetry
-from frog_bt.telemetry.spec import DEFAULT_URL, Sink, parse_spec
-from frog_bt.tree.loader import load_tree
+from frog_bt.live.telemetry import Telemetry
+from frog_bt.live.telemetry.spec import DEFAULT_URL, Sink, parse_spec
 
 
 @pytest.mark.parametrize(("spec", "sink"), [
@@ -57,8 +57,9 @@ def test_open_rejects_a_bad_spec_before_starting_anything():
 
 
 def test_importing_telemetry_does_not_import_rerun():
-    code = ("import sys, frog_bt.telemetry, frog_bt.telemetry.rows, frog_bt.telemetry.layout, "
-            "frog_bt.telemetry.site_map, frog_bt.telemetry.spec; "
+    code = ("import sys, frog_bt.live.telemetry, frog_bt.live.telemetry.rows, "
+            "frog_bt.live.telemetry.layout, frog_bt.live.telemetry.site_map, "
+            "frog_bt.live.telemetry.spec; "
             "sys.exit('rerun imported' if 'rerun' in sys.modules else 0)")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             timeout=60)

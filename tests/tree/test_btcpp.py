@@ -8,11 +8,11 @@ from pathlib import Path
 import behaviortreepy as btcpp
 import pytest
 
+from frog_bt.behaviours import FACTORY, load_tree
 from frog_bt.commands.render import btcpp_xml
 from frog_bt.config import load_site
-from frog_bt.tools import render
+from frog_bt.tree import render
 from frog_bt.tree.catalogue import catalogue
-from frog_bt.tree.loader import load_tree
 
 BUILTIN = {"Sequence", "ReactiveSequence", "Fallback", "ReactiveFallback", "Parallel",
            "RetryUntilSuccessful", "ForceSuccess", "SubTree"}
@@ -40,7 +40,7 @@ def test_one_behavior_tree_per_file_subtrees_and_a_model(xml_text: str) -> None:
     assert root.find(".//ReactiveFallback").get("name") == "FROG"
     # every frog-bt node type used is declared, with its parameters as ports
     model = {e.get("ID"): e for e in root.find("TreeNodesModel")}
-    params = {n.name: [p.name for p in n.params] for n in catalogue()}
+    params = {n.name: [p.name for p in n.params] for n in catalogue(FACTORY)}
     used = {e.tag for e in root.iter() if e.tag not in BUILTIN} - {
         "root", "BehaviorTree", "TreeNodesModel", "Action", "Decorator", "input_port",
         "MetadataFields", "Metadata"}

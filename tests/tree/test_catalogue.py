@@ -8,17 +8,16 @@ from pathlib import Path
 
 import pytest
 
+from frog_bt.behaviours import FACTORY
 from frog_bt.cli import main
 from frog_bt.tree.catalogue import as_markdown, catalogue
-from frog_bt.tree.decorators import DECORATORS
-from frog_bt.tree.leaf import LEAVES
 
 TREES_MD = Path(__file__).resolve().parents[2] / "docs" / "TREES.md"
 
 
 def test_every_registered_type_is_listed_with_its_keys() -> None:
-    nodes = {n.name: n for n in catalogue()}
-    assert set(nodes) == {"Sequence", "Selector", "Parallel", *LEAVES, *DECORATORS}
+    nodes = {n.name: n for n in catalogue(FACTORY)}
+    assert set(nodes) == {"Sequence", "Selector", "Parallel", *FACTORY.leaves, *FACTORY.decorators}
     for name in ("MustAbort", "ClearAbort", "GiveUp", "ConfirmResume", "Checkpointed"):
         assert name in nodes
     seek = nodes["SeekVisitor"]
@@ -31,7 +30,7 @@ def test_the_docs_node_reference_is_the_catalogue() -> None:
     text = TREES_MD.read_text()
     start = text.index("<!-- leaves:begin -->\n") + len("<!-- leaves:begin -->\n")
     end = text.index("<!-- leaves:end -->")
-    assert text[start:end] == as_markdown(catalogue()), (
+    assert text[start:end] == as_markdown(catalogue(FACTORY)), (
         "docs/TREES.md is out of date: paste `frog-bt leaves` between the leaves markers")
 
 

@@ -11,13 +11,13 @@ import pytest
 from bench import Bench, write_tree
 
 from frog_bt import resources
+from frog_bt.behaviours import FACTORY, load_tree
 from frog_bt.config import load_site
 from frog_bt.errors import TreeError
-from frog_bt.kernel.key import Key, Scope, Source
-from frog_bt.kernel.outcomes import IncidentKind
+from frog_bt.model.key import Key, Scope, Source
+from frog_bt.model.outcomes import IncidentKind
 from frog_bt.tree import loader
-from frog_bt.tree.leaf import FAILURE, LEAVES, SUCCESS, Leaf, Status
-from frog_bt.tree.loader import load_tree
+from frog_bt.tree.leaf import FAILURE, SUCCESS, Leaf, Status
 
 
 @pytest.fixture
@@ -149,7 +149,7 @@ class Mood(Leaf):
 ])
 def test_keys_are_declared_once(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                          leaf: type[Leaf], message: str) -> None:
-    monkeypatch.setitem(LEAVES, leaf.__name__, leaf)
+    monkeypatch.setitem(FACTORY.leaves, leaf.__name__, leaf)
     path = write_tree(tmp_path, f"""
         root:
           type: Sequence

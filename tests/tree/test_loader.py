@@ -7,9 +7,9 @@ import re
 import pytest
 from bench import write_tree
 
+from frog_bt.behaviours import load_tree
 from frog_bt.config import load_site
 from frog_bt.errors import TreeError
-from frog_bt.tree.loader import load_tree
 
 
 @pytest.fixture(scope="module")

@@ -10,6 +10,7 @@ import pytest
 import yaml
 
 from frog_bt import resources
+from frog_bt.behaviours import FACTORY
 from frog_bt.cli import main
 from frog_bt.tree.schema import (
     SITE_SCHEMA_FILE,
@@ -29,7 +30,7 @@ def validator(schema: dict) -> jsonschema.Draft202012Validator:
 
 
 def test_the_shipped_schemas_are_the_generated_ones() -> None:
-    assert (resources.tree_dir() / TREE_SCHEMA_FILE).read_text() == dumps(tree_schema()), (
+    assert (resources.tree_dir() / TREE_SCHEMA_FILE).read_text() == dumps(tree_schema(FACTORY)), (
         "run: frog-bt schema tree > trees/tree.schema.json")
     assert (resources.site_dir() / SITE_SCHEMA_FILE).read_text() == dumps(site_schema()), (
         "run: frog-bt schema site > config/site.schema.json")
@@ -39,7 +40,7 @@ def test_the_shipped_schemas_are_the_generated_ones() -> None:
 def test_every_shipped_tree_validates_and_points_at_the_schema(path: Path) -> None:
     text = path.read_text()
     assert text.startswith(f"# yaml-language-server: $schema={TREE_SCHEMA_FILE}\n")
-    assert list(validator(tree_schema()).iter_errors(yaml.safe_load(text))) == []
+    assert list(validator(tree_schema(FACTORY)).iter_errors(yaml.safe_load(text))) == []
 
 
 def test_the_shipped_site_validates_and_points_at_the_schema() -> None:
@@ -57,13 +58,13 @@ def test_the_shipped_site_validates_and_points_at_the_schema() -> None:
     {"type": "PlayContent", "poi": "POI1", "part": "c"},
 ])
 def test_mistakes_are_flagged(root: dict) -> None:
-    assert list(validator(tree_schema()).iter_errors({"root": root}))
+    assert list(validator(tree_schema(FACTORY)).iter_errors({"root": root}))
 
 
 def test_variables_are_accepted_for_any_parameter() -> None:
     tree = {"root": {"type": "Retry", "attempts": "{nav_attempts}",
                      "child": {"type": "Navigate", "poi": "{poi}"}}}
-    assert list(validator(tree_schema()).iter_errors(tree)) == []
+    assert list(validator(tree_schema(FACTORY)).iter_errors(tree)) == []
 
 
 def test_schema_command(capsys: pytest.CaptureFixture[str]) -> None:

@@ -13,12 +13,12 @@ from typing import Any, ClassVar
 import pytest
 from bench import Bench, write_tree
 
+from frog_bt.behaviours import FACTORY, load_tree
 from frog_bt.config import load_site
 from frog_bt.errors import TreeError
-from frog_bt.kernel import keys
-from frog_bt.kernel.key import Key
-from frog_bt.tree.leaf import LEAVES, SUCCESS, Leaf, Status
-from frog_bt.tree.loader import load_tree
+from frog_bt.model import keys
+from frog_bt.model.key import Key
+from frog_bt.tree.leaf import SUCCESS, Leaf, Status
 
 
 class WriteEngaged(Leaf):
@@ -55,7 +55,7 @@ class NeedEngaged(Leaf):
 @pytest.fixture(autouse=True)
 def leaves(monkeypatch: pytest.MonkeyPatch) -> None:
     for cls in (WriteEngaged, SeeEngaged, NeedEngaged):
-        monkeypatch.setitem(LEAVES, cls.__name__, cls)
+        monkeypatch.setitem(FACTORY.leaves, cls.__name__, cls)
     SeeEngaged.seen = []
 
 

@@ -1,0 +1,99 @@
+"""Commands to the robot over rosbridge, and the one goal awaiting ``/FROG_response``.
+
+``/GotoWayPoint`` and ``/ApproachPeopleFar`` share ``/FROG_response`` and carry
+no goal id, so at most one of them is pending at a time: a new goal replaces
+the active one (CONTRACT §1), and a response that arrives while nothing is
+pending is stale and ignored.
+
+Results reach the tree as values, not by mutation: the pre-tick step applies the
+responses that arrived (:meth:`Actions.on_response`) and writes the newest goal's state
+to :data:`frog_bt.model.keys.GOAL`, so every tick sees one consistent state. A leaf
+keeps the :class:`Goal` it sent and compares ids: the key's goal is its own, a newer
+one (it was replaced), or, within the tick that sent it, an older one.
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+from collections.abc import Callable
+from dataclasses import replace
+
+from frog_bt.clock import Clock
+from frog_bt.config import Poi
+from frog_bt.model.goals import Goal
+from frog_bt.model.ros import Pose
+from frog_bt.model.wire import Response
+
+log = logging.getLogger(__name__)
+
+# (output role, value: the wire table encodes it, the goal it carries: goto and approach)
+Publish = Callable[[str, object, "Goal | None"], None]
+
+
+class Actions:
+    """Publishes robot commands by role (``goto``, ``approach``, ``icl``, ``dock``) and
+    tracks the one pending goal (a service: leaves learn results from the blackboard)."""
+
+    def __init__(self, publish: Publish, clock: Clock) -> None:
+        self._publish = publish
+        self._clock = clock
+        self._ids = itertools.count(1)
+        self.pending: Goal | None = None
+        self.latest: Goal | None = None  # the newest goal sent, with its latest response
+        self.stale_responses = 0
+        self.last_approach_at = -math.inf  # project-clock time of the last approach sent
+
+    def goto(self, waypoint: str, poi: Poi) -> Goal:
+        now = self._clock.now()
+        pose = Pose(now, "map", poi.x, poi.y, poi.z, poi.w)
+        goal = self._replace(Goal(next(self._ids), "goto", waypoint, now, pose))
+        self._publish("goto", pose, goal)
+        return goal
+
+    def approach(self, person_id: int) -> Goal:
+        self.last_approach_at = now = self._clock.now()
+        goal = self._replace(Goal(next(self._ids), "approach", str(person_id), now, person_id))
+        self._publish("approach", person_id, goal)
+        return goal
+
+    def resend_pending(self) -> Goal | None:
+        """Publish the pending goal or approach again (after a reconnect its answer may
+        have been lost while the link was down). The goal keeps waiting as before."""
+        goal = self.pending
+        if goal is not None:
+            self._publish(goal.kind, goal.value, goal)  # the kind is the output role
+            log.info("re-sent %s %s after a reconnect", goal.kind, goal.target)
+        return goal
+
+    def _replace(self, goal: Goal) -> Goal:
+        self.pending = self.latest = goal
+        return goal
+
+    def cancel(self, goal: Goal | None) -> None:
+        """Stop waiting for ``goal``; a later response to it is stale."""
+        if goal is not None and self.pending is not None and self.pending.id == goal.id:
+            self.pending = None
+
+    def on_response(self, code: int, at: float) -> Goal | None:
+        """Apply one ``/FROG_response`` code; the goal it answered, if any. A code the
+        contract does not know is counted as stale."""
+        goal = self.pending
+        known = Response.of(code)
+        if goal is None or known is None:
+            self.stale_responses += 1
+            log.debug("ignored /FROG_response %d: %s", code,
+                      "nothing pending" if known is not None else "unknown code")
+            return None
+        goal = replace(goal, code=known, answered_at=at)
+        self.pending = None if goal.done else goal
+        if self.latest is not None and self.latest.id == goal.id:
+            self.latest = goal
+        return goal
+
+    def dock(self, action: str) -> None:
+        self._publish("dock", action, None)
+
+    def icl(self, on: bool) -> None:
+        self._publish("icl", "start" if on else "stop", None)

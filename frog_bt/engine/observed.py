@@ -1,0 +1,89 @@
+"""Every status change of a frog-bt tree, seen without patching py_trees; and scopes.
+
+py_trees changes a node's status in two places: in its ``tick`` (the tick
+yields every node it reaches) and in its ``stop`` (which yields nothing). Every
+node a tree file can build is one of our classes — leaves, decorators and the
+composites below — and their ``stop`` reports the node to ``stop_log`` when one
+is attached (:class:`~frog_bt.engine.core.Core` attaches its own). Observers such as
+telemetry then follow the tree in O(active path), not O(tree).
+
+Each core has its own :class:`Trace` (handed to every node in ``setup(trace=...)``):
+which nodes are ticking or stopping now, innermost last (a command sent now is the last
+one's doing: blame), and which nodes with reads ended in the current tick (what decided
+a command sent later in the same tick). Nothing here is global.
+
+A node that starts a scope (each stop of a ``foreach``, ``scope:`` in a tree file) clears
+that scope's keys on the board (``setup(board=...)``) each time it starts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import py_trees
+
+from frog_bt.model.key import Scope
+
+if TYPE_CHECKING:
+    from frog_bt.engine.blackboard import Board
+
+Behaviour = py_trees.behaviour.Behaviour
+
+
+@dataclass(slots=True)
+class Trace:
+    """What one core's tree is doing now (blame reads it)."""
+
+    acting: list[Behaviour] = field(default_factory=list)  # ticking or stopping, innermost last
+    decided: list[Behaviour] = field(default_factory=list)  # nodes with reads ended this tick
+
+    def current(self) -> Behaviour | None:
+        """The innermost frog-bt node ticking or stopping now, if any."""
+        return self.acting[-1] if self.acting else None
+
+
+class Observed:
+    """Mixin (before the py_trees base): ``stop`` appends the node to ``stop_log``; a node
+    with a ``scope`` clears it when it starts (:meth:`start_scope`)."""
+
+    stop_log: list[Behaviour] | None = None
+    scope: Scope | None = None  # set by the loader on a node that starts a scope
+    _trace: Trace | None = None
+    _board: Board | None = None
+
+    def setup(self, **kwargs: Any) -> None:
+        self._trace = kwargs.get("trace")
+        self._board = kwargs.get("board")
+        super().setup(**kwargs)  # type: ignore[misc]
+
+    def start_scope(self) -> None:
+        """Clear this node's scope, if it starts one: called as it starts (from its
+        ``initialise`` or its tick, never from py_trees' eager ``self.tick()`` calls)."""
+        if self.scope is not None and self._board is not None:
+            self._board.clear_scope(self.scope)
+
+    def stop(self, new_status: py_trees.common.Status = py_trees.common.Status.INVALID
+             ) -> None:
+        trace = self._trace
+        if trace is None:
+            super().stop(new_status)  # type: ignore[misc]
+        else:
+            trace.acting.append(self)  # type: ignore[arg-type]
+            try:
+                super().stop(new_status)  # type: ignore[misc]
+            finally:
+                trace.acting.pop()
+        log = self.stop_log
+        if log is not None:
+            log.append(self)  # type: ignore[arg-type]
+
+
+def attach(root: Behaviour, log: list[Behaviour]) -> None:
+    """Report every stop in the tree under ``root`` to ``log``; TypeError for a node that
+    cannot report (a tree not built by the loader)."""
+    for node in root.iterate():
+        if not isinstance(node, Observed):
+            raise TypeError(f"{node.name}: {type(node).__name__} is not an observed frog-bt "
+                            "node type")
+        node.stop_log = log

@@ -1,0 +1,139 @@
+"""Operator commands (CONTRACT §7): checked, applied to the board at a tick boundary, answered.
+
+The console and ``frog-bt ctl`` queue commands; the executive hands each to
+:meth:`Operator.apply` just before a tick (and replay does the same at the recorded tick),
+so a command enters the tree as an input, like any other. The tree files decide what it
+does: ``MustAbort`` reads ``/home`` (the same polite abort as a low battery),
+``OperatorSkip`` around each stop reads ``/skip``, ``Navigate`` and ``PlayContent`` hold
+while ``/paused``, ``WaitInService`` keeps the robot docked while out of service.
+
+Each command is answered with what it did, or refused with why (a ``skip`` while
+docked); nothing is half-applied: a refused command changes nothing. A pause longer
+than ``pause_max`` seconds of project-clock time ends the tour politely
+(:meth:`Operator.check_pause`).
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+
+from frog_bt.engine.blackboard import Board
+from frog_bt.engine.journal import Journal
+from frog_bt.model import keys
+from frog_bt.model.outcomes import AbortCause, AbortReason, IncidentKind, TourState
+
+
+class Command(enum.StrEnum):
+    HOME = "home"
+    SKIP = "skip"
+    PAUSE = "pause"
+    RESUME = "resume"
+    SERVICE_OFF = "service_off"
+    SERVICE_ON = "service_on"
+    ACK_ALERT = "ack_alert"  # the alerts' business, not the tree's (the executive answers it)
+
+
+TREE_COMMANDS = frozenset(Command) - {Command.ACK_ALERT}
+SENT_HOME = AbortReason(AbortCause.OPERATOR, "operator")
+
+
+@dataclass(frozen=True, slots=True)
+class Answer:
+    """``ok``: applied, and ``text`` says what it did; else ``text`` says why not."""
+
+    ok: bool
+    text: str
+
+
+class Operator:
+    """The tree's side of operator commands, for one core.
+
+    ``stops`` gives the stops the tree is at or driving to now (the running
+    ``OperatorSkip`` nodes' POIs, innermost last)."""
+
+    def __init__(self, board: Board, journal: Journal, stops: Callable[[], Iterable[str]],
+                 pause_max: float) -> None:
+        self.board = board
+        self.journal = journal
+        self.stops = stops
+        self.pause_max = pause_max
+        self.paused_since: float | None = None
+        board.set(keys.PAUSED, False)
+        board.set(keys.IN_SERVICE, True)
+
+    def _touring(self) -> bool:
+        return self.board.get(keys.TOUR_STATE) is TourState.STARTED
+
+    def apply(self, command: Command, now: float) -> Answer:
+        """Check ``command`` against the tour now and apply it to the board."""
+        answer = self._decide(command, now)
+        if answer.ok:
+            self.journal.note(f"operator: {command}: {answer.text}", IncidentKind.OPERATOR,
+                              subject=command.value)
+        return answer
+
+    def _decide(self, command: Command, now: float) -> Answer:
+        board = self.board
+        if command is Command.HOME:
+            if not self._touring():
+                return Answer(False, "no tour is running: the robot is at the dock or going "
+                                     "there")
+            if board.get(keys.HOME) is not None or board.get(keys.ABORT_REASON) is not None:
+                return Answer(False, "the tour is already ending: the robot is going home")
+            board.set(keys.HOME, SENT_HOME)
+            self._unpause()
+            return Answer(True, "ending the tour: the robot goes home and docks")
+        if command is Command.SKIP:
+            stops = list(self.stops())
+            if not self._touring() or not stops:
+                return Answer(False, "not at a stop or driving to one: nothing to skip")
+            if board.get(keys.HOME) is not None or board.get(keys.ABORT_REASON) is not None:
+                return Answer(False, "the tour is ending: nothing to skip")
+            board.set(keys.SKIP, (board.get(keys.SKIP) or 0) + 1)
+            return Answer(True, f"skipping {stops[-1]}: on to the next stop")
+        if command is Command.PAUSE:
+            if board.get(keys.PAUSED):
+                return Answer(False, "already paused")
+            if not self._touring():
+                return Answer(False, "no tour is running (service_off keeps the robot docked)")
+            board.set(keys.PAUSED, True)
+            self.paused_since = now
+            return Answer(True, f"pausing at the next step (at most {self.pause_max:g} s, "
+                                "then the tour ends)")
+        if command is Command.RESUME:
+            if not board.get(keys.PAUSED):
+                return Answer(False, "not paused")
+            self._unpause()
+            return Answer(True, "resuming the tour")
+        if command is Command.SERVICE_OFF:
+            if not board.get(keys.IN_SERVICE):
+                return Answer(False, "already out of service")
+            board.set(keys.IN_SERVICE, False)
+            return Answer(True, "out of service: this tour finishes, then no new tour starts"
+                          if self._touring() else "out of service: no new tour starts")
+        if command is Command.SERVICE_ON:
+            if board.get(keys.IN_SERVICE):
+                return Answer(False, "already in service")
+            board.set(keys.IN_SERVICE, True)
+            return Answer(True, "in service: tours start again")
+        return Answer(False, f"{command} is not a tree command")
+
+    def _unpause(self) -> None:
+        self.board.set(keys.PAUSED, False)
+        self.paused_since = None
+
+    def check_pause(self, now: float) -> AbortReason | None:
+        """Before each tick: a pause that ran out ends the tour politely (its reason)."""
+        if self.paused_since is None or now - self.paused_since < self.pause_max:
+            return None
+        self._unpause()
+        if not self._touring():
+            return None
+        reason = AbortReason(AbortCause.OPERATOR, f"paused longer than {self.pause_max:g} s")
+        if self.board.get(keys.HOME) is None and self.board.get(keys.ABORT_REASON) is None:
+            self.board.set(keys.HOME, reason)
+        self.journal.note(f"pause ran out after {self.pause_max:g} s: ending the tour",
+                          IncidentKind.OPERATOR, subject="pause")
+        return reason

@@ -1,0 +1,1 @@
+"""Live observers of a running executive: recording, console, telemetry, status line."""

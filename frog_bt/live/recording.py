@@ -1,0 +1,448 @@
+"""MCAP recordings of everything the executive receives and sends (CONTRACT §6).
+
+:class:`Recorder` writes one MCAP file with JSON message encoding:
+
+* one channel per ROS topic the executive subscribes to or publishes (channel
+  topic = ROS topic, schema name = ROS type, e.g. ``geometry_msgs/PoseStamped``),
+  ``/clock`` included under sim time; the message data is the rosbridge ``msg``
+  object, exactly as received or sent;
+* ``/frontend/in`` and ``/frontend/out``: every UDP datagram from the front-end
+  host and to the front end (acks and resends included), data = the datagram's
+  bytes;
+* ``/frog_bt/tree``: once, the tree that ran as BehaviorTree.CPP v4 XML
+  (``{"format", "file", "xml"}``: Groot2 opens the XML);
+* ``/frog_bt/blame``: after each command, the tree node that sent it and the
+  blackboard values it read (``{"channel", "node", "reads"}``), for replay's
+  divergence report;
+* ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``).
+  Live ticks coalesce bursts of inputs and fall wherever the event loop gets to
+  them, so replay ticks exactly where the live executive did
+  (:mod:`frog_bt.offline.replay`).
+
+Every message is stamped (``log_time`` = ``publish_time``, ns) with the
+project-clock time it was received or sent; ``/clock`` with the time it carries
+(the time it starts). Under sim time, what arrives before the first ``/clock``
+is held and stamped with that first time, so a recording has no zero stamps.
+
+Each channel carries a JSON Schema (encoding ``jsonschema``), so Foxglove
+can browse and plot the fields. Writing costs one ``json.dumps`` and one
+``add_message`` per message, the latter once the event loop's current callback
+(a tick, an input) is over, in order; chunks are bounded (:data:`CHUNK_SIZE`) and
+flushed at least every :data:`FLUSH_EVERY` wall seconds, so memory stays small
+and a crash loses little. :meth:`Recorder.close` (idempotent, also run at
+interpreter exit) writes the summary and footer: a recording stays valid MCAP
+when the run command stops on SIGTERM, or on an exception.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import logging
+import os
+import time
+import weakref
+from collections import deque
+from collections.abc import Callable
+from pathlib import Path
+from typing import IO, TYPE_CHECKING, Any
+
+import msgspec
+from mcap.writer import CompressionType, Writer
+
+from frog_bt import __version__
+from frog_bt.errors import DecodeError
+from frog_bt.model import channels
+from frog_bt.model.channels import (
+    ALERT,
+    BLAME,
+    DATAGRAM_TYPE,
+    FRONTEND_IN,
+    FRONTEND_OUT,
+    OPERATOR,
+    OWN_TYPES,
+    PRIMER,
+    TICK,
+    TREE,
+    from_ns,
+    schema_for,
+    to_ns,
+)
+from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS, Keep
+
+if TYPE_CHECKING:
+    from frog_bt.engine.core import Core, Outgoing
+    from frog_bt.engine.operator import Answer, Command
+    from frog_bt.runtime.observer import Host
+
+log = logging.getLogger(__name__)
+
+CHUNK_SIZE = 256 * 1024  # bytes of uncompressed messages per chunk
+FLUSH_EVERY = 1.0  # wall seconds between chunk flushes: a kill loses at most this much
+PRIMER_DATAGRAMS = 16  # recent datagrams in, so that their resends stay duplicates
+PRIMER_SEQS = 64  # recent seqs out, so that resends of earlier commands are not new ones
+HELD_LIMIT = 10_000  # messages held before the first /clock
+
+def _dumps(msg: Any) -> bytes:
+    return json.dumps(msg, separators=(",", ":")).encode()
+
+
+def _raw(msg: Any) -> bytes:
+    """A received ``msg`` as JSON bytes: as it came (raw) when it is raw JSON."""
+    return bytes(msg) if isinstance(msg, bytes | msgspec.Raw) else _dumps(msg)
+
+
+Queued = tuple[int, int, bytes, int]  # channel id, log time (ns), data, sequence
+
+
+def _write_queued(writer: Writer, queue: list[Queued]) -> None:
+    """Write ``queue`` in order, emptying it."""
+    for cid, ns, data, seq in queue:
+        writer.add_message(cid, log_time=ns, data=data, publish_time=ns, sequence=seq)
+    queue.clear()
+
+
+def _finish(writer: Writer, stream: IO[bytes], queue: list[Queued]) -> None:
+    """Write what is queued, summary and footer, close the file (the finalizer: runs once)."""
+    try:
+        _write_queued(writer, queue)
+        writer.finish()
+    except Exception:
+        log.exception("recording: cannot finish the MCAP file")
+    finally:
+        stream.close()
+
+
+class Recorder:
+    """Writes an MCAP recording of one executive run; see the module docstring.
+
+    ``Recorder(path)`` creates the file (``OSError`` when it cannot);
+    :meth:`attach` hooks it to an :class:`~frog_bt.runtime.executive.Executive`;
+    :meth:`rotate` finishes the file and carries on in a new one (``--record DIR``,
+    :mod:`frog_bt.live.rotation`); :meth:`close` finishes it. A write error is
+    logged once and stops the recording; it never reaches the tick path.
+    """
+
+    def __init__(self, path: Path, *, chunk_size: int = CHUNK_SIZE,
+                 flush_every: float = FLUSH_EVERY,
+                 metadata: dict[str, str] | None = None) -> None:
+        self._chunk_size = chunk_size
+        self._flush_every = flush_every
+        # Messages wait in _incoming until the event loop's current callback (a tick, an
+        # input) is over, so that a tick pays a list append per message, not an MCAP
+        # record each; _queue holds them stamped, for the writer (and the finalizer).
+        self._incoming: list[tuple[str, float | None, bytes]] = []
+        self._queue: list[Queued] = []
+        self._drain_scheduled = False
+        self._flush_timer: asyncio.TimerHandle | None = None
+        self._syncing = False
+        self._registered: dict[str, str] = {}  # topic -> type, for the next file too
+        self._last_ns = 0
+        self._held: list[tuple[str, bytes]] = []
+        self._ready: Callable[[], bool] = lambda: True
+        self._clock_topic: str | None = None
+        self._tree: bytes | None = None
+        # What a new file starts with (rotation): the latest message of each input kept
+        # as latest, the last /clock, recent datagrams in and the seqs sent out.
+        self._latest_topics: frozenset[str] = frozenset()
+        self._latest_raw: dict[str, tuple[float, bytes]] = {}
+        self._clock_raw: bytes | None = None
+        self._frontend_in: deque[bytes] = deque(maxlen=PRIMER_DATAGRAMS)
+        self._frontend_out_seqs: deque[int] = deque(maxlen=PRIMER_SEQS)
+        self.messages = 0
+        self.dropped = 0  # held before the first /clock beyond HELD_LIMIT
+        self.closed = False
+        self._open(Path(path), metadata)
+
+    def _open(self, path: Path, metadata: dict[str, str] | None) -> None:
+        self.path = path
+        stream: IO[bytes] = open(path, "wb")  # noqa: SIM115 - closed by _finish
+        self._stream = stream
+        compression = CompressionType.NONE
+        try:
+            import lz4.frame  # noqa: F401 - optional, chosen only when installed
+
+            compression = CompressionType.LZ4
+        except ImportError:
+            pass
+        self._writer = Writer(stream, chunk_size=self._chunk_size, compression=compression)
+        self._writer.start(profile="", library=f"frog-bt {__version__}")
+        if metadata:
+            self._writer.add_metadata("frog_bt", metadata)
+        self._queue = []
+        self._finalizer = weakref.finalize(self, _finish, self._writer, stream, self._queue)
+        self._flushed_at = time.monotonic()
+        self._schemas: dict[str, int] = {}
+        self._channels: dict[str, int] = {}
+        self._sequence: dict[int, int] = {}
+        for topic, type_ in self._registered.items():
+            self.channel(topic, type_)
+
+    # ------------------------------------------------------------ wiring
+
+    def attach(self, host: Host) -> None:
+        """Register every channel and hook the executive's wire and core taps (a live
+        host only: a recording needs the raw traffic)."""
+        wire = host.wire
+        if wire is None:
+            raise ValueError("a recorder attaches to the live executive (raw traffic)")
+        site = host.site
+        for role, topic in (*INPUTS.items(), *OUTPUTS.items()):
+            self.channel(site.topic(role), topic.type)
+        self._latest_topics = frozenset(site.topic(role) for role, inp in INPUTS.items()
+                                        if inp.keep is Keep.LATEST)
+        if host.sim_time:
+            self._clock_topic = CLOCK.name
+            self.channel(CLOCK.name, CLOCK.type)
+        self.channel(FRONTEND_IN, DATAGRAM_TYPE)
+        self.channel(FRONTEND_OUT, DATAGRAM_TYPE)
+        for channel in (TICK, BLAME, OPERATOR, ALERT):
+            self.channel(channel, OWN_TYPES[channel])
+        clock = host.clock
+        self._ready = lambda: bool(clock.ready)
+        self._tree = self._tree_message(host)
+        if self._tree is not None:
+            self._write(TREE, None, self._tree)
+        wire.ros_in.append(self.on_ros_in)
+        host.taps.ros_out.append(self.on_ros_out)
+        wire.datagram.append(self.on_datagram)
+        host.taps.tick.append(self.on_tick)
+        host.taps.blame.append(self.on_blame)
+        host.taps.operator.append(self.on_operator)
+
+    def channel(self, topic: str, type_: str) -> str:
+        """Register ``topic`` (and its schema) in the file on first use; the topic."""
+        if topic not in self._channels:
+            sid = self._schemas.get(type_)
+            if sid is None:
+                schema = schema_for(type_)
+                sid = self._writer.register_schema(type_, "jsonschema", _dumps(schema))
+                self._schemas[type_] = sid
+            self._channels[topic] = self._writer.register_channel(topic, "json", sid)
+            self._registered.setdefault(topic, type_)
+        return topic
+
+    # ------------------------------------------------------------ taps (tick path: keep cheap)
+
+    def on_ros_in(self, t: float, topic: str, msg: Any) -> None:
+        if topic not in self._channels:
+            self.channel(topic, "unknown")
+        data = _raw(msg)
+        if topic == self._clock_topic:
+            try:  # /clock is seen before the clock takes it: stamp it with its own time
+                clock = CLOCK.codec.decode(data)
+            except DecodeError:
+                pass
+            else:
+                self._clock_raw = data
+                self._write(topic, max(t, clock) if self._ready() else clock, data)
+                return
+        if topic in self._latest_topics:
+            self._latest_raw[topic] = (t, data)
+        self._write(topic, t if self._ready() else None, data)
+
+    def on_ros_out(self, t: float, out: Outgoing) -> None:
+        topic, msg = out.topic, out.msg
+        if topic not in self._channels:
+            self.channel(topic, "unknown")
+        self._write(topic, t, _dumps(msg))
+
+    def on_datagram(self, direction: str, data: bytes, t: float) -> None:
+        data = bytes(data)
+        if direction == "in":
+            topic = FRONTEND_IN
+            self._frontend_in.append(data)
+        else:
+            topic = FRONTEND_OUT
+            try:
+                seq = json.loads(data).get("seq")
+            except (ValueError, AttributeError):
+                seq = None
+            if isinstance(seq, int) and seq not in self._frontend_out_seqs:
+                self._frontend_out_seqs.append(seq)
+        self._write(topic, t if self._ready() else None, data)
+
+    def _tree_message(self, host: Host) -> bytes | None:
+        """The tree that runs, so that a recording explains itself without the files."""
+        tree = getattr(host.core, "tree", None)
+        if tree is None or tree.factory is None:
+            return None
+        try:
+            tree_file = Path(tree.file)
+            xml = tree.factory.export_xml(tree_file, host.site)
+        except Exception as exc:
+            log.info("recording without the tree's XML: %s", exc)
+            return None
+        return channels.encode(channels.Tree("BehaviorTree.CPP v4", str(tree_file), xml))
+
+    def on_blame(self, t: float, channel: str, node: str, reads: dict[str, str]) -> None:
+        self._write(BLAME, t, channels.encode(channels.Blame(channel, node, reads)))
+
+    def on_operator(self, t: float, tick: int, command: Command, answer: Answer) -> None:
+        self._write(OPERATOR, t, channels.encode(channels.Operator(
+            tick, command.value, answer.ok, answer.text)))
+
+    def on_alert(self, t: float, alert: channels.Alert) -> None:
+        """An alert raised, cleared or acknowledged (the executive's alert book calls it)."""
+        self._write(ALERT, t, channels.encode(alert))
+
+    def on_tick(self, core: Core) -> None:
+        status = core.root.status.name
+        self._write(TICK, core.clock.now(), channels.encode(channels.Tick(core.ticks, status)))
+
+    # ------------------------------------------------------------ writing
+
+    def _write(self, topic: str, t: float | None, data: bytes) -> None:
+        """Take a message (``t`` None: before the clock has a time); it is stamped and
+        written once the event loop's current callback is over (at once without a loop)."""
+        if self.closed:
+            return
+        self._incoming.append((topic, t, data))
+        if not self._drain_scheduled:
+            try:
+                loop = asyncio.get_running_loop()
+            except RuntimeError:  # no event loop: write now
+                self._drain()
+                return
+            self._drain_scheduled = True
+            loop.call_soon(self._drain)
+
+    def _stamp(self) -> None:
+        """Give the incoming messages their log times and sequence numbers, in order."""
+        incoming, self._incoming = self._incoming, []
+        for topic, t, data in incoming:
+            if t is None:  # before the first /clock: no time yet
+                if len(self._held) < HELD_LIMIT:
+                    self._held.append((topic, data))
+                else:
+                    self.dropped += 1
+                continue
+            ns = max(to_ns(t), self._last_ns)
+            if self._held:
+                held, self._held = self._held, []
+                for held_topic, held_data in held:
+                    self._add(held_topic, ns, held_data)
+            self._add(topic, ns, data)
+            self._last_ns = ns
+
+    def _add(self, topic: str, ns: int, data: bytes) -> None:
+        cid = self._channels.get(topic)
+        if cid is None:  # a channel of ours, first used now (or an unknown topic)
+            cid = self._channels[self.channel(topic, OWN_TYPES.get(topic, "unknown"))]
+        seq = self._sequence.get(cid, 0)
+        self._sequence[cid] = seq + 1
+        self._queue.append((cid, ns, data, seq & 0xFFFFFFFF))
+        self.messages += 1
+
+    def _drain(self) -> None:
+        """Write the queued messages, in order; flush a chunk every ``flush_every`` s."""
+        self._drain_scheduled = False
+        if self.closed:
+            return  # close() wrote them
+        try:
+            self._stamp()
+            _write_queued(self._writer, self._queue)
+            if time.monotonic() - self._flushed_at >= self._flush_every:
+                self._flush()
+            elif self._flush_timer is None:  # a quiet spell must not keep the tail back
+                try:
+                    loop = asyncio.get_running_loop()
+                except RuntimeError:
+                    return
+                self._flush_timer = loop.call_later(self._flush_every, self._timed_flush)
+        except Exception as exc:  # disk full, ...: stop recording, never stop the robot
+            self._failed(exc)
+
+    def _timed_flush(self) -> None:
+        self._flush_timer = None
+        if not self.closed:
+            try:
+                self._flush()
+            except Exception as exc:
+                self._failed(exc)
+
+    def _flush(self) -> None:
+        """End the chunk and hand it to the OS (a kill -9 then loses nothing of it), and
+        ask for it on the disk (power loss) in a worker thread, off the event loop."""
+        self._flushed_at = time.monotonic()
+        self._writer.flush()
+        self._stream.flush()
+        if self._syncing:
+            return
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:
+            return
+        self._syncing = True
+        future = loop.run_in_executor(None, _fsync, self._stream)
+        future.add_done_callback(lambda _f: setattr(self, "_syncing", False))
+
+    def _failed(self, exc: Exception) -> None:
+        log.error("recording to %s stopped: %s", self.path, exc)
+        self._queue.clear()
+        self.close()
+
+    def primer(self, frontend_ready: bool) -> bytes:
+        """A :data:`PRIMER` message: what the executive carries from before now."""
+        return channels.encode(channels.Primer(
+            inputs=[channels.PrimerInput(topic, t, msgspec.Raw(data))
+                    for topic, (t, data) in sorted(self._latest_raw.items())],
+            frontend_ready=frontend_ready,
+            frontend_in=[d.decode("utf-8", "replace") for d in self._frontend_in],
+            frontend_out_seqs=list(self._frontend_out_seqs)))
+
+    def rotate(self, path: Path, metadata: dict[str, str] | None = None,
+               primer: bytes | None = None) -> None:
+        """Finish this file and go on in ``path``: it starts with the tree, the last
+        /clock and ``primer`` (on :data:`PRIMER`), stamped now."""
+        if self.closed:
+            return
+        self._stamp()
+        self._close_file()
+        try:
+            self._open(Path(path), metadata)
+        except OSError as exc:
+            log.error("recording to %s stopped: %s", path, exc)
+            self.closed = True
+            return
+        if self._tree is not None:
+            self._write(TREE, None, self._tree)
+        if self._clock_raw is not None and self._clock_topic is not None:
+            self._write(self._clock_topic, from_ns(self._last_ns), self._clock_raw)
+        if primer is not None:
+            self._write(PRIMER, from_ns(self._last_ns), primer)
+
+    def _close_file(self) -> None:
+        if self._flush_timer is not None:
+            self._flush_timer.cancel()
+            self._flush_timer = None
+        self._finalizer()
+
+    def close(self) -> None:
+        """Write the summary and footer and close the file; idempotent."""
+        if self.closed:
+            return
+        try:
+            self._stamp()
+        except Exception as exc:  # a bug: what is stamped is still written
+            log.error("recording to %s: %s", self.path, exc)
+        self.closed = True
+        if self._held:
+            log.warning("recording: %d messages before the first /clock were never stamped",
+                        len(self._held))
+            self._held = []
+        if self.dropped:
+            log.warning("recording: %d messages before the first /clock dropped", self.dropped)
+        self._close_file()
+
+    def __enter__(self) -> Recorder:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _fsync(stream: IO[bytes]) -> None:
+    with contextlib.suppress(OSError, ValueError):  # closed meanwhile: close synced it
+        os.fsync(stream.fileno())

@@ -1,0 +1,163 @@
+"""What happened on a tour, from the executive's own traffic (``frog-bt demo`` prints it).
+
+:class:`TourSummary` is a set of taps for :class:`~frog_bt.runtime.executive.Taps`: it
+watches the goals sent and answered, the content started, the visitors
+approached and recruited.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from frog_bt.config import Site
+from frog_bt.engine.context import Incident
+from frog_bt.maths.engagement import Decision
+from frog_bt.model import keys
+from frog_bt.model.frontend import StartPoi, Tour, UserPositive
+from frog_bt.model.outcomes import IncidentKind
+from frog_bt.model.ros import POSE
+from frog_bt.model.wire import SUCCEEDED
+from frog_bt.runtime.observer import Host
+
+if TYPE_CHECKING:
+    from frog_bt.engine.core import Outgoing
+
+
+@dataclass
+class TourSummary:
+    site: Site
+    visited: list[str] = field(default_factory=list)  # waypoints arrived at, in order
+    content: list[tuple[str, str, str]] = field(default_factory=list)  # (poi, waypoint, part)
+    approached: list[int] = field(default_factory=list)
+    recruited: list[int] = field(default_factory=list)
+    decisions: list[tuple[str, Decision]] = field(default_factory=list)  # (about, decision)
+    incidents: list[Incident] = field(default_factory=list)
+    tours: list[str] = field(default_factory=list)  # "ended" / "aborted: reason", in order
+    skipped: list[str] = field(default_factory=list)  # stops skipped in the latest tour
+    resumed: str | None = None
+    _goal: str | None = None
+    _last_decision: Any = None
+    _seen_incidents: int = 0
+
+    def waypoint_of(self, msg: dict[str, Any]) -> str:
+        return self.site.waypoint_of(POSE.convert(msg))
+
+    # taps: (t, channel, payload)
+    def ros_out(self, t: float, out: Outgoing) -> None:
+        if out.role == "goto" and out.goal is not None:
+            self._goal = out.goal.target  # the waypoint, as the tree named it
+        elif out.role == "approach" and isinstance(out.value, int):
+            self._goal = None
+            self.approached.append(out.value)
+
+    def ros_in(self, t: float, topic: str, value: Any) -> None:
+        if topic == self.site.topic("response") and value == SUCCEEDED and self._goal:
+            self.visited.append(self._goal)
+            self._goal = None
+
+    def frontend_out(self, t: float, type_: str, message: Any) -> None:
+        if isinstance(message, StartPoi):
+            self.content.append((message.poi, message.waypoint, message.part))
+        elif isinstance(message, Tour):
+            if message.state == "started":
+                self.skipped.clear()
+            else:
+                self.tours.append(message.state + (f": {message.reason}" if message.reason
+                                                   else ""))
+
+    def frontend_in(self, t: float, type_: str, message: Any) -> None:
+        if isinstance(message, UserPositive) and self.approached:
+            self.recruited.append(self.approached[-1])
+
+    def tick(self, core: Any) -> None:
+        board = core.board
+        decision = board.get(keys.ENGAGEMENT_DECISION)
+        if decision is not None and decision is not self._last_decision:
+            self._last_decision = decision
+            self.decisions.append(decision)
+        journal = core.journal
+        for incident in journal.incidents_since(self._seen_incidents):
+            self.incidents.append(incident)
+            if incident.kind in (IncidentKind.STOP_SKIPPED, IncidentKind.STOP_LEFT):
+                self.skipped.append(incident.subject)
+        self._seen_incidents = journal.incident_total
+        resumed = board.get(keys.RESUMED)
+        if resumed and self.resumed is None:
+            self.resumed = resumed
+
+    def attach(self, host: Host) -> None:
+        taps = host.taps
+        taps.tick.append(self.tick)
+        taps.ros_out.append(self.ros_out)
+        taps.ros_in.append(self.ros_in)
+        taps.frontend_out.append(self.frontend_out)
+        taps.frontend_in.append(self.frontend_in)
+
+    def close(self) -> None:
+        """Nothing to finish: the summary is read from its fields."""
+
+    # ------------------------------------------------------------ verdict
+
+    @property
+    def complete(self) -> bool:
+        """The latest tour ended docked with every stop visited."""
+        return bool(self.tours) and self.tours[-1] == "ended" and not self.skipped
+
+    def verdict(self) -> str:
+        if not self.tours:
+            return "no tour ended"
+        last = self.tours[-1]
+        if last != "ended":
+            return f"tour {last}"
+        if self.skipped:
+            return f"tour ended docked, but {_words(self.skipped)} skipped"
+        return "tour ended docked, every stop visited"
+
+    def lines(self, frontend: Any = None) -> list[str]:
+        """The summary, one line each; ``frontend`` (the link's stats) adds its restarts
+        and the commands it never acked."""
+        played = ", ".join(f"{poi} {part}" + (f" ({wp})" if wp != poi else "")
+                           for poi, wp, part in self.content) or "none"
+        out = [
+            f"route:     {' -> '.join(self.visited) or 'nowhere'}",
+            f"content:   {played}",
+            f"visitors:  {_visitors(self.approached, self.recruited)}",
+            *(f"{'engaged?' if i == 0 else '':<10} {about}: {d.describe()}"
+              for i, (about, d) in enumerate(self.decisions)),
+        ]
+        if self.resumed:
+            out.append(f"resumed:   {self.resumed}")
+        counts = Counter(i.kind for i in self.incidents if i.kind is not IncidentKind.RESUMED)
+        if frontend is not None and frontend.peer_restarts:
+            counts["front end restarted"] = frontend.peer_restarts
+        if frontend is not None and frontend.unacked:
+            counts["front-end commands never acked"] = frontend.unacked
+        if counts:
+            out.append("problems:  " + "; ".join(f"{kind} ({n})" if n > 1 else kind
+                                                 for kind, n in counts.items()))
+            out += [f"{'':<10} {i.text}" for i in self.incidents[-MAX_LISTED:]
+                    if i.kind != "resumed"]
+        out.append(f"outcome:   {self.verdict()}")
+        return out
+
+
+MAX_LISTED = 12  # incidents listed one per line (the counts cover all of them)
+
+
+def _words(items: list[Any]) -> str:
+    items = [str(i) for i in items]
+    if len(items) <= 1:
+        return "".join(items)
+    return ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def _visitors(approached: list[int], recruited: list[int]) -> str:
+    if not approached:
+        return "nobody approached"
+    times = Counter(approached)
+    people = [f"{pid}" + (f" ({n} times)" if n > 1 else "") for pid, n in times.items()]
+    text = f"approached {_words(people)}"
+    return text + (f"; recruited {_words(list(dict.fromkeys(recruited)))}" if recruited
+                   else "; nobody recruited")

@@ -1,0 +1,184 @@
+"""Live telemetry written by a process of its own.
+
+On the robot, ``frog-bt run --rerun SPEC`` keeps only the taps
+(:class:`~frog_bt.live.telemetry.rows.Rows`: appends on the tick path) in the
+executive. Every ``batch_ticks`` ticks the rows go, as one batch, into a bounded
+queue to a child process that owns the rerun recording stream
+(:class:`~frog_bt.live.telemetry.Telemetry` there) and does all the formatting and
+logging. So:
+
+* the tick never waits for rerun (the queue's feeder thread pickles the batch);
+* the rerun SDK's own memory, which grows with every row it has logged (see
+  docs/PERFORMANCE.md), is the child's, not the executive's; and the child is
+  replaced by a fresh one every :data:`RECYCLE_ROWS` rows, which gives that
+  memory back. A ``save:`` recording then goes on in ``FILE.2.rrd``,
+  ``FILE.3.rrd``, ... (the viewer opens them together: one recording id);
+  ``spawn``, ``connect`` and ``serve`` keep streaming to the same viewer;
+* a full queue (a child that cannot keep up, or died) drops the batch, counted
+  and logged at most once a minute: telemetry never stops the robot.
+
+The child is forked (it inherits the site and the tree, and never the parent's
+event loop); on platforms without ``fork`` the live executive writes in-process.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import multiprocessing
+import multiprocessing.queues
+import queue
+import uuid
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from frog_bt.live.telemetry.observer import TelemetryObserver
+from frog_bt.live.telemetry.rows import Batch
+from frog_bt.live.telemetry.spec import parse_spec
+from frog_bt.model.links import LinkStatus
+from frog_bt.warning_limit import WarningLimiter
+
+if TYPE_CHECKING:
+    from frog_bt.config import Site
+    from frog_bt.tree.loader import LoadedTree
+
+log = logging.getLogger(__name__)
+QUEUE_BATCHES = 64  # batches waiting for the child (50 ticks each: 5 minutes at 10 Hz)
+RECYCLE_ROWS = 250_000  # rows a child writes before a fresh one takes over (~20 min)
+CLOSE_TIMEOUT = 6.0  # seconds close() waits for the child to finish its file
+
+
+def available() -> bool:
+    return "fork" in multiprocessing.get_all_start_methods()
+
+
+Item = tuple[object, ...]  # ("batch", Batch) | ("links", tick, t, changes) | ("close",)
+
+
+def _serve(spec: str, site: Site, tree: LoadedTree, recording_id: str,
+           inbox: multiprocessing.queues.Queue[Item]) -> None:
+    """The child: write what comes until ``close`` (or the parent is gone)."""
+    from frog_bt.live.telemetry import Telemetry
+
+    telemetry = Telemetry.open(spec, site, tree, recording_id=recording_id)
+    try:
+        while True:
+            try:
+                item = inbox.get(timeout=5.0)
+            except queue.Empty:
+                parent = multiprocessing.parent_process()
+                if parent is None or not parent.is_alive():
+                    return  # the executive was killed: finish the file
+                continue
+            kind = item[0]
+            if kind == "batch":
+                batch = item[1]
+                assert isinstance(batch, Batch)
+                try:
+                    telemetry.writer.write(batch)
+                except Exception:
+                    log.exception("rerun telemetry: could not write %d rows", len(batch))
+            elif kind == "links":
+                telemetry.writer.write_links(*item[1:])  # type: ignore[arg-type]
+            elif kind == "close":
+                return
+    finally:
+        telemetry.close()
+
+
+def _numbered(spec: str, n: int) -> str:
+    """``save:tour.rrd`` for the first child, ``save:tour.2.rrd`` for the second, ..."""
+    sink = parse_spec(spec)
+    if sink.kind != "save" or n == 1:
+        return spec
+    path = Path(sink.target)
+    return f"save:{path.with_suffix(f'.{n}{path.suffix}')}"
+
+
+class TelemetryProcess(TelemetryObserver):
+    """The executive's side: rows buffered here, written by a child; see the module
+    docstring. Attached and closed like :class:`~frog_bt.live.telemetry.Telemetry`."""
+
+    def __init__(self, spec: str, site: Site, tree: LoadedTree, *, batch_ticks: int = 50,
+                 recycle_rows: int | None = None) -> None:
+        parse_spec(spec)  # ValueError for a spec it does not know, before anything starts
+        super().__init__(site, tree, batch_ticks=batch_ticks)
+        self.spec = spec
+        self.recording_id = str(uuid.uuid4())
+        self.recycle_rows = recycle_rows or RECYCLE_ROWS
+        self._context = multiprocessing.get_context("fork")
+        self.children = 0
+        self.dropped = 0  # batches not written (the queue was full)
+        self._written = 0  # rows sent to the current child
+        self._warnings = WarningLimiter(60.0, logger=log)
+        self._start_child()
+
+    def _start_child(self) -> None:
+        self.children += 1
+        self._inbox = self._context.Queue(maxsize=QUEUE_BATCHES)
+        self._child = self._context.Process(
+            target=_serve, name=f"frog-bt telemetry {self.children}", daemon=True,
+            args=(_numbered(self.spec, self.children), self.site, self.tree,
+                  self.recording_id, self._inbox))
+        self._child.start()
+        self._written = 0
+
+    def _stop_child(self, timeout: float) -> None:
+        inbox, child = self._inbox, self._child
+        with contextlib.suppress(queue.Full):
+            inbox.put(("close",), timeout=timeout)
+        inbox.close()
+        inbox.join_thread()
+        child.join(timeout)
+        if child.is_alive():
+            log.warning("rerun telemetry: the writer did not finish within %.0f s", timeout)
+            child.terminate()
+            child.join(1.0)
+
+    # ------------------------------------------------------------ the executive's side
+
+    def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]
+                     ) -> None:
+        self._send(("links", tick, t, changes))
+
+    def _flush_soon(self) -> None:
+        self.flush()
+
+    def flush(self) -> None:
+        """Send the buffered rows to the child (never waits: a full queue drops them)."""
+        self._flush_pending = False
+        if self._closed:
+            return
+        batch = self.rows.drain()
+        if len(batch):
+            if self._send(("batch", batch)):
+                self._written += len(batch)
+            if self._written >= self.recycle_rows:
+                self._stop_child(CLOSE_TIMEOUT)
+                self._start_child()
+                links, self._links = self._links, {}  # the new file's lanes start with them
+                if links and self._core is not None:
+                    self._send(("links", self._core.ticks, self._core.clock.now(),
+                                list(links.items())))
+                    self._links = links
+
+    def _send(self, item: Item) -> bool:
+        if self._closed:
+            return False
+        try:
+            self._inbox.put_nowait(item)
+            return True
+        except queue.Full:
+            self.dropped += 1
+            self._warnings.warn("full", f"rerun telemetry: the writer is behind; "
+                                        f"{self.dropped} batches dropped so far")
+            return False
+
+    def close(self) -> None:
+        """Send what is left, let the child finish its file (bounded). Idempotent."""
+        if self._closed:
+            return
+        self.flush()
+        self._closed = True
+        self.rows.detach()
+        self._stop_child(CLOSE_TIMEOUT)

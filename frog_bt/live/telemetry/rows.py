@@ -1,0 +1,205 @@
+"""The taps of telemetry: cheap appends of plain values on the tick path (no rerun here).
+
+:class:`Rows` is attached to a :class:`~frog_bt.engine.core.Core`'s taps. Each tap
+only appends a tuple stamped with the tick it belongs to and the project-clock
+time; the tick tap also records the tree's statuses when they changed, the new
+decision notes and the engagement meter/decision from the blackboard. The
+writer (:mod:`frog_bt.live.telemetry.writer`) takes the rows in batches
+(:meth:`Rows.drain`) and does all formatting and logging.
+
+A row's ``tick`` is the tick that consumes or produces it: inputs that arrive
+after tick N, and commands sent while tick N+1 runs, belong to tick N+1, whose
+statuses are recorded when it ends. So at tick N the viewer shows what the
+tree saw, what it sent and where it ended. Rows that arrive before the clock
+has a time (sim time before the first ``/clock``) take the time of the first
+tick.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import py_trees
+
+from frog_bt.live.telemetry.layout import TreeIndex
+from frog_bt.model import keys
+from frog_bt.model.outcomes import Level
+from frog_bt.model.wire import INPUTS
+
+if TYPE_CHECKING:
+    from frog_bt.config import Site
+    from frog_bt.engine.core import Core, Outgoing
+
+Status = py_trees.common.Status
+ENGAGEMENT_KEYS = (keys.ENGAGEMENT_METER, keys.ENGAGEMENT_DECISION)
+
+
+@dataclass(slots=True)
+class Batch:
+    """Rows taken by the writer, oldest first. Each row starts with ``(tick, t)``."""
+
+    poses: list[tuple[int, float, float, float, float]] = field(default_factory=list)  # x y yaw
+    inputs: list[tuple[int, float, str, Any]] = field(default_factory=list)  # role, value
+    outputs: list[tuple[int, float, str, str, Any]] = field(default_factory=list)
+    # ^ side ("ros" | "frontend"), channel (topic | message type), payload
+    events: list[tuple[int, float, str, Any]] = field(default_factory=list)  # type, message
+    statuses: list[tuple[int, float, tuple[Status, ...]]] = field(default_factory=list)
+    notes: list[tuple[int, float, str, Level]] = field(default_factory=list)
+    blackboard: list[tuple[int, float, str, Any]] = field(default_factory=list)  # key, value
+
+    def restamp(self, t: float) -> None:
+        """Give rows that arrived before the clock had a time (NaN) the time ``t``."""
+        for rows in (self.poses, self.inputs, self.outputs, self.events):
+            rows[:] = [(r[0], t, *r[2:]) if math.isnan(r[1]) else r for r in rows]
+
+    def drop_unstamped(self) -> None:
+        """Drop rows that still have no time (the clock never got one)."""
+        for rows in (self.poses, self.inputs, self.outputs, self.events):
+            rows[:] = [r for r in rows if not math.isnan(r[1])]
+
+    def __len__(self) -> int:
+        return (len(self.poses) + len(self.inputs) + len(self.outputs) + len(self.events)
+                + len(self.statuses) + len(self.notes) + len(self.blackboard))
+
+
+class Rows:
+    """Buffers rows from a core's taps until :meth:`drain`; calls ``on_full`` every
+    ``batch_ticks`` ticks so the owner can write them out."""
+
+    def __init__(self, site: Site, index: TreeIndex, *, batch_ticks: int = 50,
+                 on_full: Callable[[], None] | None = None) -> None:
+        self.index = index
+        self.roles = {site.topic(role): role for role in INPUTS}
+        self.batch = Batch()
+        self.batch_ticks = batch_ticks
+        self.on_full = on_full
+        self.core: Core | None = None
+        self._behaviours = list(index.behaviours)
+        self._position = {b: i for i, b in enumerate(self._behaviours)}  # by identity
+        self._statuses: tuple[Status, ...] = ()
+        self._current: list[Status] = []
+        self._scan_all = True  # read every node's status at the next tick
+        self._last_note: tuple[float, str] | None = None
+        self._blackboard: dict[str, Any] = {}
+        self._ticks_since_drain = 0
+        self._unstamped = False
+
+    def attach(self, core: Core) -> None:
+        self.core = core
+        taps = core.taps
+        taps.ros_in.append(self.ros_in)
+        taps.ros_out.append(self.ros_out)
+        taps.frontend_in.append(self.frontend_in)
+        taps.frontend_out.append(self.frontend_out)
+        taps.tick.append(self.tick)
+
+    def detach(self) -> None:
+        """Remove the taps from the core (after close nothing more is buffered)."""
+        core, self.core = self.core, None
+        if core is None:
+            return
+        taps = core.taps
+        for taps_list, tap in ((taps.ros_in, self.ros_in), (taps.ros_out, self.ros_out),
+                               (taps.frontend_in, self.frontend_in),
+                               (taps.frontend_out, self.frontend_out), (taps.tick, self.tick)):
+            if tap in taps_list:
+                taps_list.remove(tap)
+
+    def _stamp(self, t: float) -> tuple[int, float] | None:
+        """(tick, t) for a row arriving now; None when detached. Before the clock has a
+        time (sim time before the first ``/clock``) the time is NaN until the first tick."""
+        core = self.core
+        if core is None:
+            return None
+        if not core.clock.ready:
+            self._unstamped = True
+            return core.ticks + 1, math.nan
+        return core.ticks + 1, t
+
+    # ------------------------------------------------------------ taps (t, channel, payload)
+
+    def ros_in(self, t: float, topic: str, value: Any) -> None:
+        stamp = self._stamp(t)
+        if stamp is None:
+            return
+        role = self.roles.get(topic)
+        if role == "pose":
+            self.batch.poses.append((*stamp, value.x, value.y, value.yaw))
+        elif role is not None:
+            self.batch.inputs.append((*stamp, role, value))
+
+    def ros_out(self, t: float, out: Outgoing) -> None:
+        stamp = self._stamp(t)
+        if stamp is not None:
+            self.batch.outputs.append((*stamp, "ros", out.topic, out))
+
+    def frontend_out(self, t: float, type_: str, message: Any) -> None:
+        stamp = self._stamp(t)
+        if stamp is not None:
+            self.batch.outputs.append((*stamp, "frontend", type_, message))
+
+    def frontend_in(self, t: float, type_: str, message: Any) -> None:
+        stamp = self._stamp(t)
+        if stamp is not None:
+            self.batch.events.append((*stamp, type_, message))
+
+    def tick(self, core: Core) -> None:
+        """After each tick: what changed in the tree, the notes, the engagement keys."""
+        if not core.clock.ready:
+            self._scan_all = True  # this tick's changes are not followed
+            return
+        tick, t, batch = core.ticks, core.clock.now(), self.batch
+        if self._unstamped:
+            batch.restamp(t)
+            self._unstamped = False
+        touched = getattr(core, "touched", None)
+        if self._scan_all or touched is None:
+            statuses = tuple([b.status for b in self._behaviours])
+            self._current = list(statuses)
+            self._scan_all = touched is None
+            changed = statuses != self._statuses
+        else:
+            # Only the nodes the tick reached or stopped can have changed (Core.touched):
+            # the cost follows the active path, not the size of the tour.
+            current, position, changed = self._current, self._position, False
+            for node in touched:
+                i = position.get(node)
+                if i is not None and current[i] is not node.status:
+                    current[i] = node.status
+                    changed = True
+            statuses = tuple(current) if changed else self._statuses
+        if changed:
+            self._statuses = statuses
+            batch.statuses.append((tick, t, statuses))
+        notes = core.journal.notes
+        if notes and notes[-1] is not self._last_note:
+            i = len(notes) - 1
+            while i >= 0 and notes[i] is not self._last_note:
+                i -= 1
+            batch.notes.extend((tick, n.at, n.text, n.level) for n in notes[i + 1:])
+            self._last_note = notes[-1]
+        for key in ENGAGEMENT_KEYS:
+            value = core.board.get(key)
+            if value is not self._blackboard.get(key.name):
+                self._blackboard[key.name] = value
+                batch.blackboard.append((tick, t, key.name, value))
+        self._ticks_since_drain += 1
+        if self._ticks_since_drain >= self.batch_ticks and self.on_full is not None:
+            self.on_full()
+
+    # ------------------------------------------------------------ the writer's side
+
+    def drain(self) -> Batch:
+        """The rows buffered so far; the buffer starts afresh."""
+        batch, self.batch = self.batch, Batch()
+        self._ticks_since_drain = 0
+        if self._unstamped:  # drained before the first tick with a time
+            core = self.core
+            if core is not None and core.clock.ready:
+                batch.restamp(core.clock.now())
+            batch.drop_unstamped()
+            self._unstamped = False
+        return batch

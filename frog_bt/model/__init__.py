@@ -1,0 +1,1 @@
+"""Pure types: keys, readings, enums, goals, the wires' and the recording's Structs."""

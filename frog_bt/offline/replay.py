@@ -1,0 +1,378 @@
+"""Re-run the tree offline on a recording's inputs, on the recording's clock.
+
+:class:`Replay` reads an MCAP recording (:mod:`frog_bt.live.recording`) in log-time
+order and feeds a fresh :class:`~frog_bt.engine.core.Core` on a
+:class:`~frog_bt.clock.ManualClock` that takes the recorded times: ROS inputs
+go through :data:`~frog_bt.model.ros.ROS_TYPES` (by the channel's schema name) to
+``Core.on_ros``; ``/frontend/in`` datagrams go through a fresh
+:class:`~frog_bt.frontend.protocol.Endpoint`, so duplicates are suppressed exactly
+as live, to ``Core.on_event``; ``/clock`` moves the clock (under sim time what
+arrived before the first ``/clock`` is fed with the clock not yet ready, as live).
+
+Ticks: a recording made by :class:`~frog_bt.live.recording.Recorder` has the live
+ticks (``/frog_bt/tick``), and replay ticks exactly there, in the same place
+among the inputs. Live ticks coalesce bursts of inputs and land wherever the
+event loop gets to them, so no rule can recompute them; with the recorded ones,
+replaying the same tree is exact. A recording without ticks is replayed by the
+live rules instead (periodic ticks at ``executive.tick_hz`` on the clock, and a
+tick after each input that calls for one and after each front-end event), which
+is close but not guaranteed identical.
+
+The commands the replayed tree sends are compared, in order, with the recorded
+ones: ROS outputs (``header.stamp`` left out) and new front-end commands
+(``/frontend/out`` without acks and resends; ``seq`` left out). The first
+difference is a :class:`Divergence`. With a changed tree or configuration this
+answers "what would the robot have done": until the first divergence the
+recorded inputs are exactly what the new tree would have seen.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections import deque
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from frog_bt.clock import ManualClock
+from frog_bt.config import Site, parse_hostport
+from frog_bt.engine.core import Core, Taps
+from frog_bt.engine.operator import Command as OperatorCommand
+from frog_bt.errors import DecodeError
+from frog_bt.frontend.protocol import Endpoint
+from frog_bt.model import channels, keys
+from frog_bt.model.channels import BLAME, FRONTEND_IN, FRONTEND_OUT, OPERATOR, PRIMER, TICK, from_ns
+from frog_bt.model.frontend import EVENTS, FrontendMessage, message_fields
+from frog_bt.model.ros import ROS_TYPES
+from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
+from frog_bt.recordings.commands import (
+    Command,
+    ReplayError,
+    chain,
+    plain,
+    without_stamp,
+)
+from frog_bt.recordings.mcapfile import RecordingError
+from frog_bt.tree.loader import LoadedTree
+
+if TYPE_CHECKING:
+    from frog_bt.model.links import Links
+    from frog_bt.runtime.executive import WireTaps
+
+
+BAD_KEPT = 20  # reasons of bad messages kept in a result (all are counted)
+
+
+@dataclass(frozen=True, slots=True)
+class Divergence:
+    """The first command that differs: its number (from 1), the recorded one, the replayed one."""
+
+    number: int
+    expected: Command | None
+    got: Command | None
+
+    @property
+    def t(self) -> float:
+        """When the runs parted: the earlier of the two commands."""
+        return min(c.t for c in (self.expected, self.got) if c is not None)
+
+
+@dataclass(slots=True)
+class ReplayResult:
+    start: float  # first and last recorded times
+    end: float
+    covered: float  # last recorded time replayed
+    inputs: int = 0  # ROS messages and front-end datagrams fed in
+    ticks: int = 0
+    ros_commands: int = 0  # recorded commands, compared
+    frontend_commands: int = 0
+    exact: bool = True  # ticks taken from the recording
+    divergence: Divergence | None = None
+    wall: float = 0.0  # seconds the replay took
+    recovered: list[str] = field(default_factory=list)  # files cut short, what was read
+    bad: list[str] = field(default_factory=list)  # our own messages that did not decode: why
+    bad_count: int = 0  # all of them (``bad`` keeps the first few)
+    operator_commands: int = 0  # recorded operator commands, applied again
+
+    @property
+    def identical(self) -> bool:
+        return self.divergence is None
+
+
+class Replay:
+    """One replay of ``path`` with ``site`` and ``tree``; see the module docstring.
+
+    Raises :class:`ReplayError` when the file is no frog-bt recording. A replay is an
+    :class:`~frog_bt.runtime.observer.Host` without raw traffic or links: attach observers
+    (telemetry) to it before :meth:`run`.
+    """
+
+    wire: WireTaps | None = None  # no raw traffic in a replay
+    links: Links | None = None  # and no links
+
+    def __init__(self, path: Path, site: Site, tree: LoadedTree) -> None:
+        self.path = Path(path)
+        self.site = site
+        self._peer = parse_hostport(site.links.frontend, "links.frontend")[0]
+        try:
+            self.files = chain(self.path)
+        except RecordingError as exc:
+            raise ReplayError(str(exc)) from None
+        self.types = {topic: type_ for f in self.files for topic, type_ in f.types.items()}
+        self.recovered = [f"{f.path.name}: {f.recovered}" for f in self.files if f.recovered]
+        self.outputs = {site.topic(role) for role in OUTPUTS}
+        missing = sorted({FRONTEND_IN, FRONTEND_OUT, *self.outputs} - set(self.types))
+        if missing:
+            raise ReplayError(f"{self.path}: not a frog-bt recording for this configuration: "
+                              f"no channel {', '.join(missing)}")
+        self.start = from_ns(self.files[0].start)
+        self.end = from_ns(self.files[-1].end)
+        self.sim_time = CLOCK.name in self.types
+        self.exact = TICK in self.types
+        self.period = 1.0 / site.executive.tick_hz
+        self.clock = ManualClock(None)
+        self.core = Core(site, tree, self.clock, self._publish, self._send)
+        self.inputs = {site.topic(role): topic.type for role, topic in INPUTS.items()}
+        self.endpoint = Endpoint(self._peer, EVENTS)  # the same dedup as the live link
+        self._expected: deque[Command] = deque()
+        self._got: deque[Command] = deque()
+        self._last_expected: Command | None = None
+        # observers: ("recorded" | "replayed", command) and the divergence (the viewer)
+        self.on_command: list[Callable[[str, Command], None]] = []
+        self.on_divergence: list[Callable[[Divergence], None]] = []
+        self._seqs: set[int] = set()
+        self._compared = 0
+        self._next_tick = 0.0
+        self.result = ReplayResult(self.start, self.end, self.start, exact=self.exact,
+                                   recovered=self.recovered)
+
+    @property
+    def taps(self) -> Taps:
+        return self.core.taps
+
+    # ------------------------------------------------------------ outputs of the replayed tree
+
+    def _publish(self, topic: str, msg: dict[str, Any]) -> None:
+        self._got.append(Command(self.clock.now(), topic, without_stamp(plain(msg)),
+                                 self.core.blamed, self.core.blamed_reads))
+        self._compare()
+
+    def _send(self, message: FrontendMessage) -> None:
+        payload = plain({"type": message.type, **message_fields(message)})
+        self._got.append(Command(self.clock.now(), FRONTEND_OUT, payload, self.core.blamed,
+                                 self.core.blamed_reads))
+        self._compare()
+
+    def _compare(self) -> None:
+        while self._expected and self._got and self.result.divergence is None:
+            expected, got = self._expected.popleft(), self._got.popleft()
+            self._compared += 1
+            for observe in self.on_command:
+                observe("recorded", expected)
+                observe("replayed", got)
+            if (expected.channel, expected.payload) != (got.channel, got.payload):
+                self.result.divergence = Divergence(self._compared, expected, got)
+                for seen in self.on_divergence:
+                    seen(self.result.divergence)
+
+    # ------------------------------------------------------------ the run
+
+    def run(self, progress: Callable[[float], None] | None = None) -> ReplayResult:
+        """Replay to the end, or to the first divergence; the result says which."""
+        wall0 = time.monotonic()
+        result = self.result
+        parted = False
+        for topic, ns, data in self._messages():
+            if parted and topic != BLAME:
+                break  # the blame of the diverging command, recorded after it, is read
+            t = from_ns(ns)
+            self._on_message(topic, t, data)
+            if parted:
+                break
+            result.covered = t
+            if progress is not None:
+                progress(t)
+            parted = result.divergence is not None
+        else:
+            if not self.recovered:  # cut short: the live run neither halted nor sent more
+                self.core.halt()  # as the executive does when it stops (face stream off, ...)
+                if result.divergence is None and (self._expected or self._got):
+                    expected = self._expected.popleft() if self._expected else None
+                    got = self._got.popleft() if self._got else None
+                    result.divergence = Divergence(self._compared + 1, expected, got)
+        result.ticks = self.core.ticks
+        result.wall = time.monotonic() - wall0
+        return result
+
+    def _messages(self) -> Iterator[tuple[str, int, bytes]]:
+        for recording in self.files:  # a lead-in first, when the file continues one
+            yield from recording.messages()
+
+    def _on_message(self, topic: str, t: float, data: bytes) -> None:
+        if topic == CLOCK.name and self.sim_time:
+            try:
+                t = CLOCK.codec.decode(data)
+            except DecodeError:
+                return  # live, a malformed /clock does not move the clock either
+            self._advance(t)
+            return
+        if self.clock.ready or not self.sim_time:
+            self._advance(t)
+        if topic in self.inputs:
+            self._on_ros(topic, data)
+        elif topic == FRONTEND_IN:
+            self._on_datagram(data)
+        elif topic == TICK:
+            if self._own(topic, t, data) is not None and self.exact:
+                self._tick()
+        elif topic == FRONTEND_OUT:
+            self._expect_datagram(t, data)
+        elif topic == BLAME:
+            self._blame(self._own(topic, t, data))
+        elif topic == PRIMER:
+            self._prime(self._own(topic, t, data))
+        elif topic == OPERATOR:
+            self._operator(t, self._own(topic, t, data))
+        elif topic in self.outputs:
+            self.result.ros_commands += 1
+            self._last_expected = Command(t, topic, without_stamp(json.loads(data)))
+            self._expected.append(self._last_expected)
+            self._compare()
+
+    def _on_ros(self, topic: str, data: bytes) -> None:
+        codec = ROS_TYPES.get(self.types.get(topic, "")) or ROS_TYPES[self.inputs[topic]]
+        try:
+            value = codec.decode(data)
+        except DecodeError:
+            return  # live, the client drops a malformed message before the core
+        self.result.inputs += 1
+        if self.core.on_ros(topic, value) and not self.exact and self.clock.ready:
+            self._tick()
+
+    def _on_datagram(self, data: bytes) -> None:
+        self.result.inputs += 1
+        received = self.endpoint.receive(data, self._peer, self.clock.now())
+        if received.message is not None:
+            self.core.on_event(received.message)
+            if not self.exact and self.clock.ready:
+                self._tick()
+
+    def _expect_datagram(self, t: float, data: bytes) -> None:
+        try:
+            obj = json.loads(data)
+        except ValueError:
+            return
+        if not isinstance(obj, dict) or obj.get("type") == "ack":
+            return
+        seq = obj.pop("seq", None)
+        if seq in self._seqs:
+            return  # a resend
+        self._seqs.add(seq)
+        self.result.frontend_commands += 1
+        self._last_expected = Command(t, FRONTEND_OUT, obj)
+        self._expected.append(self._last_expected)
+        self._compare()
+
+    def _own(self, topic: str, t: float, data: bytes) -> Any:
+        """A message of one of our channels, decoded by its Struct; None for a bad one,
+        counted and reported with its reason (never dropped silently)."""
+        try:
+            return channels.decode(topic, data)
+        except DecodeError as exc:
+            self._bad(topic, t, str(exc))
+            return None
+
+    def _bad(self, topic: str, t: float, reason: str) -> None:
+        result = self.result
+        result.bad_count += 1
+        if len(result.bad) < BAD_KEPT:
+            result.bad.append(f"{topic} at +{t - self.start:.1f} s: {reason}")
+
+    def _prime(self, primer: channels.Primer | None) -> None:
+        """A recorded ``/frog_bt/primer``: what the live executive carried into this file
+        from before it (:mod:`frog_bt.live.rotation`)."""
+        if primer is None:
+            return
+        for entry in primer.inputs:
+            inp = self.core.table.get(entry.topic)
+            codec = ROS_TYPES.get(self.types.get(entry.topic, "")) if inp is not None else None
+            if inp is None or codec is None:
+                continue
+            try:
+                value = codec.decode(bytes(entry.msg))
+            except DecodeError:
+                continue  # live, the client drops a malformed message before the core
+            self.core.inputs.add(inp, value, entry.t)
+        if primer.frontend_ready:
+            self.core.board.set(keys.FRONTEND_READY, True)
+        for raw in primer.frontend_in:  # seen live: their resends are duplicates
+            self.endpoint.receive(raw.encode(), self._peer, self.clock.now())
+        self._seqs.update(primer.frontend_out_seqs)
+
+    def _blame(self, blame: channels.Blame | None) -> None:
+        """A recorded ``/frog_bt/blame``: the node that sent the command just recorded."""
+        last = self._last_expected
+        if last is None or blame is None:
+            return
+        if blame.channel == last.channel or (last.channel == FRONTEND_OUT
+                                             and last.payload.get("type") == blame.channel):
+            last.node = blame.node
+            last.reads = dict(blame.reads)
+
+    def _operator(self, t: float, recorded: channels.Operator | None) -> None:
+        """A recorded operator command: applied again here, between the same two ticks; a
+        different answer is a divergence like a different command."""
+        if recorded is None:
+            return
+        try:
+            command = OperatorCommand(recorded.command)
+        except ValueError:
+            self._bad(OPERATOR, t, f"unknown command {recorded.command!r}")
+            return
+        self.result.operator_commands += 1
+        answer = self.core.command(command)
+        self._last_expected = Command(t, OPERATOR, {"command": recorded.command,
+                                                   "ok": recorded.ok, "did": recorded.text})
+        self._expected.append(self._last_expected)
+        self._got.append(Command(self.clock.now(), OPERATOR, {
+            "command": command.value, "ok": answer.ok, "did": answer.text}))
+        self._compare()
+
+    # ------------------------------------------------------------ time and ticks
+
+    def _advance(self, t: float) -> None:
+        """Move the clock to ``t``; without recorded ticks, tick as the live loop would."""
+        clock = self.clock
+        if not clock.ready:
+            clock.set(t)
+            self.core.setup()
+            if not self.exact:  # the link came up before the clock: the loop ticks at once
+                self._next_tick = clock.now() + self.period
+                self._tick()
+            return
+        if self.exact or t < self._next_tick:
+            clock.set(t)
+            return
+        if self.sim_time:  # the clock jumps: one periodic tick at the new time
+            clock.set(t)
+            self._periodic(t)
+            self._tick()
+            return
+        while self._next_tick <= t:  # wall-clock recording: ticks at their deadlines
+            clock.set(self._next_tick)
+            self._periodic(self._next_tick)
+            self._tick()
+        clock.set(t)
+
+    def _periodic(self, now: float) -> None:
+        """The live periodic task's next deadline after waking at ``now``."""
+        while self._next_tick <= now:
+            self._next_tick = max(self._next_tick + self.period, now)
+            if self._next_tick <= now:
+                self._next_tick = now + self.period
+
+    def _tick(self) -> None:
+        if self.result.divergence is None:
+            self.core.tick()

@@ -1,0 +1,440 @@
+"""What one recording tells, read from its channels without re-running the tree.
+
+:func:`read_file` runs in a worker (a process, or a dask worker): it takes a path and the
+site, reads the channels it needs in time order and returns a :class:`FileFacts`, plain
+picklable data: the tour pieces found in the file (:class:`Piece`), the times an
+executive started in it, or the reason the file could not be read. An executive
+starts a file of its own (``--record DIR``: an idle file without a primer, the files it
+rotates into having one, or a tour's ``lead_in``; a file without frog-bt's metadata is
+one whole run).
+:mod:`frog_bt.offline.report.rows` joins the pieces into tours.
+
+A piece begins at ``tour started``, or at the file's first message: a file may open
+inside a tour (``--record DIR`` rotates at the start of a tour, so the tour file opens
+just after its ``tour started``; a restarted executive carries on a tour from its
+checkpoint in a new file, without a new ``tour started``). Such an opening piece keeps
+everything up to the file's first ``tour started`` and is kept only when it holds
+something of a tour (content, an invitation, an approach, a goal, a tour's end): the
+opening of an idle file is no tour. A piece ends at ``tour ended`` (the robot is
+docked by then), or after ``tour aborted`` once the robot has driven back and docked
+(that drive is the tour's too), or at the end of the file.
+
+Channels read: ``/frontend/out`` (tour, start_poi, finish_poi, ask_tour),
+``/frontend/in`` (user_positive/negative, content_done), ``/GotoWayPoint``,
+``/ApproachPeopleFar``, ``/FROG_response``, ``/docking/dock``, ``/docking/state``,
+``/ICL_command``, ``/ICL_FaceDataStream``, ``/FROG_pose``, ``/diagnostic``,
+``/frog_bt/operator``, ``/frog_bt/alert`` and ``/frog_bt/primer`` (a rotated file: the
+front-end seqs sent just before it, so that a resend across the rotation is not taken
+for a new command). Topic names are the site's.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from frog_bt.config import Site
+from frog_bt.maths.engagement import decide
+from frog_bt.model.ros import POSE
+from frog_bt.model.wire import SUCCEEDED
+from frog_bt.recordings.mcapfile import RecordingError, open_recording
+
+ERROR_LEVEL = 2  # diagnostic_msgs/DiagnosticStatus ERROR
+JUMP = 10.0  # metres: a pose step this long is a relocalisation, not a drive
+OWN = frozenset({"/frontend/in", "/frontend/out", "/frog_bt/operator", "/frog_bt/alert",
+                 "/frog_bt/primer"})
+ROS_ROLES = ("pose", "goto", "approach", "response", "dock", "docking_state", "icl", "faces",
+             "diagnostic")
+
+
+@dataclass
+class StopFacts:
+    """One visit of a content stop: from its part a to its ``finish_poi``."""
+
+    poi: str  # the logical POI (POI1)
+    waypoint: str = ""  # the time-of-day variant played (POI1a / POI1b)
+    parts: str = ""  # "a", "ab"
+    start: float | None = None  # part a started
+    end: float | None = None  # finish_poi
+    samples: int = 0  # face samples stored (near and facing) from the stop to part a's end
+    edge_engaged: int = 0
+    edge_total: int = 0
+    face_stream: bool = False
+    a_end: float | None = None  # the front end said part a was done
+    before_restart: float = 0.0  # seconds of this visit before a restart cut it (joined)
+
+    @property
+    def seconds(self) -> float | None:
+        """Time at the stop: part a to ``finish_poi`` (and the time before a restart)."""
+        if self.start is None or self.end is None:
+            return None
+        return self.end - self.start + self.before_restart
+
+    @property
+    def decision(self) -> str:
+        """What the engagement gate did: ``b`` (part b played), ``a only`` (part a played
+        to its end, no part b) or ``none`` (part a was cut before the gate)."""
+        if "b" in self.parts:
+            return "b"
+        return "a only" if self.a_end is not None else "none"
+
+
+@dataclass
+class Piece:
+    """One tour, or the part of one that a file holds."""
+
+    file: str
+    started: float | None = None  # `tour started` (None: the piece opens with the file)
+    started_seq: int = 0  # its front-end seq: a resend of it in the next file is no new tour
+    t0: float = 0.0  # first event of the piece
+    t1: float = 0.0  # last event of the piece
+    ended: str = ""  # "ended" | "aborted" | "" (the file ended first)
+    reason: str = ""
+    end_seq: int = 0  # the front-end seq of its `tour ended`/`aborted`
+    distance: float = 0.0
+    stops: list[StopFacts] = field(default_factory=list)
+    goals: int = 0  # /GotoWayPoint sent
+    failed_goals: list[str] = field(default_factory=list)  # waypoints of goals answered 3/4
+    nav_retries: int = 0  # goals sent again to the waypoint whose goal had just failed
+    dock_retries: int = 0  # dock/undock sent again after /docking/state failed
+    approaches: int = 0
+    approaches_ok: int = 0
+    approached: list[int] = field(default_factory=list)  # person ids, in order
+    visitors: list[int] = field(default_factory=list)  # the approached who said yes
+    invitations: int = 0
+    accepted: int = 0
+    declined: int = 0
+    faults: list[str] = field(default_factory=list)
+    operator: list[str] = field(default_factory=list)  # "skip (ok)", "home (refused)"
+    operator_skips: list[str] = field(default_factory=list)  # stops the operator skipped
+    alerts: list[str] = field(default_factory=list)  # kinds raised
+
+    def of_a_tour(self) -> bool:
+        """Something only a tour does happened in it."""
+        return bool(self.stops or self.invitations or self.approaches or self.goals
+                    or self.ended)
+
+
+@dataclass
+class FileFacts:
+    file: str
+    pieces: list[Piece] = field(default_factory=list)
+    restarts: list[float] = field(default_factory=list)  # an executive started here
+    error: str = ""  # unreadable: why (the file is reported and skipped)
+    recovered: str = ""  # a file cut short: what was read of it
+    start: float = 0.0  # first message, seconds
+
+
+def stop_of(site: Site) -> dict[str, str]:
+    """Waypoint (a POI or one of its time-of-day variants) -> logical POI of the tour."""
+    out = {}
+    for stop in site.tour.stops:
+        out[stop.poi] = stop.poi
+        for variant in site.variants.get(stop.poi, ()):
+            out[variant.waypoint] = stop.poi
+    return out
+
+
+class _Reader:
+    """A state machine over one file's messages, in time order."""
+
+    def __init__(self, path: str, site: Site) -> None:
+        self.site = site
+        self.path = path
+        self.out: list[Piece] = []
+        self.piece: Piece | None = None
+        self.back: Piece | None = None  # an aborted tour's piece until the robot docks
+        self.opening = True  # the piece open is the file's opening one (no `tour started`)
+        self.primed = False  # the file opens with a /frog_bt/primer (an idle rotation)
+        self.pose: tuple[float, float] | None = None
+        self.goal: str | None = None  # waypoint of the goal awaiting its response
+        self.failed: str | None = None  # waypoint whose goal failed last
+        self.approach = False
+        self.dock: str | None = None  # the latest dock/undock command
+        self.dock_failed: str | None = None
+        self.asked = False
+        self.stream_on = False
+        self.samples: list[tuple[float, float]] = []  # (t, level) while the stream is on
+        self.seen: set[int] = set()  # front-end seqs sent (a resend has the same one)
+        self.face_stops = {s.poi for s in site.tour.stops if s.face_stream}
+        self.stop_of = stop_of(site)
+        self.near = site.engagement.near
+        self.edge = site.engagement.edge
+        self.topics = {site.topic(role): role for role in ROS_ROLES}
+
+    def first(self, t: float) -> None:
+        """The file's first message: a piece opens, in case the file opens inside a tour."""
+        self.piece = Piece(self.path, None, 0, t, t)
+        self.out.append(self.piece)
+        self.opening = True
+
+    def finish(self) -> list[Piece]:
+        """The pieces, but an opening one that held nothing of a tour (an idle file's)."""
+        return [p for p in self.out if p.started is not None or p.of_a_tour()]
+
+    def _current(self, t: float) -> Piece | None:
+        """The piece open now (None between a tour's end and the next start), its last
+        event moved to ``t``."""
+        if self.piece is not None:
+            self.piece.t1 = t
+        return self.piece
+
+    def _stop(self, poi: str) -> StopFacts | None:
+        if self.piece is None:
+            return None
+        for stop in reversed(self.piece.stops):
+            if stop.poi == poi:
+                return stop
+        return None
+
+    def frontend_out(self, t: float, msg: dict[str, Any]) -> None:
+        kind = msg.get("type")
+        seq = msg.get("seq")
+        if kind == "ack" or not isinstance(seq, int):
+            return
+        if seq in self.seen:
+            return  # a resend (datagram loss): not a new command
+        self.seen.add(seq)
+        if kind == "tour":
+            state = msg.get("state")
+            if state == "started":
+                self._started(t, seq)
+            elif state in ("ended", "aborted"):
+                piece = self._current(t)
+                if piece is not None:  # (None: said again after the tour's end)
+                    piece.ended, piece.reason = str(state), str(msg.get("reason") or "")
+                    piece.end_seq = seq
+                    if state == "aborted":
+                        self.back = piece  # the robot returns to its dock: still this tour's
+                if piece is not None and self.opening:
+                    # A tour file has no primer: this may be the tour before's end, resent
+                    # (rows.join tells by its seq); what follows goes into a new opening
+                    # piece, in case it is the open tour's.
+                    self.piece = Piece(self.path, None, 0, t, t)
+                    self.out.append(self.piece)
+                else:
+                    self.piece, self.opening = None, False
+            return
+        piece = self._current(t)
+        if piece is None:
+            return
+        if kind == "start_poi":
+            poi, part = str(msg.get("poi")), str(msg.get("part"))
+            stop = self._stop(poi)
+            if part == "a" or stop is None:
+                stop = StopFacts(poi, str(msg.get("waypoint") or poi), face_stream=(
+                    poi in self.face_stops))
+                piece.stops.append(stop)
+                stop.start = t
+            if part not in stop.parts:
+                stop.parts += part
+            if part == "b":
+                self._engagement(stop, t)
+        elif kind == "finish_poi":
+            stop = self._stop(str(msg.get("poi")))
+            if stop is not None:
+                stop.end = t
+                if "b" not in stop.parts:
+                    self._engagement(stop, t)
+        elif kind == "ask_tour":
+            self.asked = True
+            piece.invitations += 1
+
+    def _started(self, t: float, seq: int) -> None:
+        piece = self.piece
+        if piece is not None and not self.opening:
+            return  # said again (a resend taken anew): the same tour
+        if piece is not None and not piece.of_a_tour():
+            self.out.remove(piece)  # an idle file's opening: no tour
+        self.back = None
+        self.piece = Piece(self.path, t, seq, t, t)
+        self.out.append(self.piece)
+        self.opening = False
+
+    def _engagement(self, stop: StopFacts, t: float) -> None:
+        """The face samples stored since the stop's start, and the edge vote over them
+        (:func:`frog_bt.maths.engagement.decide`, the executive's own rule)."""
+        if not stop.face_stream or stop.start is None:
+            return
+        end = stop.a_end if stop.a_end is not None else t
+        levels = [level for ts, level in self.samples if ts <= end]  # since the stream began
+        stop.samples = len(levels)
+        if levels:
+            d = decide(np.asarray(levels), self.edge)
+            stop.edge_engaged, stop.edge_total = d.engaged_votes, d.votes
+
+    def frontend_in(self, t: float, msg: dict[str, Any]) -> None:
+        kind = msg.get("type")
+        if kind == "content_done" and msg.get("part") == "a":
+            stop = self._stop(str(msg.get("poi")))
+            if stop is not None and stop.a_end is None:
+                stop.a_end = t  # the decision counts the samples up to here
+        if kind in ("user_positive", "user_negative") and self.piece is not None \
+                and self.asked:
+            self.asked = False
+            piece = self.piece
+            if kind == "user_positive":
+                piece.accepted += 1
+                if piece.approached:
+                    piece.visitors.append(piece.approached[-1])
+            else:
+                piece.declined += 1
+
+    def ros(self, t: float, role: str, msg: dict[str, Any]) -> None:
+        # the drive back after an abort is the aborted tour's
+        piece = self.back if self.back is not None else self.piece
+        if role == "pose":
+            p = msg.get("pose", {}).get("position", {})
+            x, y = p.get("x"), p.get("y")
+            if isinstance(x, int | float) and isinstance(y, int | float):
+                if self.pose is not None and piece is not None:
+                    step = math.hypot(x - self.pose[0], y - self.pose[1])
+                    if step < JUMP:
+                        piece.distance += step
+                self.pose = (x, y)
+        elif role == "goto":
+            goal, self.approach = _waypoint(self.site, msg), False
+            if piece is not None:
+                piece.goals += 1
+                piece.nav_retries += goal == self.failed
+                piece.t1 = t
+            self.goal, self.failed = goal, None
+        elif role == "approach":
+            self.approach, self.goal = True, None
+            piece = self.piece
+            if piece is not None:
+                piece.approaches += 1
+                person = msg.get("data")
+                if isinstance(person, int):
+                    piece.approached.append(person)
+                piece.t1 = t
+        elif role == "response":
+            code = msg.get("data")
+            if code not in (2, 3, 4):
+                return
+            if self.approach:
+                self.approach = False
+                if code == SUCCEEDED and piece is not None:
+                    piece.approaches_ok += 1
+            elif self.goal is not None:
+                if code != SUCCEEDED:
+                    self.failed = self.goal
+                    if piece is not None:
+                        piece.failed_goals.append(self.goal)
+                self.goal = None
+        elif role == "dock":
+            command = msg.get("data")
+            if piece is not None and command == self.dock_failed:
+                piece.dock_retries += 1
+            self.dock, self.dock_failed = str(command), None
+        elif role == "docking_state":
+            state = msg.get("data")
+            if state in ("docking", "undocking"):  # what is under way (a file may open here)
+                self.dock = "dock" if state == "docking" else "undock"
+            elif state == "failed" and self.dock is not None:
+                self.dock_failed = self.dock
+            elif state == "docked" and self.back is not None:
+                self.back.t1, self.back = t, None  # home after the abort: the tour is over
+        elif role == "icl":
+            on = msg.get("data") == "start"
+            if on and not self.stream_on:
+                self.samples = []
+            self.stream_on = on
+        elif role == "faces" and self.stream_on:
+            for face in msg.get("faces") or ():
+                try:
+                    if float(face["distance"]) <= self.near and face["facing"] is True:
+                        self.samples.append((t, float(face["engagement"])))
+                except (KeyError, TypeError, ValueError):
+                    continue
+        elif role == "diagnostic" and piece is not None:
+            for status in msg.get("status") or ():
+                if isinstance(status, dict) and status.get("level") == ERROR_LEVEL:
+                    name = f"{status.get('name')}: {status.get('message')}"
+                    if name not in piece.faults:
+                        piece.faults.append(name)
+
+    def own(self, t: float, topic: str, msg: dict[str, Any]) -> None:
+        if topic == "/frog_bt/primer":  # a rotated file: the seqs sent just before it
+            self.primed = True
+            seqs = msg.get("frontend_out_seqs") or []
+            self.seen.update(s for s in seqs if isinstance(s, int))
+            return
+        piece = self.piece
+        if piece is None:
+            return
+        if topic == "/frog_bt/operator":
+            command, ok = str(msg.get("command")), bool(msg.get("ok"))
+            piece.operator.append(f"{command} ({'ok' if ok else 'refused'})")
+            if command == "skip" and ok:
+                at = self._skipping()
+                if at is not None:
+                    piece.operator_skips.append(at)
+        elif topic == "/frog_bt/alert" and msg.get("state") == "raised":
+            piece.alerts.append(str(msg.get("kind")))
+
+    def _skipping(self) -> str | None:
+        """The stop an operator's skip leaves: the one playing, or the one driven to."""
+        assert self.piece is not None
+        stops = self.piece.stops
+        if stops and stops[-1].end is None:
+            return stops[-1].poi
+        return self.stop_of.get(self.goal) if self.goal is not None else None
+
+
+def _waypoint(site: Site, msg: dict[str, Any]) -> str:
+    """The POI a goal names (position and orientation, as TourSummary matches it)."""
+    try:
+        pose = POSE.convert(msg)
+    except Exception:
+        return "?"
+    return site.waypoint_of(pose)
+
+
+def read_file(path: str, site: Site) -> FileFacts:
+    """The tour pieces in one recording; any failure is an unreadable file, never a crash."""
+    try:
+        recording = open_recording(Path(path))
+        if "/frontend/out" not in recording.types:
+            return FileFacts(path, error="not a frog-bt tour recording (no /frontend/out)")
+        reader = _Reader(path, site)
+        ros = reader.topics
+        start = None
+        for topic, ns, data in recording.messages():
+            t = ns / 1e9
+            if start is None:
+                start = t
+                reader.first(t)
+            role = ros.get(topic)
+            if role is None and topic not in OWN:
+                continue
+            try:
+                msg = json.loads(data)
+            except ValueError:
+                continue
+            if not isinstance(msg, dict):
+                continue
+            if role is not None:
+                reader.ros(t, role, msg)
+            elif topic == "/frontend/out":
+                reader.frontend_out(t, msg)
+            elif topic == "/frontend/in":
+                reader.frontend_in(t, msg)
+            else:
+                reader.own(t, topic, msg)
+        # An executive's first file: neither a tour file nor an idle file it rotated into
+        # (those open with a primer); a file without our metadata is one whole run.
+        kind = recording.metadata.get("frog_bt", {}).get("kind")
+        restarts = [start] if start is not None and kind != "tour" and not reader.primed \
+            else []
+        return FileFacts(path, reader.finish(), restarts, recovered=recording.recovered,
+                         start=start or 0.0)
+    except RecordingError as exc:
+        return FileFacts(path, error=str(exc).replace(f"{path}: ", ""))
+    except Exception as exc:  # a damaged file must not stop the corpus
+        return FileFacts(path, error=f"{type(exc).__name__}: {exc}".splitlines()[0][:200])

@@ -1,0 +1,104 @@
+"""A rehearsal: the real executive against the built-in simulator, in one event loop.
+
+``frog-bt demo`` runs one; end-to-end tests and benchmarks run many. The
+simulator binds free loopback ports, the executive runs on sim time with the
+simulator's ``/clock``, and ``prepare`` (if given) attaches recorders,
+telemetry or taps to the executive before it connects::
+
+    async with Rehearsal(scenario_from("default", {"speed": 200}), site=site) as r:
+        await r.sim.wait_for(lambda rec: rec.channel == "/GotoWayPoint", 10)
+        outcome = await r.finish()
+"""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+from collections.abc import Callable
+from typing import Any
+
+from frog_bt.behaviours import load_tree
+from frog_bt.clock import SimClock
+from frog_bt.config import Site
+from frog_bt.runtime.executive import Executive, Outcome
+from frog_bt.sim import Simulator
+from frog_bt.sim.scenario import Scenario
+from frog_bt.tree.loader import LoadedTree
+
+HOST = "127.0.0.1"
+
+
+def free_udp_port(host: str = HOST) -> int:
+    """A UDP port free right now (the executive's listen port must be known to the simulator)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind((host, 0))
+        return int(s.getsockname()[1])
+
+
+class Rehearsal:
+    """The executive (``once`` by default) against a simulator of ``scenario``.
+
+    Pass ``sim`` and ``listen`` to run a second executive against a simulator
+    that is already running (a restart); it is then not stopped on exit.
+    """
+
+    def __init__(self, scenario: Scenario | None, *, site: Site,
+                 tree: LoadedTree | None = None, sim: Simulator | None = None,
+                 listen: tuple[str, int] | None = None, sim_secret: str | None = None,
+                 prepare: Callable[[Executive], Any] | None = None,
+                 **executive_kwargs: Any) -> None:
+        if sim is None:
+            if scenario is None:
+                raise ValueError("a scenario, or a running simulator and its listen address")
+            listen = (HOST, free_udp_port())
+            sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=listen,
+                            secret=sim_secret)
+            self.own_sim = True
+        else:
+            if listen is None:
+                raise ValueError("a running simulator needs the listen address it sends to")
+            self.own_sim = False
+        self.sim = sim
+        self.listen = listen
+        self.site = site
+        self.tree = tree or load_tree(site=site)
+        self.prepare = prepare
+        self.executive_kwargs = {"once": True, **executive_kwargs}
+        self.task: asyncio.Task[Outcome] | None = None
+
+    async def __aenter__(self) -> Rehearsal:
+        if self.own_sim:
+            await self.sim.start()
+        self.executive = Executive(self.site, self.tree, SimClock(),
+                                   rosbridge_url=self.sim.via
+                                   or f"ws://{HOST}:{self.sim.rosbridge_port}",
+                                   frontend=(HOST, self.sim.frontend_port), listen=self.listen,
+                                   sim_time=True, **self.executive_kwargs)
+        if self.prepare is not None:
+            self.prepare(self.executive)
+        self.sim.follow(self._executive_time, self.executive.clock.sleep_until)
+        self.task = asyncio.create_task(self.executive.run())
+        return self
+
+    def _executive_time(self) -> float | None:
+        """The executive's clock while it runs and is connected (the simulator follows it)."""
+        exe = self.executive
+        if self.task is None or self.task.done() or not exe.client.link.connected:
+            return None
+        return exe.clock.now() if exe.clock.ready else None
+
+    async def finish(self, timeout: float = 60.0) -> Outcome:
+        """The executive's outcome (with ``once``: after one tour); TimeoutError after
+        ``timeout`` wall seconds."""
+        assert self.task is not None
+        return await asyncio.wait_for(asyncio.shield(self.task), timeout)
+
+    async def __aexit__(self, *exc: object) -> None:
+        try:
+            if self.task is not None:
+                self.executive.stop("rehearsal over")
+                await asyncio.wait_for(self.task, 10)
+        finally:
+            self.sim.follow(None)
+            if self.own_sim:
+                await self.sim.stop()
