@@ -42,6 +42,7 @@ async def record(path: Path, minutes: float, speed: float) -> dict[str, Any]:
     from frog_bt.config import load_site
     from frog_bt.live.recording import Recorder
     from frog_bt.runtime.executive import Executive
+    from frog_bt.runtime.observer import attach_all
     from frog_bt.sim import Simulator
 
     site = load_site()
@@ -54,7 +55,7 @@ async def record(path: Path, minutes: float, speed: float) -> dict[str, Any]:
                           rosbridge_url=f"ws://{LOOPBACK}:{sim.rosbridge_port}",
                           frontend=(LOOPBACK, sim.frontend_port), listen=listen, sim_time=True)
     recorder = Recorder(path)
-    recorder.attach(executive)
+    attach_all(executive, [recorder])
     end = sim.clock.now() + minutes * 60.0
     wall0 = time.monotonic()
 

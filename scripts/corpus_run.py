@@ -84,6 +84,7 @@ def record(tour: Seeded, directory: str) -> dict[str, Any]:
     from frog_bt.config import load_site
     from frog_bt.live.recording import Recorder
     from frog_bt.rehearsal import Rehearsal
+    from frog_bt.runtime.observer import attach_all
     from frog_bt.sim import scenario_from
 
     path = Path(directory) / tour.file
@@ -93,7 +94,7 @@ def record(tour: Seeded, directory: str) -> dict[str, Any]:
     async def run() -> tuple[int, str]:
         recorder = Recorder(path)
         try:
-            async with Rehearsal(scenario, site=load_site(), prepare=recorder.attach) as r:
+            async with Rehearsal(scenario, site=load_site(), prepare=lambda exe: attach_all(exe, [recorder])) as r:
                 outcome = await r.finish(120.0)
         finally:
             recorder.close()

@@ -11,7 +11,7 @@ import py_trees
 from frog_bt.behaviours import load_tree
 from frog_bt.clock import ManualClock
 from frog_bt.config import Site, load_site
-from frog_bt.engine.core import Core, Taps
+from frog_bt.engine.core import Core
 from frog_bt.model.frontend import FrontendMessage
 from frog_bt.model.ros import (
     PersonDetection,
@@ -21,6 +21,7 @@ from frog_bt.model.ros import (
     TrackedPeople,
     TrackedPerson,
 )
+from frog_bt.runtime.observer import Observers
 from frog_bt.tree.loader import LoadedTree
 
 MORNING = 1780302600.0  # 2026-06-01 10:30 Europe/Madrid
@@ -34,9 +35,8 @@ def write_tree(tmp_path: Path, text: str, name: str = "t.yaml") -> Path:
 
 
 class Bench:
-    """A core ticked by hand; an observers.Host without wire traffic or links."""
+    """A core ticked by hand; an observer Host without wire traffic or links."""
 
-    wire = None
     links = None
     sim_time = False
 
@@ -48,13 +48,10 @@ class Bench:
         self.clock = ManualClock(start)
         self.published: list[tuple[str, dict[str, Any]]] = []
         self.sent: list[FrontendMessage] = []
+        self.observers = Observers()
         self.core = Core(self.site, tree, self.clock,
                          lambda topic, msg: self.published.append((topic, msg)),
-                         lambda message: self.sent.append(message))
-
-    @property
-    def taps(self) -> Taps:
-        return self.core.taps
+                         lambda message: self.sent.append(message), emit=self.observers.emit)
 
     # inputs
     def ros(self, role: str, value: Any) -> None:

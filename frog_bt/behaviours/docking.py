@@ -6,18 +6,19 @@ from typing import Literal
 
 from pydantic import Field
 
+from frog_bt.behaviours.goal_leaf import Failure, GoalLeaf
 from frog_bt.behaviours.registry import register
 from frog_bt.model import keys
-from frog_bt.model.outcomes import IncidentKind
-from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
+from frog_bt.model.outcomes import DockingState, IncidentKind
+from frog_bt.tree.leaf import RUNNING, SUCCESS, Params, Status
 
-TARGET = {"dock": "docked", "undock": "undocked"}
-BUSY = {"dock": "docking", "undock": "undocking"}
+TARGET = {"dock": DockingState.DOCKED, "undock": DockingState.UNDOCKED}
+BUSY = {"dock": DockingState.DOCKING, "undock": DockingState.UNDOCKING}
 FAILED_GRACE = 2.0  # seconds after the command from which a "failed" is surely about it
 
 
 @register
-class Docking(Leaf):
+class Docking(GoalLeaf):
     """Dock or undock and wait for the robot to report it done.
 
     Reads ``/docking`` and ``/now``. Sends ``/docking/dock`` ``action`` in
@@ -36,34 +37,41 @@ class Docking(Leaf):
 
     reads = (keys.DOCKING, keys.NOW)
 
-    def initialise(self) -> None:
-        action = self.params.action
-        state = self.get(keys.DOCKING)
-        self.sent_at = self.ctx.clock.now()
-        self.already = state is not None and state.value == TARGET[action]
-        self.took = False
-        if not self.already:
-            self.ctx.actions.dock(action)
-            self.ctx.note(f"{action}")
+    def default_timeout(self) -> float:
         timeouts = self.ctx.site.timeouts
-        self.timeout = self.params.timeout or getattr(timeouts, action)
+        return float(getattr(timeouts, self.params.action))
 
-    def update(self) -> Status:
+    def begin(self) -> None:
+        state = self.get(keys.DOCKING)
+        self.already = state is not None and state.value == TARGET[self.params.action]
+        self.took = False
+
+    def send(self) -> None:
+        if not self.already:
+            self.ctx.actions.dock(self.params.action)
+            self.ctx.note(f"{self.params.action}")
+
+    def poll(self) -> Status | Failure:
         if self.already:
             return SUCCESS
+        assert self.sent_at is not None
         state = self.get(keys.DOCKING)
         if state is not None and state.at >= self.sent_at:
             if state.value == TARGET[self.params.action]:
                 return SUCCESS
             if state.value == BUSY[self.params.action]:
                 self.took = True
-            if state.value == "failed" and (
+            if state.value == DockingState.FAILED and (
                     self.took or state.at - self.sent_at >= FAILED_GRACE):
-                self.ctx.note(f"{self.params.action} failed", incident=IncidentKind.DOCKING_FAILED)
-                return FAILURE
-        if self.need(keys.NOW) - self.sent_at >= self.timeout:
-            self.ctx.note(f"{self.params.action}: no {TARGET[self.params.action]} "
-                          f"within {self.timeout:g} s", incident=IncidentKind.DOCKING_FAILED)
-            return FAILURE
-        self.feedback_message = f"{state.value if state else 'no state'}"
+                return Failure.REFUSED
         return RUNNING
+
+    def failed(self, why: Failure) -> None:
+        action = self.params.action
+        self.ctx.note(f"{action}: no {TARGET[action]} within {self.timeout:g} s"
+                      if why is Failure.TIMED_OUT else f"{action} failed",
+                      incident=IncidentKind.DOCKING_FAILED)
+
+    def progress(self) -> str:
+        state = self.get(keys.DOCKING)
+        return f"{state.value if state else 'no state'}"

@@ -4,20 +4,12 @@ from __future__ import annotations
 
 from pydantic import Field, ValidationInfo, field_validator
 
+from frog_bt.behaviours.goal_leaf import Failure, GoalLeaf
 from frog_bt.behaviours.registry import register
 from frog_bt.model import keys
 from frog_bt.model.goals import Goal
 from frog_bt.model.outcomes import IncidentKind
-from frog_bt.model.wire import SUCCEEDED
-from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status
-
-
-def goal_state(sent: Goal, latest: Goal | None) -> Goal | None:
-    """``sent`` as the board's ``/goal`` says it is now; None once a newer goal replaced
-    it. Within the tick that sent it the board may still hold an older goal."""
-    if latest is None or latest.id < sent.id:
-        return sent
-    return latest if latest.id == sent.id else None
+from frog_bt.tree.leaf import FAILURE, SUCCESS, Leaf, Params, Status
 
 
 class PoiParams(Params):
@@ -34,7 +26,7 @@ class PoiParams(Params):
 
 
 @register
-class Navigate(Leaf):
+class Navigate(GoalLeaf):
     """Drive to ``poi``, choosing its time-of-day variant from the project clock.
 
     Sends ``/GotoWayPoint`` in initialise (a new goal replaces the active one), or once
@@ -52,53 +44,48 @@ class Navigate(Leaf):
     reads = (keys.NOW, keys.GOAL)
     optional_reads = (keys.PAUSED,)
     writes = (keys.TARGET, keys.WAYPOINT, keys.SKIPPED)
+    waits_while_paused = True
 
-    def initialise(self) -> None:
-        self.goal: Goal | None = None
-        self.timeout = self.params.timeout or self.ctx.site.timeouts.navigation
+    def default_timeout(self) -> float:
+        return self.ctx.site.timeouts.navigation
+
+    def begin(self) -> None:
         self.set(keys.TARGET, self.params.poi)
         self.set(keys.SKIPPED, None)
-        if not self.get(keys.PAUSED):
-            self._send()
 
-    def _send(self) -> None:
+    def paused_feedback(self) -> str:
+        return f"paused: {self.params.poi} waits"
+
+    def send(self) -> Goal:
         site, clock = self.ctx.site, self.ctx.clock
         poi = self.params.poi
         waypoint = site.waypoint_for(poi, clock.local_time().time())
-        self.goal = self.ctx.actions.goto(waypoint, site.pois[waypoint])
+        goal = self.ctx.actions.goto(waypoint, site.pois[waypoint])
         self.set(keys.WAYPOINT, waypoint)
         self.ctx.note(f"go to {waypoint}" + (f" ({poi} at {clock.local_time():%H:%M})"
                                              if waypoint != poi else ""))
+        return goal
 
-    def update(self) -> Status:
-        if self.goal is None:
-            if self.get(keys.PAUSED):
-                self.feedback_message = f"paused: {self.params.poi} waits"
-                return RUNNING
-            self._send()
+    def succeeded(self) -> None:
+        assert self.goal is not None
+        self.ctx.note(f"arrived at {self.goal.target}")
+
+    def failed(self, why: Failure) -> None:
         assert self.goal is not None
         target = self.goal.target
-        goal = goal_state(self.goal, self.get(keys.GOAL))
-        if goal is None:
+        if why is Failure.REPLACED:
             self.ctx.note(f"navigation to {target} replaced by another goal")
-            return FAILURE
-        if goal.code == SUCCEEDED:
-            self.ctx.note(f"arrived at {target}")
-            return SUCCESS
-        if goal.done:
-            self.ctx.note(f"navigation to {target} {goal.state()}",
-                          incident=IncidentKind.NAVIGATION_FAILED)
-            return FAILURE
-        if self.need(keys.NOW) - goal.sent_at >= self.timeout:
+        elif why is Failure.TIMED_OUT:
             self.ctx.note(f"navigation to {target}: no arrival within {self.timeout:g} s",
                           incident=IncidentKind.NAVIGATION_FAILED)
-            return FAILURE
-        self.feedback_message = f"{target}: {goal.state()}"
-        return RUNNING
+        else:
+            assert self.latest is not None
+            self.ctx.note(f"navigation to {target} {self.latest.state()}",
+                          incident=IncidentKind.NAVIGATION_FAILED)
 
-    def terminate(self, new_status: Status) -> None:
-        if new_status in (INVALID, FAILURE):
-            self.ctx.actions.cancel(getattr(self, "goal", None))
+    def progress(self) -> str:
+        assert self.goal is not None and self.latest is not None
+        return f"{self.goal.target}: {self.latest.state()}"
 
 
 @register

@@ -13,6 +13,7 @@ import py_trees
 
 from frog_bt.behaviours.navigation import PoiParams
 from frog_bt.behaviours.registry import register, register_decorator
+from frog_bt.engine.observed import Role
 from frog_bt.model import keys
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.tree.decorators import FrogDecorator
@@ -31,7 +32,7 @@ class OperatorSkip(FrogDecorator):
 
     Params = PoiParams
     optional_reads = (keys.SKIP,)
-    handles_skip = True  # the core asks the running ones what a skip would leave
+    role = Role.STOP  # the core asks the running ones what a skip would leave
     _requested = False
 
     def initialise(self) -> None:

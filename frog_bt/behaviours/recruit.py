@@ -6,8 +6,9 @@ import math
 
 from pydantic import Field
 
-from frog_bt.behaviours.navigation import goal_state
+from frog_bt.behaviours.goal_leaf import Failure, GoalLeaf
 from frog_bt.behaviours.registry import register
+from frog_bt.engine.observed import Role
 from frog_bt.model import keys
 from frog_bt.model.frontend import AskTour as AskTourCommand
 from frog_bt.model.frontend import StartIntroduction as StartIntroductionCommand
@@ -15,8 +16,7 @@ from frog_bt.model.frontend import UserNegative, UserPositive
 from frog_bt.model.goals import Goal
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.model.ros import PersonDetection, Pose
-from frog_bt.model.wire import SUCCEEDED
-from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status
+from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
 
 Timeout = Field(None, gt=0, allow_inf_nan=False,
                 description="seconds before it fails (default: the site's timeouts entry)")
@@ -51,6 +51,7 @@ class SeekVisitor(Leaf):
     Writes ``/visitor`` (the person id). RUNNING until someone qualifies, then SUCCESS.
     """
 
+    role = Role.SEEK  # the executive's alert when the search runs too long
     reads = (keys.PERSONS, keys.POSE, keys.NOW)
     optional_reads = (keys.DECLINED, keys.APPROACH_FAILED)
     writes = (keys.VISITOR,)
@@ -83,7 +84,7 @@ class SeekVisitor(Leaf):
 
 
 @register
-class ApproachVisitor(Leaf):
+class ApproachVisitor(GoalLeaf):
     """Approach ``/visitor`` with ``/ApproachPeopleFar``, never faster than the site allows.
 
     Reads ``/visitor``, ``/now``, ``/goal`` (its result), ``/approach_failed``; writes
@@ -102,41 +103,29 @@ class ApproachVisitor(Leaf):
     optional_reads = (keys.APPROACH_FAILED,)
     writes = (keys.APPROACH_FAILED,)
 
-    def initialise(self) -> None:
+    def default_timeout(self) -> float:
+        return self.ctx.site.timeouts.approach
+
+    def begin(self) -> None:
         visitor = self.get(keys.VISITOR)
         assert visitor is not None  # a required read of a leaf's key: never None
         self.visitor = visitor
-        self.goal: Goal | None = None
-        self.timeout = self.params.timeout or self.ctx.site.timeouts.approach
-        self._send_when_due()
 
-    def _send_when_due(self) -> None:
-        actions, now = self.ctx.actions, self.ctx.clock.now()
-        due = actions.last_approach_at + self.ctx.site.recruit.approach_interval
-        if now < due:
-            self.feedback_message = f"next approach in {due - now:.1f} s"
-            return
-        self.goal = actions.approach(self.visitor)
+    def hold(self) -> str | None:
+        due = self.ctx.actions.last_approach_at + self.ctx.site.recruit.approach_interval
+        now = self.ctx.clock.now()
+        return f"next approach in {due - now:.1f} s" if now < due else None
+
+    def send(self) -> Goal:
+        goal = self.ctx.actions.approach(self.visitor)
         self.ctx.note(f"approach visitor {self.visitor}")
+        return goal
 
-    def update(self) -> Status:
-        if self.goal is None:
-            self._send_when_due()
-            if self.goal is None:
-                return RUNNING
-        goal = goal_state(self.goal, self.get(keys.GOAL))
-        if goal is None:
-            return self._failed("replaced")
-        if goal.code == SUCCEEDED:
-            self.ctx.note(f"approached visitor {self.visitor}")
-            return SUCCESS
-        if goal.done:
-            return self._failed(goal.state())
-        if self.need(keys.NOW) - goal.sent_at >= self.timeout:
-            return self._failed("timed out")
-        return RUNNING
+    def succeeded(self) -> None:
+        self.ctx.note(f"approached visitor {self.visitor}")
 
-    def _failed(self, how: str) -> Status:
+    def failed(self, why: Failure) -> None:
+        how = self.latest.state() if why is Failure.REFUSED and self.latest else why.value
         failed = dict(self.get(keys.APPROACH_FAILED) or {})
         now = self.need(keys.NOW)
         retry_after = self.ctx.site.recruit.retry_after
@@ -145,11 +134,6 @@ class ApproachVisitor(Leaf):
         self.set(keys.APPROACH_FAILED, failed)
         self.ctx.note(f"approach of visitor {self.visitor} {how}: seek again "
                       f"(not them for {retry_after:g} s)", incident=IncidentKind.APPROACH_FAILED)
-        return FAILURE
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status in (INVALID, FAILURE):
-            self.ctx.actions.cancel(getattr(self, "goal", None))
 
 
 @register

@@ -15,6 +15,7 @@ from frog_bt.model.key import Reading
 from frog_bt.model.outcomes import (
     AbortCause,
     AbortReason,
+    DockingState,
     Incident,
     IncidentKind,
     TourState,
@@ -115,7 +116,7 @@ class GiveUp(Leaf):
             cause = Incident(self.ctx.clock.now(), IncidentKind.GAVE_UP,
                              "the tour cannot go on")
         reason = cause.text
-        self.ctx.send(Tour(TourState.ABORTED.value, reason))
+        self.ctx.send(Tour(TourState.ABORTED, reason))
         self.set(keys.TOUR_STATE, TourState.ABORTED)
         self.set(keys.TOUR_REASON, reason)
         self.set(keys.PROGRESS, EMPTY)
@@ -151,7 +152,7 @@ class ConfirmResume(Leaf):
         if resume is None:
             return SUCCESS
         state = self.get(keys.DOCKING)
-        if state is not None and state.value not in ("docked", "docking"):
+        if state is not None and state.value not in (DockingState.DOCKED, DockingState.DOCKING):
             announce = resume.announce([stop.poi for stop in self.ctx.site.tour.stops])
             self.set(keys.RESUMED, announce)
             self.set(keys.TOUR_STATE, TourState.STARTED)  # no new `tour started` is sent

@@ -71,7 +71,7 @@ class TourStatus(Leaf):
         state = TourState(p.state)
         abort = self.get(keys.ABORT_REASON) if state is TourState.ABORTED else None
         reason = p.reason or (abort.text if abort is not None else "")
-        self.ctx.send(Tour(state.value, reason))
+        self.ctx.send(Tour(state, reason))
         self.ctx.note(f"tour {state}" + (f": {reason}" if reason else ""))
         if state is not TourState.STARTED:
             self.set(keys.PROGRESS, EMPTY)

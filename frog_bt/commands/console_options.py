@@ -101,14 +101,10 @@ class People:
 async def start_people(executive: Executive, settings: ConsoleSettings | None,
                        observers: Sequence[object]) -> People:
     from frog_bt.live.console.webhooks import Webhooks
+    from frog_bt.runtime import logctx
 
-    book = executive.staff.book
     webhooks = Webhooks(executive.site.alerts)
-    book.listeners.append(webhooks.notify)
-    webhooks.start()
-    for observer in observers:  # the recording: every alert change, on /frog_bt/alert
-        on_alert = getattr(observer, "on_alert", None)
-        if on_alert is not None:
-            book.listeners.append(on_alert)
+    executive.observers.attach(executive, [webhooks])  # every alert change
+    logctx.run_as(executive, webhooks.start)  # its lines are the executive's (console log)
     console = await start_console(executive, settings) if settings is not None else None
     return People(console, webhooks)

@@ -37,6 +37,7 @@ from frog_bt.behaviours import load_tree
 from frog_bt.commands.options import add_tree_and_config
 from frog_bt.config import load_site
 from frog_bt.errors import DefinitionError, error_lines
+from frog_bt.runtime.observer import attach_all
 
 REDRAW = 0.1  # wall seconds between progress-bar redraws
 BAR = 30
@@ -210,7 +211,7 @@ def run_one(args: argparse.Namespace) -> int:
         except (ValueError, OSError) as exc:
             print(f"frog-bt replay: {exc}", file=sys.stderr)
             return 2
-        telemetry.attach(replay)
+        attach_all(replay, [telemetry])
         from frog_bt.commands.rerun_compare import compare_lanes
 
         compare_lanes(telemetry.rec, replay, site)
@@ -235,7 +236,7 @@ def run_one(args: argparse.Namespace) -> int:
     for recovered in result.recovered:
         print(f"note: {recovered}; replayed up to the cut")
     if result.bad_count:
-        print(f"note: {result.bad_count} bad message(s) of frog-bt's own channels, skipped:")
+        print(f"note: {result.bad_count} bad message(s) in the recording, skipped:")
         for reason in result.bad:
             print(f"  {reason}")
     div = result.divergence

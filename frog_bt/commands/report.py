@@ -96,6 +96,9 @@ def run(args: argparse.Namespace) -> int:
     for f in facts:
         if f.recovered and not f.error:
             print(f"frog-bt report: {f.file}: {f.recovered}", file=sys.stderr)
+        if f.bad and not f.error:
+            print(f"frog-bt report: {f.file}: {f.bad} message(s) did not decode, read past "
+                  f"({'; '.join(f.bad_first)})", file=sys.stderr)
     rows = tour_rows([f for f in facts if not f.error], site)
     face_stops = [s.poi for s in site.tour.stops if s.face_stream]
     t = totals(rows, face_stops, unreadable=len(skipped))

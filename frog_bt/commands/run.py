@@ -232,13 +232,13 @@ async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Setti
         loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)
     summary = TourSummary(site) if args.once else None
     if summary is not None:
-        summary.attach(executive)
+        attach_all(executive, [summary])
     status = None
     if not args.quiet:  # on a terminal a countdown; in a journal, states only
         status = StatusLine(source=lambda: executive.status_text(countdown=status.tty))
     refresher = None
     if status is not None:
-        status.attach(executive)
+        attach_all(executive, [status])
         # The tree does not tick while rosbridge is unreachable (or before /clock):
         # the line must still say what the executive is waiting for.
         refresher = asyncio.create_task(_refresh(status))

@@ -27,20 +27,28 @@ T = TypeVar("T")
 
 class Board:
     """Typed keys to values; a key never written (or cleared) reads as None, and
-    :meth:`written` tells it from one written as None (no data)."""
+    :meth:`written` tells it from one written as None (no data).
 
-    def __init__(self) -> None:
+    A :attr:`~frog_bt.model.key.Key.lasting` key is kept in ``lasting``, a store the
+    executive owns (:class:`~frog_bt.engine.standing.Standing`): the next core's board,
+    after a reload, reads the same values."""
+
+    def __init__(self, lasting: dict[Key[Any], Any] | None = None) -> None:
         self._values: dict[Key[Any], Any] = {}
+        self._lasting: dict[Key[Any], Any] = lasting if lasting is not None else {}
+
+    def _store(self, key: Key[Any]) -> dict[Key[Any], Any]:
+        return self._lasting if key.lasting else self._values
 
     def get(self, key: Key[T]) -> T | None:
-        return self._values.get(key)
+        return self._store(key).get(key)  # type: ignore[no-any-return]
 
     def set(self, key: Key[T], value: T | None) -> None:
-        self._values[key] = value
+        self._store(key)[key] = value
 
     def written(self, key: Key[Any]) -> bool:
         """Has ``key`` a value of this scope (None included)?"""
-        return key in self._values
+        return key in self._store(key)
 
     def clear_scope(self, scope: Scope) -> list[Key[Any]]:
         """Forget every value that ends when ``scope`` starts; the keys that had one."""
@@ -51,7 +59,7 @@ class Board:
 
     def items(self) -> Iterator[tuple[Key[Any], Any]]:
         """Every key written so far, with its value (observers: telemetry, blame)."""
-        return iter(list(self._values.items()))
+        return iter([*self._lasting.items(), *self._values.items()])
 
 
 class Inputs:
@@ -91,8 +99,10 @@ class Snapshot:
         self.inputs = inputs
         self.clock = clock
         self.actions = actions
-        self.events = EventLog()
-        board.set(keys.FRONTEND_READY, False)
+        events = board.get(keys.EVENTS)  # the executive's, kept across trees
+        self.events = events if events is not None else EventLog()
+        if not board.written(keys.FRONTEND_READY):
+            board.set(keys.FRONTEND_READY, False)
         self.write()
 
     def write(self) -> None:

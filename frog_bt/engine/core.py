@@ -4,17 +4,18 @@
 and the py_trees tree. The online executive feeds it from rosbridge and UDP;
 replay feeds it from a recording; tests feed it by hand. Outputs leave through
 the two callbacks given to it (``publish(topic, msg)`` and ``send(message)``),
-so the same tick code runs everywhere.
+so the same tick code runs everywhere. What crosses it is told to ``emit`` as one
+:data:`~frog_bt.model.events.Event` at a time (the host's observers hear it).
 """
 
 from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import py_trees
 
 from frog_bt.clock import Clock
@@ -23,82 +24,65 @@ from frog_bt.engine import observed
 from frog_bt.engine.actions import Actions
 from frog_bt.engine.blackboard import Board, Inputs, Snapshot
 from frog_bt.engine.context import Context
-from frog_bt.engine.journal import Journal
 from frog_bt.engine.loaded import LoadedTree
-from frog_bt.engine.observed import Trace
+from frog_bt.engine.observed import Role, Trace
 from frog_bt.engine.operator import Answer, Command, Operator
+from frog_bt.engine.standing import Standing
 from frog_bt.model import keys
-from frog_bt.model.frontend import FrontendMessage
+from frog_bt.model.events import (
+    Blamed,
+    Event,
+    FrontendIn,
+    FrontendOut,
+    OperatorDone,
+    RobotCommand,
+    RobotInput,
+    Ticked,
+)
+from frog_bt.model.frontend import FrontendMessage, Tour
 from frog_bt.model.goals import Goal
 from frog_bt.model.key import Reading
-from frog_bt.model.outcomes import AbortReason
+from frog_bt.model.outcomes import AbortReason, TourState
 from frog_bt.model.wire import INPUTS, OUTPUTS
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
 
-Tap = Callable[[float, str, Any], None]  # (project-clock time, channel, payload)
 Behaviour = py_trees.behaviour.Behaviour
-__all__ = ["Core", "Outgoing", "Taps"]
-
-
-@dataclass(frozen=True, slots=True)
-class Outgoing:
-    """One command to the robot: its output role and topic, the typed value, the
-    ``msg`` dict sent, and the goal it carries (goto, approach; None for the others)."""
-
-    role: str
-    topic: str
-    value: object
-    msg: dict[str, Any]
-    goal: Goal | None = None
-
-
-@dataclass(slots=True)
-class Taps:
-    """Observers of what crosses the core (recording, telemetry, summaries, status line).
-
-    ``ros_in`` gets typed values, ``ros_out`` each :class:`Outgoing` command,
-    ``frontend_in`` and ``frontend_out`` typed front-end messages (channel = message
-    type), ``tick`` the core after each tick. Taps must be quick: they run on the tick
-    path.
-    """
-
-    ros_in: list[Tap] = field(default_factory=list)
-    ros_out: list[Callable[[float, Outgoing], None]] = field(default_factory=list)
-    frontend_in: list[Tap] = field(default_factory=list)
-    frontend_out: list[Tap] = field(default_factory=list)
-    tick: list[Callable[[Core], None]] = field(default_factory=list)
-    blame: list[Tap] = field(default_factory=list)  # (t, channel, node, reads) after each command
-    operator: list[Callable[[float, int, Command, Answer], None]] = field(
-        default_factory=list)  # (t, tick it precedes, command, answer) for each command
+Emit = Callable[[Event], None]
+__all__ = ["Core", "Emit"]
 
 
 class Core:
     def __init__(self, site: Site, tree: LoadedTree, clock: Clock,
                  publish: Callable[[str, dict[str, Any]], None],
-                 send: Callable[[FrontendMessage], None]) -> None:
+                 send: Callable[[FrontendMessage], None], emit: Emit | None = None,
+                 standing: Standing | None = None) -> None:
         self.site = site
         self.tree = tree
         self.clock = clock
         self._publish_topic = publish
         self._send = send
-        self.taps = Taps()
+        self.emit = emit  # the host's observers (None: nobody listens)
+        # The executive's state, kept across trees (a reload hands the next core the same)
+        standing = self.standing = standing if standing is not None else Standing(clock)
         self.blamed = "-"  # the node that sent the latest command (see who())
         self.blamed_reads: dict[str, str] = {}  # what that node read, as short text
         self._labels: dict[int, str] = {}
         self.table = {site.topic(role): inp for role, inp in INPUTS.items()}
-        self.inputs = Inputs(self.table)
+        if standing.inputs is None:
+            standing.inputs = Inputs(self.table)
+        self.inputs = standing.inputs  # what the robot last said still holds after a reload
         self.actions = Actions(self._publish, clock)
-        self.board = Board()  # this core's own: nothing global, two cores in one process
+        self.board = Board(standing.values)  # this core's own; the lasting keys the executive's
         self.trace = Trace()
-        self.journal = Journal(clock)
+        self.journal = standing.journal
         self.ctx = Context(clock, site, self.actions, self._send_message, self.journal)
         self.snapshot = Snapshot(self.board, self.inputs, clock, self.actions)
         self.root = tree.root
-        self._skippable = [n for n in tree.root.iterate() if getattr(n, "handles_skip", False)]
-        self.operator = Operator(self.board, self.journal, self._stops_now,
-                                 site.operator.pause_max)
+        self.stops = [n for n in tree.root.iterate() if getattr(n, "role", None) is Role.STOP]
+        self.seekers = [n for n in tree.root.iterate() if getattr(n, "role", None) is Role.SEEK]
+        self.operator = Operator(self.board, standing, self._stops_now, site.operator.pause_max)
         self.pause_ran_out: AbortReason | None = None  # set by the tick it happened before
         self.ticks = 0
         self._setup = False
@@ -138,29 +122,27 @@ class Core:
                     reads[key.name] = _short(self.board.get(key))
         self.blamed_reads = reads
 
-    def _blame(self, channel: str) -> None:
-        if self.taps.blame:
-            now = self.clock.now()
-            for tap in self.taps.blame:
-                tap(now, channel, self.blamed, self.blamed_reads)
-
     def _publish(self, role: str, value: object, goal: Goal | None) -> None:
         topic = self.site.topic(role)
         self._note_sender()
         msg = OUTPUTS[role].codec.encode(value)
         self._publish_topic(topic, msg)
-        if self.taps.ros_out:
-            out = Outgoing(role, topic, value, msg, goal)
-            for tap in self.taps.ros_out:
-                tap(self.clock.now(), out)
-        self._blame(topic)
+        emit = self.emit
+        if emit is not None:
+            now = self.clock.now()
+            emit(RobotCommand(now, role, topic, value, msg, goal))
+            emit(Blamed(now, topic, self.blamed, self.blamed_reads))
 
     def _send_message(self, message: FrontendMessage) -> None:
         self._note_sender()
+        if isinstance(message, Tour) and message.state == TourState.STARTED:
+            self.journal.tally.tour_started()
         self._send(message)
-        for tap in self.taps.frontend_out:
-            tap(self.clock.now(), message.type, message)
-        self._blame(message.type)
+        emit = self.emit
+        if emit is not None:
+            now = self.clock.now()
+            emit(FrontendOut(now, message))
+            emit(Blamed(now, message.type, self.blamed, self.blamed_reads))
 
     def setup(self) -> None:
         """Hand every node the context, this core's board and trace (py_trees' setup)."""
@@ -170,44 +152,48 @@ class Core:
 
     # ------------------------------------------------------------ inputs (cache only)
 
-    def on_ros(self, topic: str, value: Any) -> bool:
-        """Cache one decoded message; True when it calls for a tick."""
+    def on_ros(self, topic: str, value: object, raw: msgspec.Raw | None = None) -> bool:
+        """Cache one decoded message (``value`` None: it did not decode, or the tree does
+        not read its topic: told to the observers only); True when it calls for a tick."""
         now = self.clock.now()
-        for tap in self.taps.ros_in:
-            tap(now, topic, value)
+        if self.emit is not None:
+            self.emit(RobotInput(now, topic, value, raw))
         inp = self.table.get(topic)
-        if inp is None:
+        if inp is None or value is None:
             return False
         self.inputs.add(inp, value, now)
         return inp.tick
 
     def on_event(self, message: FrontendMessage) -> None:
+        """Queue a new front-end event for the next tick's snapshot."""
         now = self.clock.now()
-        for tap in self.taps.frontend_in:
-            tap(now, message.type, message)
+        if self.emit is not None:
+            self.emit(FrontendIn(now, message))
         self.inputs.events.append((message, now))
 
     # ------------------------------------------------------------ operator commands
 
     def _stops_now(self) -> list[str]:
         """The stops being visited or driven to now (what a skip would leave)."""
-        return [n.params.poi for n in self._skippable  # type: ignore[attr-defined]
-                if n.status == Status.RUNNING]
+        return [n.params.poi for n in self.stops  # type: ignore[attr-defined]
+                if n.status is Status.RUNNING]
 
-    def command(self, command: Command) -> Answer:
+    def command(self, command: Command, by: str = "") -> Answer:
         """Apply an operator command now: call it between ticks (it takes effect in the
-        next one). The operator taps hear it, with its answer."""
+        next one). The observers hear it, with its answer and who sent it (``by``)."""
         now = self.clock.now()
         answer = self.operator.apply(command, now)
-        for tap in self.taps.operator:
-            tap(now, self.ticks + 1, command, answer)
+        if self.emit is not None:
+            self.emit(OperatorDone(now, self.ticks + 1, command.value, answer.ok, answer.text,
+                                   by=by))
         return answer
 
     # ------------------------------------------------------------ ticking
 
     def tick(self) -> Status:
         """The pre-tick step (snapshot the inputs, apply the responses), one tick of the
-        root, the tick taps; the root's status."""
+        root, then :class:`~frog_bt.model.events.Ticked` to the observers (they may read this
+        core's tree, board and journal as the tick left them); the root's status."""
         self.setup()
         self.trace.decided.clear()
         self.pause_ran_out = self.operator.check_pause(self.clock.now())
@@ -215,10 +201,11 @@ class Core:
         touched = self.touched
         touched.extend(self.root.tick())  # stopped nodes are already in it
         self.ticks += 1
-        for tap in self.taps.tick:
-            tap(self)
+        status = self.root.status
+        if self.emit is not None:
+            self.emit(Ticked(self.clock.now(), self.ticks, status.name))  # type: ignore[arg-type]
         touched.clear()
-        return self.root.status
+        return status
 
     def halt(self) -> None:
         """Stop whatever runs; scopes clean up (face stream off, ...)."""

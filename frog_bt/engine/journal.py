@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 from frog_bt.clock import Clock
+from frog_bt.engine.tally import Tally
 from frog_bt.model.outcomes import Incident, IncidentKind, Level
 
 
@@ -35,6 +36,7 @@ class Journal:
         self.notes: list[Note] = []
         self.incidents: list[Incident] = []
         self.incident_total = 0  # incidents ever recorded (the list keeps the latest)
+        self.tally = Tally()  # the one count of incidents
 
     def note(self, text: str, incident: IncidentKind | None = None, subject: str = ""
              ) -> Incident | None:
@@ -51,6 +53,7 @@ class Journal:
         record = Incident(now, incident, text, subject)
         self.incidents.append(record)
         self.incident_total += 1
+        self.tally.add(record)
         return record
 
     @property

@@ -18,6 +18,7 @@ that scope's keys on the board (``setup(board=...)``) each time it starts.
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -43,12 +44,21 @@ class Trace:
         return self.acting[-1] if self.acting else None
 
 
+class Role(enum.Enum):
+    """What the executive asks of a node, by what it declares rather than by its class."""
+
+    STOP = "stop"  # a stop being visited or driven to: what ``skip`` leaves (its params.poi)
+    SEEK = "seek"  # the search for a visitor (an alert when it runs too long)
+
+
 class Observed:
     """Mixin (before the py_trees base): ``stop`` appends the node to ``stop_log``; a node
-    with a ``scope`` clears it when it starts (:meth:`start_scope`)."""
+    with a ``scope`` clears it when it starts (:meth:`start_scope`); ``role`` says what the
+    executive may ask of it (:class:`Role`)."""
 
     stop_log: list[Behaviour] | None = None
     scope: Scope | None = None  # set by the loader on a node that starts a scope
+    role: Role | None = None
     _trace: Trace | None = None
     _board: Board | None = None
 

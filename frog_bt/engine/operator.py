@@ -20,7 +20,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from frog_bt.engine.blackboard import Board
-from frog_bt.engine.journal import Journal
+from frog_bt.engine.standing import Standing
 from frog_bt.model import keys
 from frog_bt.model.outcomes import AbortCause, AbortReason, IncidentKind, TourState
 
@@ -53,15 +53,21 @@ class Operator:
     ``stops`` gives the stops the tree is at or driving to now (the running
     ``OperatorSkip`` nodes' POIs, innermost last)."""
 
-    def __init__(self, board: Board, journal: Journal, stops: Callable[[], Iterable[str]],
+    def __init__(self, board: Board, standing: Standing, stops: Callable[[], Iterable[str]],
                  pause_max: float) -> None:
         self.board = board
-        self.journal = journal
+        self.standing = standing  # the pause timer and the journal outlive this tree
+        self.journal = standing.journal
         self.stops = stops
         self.pause_max = pause_max
-        self.paused_since: float | None = None
-        board.set(keys.PAUSED, False)
-        board.set(keys.IN_SERVICE, True)
+        if not board.written(keys.PAUSED):
+            board.set(keys.PAUSED, False)
+        if not board.written(keys.IN_SERVICE):
+            board.set(keys.IN_SERVICE, True)
+
+    @property
+    def paused_since(self) -> float | None:
+        return self.standing.paused_since
 
     def _touring(self) -> bool:
         return self.board.get(keys.TOUR_STATE) is TourState.STARTED
@@ -99,7 +105,7 @@ class Operator:
             if not self._touring():
                 return Answer(False, "no tour is running (service_off keeps the robot docked)")
             board.set(keys.PAUSED, True)
-            self.paused_since = now
+            self.standing.paused_since = now
             return Answer(True, f"pausing at the next step (at most {self.pause_max:g} s, "
                                 "then the tour ends)")
         if command is Command.RESUME:
@@ -122,7 +128,7 @@ class Operator:
 
     def _unpause(self) -> None:
         self.board.set(keys.PAUSED, False)
-        self.paused_since = None
+        self.standing.paused_since = None
 
     def check_pause(self, now: float) -> AbortReason | None:
         """Before each tick: a pause that ran out ends the tour politely (its reason)."""

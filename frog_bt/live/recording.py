@@ -69,11 +69,19 @@ from frog_bt.model.channels import (
     schema_for,
     to_ns,
 )
+from frog_bt.model.events import (
+    AlertChanged,
+    Blamed,
+    Datagram,
+    Event,
+    OperatorDone,
+    RobotCommand,
+    RobotInput,
+    Ticked,
+)
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS, Keep
 
 if TYPE_CHECKING:
-    from frog_bt.engine.core import Core, Outgoing
-    from frog_bt.engine.operator import Answer, Command
     from frog_bt.runtime.observer import Host
 
 log = logging.getLogger(__name__)
@@ -148,6 +156,10 @@ class Recorder:
         self._latest_topics: frozenset[str] = frozenset()
         self._latest_raw: dict[str, tuple[float, bytes]] = {}
         self._clock_raw: bytes | None = None
+        self._handlers: dict[type, Callable[[Any], None]] = {
+            RobotInput: self._ros_in, RobotCommand: self._ros_out, Datagram: self._datagram,
+            Ticked: self._tick, Blamed: self._blame, OperatorDone: self._operator,
+            AlertChanged: self._alert}
         self._frontend_in: deque[bytes] = deque(maxlen=PRIMER_DATAGRAMS)
         self._frontend_out_seqs: deque[int] = deque(maxlen=PRIMER_SEQS)
         self.messages = 0
@@ -182,10 +194,9 @@ class Recorder:
     # ------------------------------------------------------------ wiring
 
     def attach(self, host: Host) -> None:
-        """Register every channel and hook the executive's wire and core taps (a live
-        host only: a recording needs the raw traffic)."""
-        wire = host.wire
-        if wire is None:
+        """Register every channel and write the tree (a live host only: a recording needs
+        the raw traffic, which a replay has not)."""
+        if host.links is None:
             raise ValueError("a recorder attaches to the live executive (raw traffic)")
         site = host.site
         for role, topic in (*INPUTS.items(), *OUTPUTS.items()):
@@ -204,12 +215,12 @@ class Recorder:
         self._tree = self._tree_message(host)
         if self._tree is not None:
             self._write(TREE, None, self._tree)
-        wire.ros_in.append(self.on_ros_in)
-        host.taps.ros_out.append(self.on_ros_out)
-        wire.datagram.append(self.on_datagram)
-        host.taps.tick.append(self.on_tick)
-        host.taps.blame.append(self.on_blame)
-        host.taps.operator.append(self.on_operator)
+
+    def on_event(self, event: Event) -> None:
+        """Each event its channel (tick path: a list append, see :meth:`_write`)."""
+        handler = self._handlers.get(type(event))
+        if handler is not None:
+            handler(event)
 
     def channel(self, topic: str, type_: str) -> str:
         """Register ``topic`` (and its schema) in the file on first use; the topic."""
@@ -223,12 +234,15 @@ class Recorder:
             self._registered.setdefault(topic, type_)
         return topic
 
-    # ------------------------------------------------------------ taps (tick path: keep cheap)
+    # ------------------------------------------------------------ events (tick path: keep cheap)
 
-    def on_ros_in(self, t: float, topic: str, msg: Any) -> None:
+    def _ros_in(self, event: RobotInput) -> None:
+        t, topic = event.t, event.topic
+        if event.raw is None:
+            return  # nothing as received (a host without raw traffic)
         if topic not in self._channels:
             self.channel(topic, "unknown")
-        data = _raw(msg)
+        data = _raw(event.raw)
         if topic == self._clock_topic:
             try:  # /clock is seen before the clock takes it: stamp it with its own time
                 clock = CLOCK.codec.decode(data)
@@ -242,15 +256,15 @@ class Recorder:
             self._latest_raw[topic] = (t, data)
         self._write(topic, t if self._ready() else None, data)
 
-    def on_ros_out(self, t: float, out: Outgoing) -> None:
-        topic, msg = out.topic, out.msg
+    def _ros_out(self, event: RobotCommand) -> None:
+        topic = event.topic
         if topic not in self._channels:
             self.channel(topic, "unknown")
-        self._write(topic, t, _dumps(msg))
+        self._write(topic, event.t, _dumps(event.msg))
 
-    def on_datagram(self, direction: str, data: bytes, t: float) -> None:
-        data = bytes(data)
-        if direction == "in":
+    def _datagram(self, event: Datagram) -> None:
+        data, t = event.data, event.t
+        if event.direction == "in":
             topic = FRONTEND_IN
             self._frontend_in.append(data)
         else:
@@ -276,20 +290,20 @@ class Recorder:
             return None
         return channels.encode(channels.Tree("BehaviorTree.CPP v4", str(tree_file), xml))
 
-    def on_blame(self, t: float, channel: str, node: str, reads: dict[str, str]) -> None:
-        self._write(BLAME, t, channels.encode(channels.Blame(channel, node, reads)))
+    def _blame(self, event: Blamed) -> None:
+        self._write(BLAME, event.t, channels.encode(channels.Blame(
+            event.channel, event.node, event.reads)))
 
-    def on_operator(self, t: float, tick: int, command: Command, answer: Answer) -> None:
-        self._write(OPERATOR, t, channels.encode(channels.Operator(
-            tick, command.value, answer.ok, answer.text)))
+    def _operator(self, event: OperatorDone) -> None:
+        self._write(OPERATOR, event.t, channels.encode(channels.Operator(
+            event.tick, event.command, event.ok, event.text, event.id)))
 
-    def on_alert(self, t: float, alert: channels.Alert) -> None:
-        """An alert raised, cleared or acknowledged (the executive's alert book calls it)."""
-        self._write(ALERT, t, channels.encode(alert))
+    def _alert(self, event: AlertChanged) -> None:
+        """An alert raised, cleared or acknowledged."""
+        self._write(ALERT, event.t, channels.encode(event.alert))
 
-    def on_tick(self, core: Core) -> None:
-        status = core.root.status.name
-        self._write(TICK, core.clock.now(), channels.encode(channels.Tick(core.ticks, status)))
+    def _tick(self, event: Ticked) -> None:
+        self._write(TICK, event.t, channels.encode(channels.Tick(event.tick, event.status)))
 
     # ------------------------------------------------------------ writing
 

@@ -39,9 +39,10 @@ from typing import Any
 import py_trees
 
 from frog_bt.clock import SITE_TZ
+from frog_bt.engine.core import Core
 from frog_bt.live.recording import Recorder
 from frog_bt.model import keys
-from frog_bt.model.channels import Alert
+from frog_bt.model.events import Event, Ticked
 from frog_bt.model.outcomes import TourState
 from frog_bt.runtime.observer import Host
 
@@ -81,6 +82,7 @@ class RecordingDir:
         self._clock: Any = None
         self._tour_state: TourState | None = None
         self._named_by_clock = False
+        self._host: Host | None = None
 
     @property
     def path(self) -> Path | None:
@@ -99,14 +101,18 @@ class RecordingDir:
         self.recorder = Recorder(path, metadata={"kind": "idle", "tour": str(self.number)})
         self.files.append(path)
         self.recorder.attach(host)
-        host.taps.tick.append(self.on_tick)  # after the recorder's: the tick is in
+        self._host = host
 
-    def on_alert(self, t: float, alert: Alert) -> None:
-        """An alert change, into the file being written now."""
-        if self.recorder is not None:
-            self.recorder.on_alert(t, alert)
+    def on_event(self, event: Event) -> None:
+        """Into the file being written now; after a tick (in it now), rotate if a tour
+        started or the tree's run ended."""
+        recorder = self.recorder
+        if recorder is not None:
+            recorder.on_event(event)
+        if type(event) is Ticked and self._host is not None:
+            self.on_tick(self._host.core)
 
-    def on_tick(self, core: Any) -> None:
+    def on_tick(self, core: Core) -> None:
         """Between ticks: a tour started, or the tree's run ended."""
         if not self._named_by_clock:
             self._rename_first()

@@ -1,8 +1,9 @@
 """What happened on a tour, from the executive's own traffic (``frog-bt demo`` prints it).
 
-:class:`TourSummary` is a set of taps for :class:`~frog_bt.runtime.executive.Taps`: it
-watches the goals sent and answered, the content started, the visitors
-approached and recruited.
+:class:`TourSummary` is an :class:`~frog_bt.runtime.observer.Observer`: it watches
+the goals sent and answered, the content started, the visitors approached and
+recruited, and reads the incidents from the one tally
+(:class:`~frog_bt.engine.tally.Tally`).
 """
 
 from __future__ import annotations
@@ -13,16 +14,18 @@ from typing import TYPE_CHECKING, Any
 
 from frog_bt.config import Site
 from frog_bt.engine.context import Incident
+from frog_bt.engine.tally import Tally
 from frog_bt.maths.engagement import Decision
 from frog_bt.model import keys
-from frog_bt.model.frontend import StartPoi, Tour, UserPositive
+from frog_bt.model.events import Event, FrontendIn, FrontendOut, RobotCommand, RobotInput, Ticked
+from frog_bt.model.frontend import FrontendMessage, StartPoi, Tour, UserPositive
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.model.ros import POSE
 from frog_bt.model.wire import SUCCEEDED
 from frog_bt.runtime.observer import Host
 
 if TYPE_CHECKING:
-    from frog_bt.engine.core import Outgoing
+    from frog_bt.engine.core import Core
 
 
 @dataclass
@@ -35,65 +38,74 @@ class TourSummary:
     decisions: list[tuple[str, Decision]] = field(default_factory=list)  # (about, decision)
     incidents: list[Incident] = field(default_factory=list)
     tours: list[str] = field(default_factory=list)  # "ended" / "aborted: reason", in order
-    skipped: list[str] = field(default_factory=list)  # stops skipped in the latest tour
     resumed: str | None = None
     _goal: str | None = None
     _last_decision: Any = None
     _seen_incidents: int = 0
+    _host: Host | None = None
+    _tally: Tally | None = None
 
     def waypoint_of(self, msg: dict[str, Any]) -> str:
         return self.site.waypoint_of(POSE.convert(msg))
 
-    # taps: (t, channel, payload)
-    def ros_out(self, t: float, out: Outgoing) -> None:
+    def on_event(self, event: Event) -> None:
+        kind = type(event)
+        if kind is RobotInput:
+            self._ros_in(event)  # type: ignore[arg-type]
+        elif kind is RobotCommand:
+            self._ros_out(event)  # type: ignore[arg-type]
+        elif kind is FrontendOut:
+            self._frontend_out(event.message)  # type: ignore[union-attr]
+        elif kind is FrontendIn:
+            self._frontend_in(event.message)  # type: ignore[union-attr]
+        elif kind is Ticked and self._host is not None:
+            self._tick(self._host.core)
+
+    def _ros_out(self, out: RobotCommand) -> None:
         if out.role == "goto" and out.goal is not None:
             self._goal = out.goal.target  # the waypoint, as the tree named it
         elif out.role == "approach" and isinstance(out.value, int):
             self._goal = None
             self.approached.append(out.value)
 
-    def ros_in(self, t: float, topic: str, value: Any) -> None:
-        if topic == self.site.topic("response") and value == SUCCEEDED and self._goal:
+    def _ros_in(self, event: RobotInput) -> None:
+        if (event.topic == self.site.topic("response") and event.value == SUCCEEDED
+                and self._goal):
             self.visited.append(self._goal)
             self._goal = None
 
-    def frontend_out(self, t: float, type_: str, message: Any) -> None:
+    def _frontend_out(self, message: FrontendMessage) -> None:
         if isinstance(message, StartPoi):
             self.content.append((message.poi, message.waypoint, message.part))
-        elif isinstance(message, Tour):
-            if message.state == "started":
-                self.skipped.clear()
-            else:
-                self.tours.append(message.state + (f": {message.reason}" if message.reason
-                                                   else ""))
+        elif isinstance(message, Tour) and message.state != "started":
+            self.tours.append(message.state + (f": {message.reason}" if message.reason
+                                               else ""))
 
-    def frontend_in(self, t: float, type_: str, message: Any) -> None:
+    def _frontend_in(self, message: FrontendMessage) -> None:
         if isinstance(message, UserPositive) and self.approached:
             self.recruited.append(self.approached[-1])
 
-    def tick(self, core: Any) -> None:
+    def _tick(self, core: Core) -> None:
         board = core.board
         decision = board.get(keys.ENGAGEMENT_DECISION)
         if decision is not None and decision is not self._last_decision:
             self._last_decision = decision
             self.decisions.append(decision)
         journal = core.journal
-        for incident in journal.incidents_since(self._seen_incidents):
-            self.incidents.append(incident)
-            if incident.kind in (IncidentKind.STOP_SKIPPED, IncidentKind.STOP_LEFT):
-                self.skipped.append(incident.subject)
+        self.incidents.extend(journal.incidents_since(self._seen_incidents))
         self._seen_incidents = journal.incident_total
+        self._tally = journal.tally
         resumed = board.get(keys.RESUMED)
         if resumed and self.resumed is None:
             self.resumed = resumed
 
+    @property
+    def skipped(self) -> list[str]:
+        """Stops skipped or left in the latest tour (the one tally's)."""
+        return self._tally.stops_left() if self._tally is not None else []
+
     def attach(self, host: Host) -> None:
-        taps = host.taps
-        taps.tick.append(self.tick)
-        taps.ros_out.append(self.ros_out)
-        taps.ros_in.append(self.ros_in)
-        taps.frontend_out.append(self.frontend_out)
-        taps.frontend_in.append(self.frontend_in)
+        self._host = host
 
     def close(self) -> None:
         """Nothing to finish: the summary is read from its fields."""

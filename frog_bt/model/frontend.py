@@ -17,9 +17,9 @@ import msgspec
 
 from frog_bt.codec import convert, decoder
 from frog_bt.errors import DecodeError
+from frog_bt.model.outcomes import TourState
 
 Part = Literal["a", "b"]
-TourState = Literal["started", "ended", "aborted"]
 Level = Annotated[float, msgspec.Meta(ge=-1.0, le=1.0)]
 Percent = Annotated[int, msgspec.Meta(ge=0, le=100)]
 Seq = Annotated[int, msgspec.Meta(ge=0)]
@@ -119,7 +119,6 @@ EVENTS: dict[str, type[FrontendMessage]] = {
     cls.type: cls
     for cls in (FrontendIdle, FinishIntroduction, UserPositive, UserNegative, ContentDone)
 }
-TOUR_STATES: tuple[str, ...] = TourState.__args__  # type: ignore[attr-defined]
 
 
 class Envelope(msgspec.Struct, frozen=True):

@@ -44,14 +44,17 @@ class Scope(enum.IntEnum):
 class Key(Generic[T]):
     """One value of the tour: ``name`` (as tree files, docs and telemetry show it), the
     ``type`` of its value (None is always allowed: not written yet, or cleared), its
-    ``source``, its ``scope`` and what it means (``doc``). Keys compare by identity:
-    each is declared once."""
+    ``source``, its ``scope`` and what it means (``doc``). A ``lasting`` key is the
+    executive's, not one tree's: what people decided (in service, paused) and the tours'
+    bookkeeping outlive a reload (:class:`~frog_bt.engine.standing.Standing`). Keys compare
+    by identity: each is declared once."""
 
     name: str
     type: Any
     source: Source
     scope: Scope
     doc: str
+    lasting: bool = False  # kept by the executive across trees (a reload), not by one core
 
     def __repr__(self) -> str:
         return self.name

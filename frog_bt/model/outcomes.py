@@ -86,3 +86,46 @@ class Incident:
     kind: IncidentKind
     text: str  # plain words: "skipped POI3: navigation kept failing"
     subject: str = ""  # what it is about, where a summary needs it (the POI skipped)
+
+
+class DockingState(enum.StrEnum):
+    """The ``/docking/state`` words (CONTRACT §1): published on each change, repeated."""
+
+    DOCKED = "docked"
+    UNDOCKING = "undocking"
+    UNDOCKED = "undocked"
+    DOCKING = "docking"
+    FAILED = "failed"
+
+    @classmethod
+    def of(cls, word: str) -> DockingState | None:
+        """The state a word means; None for a word the contract does not know."""
+        return cls._value2member_map_.get(word)  # type: ignore[return-value]
+
+
+class DockCommand(enum.StrEnum):
+    """What ``/docking/dock`` asks of the robot (CONTRACT §1)."""
+
+    DOCK = "dock"
+    UNDOCK = "undock"
+
+    @property
+    def busy(self) -> DockingState:
+        """The docking state while it is under way."""
+        return DockingState.DOCKING if self is DockCommand.DOCK else DockingState.UNDOCKING
+
+
+class FaceStream(enum.StrEnum):
+    """What ``/ICL_command`` asks of the face data stream (CONTRACT §1)."""
+
+    START = "start"
+    STOP = "stop"
+
+
+class DiagnosticLevel(enum.IntEnum):
+    """``diagnostic_msgs/DiagnosticStatus`` levels; ERROR and STALE are faults."""
+
+    OK = 0
+    WARN = 1
+    ERROR = 2
+    STALE = 3

@@ -77,7 +77,7 @@ class Input(Topic):
 POSE = input_key("/pose", Reading[Pose], "the robot's pose in the map frame")
 RESPONSES = input_key("/responses", tuple[tuple[int, float], ...],
                       "/FROG_response codes received since the last tick: (code, t)")
-DOCKING = input_key("/docking", Reading[str], "the docking state (docked, undocking, ...)")
+DOCKING = input_key("/docking", Reading[str], "the docking state (a DockingState word: docked, undocking, ...)")
 DIAGNOSTICS = input_key("/diagnostics", Reading[Diagnostics],
                         "battery level and electronics faults")
 PERSONS = input_key("/persons", Reading[PersonDetections],
@@ -128,7 +128,6 @@ class Response(enum.IntEnum):
 
 
 ACTIVE, SUCCEEDED, FAILED, ABORTED = Response
-DOCKING_STATES = ("docked", "undocking", "undocked", "docking", "failed")
 
 DEFAULT_ROSBRIDGE_URL = "ws://127.0.0.1:9090"
 DEFAULT_FRONTEND = ("127.0.0.1", 5005)  # where the front end listens

@@ -9,6 +9,12 @@ go through :data:`~frog_bt.model.ros.ROS_TYPES` (by the channel's schema name) t
 as live, to ``Core.on_event``; ``/clock`` moves the clock (under sim time what
 arrived before the first ``/clock`` is fed with the clock not yet ready, as live).
 
+The recording is read through the one decoder of recordings
+(:class:`~frog_bt.recordings.reader.Reader`): a message that does not decode (a damaged
+robot input, command, datagram or one of our own) is counted and reported in
+:attr:`ReplayResult.bad`, never dropped silently; live, the executive did not act on it
+either.
+
 Ticks: a recording made by :class:`~frog_bt.live.recording.Recorder` has the live
 ticks (``/frog_bt/tick``), and replay ticks exactly there, in the same place
 among the inputs. Live ticks coalesce bursts of inputs and land wherever the
@@ -28,25 +34,22 @@ recorded inputs are exactly what the new tree would have seen.
 
 from __future__ import annotations
 
-import json
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from frog_bt.clock import ManualClock
 from frog_bt.config import Site, parse_hostport
-from frog_bt.engine.core import Core, Taps
+from frog_bt.engine.core import Core
 from frog_bt.engine.operator import Command as OperatorCommand
-from frog_bt.errors import DecodeError
 from frog_bt.frontend.protocol import Endpoint
 from frog_bt.model import channels, keys
-from frog_bt.model.channels import BLAME, FRONTEND_IN, FRONTEND_OUT, OPERATOR, PRIMER, TICK, from_ns
+from frog_bt.model.channels import BLAME, FRONTEND_IN, FRONTEND_OUT, OPERATOR, TICK, from_ns
 from frog_bt.model.frontend import EVENTS, FrontendMessage, message_fields
-from frog_bt.model.ros import ROS_TYPES
-from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
+from frog_bt.model.wire import CLOCK, OUTPUTS
 from frog_bt.recordings.commands import (
     Command,
     ReplayError,
@@ -55,14 +58,24 @@ from frog_bt.recordings.commands import (
     without_stamp,
 )
 from frog_bt.recordings.mcapfile import RecordingError
+from frog_bt.recordings.reader import (
+    CLOCK_ROLE,
+    Bad,
+    FrontendAck,
+    FrontendIn,
+    FrontendOut,
+    Own,
+    Primed,
+    Reader,
+    Record,
+    RobotCommand,
+    RobotInput,
+)
+from frog_bt.runtime.observer import Observers
 from frog_bt.tree.loader import LoadedTree
 
 if TYPE_CHECKING:
     from frog_bt.model.links import Links
-    from frog_bt.runtime.executive import WireTaps
-
-
-BAD_KEPT = 20  # reasons of bad messages kept in a result (all are counted)
 
 
 @dataclass(frozen=True, slots=True)
@@ -92,7 +105,7 @@ class ReplayResult:
     divergence: Divergence | None = None
     wall: float = 0.0  # seconds the replay took
     recovered: list[str] = field(default_factory=list)  # files cut short, what was read
-    bad: list[str] = field(default_factory=list)  # our own messages that did not decode: why
+    bad: list[str] = field(default_factory=list)  # messages that did not decode: where, why
     bad_count: int = 0  # all of them (``bad`` keeps the first few)
     operator_commands: int = 0  # recorded operator commands, applied again
 
@@ -109,8 +122,7 @@ class Replay:
     (telemetry) to it before :meth:`run`.
     """
 
-    wire: WireTaps | None = None  # no raw traffic in a replay
-    links: Links | None = None  # and no links
+    links: Links | None = None  # no links (and no raw traffic) in a replay
 
     def __init__(self, path: Path, site: Site, tree: LoadedTree) -> None:
         self.path = Path(path)
@@ -133,8 +145,10 @@ class Replay:
         self.exact = TICK in self.types
         self.period = 1.0 / site.executive.tick_hz
         self.clock = ManualClock(None)
-        self.core = Core(site, tree, self.clock, self._publish, self._send)
-        self.inputs = {site.topic(role): topic.type for role, topic in INPUTS.items()}
+        self.observers = Observers()  # attach with attach_all(replay, [...]) before run()
+        self.core = Core(site, tree, self.clock, self._publish, self._send,
+                         emit=self.observers.emit)
+        self.reader = Reader(site)  # the one decoder; its tally counts the bad messages
         self.endpoint = Endpoint(self._peer, EVENTS)  # the same dedup as the live link
         self._expected: deque[Command] = deque()
         self._got: deque[Command] = deque()
@@ -147,10 +161,6 @@ class Replay:
         self._next_tick = 0.0
         self.result = ReplayResult(self.start, self.end, self.start, exact=self.exact,
                                    recovered=self.recovered)
-
-    @property
-    def taps(self) -> Taps:
-        return self.core.taps
 
     # ------------------------------------------------------------ outputs of the replayed tree
 
@@ -184,16 +194,15 @@ class Replay:
         wall0 = time.monotonic()
         result = self.result
         parted = False
-        for topic, ns, data in self._messages():
-            if parted and topic != BLAME:
+        for record in self.reader.read_all(self.files):  # a lead-in first, if any
+            if parted and not (isinstance(record, Own) and record.channel == BLAME):
                 break  # the blame of the diverging command, recorded after it, is read
-            t = from_ns(ns)
-            self._on_message(topic, t, data)
+            self._on_record(record)
             if parted:
                 break
-            result.covered = t
+            result.covered = record.t
             if progress is not None:
-                progress(t)
+                progress(record.t)
             parted = result.divergence is not None
         else:
             if not self.recovered:  # cut short: the live run neither halted nor sent more
@@ -203,55 +212,53 @@ class Replay:
                     got = self._got.popleft() if self._got else None
                     result.divergence = Divergence(self._compared + 1, expected, got)
         result.ticks = self.core.ticks
+        result.bad_count = self.reader.tally.count
+        result.bad = self.reader.tally.lines(self.start)
         result.wall = time.monotonic() - wall0
         return result
 
-    def _messages(self) -> Iterator[tuple[str, int, bytes]]:
-        for recording in self.files:  # a lead-in first, when the file continues one
-            yield from recording.messages()
-
-    def _on_message(self, topic: str, t: float, data: bytes) -> None:
-        if topic == CLOCK.name and self.sim_time:
-            try:
-                t = CLOCK.codec.decode(data)
-            except DecodeError:
-                return  # live, a malformed /clock does not move the clock either
-            self._advance(t)
+    def _on_record(self, record: Record) -> None:
+        if isinstance(record, RobotInput) and record.role == CLOCK_ROLE:
+            if self.sim_time and isinstance(record.value, float):
+                self._advance(record.value)  # /clock: the time it carries
             return
+        if isinstance(record, Bad) and record.channel == CLOCK.name:
+            return  # live, a malformed /clock does not move the clock either
         if self.clock.ready or not self.sim_time:
-            self._advance(t)
-        if topic in self.inputs:
-            self._on_ros(topic, data)
-        elif topic == FRONTEND_IN:
-            self._on_datagram(data)
-        elif topic == TICK:
-            if self._own(topic, t, data) is not None and self.exact:
-                self._tick()
-        elif topic == FRONTEND_OUT:
-            self._expect_datagram(t, data)
-        elif topic == BLAME:
-            self._blame(self._own(topic, t, data))
-        elif topic == PRIMER:
-            self._prime(self._own(topic, t, data))
-        elif topic == OPERATOR:
-            self._operator(t, self._own(topic, t, data))
-        elif topic in self.outputs:
+            self._advance(record.t)
+        if isinstance(record, RobotInput):
+            self._on_ros(record)
+        elif (datagram := _datagram_in(record)) is not None:
+            self._on_datagram(datagram)  # a bad one too: live, the link acked it if it could
+        elif isinstance(record, FrontendOut):
+            self._expect_datagram(record)
+        elif isinstance(record, RobotCommand):
             self.result.ros_commands += 1
-            self._last_expected = Command(t, topic, without_stamp(json.loads(data)))
-            self._expected.append(self._last_expected)
-            self._compare()
+            self._expect(Command(record.t, record.topic, without_stamp(record.msg)))
+        elif isinstance(record, Own):
+            self._on_own(record)
+        elif isinstance(record, Primed):
+            self._prime(record)
 
-    def _on_ros(self, topic: str, data: bytes) -> None:
-        codec = ROS_TYPES.get(self.types.get(topic, "")) or ROS_TYPES[self.inputs[topic]]
-        try:
-            value = codec.decode(data)
-        except DecodeError:
-            return  # live, the client drops a malformed message before the core
+    def _on_own(self, record: Own) -> None:
+        message = record.message
+        if isinstance(message, channels.Tick):
+            if self.exact:
+                self._tick()
+        elif isinstance(message, channels.Blame):
+            self._blame(message)
+        elif isinstance(message, channels.Operator):
+            self._operator(record.t, message)
+
+    def _on_ros(self, record: RobotInput) -> None:
         self.result.inputs += 1
-        if self.core.on_ros(topic, value) and not self.exact and self.clock.ready:
+        if self.core.on_ros(record.topic, record.value) and not self.exact \
+                and self.clock.ready:
             self._tick()
 
     def _on_datagram(self, data: bytes) -> None:
+        """A datagram in, through the live link's own protocol (its duplicates and
+        restarts are the executive's to tell, as live)."""
         self.result.inputs += 1
         received = self.endpoint.receive(data, self._peer, self.clock.now())
         if received.message is not None:
@@ -259,73 +266,50 @@ class Replay:
             if not self.exact and self.clock.ready:
                 self._tick()
 
-    def _expect_datagram(self, t: float, data: bytes) -> None:
-        try:
-            obj = json.loads(data)
-        except ValueError:
-            return
-        if not isinstance(obj, dict) or obj.get("type") == "ack":
-            return
-        seq = obj.pop("seq", None)
-        if seq in self._seqs:
+    def _expect_datagram(self, record: FrontendOut) -> None:
+        if record.seq in self._seqs:
             return  # a resend
-        self._seqs.add(seq)
+        self._seqs.add(record.seq)
         self.result.frontend_commands += 1
-        self._last_expected = Command(t, FRONTEND_OUT, obj)
-        self._expected.append(self._last_expected)
+        message = record.message
+        self._expect(Command(record.t, FRONTEND_OUT,
+                             plain({"type": message.type, **message_fields(message)})))
+
+    def _expect(self, command: Command) -> None:
+        self._last_expected = command
+        self._expected.append(command)
         self._compare()
 
-    def _own(self, topic: str, t: float, data: bytes) -> Any:
-        """A message of one of our channels, decoded by its Struct; None for a bad one,
-        counted and reported with its reason (never dropped silently)."""
-        try:
-            return channels.decode(topic, data)
-        except DecodeError as exc:
-            self._bad(topic, t, str(exc))
-            return None
-
     def _bad(self, topic: str, t: float, reason: str) -> None:
-        result = self.result
-        result.bad_count += 1
-        if len(result.bad) < BAD_KEPT:
-            result.bad.append(f"{topic} at +{t - self.start:.1f} s: {reason}")
+        self.reader.tally.add(Bad(t, topic, reason))
 
-    def _prime(self, primer: channels.Primer | None) -> None:
+    def _prime(self, primed: Primed) -> None:
         """A recorded ``/frog_bt/primer``: what the live executive carried into this file
         from before it (:mod:`frog_bt.live.rotation`)."""
-        if primer is None:
-            return
-        for entry in primer.inputs:
-            inp = self.core.table.get(entry.topic)
-            codec = ROS_TYPES.get(self.types.get(entry.topic, "")) if inp is not None else None
-            if inp is None or codec is None:
-                continue
-            try:
-                value = codec.decode(bytes(entry.msg))
-            except DecodeError:
-                continue  # live, the client drops a malformed message before the core
-            self.core.inputs.add(inp, value, entry.t)
+        for received in primed.inputs:  # (one that did not decode is a Bad record)
+            inp = self.core.table.get(received.topic)
+            if inp is not None:
+                self.core.inputs.add(inp, received.value, received.t)
+        primer = primed.primer
         if primer.frontend_ready:
             self.core.board.set(keys.FRONTEND_READY, True)
         for raw in primer.frontend_in:  # seen live: their resends are duplicates
             self.endpoint.receive(raw.encode(), self._peer, self.clock.now())
         self._seqs.update(primer.frontend_out_seqs)
 
-    def _blame(self, blame: channels.Blame | None) -> None:
+    def _blame(self, blame: channels.Blame) -> None:
         """A recorded ``/frog_bt/blame``: the node that sent the command just recorded."""
         last = self._last_expected
-        if last is None or blame is None:
+        if last is None:
             return
         if blame.channel == last.channel or (last.channel == FRONTEND_OUT
                                              and last.payload.get("type") == blame.channel):
             last.node = blame.node
             last.reads = dict(blame.reads)
 
-    def _operator(self, t: float, recorded: channels.Operator | None) -> None:
+    def _operator(self, t: float, recorded: channels.Operator) -> None:
         """A recorded operator command: applied again here, between the same two ticks; a
         different answer is a divergence like a different command."""
-        if recorded is None:
-            return
         try:
             command = OperatorCommand(recorded.command)
         except ValueError:
@@ -376,3 +360,14 @@ class Replay:
     def _tick(self) -> None:
         if self.result.divergence is None:
             self.core.tick()
+
+
+def _datagram_in(record: Record) -> bytes | None:
+    """The datagram from the front end a record is (an event, an ack, or one that did not
+    decode); None for any other record."""
+    if isinstance(record, FrontendIn) or (isinstance(record, FrontendAck)
+                                          and record.direction == "in"):
+        return record.raw
+    if isinstance(record, Bad) and record.channel == FRONTEND_IN:
+        return record.raw
+    return None

@@ -63,7 +63,9 @@ class RosbridgeClient:
     """rosbridge v2 client with reconnect; see the module docstring.
 
     ``on_message(topic, value)`` gets the typed value of every well-formed
-    message on a subscribed topic; ``on_link(state)`` gets the new
+    message on a subscribed topic; ``on_input(topic, value, msg)`` gets every message on a
+    subscribed topic, well-formed or not (``value`` None: it did not decode, and was
+    counted), with its ``msg`` as received; ``on_link(state)`` gets the new
     :class:`LinkState` each time the link goes up or down. Exceptions from
     either callback are logged and otherwise ignored.
 
@@ -83,6 +85,7 @@ class RosbridgeClient:
         on_message: Callable[[str, Any], None] | None = None,
         on_link: Callable[[LinkState], None] | None = None,
         on_raw: Callable[[str, Any], None] | None = None,
+        on_input: Callable[[str, object, Any], None] | None = None,
     ) -> None:
         try:
             parse_uri(url)
@@ -102,6 +105,7 @@ class RosbridgeClient:
         self.on_message = on_message
         self.on_link = on_link
         self.on_raw = on_raw  # (topic, msg JSON) of every publish on a subscribed topic
+        self.on_input = on_input
         self.session = Session(queue_limit=queue_limit, secret=secret)
         self.stats = ClientStats()
         self._link = LinkState(connected=False, since=time.monotonic())
@@ -392,15 +396,16 @@ class RosbridgeClient:
             return
         if self.on_raw is not None:
             self.on_raw(event.topic, event.msg)
+        value: object = None
         try:
             value = ROS_TYPES[sub.type].decode(event.msg)
         except DecodeError as exc:
             self._malformed(event.topic, f"malformed {sub.type} on {event.topic}: msg.{exc}")
-            return
-        if self.on_message is None:
-            return
         try:
-            self.on_message(event.topic, value)
+            if self.on_input is not None:
+                self.on_input(event.topic, value, event.msg)
+            elif self.on_message is not None and value is not None:
+                self.on_message(event.topic, value)
         except Exception:
             held = self._throttle.allow(f"on_message {event.topic}")
             if held is not None:

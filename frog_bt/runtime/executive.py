@@ -15,8 +15,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -25,18 +24,23 @@ import py_trees
 from frog_bt.clock import Clock, ManualClock
 from frog_bt.config import Site
 from frog_bt.engine.core import Core
+from frog_bt.engine.standing import Standing
 from frog_bt.frontend.link import FrontendLink
 from frog_bt.model import keys
+from frog_bt.model.channels import Alert
+from frog_bt.model.events import AlertChanged, Datagram, Event, LinksChanged
 from frog_bt.model.frontend import EVENTS, FrontendMessage
 from frog_bt.model.links import Links, states
-from frog_bt.model.outcomes import IncidentKind, TourState
+from frog_bt.model.outcomes import DockingState, IncidentKind, TourState
 from frog_bt.model.progress import EMPTY, Progress
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.rosbridge.link import LinkState
+from frog_bt.runtime import logctx
 from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
 from frog_bt.runtime.notify import Notifier
+from frog_bt.runtime.observer import Observers
 from frog_bt.runtime.staff import Staff
 from frog_bt.runtime.status import link_line, status_line
 from frog_bt.tree.loader import LoadedTree
@@ -57,20 +61,6 @@ class Outcome:
     tours: int = 0
 
 
-RawTap = Callable[[float, str, Any], None]
-
-
-@dataclass(slots=True)
-class WireTaps:
-    """Observers of raw traffic (the recorder): ``ros_in(t, topic, msg_dict)`` for every
-    message received on a subscribed topic, ``datagram(direction, data, t)`` for every
-    UDP datagram in (``"in"``) or out (``"out"``)."""
-
-    ros_in: list[RawTap] = field(default_factory=list)
-    datagram: list[Callable[[str, bytes, float], None]] = field(default_factory=list)
-    links: list[Callable[[float, Links], None]] = field(default_factory=list)  # on a change
-
-
 class Executive:
     def __init__(self, site: Site, tree: LoadedTree, clock: Clock, *,
                  rosbridge_url: str, frontend: tuple[str, int], listen: tuple[str, int],
@@ -83,13 +73,13 @@ class Executive:
         self.sim_time = sim_time
         self.once = once
         self.outcome = Outcome()
-        self.wire = WireTaps()
-        self.client = RosbridgeClient(rosbridge_url, secret=secret, on_message=self._on_ros,
-                                      on_link=self._on_link, on_raw=self._on_raw)
+        self.observers = Observers()  # every observer, told each event (on_event)
+        self.client = RosbridgeClient(rosbridge_url, secret=secret, on_input=self._on_ros,
+                                      on_link=self._on_link)
         self.link = FrontendLink(listen, frontend, clock, inbound=EVENTS,
                                  on_message=self._on_event, on_datagram=self._on_datagram)
-        self.core = Core(site, tree, clock, self.client.publish, self.link.send)
-        self.taps = self.core.taps
+        self.standing = Standing(clock)  # what outlives a tree: each core gets it
+        self.core = self._core(site, tree)
         self.checkpoint = checkpoint
         self._saved: Progress = EMPTY
         if checkpoint is not None and not fresh:
@@ -105,23 +95,31 @@ class Executive:
         self._link_states = states(self)
         self.swaps = 0
         self.staff = Staff(self)  # operator commands and alerts
+        self.staff.book.listeners.append(self._on_alert)
         self.notifier = Notifier.from_env()  # systemd: READY, STATUS, watchdog pings
-        self._seekers = self._find_seekers()
+
+    def _core(self, site: Site, tree: LoadedTree) -> Core:
+        """A core for ``tree``, on this executive's links, observers and standing state."""
+        return Core(site, tree, self.clock, self.client.publish, self.link.send,
+                    emit=self.observers.emit, standing=self.standing)
+
+    def emit(self, event: Event) -> None:
+        """Tell every observer."""
+        self.observers.emit(event)
 
     # ------------------------------------------------------------ I/O callbacks (cache only)
 
-    def _on_ros(self, topic: str, value: Any) -> None:
+    def _on_ros(self, topic: str, value: object, raw: Any) -> None:
         if topic == CLOCK.name and self.sim_time:
-            self.clock.set(value)  # type: ignore[attr-defined]
+            if isinstance(value, float):
+                self.clock.set(value)  # type: ignore[attr-defined]
+            self.core.on_ros(topic, None, raw)  # the observers hear it; the tree does not
             return
-        if self.core.on_ros(topic, value):
+        if self.core.on_ros(topic, value, raw):
             self._wake.set()
 
-    def _on_raw(self, topic: str, msg: Any) -> None:
-        if self.wire.ros_in:
-            now = self.clock.now()
-            for tap in self.wire.ros_in:
-                tap(now, topic, msg)
+    def _on_alert(self, t: float, alert: Alert) -> None:
+        self.emit(AlertChanged(t, alert))
 
     def _on_link(self, state: LinkState) -> None:
         self.was_connected = self.was_connected or state.connected
@@ -145,37 +143,28 @@ class Executive:
         """Tick soon (a queued operator command waits for the next tick)."""
         self._wake.set()
 
-    def _find_seekers(self) -> list[py_trees.behaviour.Behaviour]:
-        return [n for n in self.core.root.iterate() if type(n).__name__ == "SeekVisitor"]
-
-    @property
-    def seekers(self) -> list[py_trees.behaviour.Behaviour]:
-        """The tree's searches for a visitor (an alert when one runs too long)."""
-        return self._seekers
-
     @property
     def links(self) -> Links:
         """Each link's state as of the latest check."""
         return Links(*self._link_states)
 
     def check_links(self) -> None:
-        """Compare the links' states with the last seen; tell the ``wire.links`` taps."""
+        """Compare the links' states with the last seen; tell the observers a change."""
         now_states = states(self)
         if now_states != self._link_states:
             self._link_states = now_states
-            links = self.links
             now = self.clock.now() if self.clock.ready else 0.0
             self.staff.links_changed(now)
-            for tap in self.wire.links:
-                tap(now, links)
+            if self.observers:
+                self.emit(LinksChanged(now, self.links))
 
     def _on_event(self, message: FrontendMessage) -> None:
         self.core.on_event(message)
         self._wake.set()
 
     def _on_datagram(self, direction: str, data: bytes, t: float) -> None:
-        for tap in self.wire.datagram:
-            tap(direction, data, t)
+        if self.observers:
+            self.emit(Datagram(t, "in" if direction == "in" else "out", bytes(data)))
 
     # ------------------------------------------------------------ lifecycle
 
@@ -191,6 +180,7 @@ class Executive:
 
     async def run(self) -> Outcome:
         """Connect, tick until stopped (or one tour done with ``once``), then halt cleanly."""
+        logctx.mark(self)  # this task's log lines (and its tasks') are this executive's
         self.setup_wire()
         await self.link.start()
         self.client.start()
@@ -283,22 +273,16 @@ class Executive:
         """Docked, and no tour running: a safe point to swap the tree."""
         docking = self.core.inputs.latest.get(INPUTS["docking_state"].key)
         return (self.core.board.get(keys.TOUR_STATE) is not TourState.STARTED
-                and docking is not None and docking.value == "docked")
+                and docking is not None and docking.value == DockingState.DOCKED)
 
     def _swap_tree(self) -> None:
         assert self._swap is not None
         site, tree = self._swap
         self._swap = None
-        old = self.core
-        old.halt()
-        core = Core(site, tree, self.clock, self.client.publish, self.link.send)
-        core.taps = old.taps  # the observers (status, recording, summary) carry on
-        core.inputs.latest.update(old.inputs.latest)  # what the robot last said still holds
-        for key in (keys.FRONTEND_READY, keys.TOUR_STATE, keys.TOUR_REASON):
-            core.board.set(key, old.board.get(key))  # the executive's view of the tours
+        self.core.halt()
+        core = self.core = self._core(site, tree)  # same observers and standing state
         core.setup()
-        self.core, self.site, self.swaps = core, site, self.swaps + 1
-        self._seekers = self._find_seekers()
+        self.site, self.swaps = site, self.swaps + 1
         nodes = sum(1 for _ in tree.nodes())
         log.warning("tree reloaded at an idle point: %s (%d nodes)", tree.file, nodes)
         core.ctx.note(f"tree reloaded: {tree.file}")

@@ -1,23 +1,30 @@
-"""Live observers of a running core: the MCAP recorder and its rotation, the tour summary,
-the link states and the status line; rerun telemetry (:mod:`frog_bt.live.telemetry`) is one
-too. Every one attaches the same way, :class:`Observer`: ``attach(host)`` appends its taps
-to the host's (and keeps its work off the tick path), ``close()`` finishes it.
+"""How observers hear the executive: one typed event stream.
 
-A :class:`Host` is what they attach to: the online executive, or a replay (which has no
-raw wire traffic and no links: ``wire`` and ``links`` are None there).
+Every observer — the MCAP recorder and its rotation, the tour summary, the status line,
+the console's day, rerun telemetry, webhooks — attaches the same way: the host calls
+:meth:`Observer.attach` once (the observer keeps the host: its site, clock and *current*
+core, which a reload replaces), then :meth:`Observer.on_event` with each
+:data:`~frog_bt.model.events.Event`, in order, and :meth:`Observer.close` at the end.
+``on_event`` runs on the tick path: it must be quick and never block.
+
+A :class:`Host` is the online executive, or a replay (which has no links: ``links`` is
+None there). :class:`Observers` is the list a host keeps and tells.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
+
+from frog_bt.model.events import Event
 
 if TYPE_CHECKING:
     from frog_bt.clock import Clock
     from frog_bt.config import Site
-    from frog_bt.engine.core import Core, Taps
+    from frog_bt.engine.core import Core
     from frog_bt.model.links import Links
-    from frog_bt.runtime.executive import WireTaps
+
+__all__ = ["Host", "Listener", "Observer", "Observers", "attach_all", "close_all", "listen"]
 
 
 class Host(Protocol):
@@ -30,34 +37,96 @@ class Host(Protocol):
     @property
     def sim_time(self) -> bool: ...
     @property
-    def core(self) -> Core: ...
-    @property
-    def taps(self) -> Taps: ...
-    @property
-    def wire(self) -> WireTaps | None: ...  # raw traffic and link changes (live only)
+    def core(self) -> Core: ...  # the core running now (a reload replaces it)
     @property
     def links(self) -> Links | None: ...  # each link's state now (live only)
+    @property
+    def observers(self) -> Observers: ...
 
 
 @runtime_checkable
 class Observer(Protocol):
     def attach(self, host: Host) -> None:
-        """Append this observer's taps to the host's; cheap, and never blocks a tick."""
+        """Keep the host and start (open files, write what is static); cheap."""
+
+    def on_event(self, event: Event) -> None:
+        """One event of the executive; on the tick path: quick, never blocking."""
 
     def close(self) -> None:
         """Finish (write what is left, close files); idempotent, bounded in time."""
 
 
+class Observers:
+    """The observers of one host, told every event in the order they attached."""
+
+    def __init__(self) -> None:
+        self._observers: list[Observer] = []
+        self._calls: list[Callable[[Event], None]] = []  # their on_event, bound once
+
+    def __bool__(self) -> bool:
+        return bool(self._observers)
+
+    def __iter__(self) -> Iterator[Observer]:
+        return iter(list(self._observers))
+
+    def attach(self, host: Host, observers: Iterable[Observer]) -> list[Observer]:
+        """Attach each observer to ``host`` in order; the list of those attached."""
+        attached = []
+        for observer in observers:
+            observer.attach(host)
+            self._observers.append(observer)
+            self._calls.append(observer.on_event)
+            attached.append(observer)
+        return attached
+
+    def detach(self, observer: Observer) -> None:
+        """Stop telling ``observer`` (it is not closed)."""
+        if observer in self._observers:
+            i = self._observers.index(observer)
+            del self._observers[i], self._calls[i]
+
+    def emit(self, event: Event) -> None:
+        """Tell every observer, in the order they attached."""
+        for call in self._calls:
+            call(event)
+
+    def close(self) -> None:
+        """Close in the reverse order of attaching (the last attached may use the first)."""
+        for observer in reversed(self._observers):
+            observer.close()
+
+
 def attach_all(host: Host, observers: Iterable[Observer]) -> list[Observer]:
-    """Attach each observer in order; the list, for :func:`close_all`."""
-    attached = []
-    for observer in observers:
-        observer.attach(host)
-        attached.append(observer)
-    return attached
+    """Attach ``observers`` to ``host`` (its :class:`Observers`); the list attached."""
+    return host.observers.attach(host, observers)
 
 
-def close_all(observers: Sequence[Observer]) -> None:
+def close_all(observers: Iterable[Observer]) -> None:
     """Close in the reverse order of attaching (the last attached may use the first)."""
-    for observer in reversed(observers):
+    for observer in reversed(list(observers)):
         observer.close()
+
+
+class Listener:
+    """An observer that calls ``call`` with each event of the given types (all: none given)."""
+
+    def __init__(self, call: Callable[[Event], None], *types: type) -> None:
+        self.call = call
+        self.types = types
+
+    def attach(self, host: Host) -> None:
+        """Nothing to start."""
+
+    def on_event(self, event: Event) -> None:
+        if not self.types or isinstance(event, self.types):
+            self.call(event)
+
+    def close(self) -> None:
+        """Nothing to finish."""
+
+
+def listen(host: Host, call: Callable[[Event], None], *types: type) -> Listener:
+    """Attach a :class:`Listener` of ``types`` to ``host``; it, for ``detach``."""
+    listener = Listener(call, *types)
+    host.observers.attach(host, [listener])
+    return listener

@@ -17,8 +17,11 @@ import logging
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from py_trees.common import Status
+
 from frog_bt.engine.operator import Answer, Command
 from frog_bt.model import keys
+from frog_bt.model.events import OperatorDone
 from frog_bt.model.links import LinkStatus
 from frog_bt.model.outcomes import IncidentKind, TourState
 from frog_bt.runtime.alerts import AlertBook, Facts
@@ -44,8 +47,6 @@ class Staff:
     link_since: dict[str, tuple[LinkStatus, float]] = field(default_factory=dict)
     _queue: list[Queued] = field(default_factory=list)
     _seeking_since: float | None = None
-    _given_up: list[str] = field(default_factory=list)  # stops given up this tour
-    _incidents_seen: int = 0
     _pause_ran_out: bool = False
     _touring: bool = False
 
@@ -75,10 +76,13 @@ class Staff:
         core = self.executive.core
         for queued in queue:
             if queued.command is Command.ACK_ALERT:
-                ack = self.book.acknowledge(queued.alert_id, core.clock.now())
+                now = core.clock.now()
+                ack = self.book.acknowledge(queued.alert_id, now)
                 answer = (Answer(True, f"alert {ack.id} acknowledged") if ack is not None
                           else Answer(False, f"no alert {queued.alert_id!r} to acknowledge"))
                 core.journal.note(f"operator: ack_alert {queued.alert_id}: {answer.text}")
+                self.executive.emit(OperatorDone(now, core.ticks + 1, queued.command.value,
+                                                 answer.ok, answer.text, queued.alert_id))
             else:
                 answer = core.command(queued.command)
             # a person steered the robot: always in the log (warning level reaches it)
@@ -114,16 +118,11 @@ class Staff:
         board = core.board
         touring = board.get(keys.TOUR_STATE) is TourState.STARTED
         if touring and not self._touring:  # a new tour: its one-offs start afresh
-            self._given_up.clear()
             self._pause_ran_out = False
         self._touring = touring
-        journal = core.journal
-        new = journal.incidents_since(self._incidents_seen)
-        self._incidents_seen = journal.incident_total
-        self._given_up += [i.subject for i in new if i.kind is IncidentKind.STOP_SKIPPED]
         if core.pause_ran_out is not None:
             self._pause_ran_out = True
-        seeking = any(n.status.name == "RUNNING" for n in exe.seekers)
+        seeking = any(n.status is Status.RUNNING for n in core.seekers)
         if seeking and self._seeking_since is None:
             self._seeking_since = now
         elif not seeking:
@@ -146,5 +145,5 @@ class Staff:
             seeking_since=self._seeking_since,
             gave_up=gave_up.text if gave_up is not None else "",
             docking_gave_up=gave_up is not None and gave_up.kind is IncidentKind.DOCKING_FAILED,
-            stops_given_up=tuple(self._given_up),  # one-offs: until the next tour starts
+            stops_given_up=tuple(core.journal.tally.stops_given_up()),  # until the next tour
             pause_ran_out=self._pause_ran_out)

@@ -19,32 +19,23 @@ from typing import TextIO
 import py_trees
 
 from frog_bt.engine.core import Core
+from frog_bt.engine.walk import running_path
 from frog_bt.model import keys
+from frog_bt.model.events import Event, Ticked
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.observer import Host
 
 
 def phase(core: Core) -> str:
-    """The running child of the first sequence on the running path: the tour's phase."""
-    node = core.root
-    running = py_trees.common.Status.RUNNING
-    while True:
-        if isinstance(node, py_trees.decorators.Decorator):
-            node = node.decorated
-            continue
-        # A sequence's or selector's running child is its current_child (no scan of its
-        # children: this runs after every tick when the console is on); a parallel's is
-        # whichever of them runs.
-        child = getattr(node, "current_child", None)
-        if child is None or child.status != running \
-                or isinstance(node, py_trees.composites.Parallel):
-            child = next((c for c in getattr(node, "children", ()) if c.status == running),
-                         None)
-        if child is None:
-            return node.status.value.lower()
-        if isinstance(node, py_trees.composites.Sequence):
-            return child.name
-        node = child
+    """The running child of the first sequence on the running path: the tour's phase (the
+    root's status in words when nothing runs)."""
+    parent: py_trees.behaviour.Behaviour | None = None
+    for node in running_path(core.root):
+        if isinstance(parent, py_trees.composites.Sequence):
+            return node.name
+        parent = node
+    assert parent is not None  # the path holds the root at least
+    return str(parent.status.value).lower()
 
 
 MILESTONES = (1, 2, 5)  # x 10^n: the attempt counts a journal hears of
@@ -126,10 +117,15 @@ class StatusLine:
         self.source = source
         self._last = ""
         self._drawn_at = 0.0
+        self._host: Host | None = None
 
     def attach(self, host: Host) -> None:
         """Redraw after each tick (``frog-bt run`` also refreshes it while nothing ticks)."""
-        host.taps.tick.append(self.update)
+        self._host = host
+
+    def on_event(self, event: Event) -> None:
+        if type(event) is Ticked and self._host is not None:
+            self.update(self._host.core)
 
     def update(self, core: Core | None = None) -> None:
         now = time.monotonic()

@@ -2,15 +2,17 @@
 tour's robot-side inputs served over rosbridge on the recording's own clock, and its
 front-end events sent over UDP, open loop.
 
-:func:`load` reads a recording into a :class:`Played`: the inputs (every topic the
+:func:`load` reads a recording into a :class:`Played`, through the one decoder of
+recordings (:class:`~frog_bt.recordings.reader.Reader`): the inputs (every topic the
 executive subscribes to), the front end's events (``/frontend/in`` without its acks) and
 the commands the recorded executive sent (ROS outputs; ``/frontend/out`` without acks
-and resends). A tour file of ``--record DIR`` is read after the idle file it continues
-(its ``lead_in``, as replay does); a first file that starts with a ``/frog_bt/primer``
-(an idle file of ``--record DIR``) gives its inputs first, at its start: the latest
-message of each input from before the file, which a robot that publishes on change
-would not send again. The primer's datagrams are not played (the live executive had
-them; a new one never asked for them).
+and resends). A message that does not decode is not played: it is counted, and the
+summary says how many and the first few. A tour file of ``--record DIR`` is read after
+the idle file it continues (its ``lead_in``, as replay does); a first file that starts
+with a ``/frog_bt/primer`` (an idle file of ``--record DIR``) gives its inputs first, at
+its start: the latest message of each input from before the file, which a robot that
+publishes on change would not send again. The primer's datagrams are not played (the
+live executive had them; a new one never asked for them).
 
 :class:`Player` is the I/O: the built-in rosbridge server, the front end's UDP socket
 (it acks every command, as a front end does: an ack is the protocol, not the content)
@@ -31,16 +33,24 @@ import contextlib
 import json
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from frog_bt.config import Site
-from frog_bt.errors import DecodeError, FrogError
-from frog_bt.model import channels
-from frog_bt.model.channels import FRONTEND_IN, FRONTEND_OUT
+from frog_bt.errors import FrogError
+from frog_bt.model.channels import FRONTEND_IN, FRONTEND_OUT, PRIMER, from_ns
+from frog_bt.model.frontend import message_fields
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
-from frog_bt.recordings.commands import Command, chain, without_stamp
+from frog_bt.recordings.commands import Command, chain, plain, without_stamp
+from frog_bt.recordings.reader import (
+    FrontendIn,
+    FrontendOut,
+    Primed,
+    Reader,
+    RobotCommand,
+    RobotInput,
+)
 from frog_bt.sim import msgs
 from frog_bt.sim.comparison import Comparison
 from frog_bt.sim.frontend_udp import Address, FrontendSocket
@@ -55,6 +65,7 @@ SUBSCRIBE_GRACE = 0.3  # wall seconds for its other subscriptions, after the fir
 WAIT_MAX = 60.0  # wall seconds waiting for a rosbridge client before playing anyway
 SEQ_PER_PASS = 1_000_000  # --loop: front-end seqs of pass n are the recorded ones + n x this
 PASS_TAIL = 5.0  # recording seconds of /clock after its end before a pass counts as over
+BAD_TOLD = 3  # bad messages whose reasons the summary tells (all are counted)
 
 
 class PlayError(FrogError):
@@ -73,6 +84,8 @@ class Played:
     events: list[tuple[float, bytes]]  # front-end datagrams to the executive
     commands: list[Command]  # what the recorded executive sent
     types: dict[str, str]  # the served topics' ROS types
+    bad: int = 0  # recorded messages that did not decode: not played
+    bad_first: list[str] = field(default_factory=list)  # the first few: where and why
 
 
 def load(path: Path, site: Site) -> Played:
@@ -84,67 +97,38 @@ def load(path: Path, site: Site) -> Played:
         raise PlayError(str(exc)) from exc
     served = {site.topic(role): t.type for role, t in INPUTS.items()}
     commands_on = {site.topic(role) for role in OUTPUTS}
+    reader = Reader(site, only={*served, *commands_on, FRONTEND_IN, FRONTEND_OUT, PRIMER})
     inputs: list[tuple[float, str, dict[str, Any]]] = []
     events: list[tuple[float, bytes]] = []
     commands: list[Command] = []
-    seqs: set[Any] = set()
-    start = end = None
+    seqs: set[int] = set()
     for recording in recordings:
-        for topic, ns, data in recording.messages():
-            t = ns / 1e9
-            start = t if start is None else start
-            end = t
-            if topic == channels.PRIMER:
-                if recording is recordings[0] and not inputs:
-                    inputs.extend((t, name, msg) for name, msg in _primed(data, served))
-                continue
-            if topic in served or topic in commands_on or topic in (FRONTEND_IN,
-                                                                    FRONTEND_OUT):
-                try:
-                    msg = json.loads(data)
-                except ValueError:
-                    continue
-                if not isinstance(msg, dict):
-                    continue
-                if topic in served:
-                    inputs.append((t, topic, msg))
-                elif topic in commands_on:
-                    commands.append(Command(t, topic, without_stamp(msg)))
-                elif msg.get("type") == "ack":
-                    continue
-                elif topic == FRONTEND_IN:
-                    events.append((t, bytes(data)))
-                else:
-                    seq = msg.pop("seq", None)
-                    if seq in seqs:
-                        continue  # a resend
-                    seqs.add(seq)
-                    commands.append(Command(t, FRONTEND_OUT, msg))
-    if not inputs or start is None or end is None:
+        for record in reader.read(recording):
+            if isinstance(record, RobotInput):
+                inputs.append((record.t, record.topic, record.msg()))
+            elif isinstance(record, RobotCommand):
+                commands.append(Command(record.t, record.topic, without_stamp(record.msg)))
+            elif isinstance(record, FrontendIn):
+                events.append((record.t, record.raw))
+            elif isinstance(record, FrontendOut) and record.seq not in seqs:  # not a resend
+                seqs.add(record.seq)
+                message = record.message
+                commands.append(Command(record.t, FRONTEND_OUT, plain(
+                    {"type": message.type, **message_fields(message)})))
+            elif isinstance(record, Primed) and recording is recordings[0] and not inputs:
+                # the inputs' latest messages from before the file, given at its start
+                inputs.extend((record.t, i.topic, i.msg()) for i in record.inputs)
+    if not inputs:
         raise PlayError(f"{path}: no robot-side inputs in it (is it a frog-bt recording?)")
+    tally = reader.tally
+    start = from_ns(recordings[0].start)
+    if tally.count:
+        log.warning("%d recorded message(s) did not decode and are not played; first: %s",
+                    tally.count, tally.first[0].line(start))
     types = dict(served)
     types[CLOCK.name] = CLOCK.type
-    return Played([str(r.path) for r in recordings], start, end, inputs, events, commands,
-                  types)
-
-
-def _primed(data: bytes, served: dict[str, str]) -> list[tuple[str, dict[str, Any]]]:
-    """A ``/frog_bt/primer``'s inputs on served topics, as (topic, msg); none when it is
-    malformed (the file's own inputs follow anyway)."""
-    try:
-        primer = channels.decode(channels.PRIMER, bytes(data))
-    except DecodeError:
-        log.warning("a malformed /frog_bt/primer: played without it")
-        return []
-    primed = []
-    for entry in primer.inputs:
-        try:
-            msg = json.loads(bytes(entry.msg))
-        except ValueError:
-            continue
-        if entry.topic in served and isinstance(msg, dict):
-            primed.append((entry.topic, msg))
-    return primed
+    return Played([str(r.path) for r in recordings], start, from_ns(recordings[-1].end),
+                  inputs, events, commands, types, tally.count, tally.lines(start)[:BAD_TOLD])
 
 
 class Player:
@@ -198,8 +182,12 @@ class Player:
     def summary(self) -> str:
         """``played 3893 inputs and 11 front-end events; commands: ...`` (so far)."""
         passes = f" ({self.passes} whole passes)" if self.loop else ""
+        bad = ""
+        if self.played.bad:
+            bad = (f"; {self.played.bad} recorded message(s) did not decode, not played "
+                   f"({'; '.join(self.played.bad_first)})")
         return (f"played {self.inputs_sent} inputs and {self.events_sent} front-end "
-                f"events{passes}; {self.comparison.line()}")
+                f"events{passes}; {self.comparison.line()}{bad}")
 
     async def _wait_for_executive(self) -> None:
         """Until a client subscribes to a topic it serves (then a moment for its other
@@ -308,9 +296,9 @@ def restamped(msg: dict[str, Any], offset: float) -> dict[str, Any]:
     (``--loop``: a later pass keeps its stamps in step with its ``/clock``); ``msg``
     itself when there is nothing to move."""
     header = msg.get("header")
-    stamp = header.get("stamp") if isinstance(header, dict) else None
-    if not offset or not isinstance(stamp, dict):
+    if not offset or not isinstance(header, dict) or not isinstance(header.get("stamp"), dict):
         return msg
+    stamp = header["stamp"]
     for secs, nsecs in (("secs", "nsecs"), ("sec", "nanosec")):  # ROS 1, ROS 2
         s, n = stamp.get(secs), stamp.get(nsecs)
         if isinstance(s, int) and isinstance(n, int):

@@ -15,7 +15,7 @@ from test_faults import is_
 
 from frog_bt.commands.console_options import console_settings
 from frog_bt.errors import UsageError
-from frog_bt.live.console.server import RateLimit
+from frog_bt.live.console.server import ACCESS, RateLimit
 from frog_bt.model import keys
 
 
@@ -43,7 +43,7 @@ def test_every_command_and_every_refusal() -> None:
     async def main() -> list[tuple[int, dict[str, object]]]:
         async with console_tour(once=False) as (run, people, url):
             assert people.console is not None
-            people.console.limit = RateLimit(1000.0)  # this test is not about the rate
+            people.console.app[ACCESS].limit = RateLimit(1000.0)  # not about the rate
             out = []
             async with aiohttp.ClientSession() as s:
                 await run.sim.wait_for(is_("tour", state="started"), 60)
@@ -78,7 +78,8 @@ def test_auth_bad_input_size_and_rate_are_refused_with_one_line_and_change_nothi
     async def main() -> list[tuple[int, str]]:
         async with console_tour() as (run, people, url):
             assert people.console is not None
-            people.console.limit = RateLimit(2.0, clock=lambda: 0.0)  # time stands still
+            # two commands a second, and time stands still
+            people.console.app[ACCESS].limit = RateLimit(2.0, clock=lambda: 0.0)
             await run.sim.wait_for(is_("start_poi", poi="POI1", part="a"), 60)
             out = []
             async with aiohttp.ClientSession() as s:

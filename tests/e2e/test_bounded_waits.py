@@ -9,6 +9,9 @@ from collections import Counter
 
 from tour import Running, tour
 
+from frog_bt.model.events import Datagram
+from frog_bt.runtime.observer import listen
+
 
 def test_lost_finish_introduction_asks_anyway_and_the_tour_completes():
     t = tour({"frontend": {"never_sends": ["finish_introduction"]}})
@@ -52,7 +55,7 @@ def test_a_lone_visitor_whose_approach_always_fails_is_tried_once_a_minute():
 async def _lossy_tour() -> tuple[Running, list[tuple[str, bytes]]]:
     datagrams: list[tuple[str, bytes]] = []
     async with Running({"frontend": {"loss": 0.2}, "seed": 3}, once=True) as run:
-        run.executive.wire.datagram.append(lambda d, data, _t: datagrams.append((d, data)))
+        listen(run.executive, lambda e: datagrams.append((e.direction, e.data)), Datagram)
         await run.finish(90)
     return run, datagrams
 

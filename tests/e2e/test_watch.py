@@ -12,6 +12,7 @@ from tour import Running, after_ticks
 from frog_bt import resources
 from frog_bt.behaviours import load_tree
 from frog_bt.config import load_site
+from frog_bt.engine.operator import Command
 from frog_bt.model import keys
 from frog_bt.model.outcomes import TourState
 from frog_bt.runtime.watch import Watch
@@ -108,3 +109,60 @@ def test_a_change_of_links_or_topics_is_refused_it_takes_a_restart(tmp_path: Pat
             assert exe.swaps == 0 and exe.core.tree is tree
 
     asyncio.run(main())
+
+
+# ------------------------------------------------------------------ what outlives a tree
+
+
+def test_a_reload_keeps_what_people_decided(tmp_path: Path) -> None:
+    """Out of service, an acknowledged alert, the front end's events and the decision
+    journal: a reload builds a new core and keeps every one of them."""
+    tour_file = copy_trees(tmp_path)
+    site = load_site()
+    tree = load_tree(tour_file, site)
+
+    async def main() -> None:
+        async with Running({"frontend": {"idle_at": 10_000}}, site=site, tree=tree) as run:
+            exe = run.executive
+            await after_ticks(exe, lambda: bool(exe.core.ticks and exe.idle()))
+            assert (await exe.staff.submit(Command.SERVICE_OFF)).ok
+            run.sim.world.battery.percentage = 20.0  # below alerts.battery_below
+            await after_ticks(exe, lambda: "battery_low" in exe.staff.book.active)
+            assert (await exe.staff.submit(Command.ACK_ALERT, "battery_low")).ok
+            notes = len(exe.core.journal.notes)
+            old = exe.core
+
+            exe.offer(site, load_tree(tour_file, site))
+            await after_ticks(exe, lambda: exe.swaps == 1)
+            core = exe.core
+            assert core is not old and core.board.get(keys.IN_SERVICE) is False
+            assert core.journal is old.journal and len(core.journal.notes) > notes  # kept
+            assert any("tree reloaded" in n.text for n in core.journal.notes)
+            book = exe.staff.book  # still up, and still acknowledged: not shown again
+            assert "battery_low" in book.active and "battery_low" not in book.unacknowledged
+            answer = await exe.staff.submit(Command.SERVICE_OFF)
+            assert not answer.ok and "already out of service" in answer.text
+
+    asyncio.run(main())
+
+
+def test_a_reload_keeps_a_pause_and_its_timer() -> None:
+    """Two cores of one executive share its standing state: a pause set on the first is
+    the second's, and its bound still counts from when it was asked for."""
+    from bench import Bench
+
+    from frog_bt.engine.core import Core
+
+    bench = Bench(load_tree(None, load_site()))
+    first = bench.core
+    first.board.set(keys.TOUR_STATE, TourState.STARTED)
+    assert first.command(Command.PAUSE).ok
+    paused_at = bench.clock.now()
+    second = Core(bench.site, load_tree(None, bench.site), bench.clock, first._publish_topic,
+                  first._send, standing=first.standing)
+    assert second.board.get(keys.PAUSED) is True
+    assert second.operator.paused_since == paused_at
+    assert not second.command(Command.PAUSE).ok  # already paused, in the new tree too
+    bench.clock.advance(bench.site.operator.pause_max)
+    reason = second.operator.check_pause(bench.clock.now())
+    assert reason is not None and "paused longer than" in reason.text

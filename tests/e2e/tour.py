@@ -14,8 +14,10 @@ from typing import Any
 
 from frog_bt.config import Site, load_site
 from frog_bt.live.summary import TourSummary
+from frog_bt.model.events import FrontendOut, RobotCommand, Ticked
 from frog_bt.rehearsal import Rehearsal, free_udp_port
 from frog_bt.runtime.executive import Executive, Outcome
+from frog_bt.runtime.observer import attach_all, listen
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.traffic import Record
@@ -65,15 +67,15 @@ async def after_ticks(exe: Executive, condition: Callable[[], bool], wall: float
         return
     held = asyncio.Event()
 
-    def check(_core: object) -> None:
+    def check(_event: object) -> None:
         if condition():
             held.set()
 
-    exe.taps.tick.append(check)
+    listener = listen(exe, check, Ticked)
     try:
         await asyncio.wait_for(held.wait(), wall)
     finally:
-        exe.taps.tick.remove(check)
+        exe.observers.detach(listener)
 
 
 def describe(record: Record, summary: TourSummary) -> str:
@@ -103,9 +105,9 @@ class Running(Rehearsal):
                          **executive_kwargs)
 
     def _prepare(self, executive: Executive) -> None:
-        self.summary.attach(executive)
-        executive.taps.frontend_out.append(lambda t, _type, m: self.sent.append((t, m)))
-        executive.taps.ros_out.append(lambda t, out: self.published.append((t, out.topic)))
+        attach_all(executive, [self.summary])
+        listen(executive, lambda e: self.sent.append((e.t, e.message)), FrontendOut)
+        listen(executive, lambda e: self.published.append((e.t, e.topic)), RobotCommand)
 
     def tour(self) -> Tour:
         return Tour(self.sim, self.executive, self.executive.outcome, self.summary, self.site,

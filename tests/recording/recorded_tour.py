@@ -12,8 +12,10 @@ from typing import Any
 from frog_bt.config import Site, load_site
 from frog_bt.live.recording import Recorder
 from frog_bt.live.rotation import RecordingDir
+from frog_bt.model.events import Ticked
 from frog_bt.rehearsal import Rehearsal
 from frog_bt.runtime.executive import Executive, Outcome
+from frog_bt.runtime.observer import attach_all, listen
 from frog_bt.sim import scenario_from
 from frog_bt.sim.scenario import Scenario
 from frog_bt.sim.traffic import Record
@@ -42,7 +44,7 @@ async def _record(path: Path, data: dict[str, Any] | None, site: Site | None,
                   tree: LoadedTree | None, wall_timeout: float) -> RecordedTour:
     site = site or load_site()
     recorder = Recorder(path)
-    rehearsal = Rehearsal(scenario(data), site=site, tree=tree, prepare=recorder.attach)
+    rehearsal = Rehearsal(scenario(data), site=site, tree=tree, prepare=lambda exe: attach_all(exe, [recorder]))
     start = rehearsal.sim.clock.now()
     try:
         async with rehearsal:
@@ -76,9 +78,9 @@ def record_day(directory: Path, tours: int, max_bytes: int) -> RecordingDir:
         enough = asyncio.Event()
 
         def prepare(executive: Any) -> None:
-            recordings.attach(executive)
-            executive.taps.tick.append(
-                lambda _core: executive.outcome.tours >= tours and enough.set())
+            attach_all(executive, [recordings])
+            listen(executive, lambda _e: executive.outcome.tours >= tours and enough.set(),
+                   Ticked)
 
         rehearsal = Rehearsal(scenario_from("default", FAST_TOURS), site=load_site(),
                               prepare=prepare, once=False)

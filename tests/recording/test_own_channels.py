@@ -22,6 +22,7 @@ from frog_bt.live.recording import Recorder
 from frog_bt.model import channels
 from frog_bt.offline.replay import Replay
 from frog_bt.rehearsal import Rehearsal
+from frog_bt.runtime.observer import attach_all
 
 
 def is_(channel: str, **fields: object):  # type: ignore[no-untyped-def]
@@ -32,7 +33,7 @@ def is_(channel: str, **fields: object):  # type: ignore[no-untyped-def]
 async def _record_with_commands(path: Path) -> list[tuple[bool, str]]:
     site = load_site()
     recorder = Recorder(path)
-    rehearsal = Rehearsal(scenario(), site=site, prepare=recorder.attach)
+    rehearsal = Rehearsal(scenario(), site=site, prepare=lambda exe: attach_all(exe, [recorder]))
     answers = []
     try:
         async with rehearsal:
@@ -130,4 +131,4 @@ def test_a_bad_message_of_our_channels_is_counted_and_reported(commanded: Path,
     assert result.bad[0].endswith("channel: expected `str`, got `int`")
     assert main(["replay", str(bad), "--quiet"]) == 0
     out = capsys.readouterr().out
-    assert "note: 1 bad message(s) of frog-bt's own channels, skipped:" in out
+    assert "note: 1 bad message(s) in the recording, skipped:" in out

@@ -7,6 +7,7 @@ import json
 import signal
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -19,7 +20,6 @@ from rosmsgs import encode_clock
 
 from frog_bt.clock import SimClock
 from frog_bt.config import load_site
-from frog_bt.engine.core import Taps
 from frog_bt.live.recording import Recorder
 from frog_bt.model.channels import (
     DATAGRAM_TYPE,
@@ -30,9 +30,11 @@ from frog_bt.model.channels import (
     schema_for,
     to_ns,
 )
+from frog_bt.model.events import Datagram, RobotInput
+from frog_bt.model.links import Links, LinkStatus
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rehearsal import free_udp_port
-from frog_bt.runtime.executive import WireTaps
+from frog_bt.runtime.observer import Observers, attach_all
 from frog_bt.sim import Simulator
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -122,18 +124,30 @@ def test_a_recorded_tour_has_every_channel_typed_and_stamped(tour: RecordedTour)
 
 def fake_executive() -> Any:
     site = load_site()
-    taps = Taps()
-    return SimpleNamespace(site=site, sim_time=True, clock=SimClock(), wire=WireTaps(),
-                           taps=taps, core=SimpleNamespace(tree=None), links=None)
+    links = Links(LinkStatus.CONNECTED, LinkStatus.ACKING, LinkStatus.SIM)
+    return SimpleNamespace(site=site, sim_time=True, clock=SimClock(), observers=Observers(),
+                           core=SimpleNamespace(tree=None), links=links)
+
+
+def wire_of(executive: Any) -> tuple[Callable[[str, bytes, float], None],
+                                     Callable[[float, str, Any], None]]:
+    """(datagram(direction, data, t), ros_in(t, topic, msg)): raw traffic as the live
+    executive tells its observers."""
+    def datagram(direction: str, data: bytes, t: float) -> None:
+        executive.observers.emit(Datagram(t, "in" if direction == "in" else "out", data))
+
+    def ros_in(t: float, topic: str, msg: Any) -> None:
+        executive.observers.emit(RobotInput(t, topic, None, msg))
+
+    return datagram, ros_in
 
 
 def test_what_arrives_before_the_first_clock_is_stamped_with_it(tmp_path: Path) -> None:
     path = tmp_path / "early.mcap"
     executive = fake_executive()
     with Recorder(path) as recorder:
-        recorder.attach(executive)
-        (datagram,) = executive.wire.datagram
-        (ros_in,) = executive.wire.ros_in
+        attach_all(executive, [recorder])
+        datagram, ros_in = wire_of(executive)
         datagram("in", b'{"type":"frontend_idle","seq":1}', 0.0)
         ros_in(0.0, "/docking/state", {"data": "docked"})
         ros_in(0.0, "/clock", encode_clock(1_780_000_000.5))
@@ -156,8 +170,9 @@ def test_a_crash_still_leaves_valid_mcap(tmp_path: Path) -> None:
     path = tmp_path / "crash.mcap"
     code = ("import sys; from pathlib import Path\n"
             "from frog_bt.live.recording import Recorder\n"
+            "from frog_bt.model.events import Datagram\n"
             "r = Recorder(Path(sys.argv[1]))\n"
-            "r.on_datagram('out', b'{\"type\":\"tour\",\"seq\":1}', 1.0)\n"
+            "r.on_event(Datagram(1.0, 'out', b'{\"type\":\"tour\",\"seq\":1}'))\n"
             "raise RuntimeError('boom')\n")
     proc = subprocess.run([sys.executable, "-c", code, str(path)], cwd=ROOT,
                           capture_output=True, text=True, timeout=30)
@@ -215,8 +230,8 @@ def test_what_was_flushed_survives_a_kill(tmp_path: Path) -> None:
         executive = fake_executive()
         executive.clock.set(1_780_000_000.0)
         recorder = Recorder(path, flush_every=0.0)
-        recorder.attach(executive)
-        (datagram,) = executive.wire.datagram
+        attach_all(executive, [recorder])
+        datagram, _ = wire_of(executive)
         for i in range(1, 31):
             datagram("in", b'{"type":"frontend_idle","seq":%d}' % i, 1_780_000_000.0 + i)
             await asyncio.sleep(0)  # the drain runs once this callback is over

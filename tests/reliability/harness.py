@@ -21,9 +21,11 @@ from typing import Any
 
 from frog_bt.config import Site, load_site
 from frog_bt.live.summary import TourSummary
+from frog_bt.model.events import RobotCommand
 from frog_bt.rehearsal import Rehearsal
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.executive import Executive
+from frog_bt.runtime.observer import attach_all, listen
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.sim.traffic import Record
 
@@ -55,9 +57,9 @@ class TourRun(Rehearsal):
                          sim_secret=sim_secret, secret=secret, prepare=self._prepare)
 
     def _prepare(self, exe: Executive) -> None:
-        self.summary.attach(exe)
-        exe.taps.ros_out.append(
-            lambda t, out: self._add(Published(t, out.topic, out.msg, exe.client.link.connected)))
+        attach_all(exe, [self.summary])
+        listen(exe, lambda out: self._add(Published(out.t, out.topic, out.msg,
+                                                    exe.client.link.connected)), RobotCommand)
         on_link = exe.client.on_link
 
         def link_changed(state: LinkState) -> None:

@@ -30,6 +30,8 @@ from harness import TourRun, received
 from frog_bt.config import DEFAULT_CONFIG, Site, load_site
 from frog_bt.frontend.protocol import Endpoint
 from frog_bt.model import frontend as fm
+from frog_bt.model.events import Datagram, FrontendIn
+from frog_bt.runtime.observer import listen
 from frog_bt.sim.frontend import FrontendModel
 from frog_bt.sim.scenario import parse_scenario
 
@@ -68,12 +70,12 @@ def test_front_end_that_never_acks_gets_eight_sends_then_a_warning(
         async with TourRun({"frontend": {"ack": False}}) as run:
             sends: Counter[int] = Counter()
 
-            def count(direction: str, data: bytes, t: float) -> None:
-                obj = json.loads(data)
-                if direction == "out" and obj["type"] != "ack":
+            def count(event: Datagram) -> None:
+                obj = json.loads(event.data)
+                if event.direction == "out" and obj["type"] != "ack":
                     sends[obj["seq"]] += 1
 
-            run.executive.wire.datagram.append(count)
+            listen(run.executive, count, Datagram)
             outcome = await run.finish()
             assert outcome.code == 0, outcome.reason
             stats, pending = run.executive.link.stats, run.executive.link.pending
@@ -138,7 +140,7 @@ def test_front_end_restart_mid_tour_starts_no_second_tour() -> None:
         async with TourRun() as run:
             sim, exe = run.sim, run.executive
             heard: list[str] = []
-            exe.taps.frontend_in.append(lambda t, type_, message: heard.append(type_))
+            listen(exe, lambda e: heard.append(e.message.type), FrontendIn)
             await sim.wait_for(received("/GotoWayPoint", since=0.0,
                                         where=lambda p: run.summary.waypoint_of(p) == "POI1a"),
                                30)

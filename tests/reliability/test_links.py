@@ -9,7 +9,9 @@ from pathlib import Path
 from harness import TourRun
 
 from frog_bt.live.telemetry import Telemetry
+from frog_bt.model.events import LinksChanged
 from frog_bt.model.links import Links, frontend_state
+from frog_bt.runtime.observer import attach_all, listen
 
 
 def test_front_end_state_needs_a_command_waiting_and_a_quiet_peer() -> None:
@@ -34,13 +36,13 @@ def test_an_outage_and_a_silent_front_end_show_as_link_states(tmp_path: Path) ->
         async with TourRun({"speed": 200}) as run:
             sim, exe = run.sim, run.executive
             telemetry = Telemetry.open(f"save:{rrd}", exe.site, exe.core.tree)
-            telemetry.attach(exe)
+            attach_all(exe, [telemetry])
 
-            def on_links(t: float, links: Links) -> None:
-                seen.append((t, links))
+            def on_links(event: LinksChanged) -> None:
+                seen.append((event.t, event.links))
                 lines.append(exe.status_text())
 
-            exe.wire.links.append(on_links)
+            listen(exe, on_links, LinksChanged)
             await sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 30)
             await run.outage(until=asyncio.sleep(0))
             await sim.wait_for(lambda r: r.direction == "in" and r.channel == "start_poi", 30)

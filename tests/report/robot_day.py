@@ -20,7 +20,9 @@ from typing import Any
 from frog_bt.config import load_site
 from frog_bt.engine.operator import Command
 from frog_bt.live.rotation import RecordingDir
+from frog_bt.model.events import FrontendIn
 from frog_bt.rehearsal import Rehearsal
+from frog_bt.runtime.observer import attach_all, listen
 from frog_bt.sim import scenario_from
 from frog_bt.sim.traffic import Record
 
@@ -94,8 +96,8 @@ def _is(channel: str, **fields: Any) -> Callable[[Record], bool]:
 
 async def _home_after_a_no(r: Rehearsal) -> None:
     no = asyncio.Event()
-    r.executive.taps.frontend_in.append(
-        lambda _t, type_, _m: no.set() if type_ == "user_negative" else None)
+    listen(r.executive, lambda e: no.set() if e.message.type == "user_negative" else None,
+           FrontendIn)
     await asyncio.wait_for(no.wait(), 60)  # the executive has the visitor's no
     assert r.executive.core.command(Command.HOME).ok
 
@@ -142,7 +144,7 @@ async def _tour(directory: Path, kind: str) -> Seen:
     data = _merge(_merge(FAST, overrides), {"start_time": start + "+02:00"})
     site = load_site()
     recordings = RecordingDir(directory, 10**12)
-    run = Rehearsal(scenario_from(name, data), site=site, prepare=recordings.attach)
+    run = Rehearsal(scenario_from(name, data), site=site, prepare=lambda exe: attach_all(exe, [recordings]))
     try:
         async with run:
             action = ACTIONS.get(kind)
@@ -161,7 +163,7 @@ async def _resumed(directory: Path, checkpoint: Path) -> Seen:
     site = load_site()
     first = RecordingDir(directory, 10**12)
     run = Rehearsal(scenario_from(name, _merge(FAST, {"start_time": start + "+02:00"})),
-                    site=site, prepare=first.attach, checkpoint=checkpoint, once=False)
+                    site=site, prepare=lambda exe: attach_all(exe, [first]), checkpoint=checkpoint, once=False)
     try:
         async with run:
             sim, listen = run.sim, run.listen
@@ -170,7 +172,7 @@ async def _resumed(directory: Path, checkpoint: Path) -> Seen:
     finally:
         first.close()
     second = RecordingDir(directory, 10**12)
-    again = Rehearsal(None, sim=sim, listen=listen, site=site, prepare=second.attach,
+    again = Rehearsal(None, sim=sim, listen=listen, site=site, prepare=lambda exe: attach_all(exe, [second]),
                       checkpoint=checkpoint)
     try:
         async with again:

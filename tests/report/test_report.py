@@ -18,8 +18,12 @@ import pytest
 
 from frog_bt.cli import main
 from frog_bt.config import load_site
-from frog_bt.offline.report.facts import FileFacts, Piece, StopFacts, _Reader
+from frog_bt.model import channels
+from frog_bt.model.frontend import AskTour, FinishPoi, StartPoi, Tour, UserPositive
+from frog_bt.offline.report.facts import FileFacts, Piece, StopFacts, _Pieces
 from frog_bt.offline.report.rows import join, rows
+from frog_bt.recordings.reader import FrontendIn, FrontendOut, Primed
+from frog_bt.runtime.observer import attach_all
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 from corpus_run import make
@@ -201,19 +205,19 @@ def test_a_tour_file_opening_with_the_tour_befores_end_resent_is_read_whole() ->
     is still being resent when the next tour's file opens, after its `tour started`
     (seq 7, acked at once). What follows in that file is the new tour's."""
     site = load_site()
-    idle = _Reader("r/1-idle.mcap", site)
+    idle = _Pieces("r/1-idle.mcap", site)
     idle.first(100.0)
-    idle.own(100.0, "/frog_bt/primer", {"frontend_out_seqs": [4, 5, 6]})
-    idle.frontend_out(101.0, {"type": "tour", "seq": 7, "state": "started"})
-    tour = _Reader("r/2-tour.mcap", site)
+    idle.take(Primed(100.0, channels.Primer(frontend_out_seqs=[4, 5, 6]), ()))
+    idle.take(FrontendOut(101.0, 7, Tour("started", ""), b""))
+    tour = _Pieces("r/2-tour.mcap", site)
     tour.first(101.1)
-    tour.frontend_out(101.2, {"type": "tour", "seq": 5, "state": "ended", "reason": ""})
-    tour.frontend_out(130.0, {"type": "ask_tour", "seq": 9, "engaged": True})
-    tour.frontend_in(131.0, {"type": "user_positive", "seq": 3})
-    tour.frontend_out(150.0, {"type": "start_poi", "seq": 10, "poi": "POI1",
-                              "waypoint": "POI1a", "part": "a"})
-    tour.frontend_out(170.0, {"type": "finish_poi", "seq": 11, "poi": "POI1"})
-    tour.frontend_out(300.0, {"type": "tour", "seq": 20, "state": "ended", "reason": ""})
+    for record in (FrontendOut(101.2, 5, Tour("ended", ""), b""),
+                   FrontendOut(130.0, 9, AskTour(True), b""),
+                   FrontendIn(131.0, 3, UserPositive(), b""),
+                   FrontendOut(150.0, 10, StartPoi("POI1", "POI1a", "a"), b""),
+                   FrontendOut(170.0, 11, FinishPoi("POI1"), b""),
+                   FrontendOut(300.0, 20, Tour("ended", ""), b"")):
+        tour.take(record)
     files = [FileFacts("r/1-idle.mcap", idle.finish(), restarts=[]),
              FileFacts("r/2-tour.mcap", tour.finish())]
     (row,) = rows(files, site)
@@ -258,7 +262,7 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
 
     async def run() -> None:
         first_files = RecordingDir(day, 10**9)
-        first = Rehearsal(scenario, site=load_site(), prepare=first_files.attach,
+        first = Rehearsal(scenario, site=load_site(), prepare=lambda exe: attach_all(exe, [first_files]),
                           checkpoint=checkpoint, once=False)
         async with first:
             await first.sim.wait_for(lambda r: r.channel == "start_poi"
@@ -268,7 +272,7 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
         second_files = RecordingDir(day, 10**9)
         try:
             async with Rehearsal(None, site=load_site(), sim=first.sim, listen=first.listen,
-                                 prepare=second_files.attach, checkpoint=checkpoint) as second:
+                                 prepare=lambda exe: attach_all(exe, [second_files]), checkpoint=checkpoint) as second:
                 outcome = await second.finish()
                 assert outcome.code == 0, outcome.reason
         finally:

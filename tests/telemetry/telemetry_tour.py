@@ -22,6 +22,7 @@ from frog_bt.config import Site, load_site
 from frog_bt.live.telemetry import Telemetry
 from frog_bt.rehearsal import Rehearsal
 from frog_bt.runtime.executive import Outcome
+from frog_bt.runtime.observer import attach_all
 from frog_bt.tree.loader import LoadedTree
 
 
@@ -64,7 +65,7 @@ async def _run_tour(path: Path) -> Recorded:
     tree = load_tree(site=site)
     telemetry = Telemetry.open(f"save:{path}", site, tree)
     rehearsal = Rehearsal(fast(), site=site, tree=tree,
-                          prepare=lambda executive: telemetry.attach(executive))
+                          prepare=lambda executive: attach_all(executive, [telemetry]))
     try:
         async with rehearsal:
             outcome = await rehearsal.finish(60.0)

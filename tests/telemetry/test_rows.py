@@ -13,6 +13,7 @@ from frog_bt.live.telemetry.layout import TreeIndex
 from frog_bt.live.telemetry.rows import Rows
 from frog_bt.model.frontend import FrontendIdle
 from frog_bt.model.outcomes import IncidentKind, Level
+from frog_bt.runtime.observer import attach_all
 
 S = py_trees.common.Status
 TREE = """
@@ -34,7 +35,7 @@ def bench(tmp_path: Path) -> Bench:
 
 def rows_on(bench: Bench, **kwargs: object) -> Rows:
     rows = Rows(bench.site, TreeIndex.of(bench.core.tree.root), **kwargs)  # type: ignore[arg-type]
-    rows.attach(bench.core)
+    bench.observers.attach(bench, [rows])  # type: ignore[list-item]
     return rows
 
 
@@ -100,7 +101,7 @@ def test_rows_ask_to_be_written_every_batch_ticks_and_stop_after_detach(bench: B
             rows.drain()
     assert calls == [3, 6]
     rows.detach()
-    assert rows.core is None and rows.tick not in bench.core.taps.tick
+    assert rows.core is None
     bench.pose(0.0, 0.0)
     bench.tick()
     assert rows.batch.poses == [] and rows.batch.statuses == []
@@ -111,7 +112,7 @@ def test_telemetry_over_a_core_ticked_by_hand(bench: Bench, tmp_path: Path):
 
     path = tmp_path / "hand.rrd"
     telemetry = Telemetry.open(f"save:{path}", bench.site, bench.core.tree)
-    telemetry.attach(bench)
+    attach_all(bench, [telemetry])
     bench.pose(104.0, 32.0)
     bench.tick(2)
     bench.event(FrontendIdle())

@@ -1,6 +1,7 @@
 """The operator's console over HTTP (CONTRACT §7), in the executive's own event loop.
 
-aiohttp serves (``web.AppRunner`` + ``TCPSite``):
+:func:`make_app` builds the aiohttp application, :class:`Console` runs it
+(``web.AppRunner`` + ``TCPSite``). The routes, all in :data:`ROUTES`:
 
 * ``GET /`` — the page (one file, no build step, nothing fetched from elsewhere);
 * ``GET /api/state`` — the state (:func:`frog_bt.live.console.state.state`);
@@ -16,6 +17,12 @@ Every refusal is one line of JSON ``{"ok": false, "reason": ...}`` and changes n
 The token is compared in constant time and never logged or recorded. Reads need no token
 while the console listens on loopback; elsewhere they need it too (and the console does
 not start on such an address without a token file).
+
+What one console keeps lives in its application, under typed keys: :data:`EXECUTIVE`,
+:data:`ACCESS` (who may do what), :data:`SHOWN` (the day, the log lines, the stop clock)
+and :data:`PAGES` (the open WebSockets). Its lifetime is the application's: the log
+handler and the pusher start with it and end with it (``cleanup_ctx``), the pages are
+closed, within :data:`CLOSE_TIMEOUT`, as it shuts down (``on_shutdown``).
 """
 
 from __future__ import annotations
@@ -27,11 +34,12 @@ import ipaddress
 import json
 import logging
 import time
-from collections.abc import Awaitable, Callable
+from collections.abc import AsyncIterator, Awaitable, Callable
+from dataclasses import dataclass, field
 from importlib import resources
 from typing import TYPE_CHECKING, Any
 
-from aiohttp import WSMsgType, web
+from aiohttp import WSCloseCode, WSMsgType, web
 
 from frog_bt.engine.operator import Command
 from frog_bt.live.console.day import Day
@@ -45,7 +53,7 @@ log = logging.getLogger(__name__)
 Handler = Callable[[web.Request], Awaitable[web.StreamResponse]]
 SEND_TIMEOUT = 2.0  # seconds a pushed state may take to reach one page; then it is dropped
 PHASE_POLL = 0.05  # wall seconds between looks at the phase (a new one is pushed at once)
-CLOSE_TIMEOUT = 1.0  # seconds the server waits for open requests when it stops
+CLOSE_TIMEOUT = 1.0  # seconds the pages, then the open requests, get when the console stops
 
 
 def is_loopback(host: str) -> bool:
@@ -80,188 +88,281 @@ class RateLimit:
         return False
 
 
+# ---------------------------------------------------------------- one console's state
+
+
+@dataclass
+class Access:
+    """Who may do what: the staff token (None: commands are off), whether reads are open
+    (on loopback), the largest body and the command rate."""
+
+    token: str | None
+    loopback: bool
+    max_body: int
+    limit: RateLimit
+
+
+@dataclass
+class Shown:
+    """What the page shows beside the executive's own state."""
+
+    day: Day
+    logs: LogLines
+    stop_clock: StopClock
+
+
+@dataclass
+class Pages:
+    """The open pages, and the nudge that pushes the state to them at once."""
+
+    push_every: float
+    sockets: set[web.WebSocketResponse] = field(default_factory=set)
+    changed: asyncio.Event = field(default_factory=asyncio.Event)
+
+
+EXECUTIVE: web.AppKey[Executive] = web.AppKey("executive")
+ACCESS = web.AppKey("access", Access)
+SHOWN = web.AppKey("shown", Shown)
+PAGES = web.AppKey("pages", Pages)
+
+
+def snapshot(app: web.Application) -> dict[str, Any]:
+    shown = app[SHOWN]
+    return state(app[EXECUTIVE], shown.day, shown.logs, shown.stop_clock)
+
+
+# ---------------------------------------------------------------- guard
+
+
+def authorised(access: Access, request: web.Request) -> bool:
+    """The bearer token, compared in constant time (a page's reads, whose WebSocket
+    cannot send a header, may give it as ``?token=`` instead)."""
+    if access.token is None:
+        return False
+    scheme, _, value = request.headers.get("Authorization", "").partition(" ")
+    if scheme.lower() != "bearer" and request.method == "GET":
+        value = request.query.get("token", "")
+    return hmac.compare_digest(value.strip().encode(), access.token.encode())
+
+
+@web.middleware
+async def guard(request: web.Request, handler: Handler) -> web.StreamResponse:
+    """Auth, size and refusals as one line of JSON, in one place."""
+    access = request.app[ACCESS]
+    needs_token = request.method != "GET" or not access.loopback
+    if needs_token and request.path.startswith("/api") and not authorised(access, request):
+        return refuse(401, "a valid token is needed (Authorization: Bearer TOKEN)"
+                      if access.token is not None else
+                      "commands are off: the console was started without a token file")
+    if request.content_length is not None and request.content_length > access.max_body:
+        return refuse(413, f"request body over {access.max_body} bytes")
+    try:
+        return await handler(request)
+    except web.HTTPRequestEntityTooLarge:
+        return refuse(413, f"request body over {access.max_body} bytes")
+    except web.HTTPException as exc:
+        if exc.status >= 400:
+            return refuse(exc.status, exc.reason)
+        raise
+
+
+# ---------------------------------------------------------------- reads
+
+
+async def get_page(_request: web.Request) -> web.Response:
+    page = resources.files("frog_bt.live.console").joinpath("page.html").read_text("utf-8")
+    return web.Response(text=page, content_type="text/html")
+
+
+async def get_state(request: web.Request) -> web.Response:
+    return web.json_response(snapshot(request.app))
+
+
+async def get_site(request: web.Request) -> web.Response:
+    return web.json_response(site_map(request.app[EXECUTIVE]))
+
+
+async def get_tree(request: web.Request) -> web.Response:
+    return web.json_response(tree(request.app[EXECUTIVE].core.root))
+
+
+# ---------------------------------------------------------------- pushed state
+
+
+async def get_stream(request: web.Request) -> web.WebSocketResponse:
+    pages = request.app[PAGES]
+    ws = web.WebSocketResponse(heartbeat=30.0)
+    await ws.prepare(request)
+    pages.sockets.add(ws)
+    try:
+        await ws.send_str(json.dumps(snapshot(request.app)))
+        async for message in ws:  # the page sends nothing; this waits for it to go
+            if message.type == WSMsgType.ERROR:
+                break
+    finally:
+        pages.sockets.discard(ws)
+    return ws
+
+
+async def push(app: web.Application) -> None:
+    """The state to every page every ``push_every`` seconds, and within
+    :data:`PHASE_POLL` of a new phase or a command; a page that does not take it within
+    :data:`SEND_TIMEOUT` is dropped. The phase is looked at here, between ticks, not
+    after each tick: the console costs the tick nothing."""
+    loop = asyncio.get_running_loop()
+    pages, core = app[PAGES], app[EXECUTIVE].core
+    last, last_at, last_phase = "", 0.0, ""
+    while True:
+        # asyncio.timeout, not wait_for: on Python 3.11 wait_for can swallow a cancel
+        # that meets the event being set, and the cleanup would then wait for ever
+        with contextlib.suppress(TimeoutError):
+            async with asyncio.timeout(PHASE_POLL):
+                await pages.changed.wait()
+        now_phase = phase(core)
+        due = (pages.changed.is_set() or now_phase != last_phase
+               or loop.time() - last_at >= pages.push_every)
+        pages.changed.clear()
+        last_phase = now_phase
+        if not due or not pages.sockets:
+            continue
+        last_at = loop.time()
+        text = json.dumps(snapshot(app))
+        if text == last:
+            continue
+        last = text
+        for ws in list(pages.sockets):
+            try:
+                async with asyncio.timeout(SEND_TIMEOUT):
+                    await ws.send_str(text)
+            except (TimeoutError, ConnectionError, RuntimeError):
+                pages.sockets.discard(ws)
+                with contextlib.suppress(Exception):
+                    await ws.close()
+
+
+# ---------------------------------------------------------------- commands
+
+
+async def post_command(request: web.Request) -> web.Response:
+    try:
+        body = await request.json()
+    except (ValueError, UnicodeDecodeError):
+        return refuse(400, "the body is not JSON: send {\"command\": ...}")
+    if not isinstance(body, dict) or not isinstance(body.get("command"), str):
+        return refuse(400, "expected a JSON object with \"command\"")
+    try:
+        command = Command(body["command"])
+    except ValueError:
+        known = ", ".join(c.value for c in Command)
+        return refuse(400, f"unknown command {body['command'][:40]!r} (known: {known})")
+    alert_id = body.get("id", "")
+    if command is Command.ACK_ALERT and (not isinstance(alert_id, str) or not alert_id):
+        return refuse(400, "ack_alert needs the alert's \"id\"")
+    if not request.app[ACCESS].limit.take():
+        return refuse(429, "too many commands: wait a second")
+    answer = await request.app[EXECUTIVE].staff.submit(
+        command, alert_id if isinstance(alert_id, str) else "")
+    request.app[PAGES].changed.set()
+    if not answer.ok:
+        return refuse(409, answer.text)
+    return web.json_response({"ok": True, "did": answer.text})
+
+
+ROUTES = [
+    web.get("/", get_page),
+    web.get("/api/state", get_state),
+    web.get("/api/site", get_site),
+    web.get("/api/tree", get_tree),
+    web.get("/api/stream", get_stream),
+    web.post("/api/command", post_command),
+]
+
+
+# ---------------------------------------------------------------- lifetime
+
+
+async def log_lines(app: web.Application) -> AsyncIterator[None]:
+    """The console's log handler on ``frog_bt`` while the application runs (it keeps only
+    its executive's lines: :class:`~frog_bt.live.console.state.LogLines`)."""
+    logger = logging.getLogger("frog_bt")
+    logger.addHandler(app[SHOWN].logs)
+    try:
+        yield
+    finally:
+        logger.removeHandler(app[SHOWN].logs)
+
+
+async def pusher(app: web.Application) -> AsyncIterator[None]:
+    """:func:`push` while the application runs; cancelled, within a bound, as it ends."""
+    task = asyncio.get_running_loop().create_task(push(app), name="console-push")
+    try:
+        yield
+    finally:
+        task.cancel()
+        with contextlib.suppress(asyncio.CancelledError, TimeoutError):
+            async with asyncio.timeout(CLOSE_TIMEOUT):  # bounded, come what may
+                await task
+
+
+async def close_pages(app: web.Application) -> None:
+    """Every open page told the console is going, all within :data:`CLOSE_TIMEOUT`."""
+    pages = app[PAGES]
+    sockets, pages.sockets = list(pages.sockets), set()
+    if not sockets:
+        return
+    with contextlib.suppress(TimeoutError):
+        async with asyncio.timeout(CLOSE_TIMEOUT):
+            await asyncio.gather(*(ws.close(code=WSCloseCode.GOING_AWAY,
+                                            message=b"the console is stopping")
+                                   for ws in sockets), return_exceptions=True)
+
+
+def make_app(executive: Executive, *, token: str | None, loopback: bool) -> web.Application:
+    """``executive``'s console as an application: its routes, its state, its lifetime.
+    ``token`` (None: commands are off); ``loopback``: whether reads need no token."""
+    cfg = executive.site.console
+    app = web.Application(middlewares=[guard], client_max_size=cfg.max_body)
+    app[EXECUTIVE] = executive
+    app[ACCESS] = Access(token, loopback, cfg.max_body, RateLimit(cfg.commands_per_second))
+    app[SHOWN] = Shown(Day(), LogLines(owner=executive), StopClock())
+    app[PAGES] = Pages(cfg.push_every)
+    app.add_routes(ROUTES)
+    app.cleanup_ctx.extend([log_lines, pusher])
+    app.on_shutdown.append(close_pages)
+    return app
+
+
 class Console:
-    """One executive's console; :meth:`start` inside its loop, :meth:`close` on the way out."""
+    """One executive's console on ``host:port`` (0: any free port, then :attr:`bound_port`):
+    :meth:`attach` before the executive runs, :meth:`start` inside its loop, :meth:`close`
+    on the way out."""
 
     def __init__(self, executive: Executive, host: str, port: int,
                  token: str | None = None) -> None:
         self.executive = executive
         self.host, self.port = host, port
-        self.token = token
-        self.loopback = is_loopback(host)
-        cfg = executive.site.console
-        self.max_body = cfg.max_body
-        self.push_every = cfg.push_every
-        self.limit = RateLimit(cfg.commands_per_second)
-        self.day = Day()
-        self.logs = LogLines()
-        self.stop_clock = StopClock()
-        self._runner: web.AppRunner | None = None
-        self._sockets: set[web.WebSocketResponse] = set()
-        self._changed = asyncio.Event()
-        self._phase = ""
-        self._pusher: asyncio.Task[None] | None = None
+        self.app = make_app(executive, token=token, loopback=is_loopback(host))
         self.bound_port: int | None = None
-
-    # ------------------------------------------------------------ lifecycle
+        # bounded, with pages still open
+        self._runner = web.AppRunner(self.app, access_log=None, handle_signals=False,
+                                     shutdown_timeout=CLOSE_TIMEOUT)
+        self._started = False
 
     def attach(self) -> None:
-        """The day's tally and the phase watch on the executive's taps; the log lines."""
-        self.day.attach(self.executive)
-        logging.getLogger("frog_bt").addHandler(self.logs)
+        """The day's tally among the executive's observers."""
+        self.executive.observers.attach(self.executive, [self.app[SHOWN].day])
 
     async def start(self) -> None:
-        app = web.Application(middlewares=[self._guard], client_max_size=self.max_body)
-        app.router.add_get("/", self._page)
-        app.router.add_get("/api/state", self._state)
-        app.router.add_get("/api/site", self._site)
-        app.router.add_get("/api/tree", self._tree)
-        app.router.add_get("/api/stream", self._stream)
-        app.router.add_post("/api/command", self._command)
-        self._runner = web.AppRunner(app, access_log=None, handle_signals=False)
+        """Listen; OSError when the address cannot be bound (then :meth:`close`)."""
+        self._started = True
         await self._runner.setup()
-        site = web.TCPSite(self._runner, self.host, self.port,
-                           shutdown_timeout=CLOSE_TIMEOUT)  # bounded, with pages still open
-        await site.start()
-        server = site._server  # the bound port, when 0 was asked for
-        sockets = getattr(server, "sockets", None) or ()
-        self.bound_port = sockets[0].getsockname()[1] if sockets else self.port
-        self._pusher = asyncio.get_running_loop().create_task(self._push())
+        await web.TCPSite(self._runner, self.host, self.port).start()
+        self.bound_port = int(self._runner.addresses[0][1])
         log.warning("console at http://%s:%d/", self.host, self.bound_port)
 
     async def close(self) -> None:
-        logging.getLogger("frog_bt").removeHandler(self.logs)
-        if self._pusher is not None:
-            self._pusher.cancel()
-            with contextlib.suppress(asyncio.CancelledError, TimeoutError):
-                async with asyncio.timeout(CLOSE_TIMEOUT):  # bounded, come what may
-                    await self._pusher
-        for ws in list(self._sockets):
-            with contextlib.suppress(Exception):
-                await asyncio.wait_for(ws.close(), CLOSE_TIMEOUT)
-        if self._runner is not None:
+        """The pages closed, the open requests given :data:`CLOSE_TIMEOUT`, then the pusher
+        and the log handler gone. Once; nothing to do when never started."""
+        if self._started:
+            self._started = False
             await self._runner.cleanup()
-
-    # ------------------------------------------------------------ guard
-
-    def _authorised(self, request: web.Request) -> bool:
-        """The bearer token, compared in constant time (a page's reads, whose WebSocket
-        cannot send a header, may give it as ``?token=`` instead)."""
-        if self.token is None:
-            return False
-        scheme, _, value = request.headers.get("Authorization", "").partition(" ")
-        if scheme.lower() != "bearer" and request.method == "GET":
-            value = request.query.get("token", "")
-        return hmac.compare_digest(value.strip().encode(), self.token.encode())
-
-    @web.middleware
-    async def _guard(self, request: web.Request, handler: Handler) -> web.StreamResponse:
-        """Auth, size and refusals as one line of JSON, in one place."""
-        needs_token = request.method != "GET" or not self.loopback
-        if needs_token and request.path.startswith("/api") and not self._authorised(request):
-            return refuse(401, "a valid token is needed (Authorization: Bearer TOKEN)"
-                          if self.token is not None else
-                          "commands are off: the console was started without a token file")
-        if request.content_length is not None and request.content_length > self.max_body:
-            return refuse(413, f"request body over {self.max_body} bytes")
-        try:
-            return await handler(request)
-        except web.HTTPRequestEntityTooLarge:
-            return refuse(413, f"request body over {self.max_body} bytes")
-        except web.HTTPException as exc:
-            if exc.status >= 400:
-                return refuse(exc.status, exc.reason)
-            raise
-
-    # ------------------------------------------------------------ reads
-
-    def snapshot(self) -> dict[str, Any]:
-        return state(self.executive, self.day, self.logs, self.stop_clock)
-
-    async def _page(self, _request: web.Request) -> web.Response:
-        page = resources.files("frog_bt.live.console").joinpath("page.html").read_text("utf-8")
-        return web.Response(text=page, content_type="text/html")
-
-    async def _state(self, _request: web.Request) -> web.Response:
-        return web.json_response(self.snapshot())
-
-    async def _site(self, _request: web.Request) -> web.Response:
-        return web.json_response(site_map(self.executive))
-
-    async def _tree(self, _request: web.Request) -> web.Response:
-        return web.json_response(tree(self.executive.core.root))
-
-    # ------------------------------------------------------------ pushed state
-
-    async def _stream(self, request: web.Request) -> web.WebSocketResponse:
-        ws = web.WebSocketResponse(heartbeat=30.0)
-        await ws.prepare(request)
-        self._sockets.add(ws)
-        try:
-            await ws.send_str(json.dumps(self.snapshot()))
-            async for message in ws:  # the page sends nothing; this waits for it to go
-                if message.type == WSMsgType.ERROR:
-                    break
-        finally:
-            self._sockets.discard(ws)
-        return ws
-
-    async def _push(self) -> None:
-        """The state to every page every ``push_every`` seconds, and within
-        :data:`PHASE_POLL` of a new phase or a command; a page that does not take it within
-        :data:`SEND_TIMEOUT` is dropped. The phase is looked at here, between ticks, not
-        after each tick: the console costs the tick nothing."""
-        loop = asyncio.get_running_loop()
-        last, last_at = "", 0.0
-        while True:
-            # asyncio.timeout, not wait_for: on Python 3.11 wait_for can swallow a cancel
-            # that meets the event being set, and close() would then wait for ever
-            with contextlib.suppress(TimeoutError):
-                async with asyncio.timeout(PHASE_POLL):
-                    await self._changed.wait()
-            now_phase = phase(self.executive.core)
-            due = (self._changed.is_set() or now_phase != self._phase
-                   or loop.time() - last_at >= self.push_every)
-            self._changed.clear()
-            self._phase = now_phase
-            if not due or not self._sockets:
-                continue
-            last_at = loop.time()
-            text = json.dumps(self.snapshot())
-            if text == last:
-                continue
-            last = text
-            for ws in list(self._sockets):
-                try:
-                    async with asyncio.timeout(SEND_TIMEOUT):
-                        await ws.send_str(text)
-                except (TimeoutError, ConnectionError, RuntimeError):
-                    self._sockets.discard(ws)
-                    with contextlib.suppress(Exception):
-                        await ws.close()
-
-    # ------------------------------------------------------------ commands
-
-    async def _command(self, request: web.Request) -> web.Response:
-        try:
-            body = await request.json()
-        except (ValueError, UnicodeDecodeError):
-            return refuse(400, "the body is not JSON: send {\"command\": ...}")
-        if not isinstance(body, dict) or not isinstance(body.get("command"), str):
-            return refuse(400, "expected a JSON object with \"command\"")
-        try:
-            command = Command(body["command"])
-        except ValueError:
-            known = ", ".join(c.value for c in Command)
-            return refuse(400, f"unknown command {body['command'][:40]!r} (known: {known})")
-        alert_id = body.get("id", "")
-        if command is Command.ACK_ALERT and (not isinstance(alert_id, str) or not alert_id):
-            return refuse(400, "ack_alert needs the alert's \"id\"")
-        if not self.limit.take():
-            return refuse(429, "too many commands: wait a second")
-        answer = await self.executive.staff.submit(command, alert_id if isinstance(
-            alert_id, str) else "")
-        self._changed.set()
-        if not answer.ok:
-            return refuse(409, answer.text)
-        return web.json_response({"ok": True, "did": answer.text})

@@ -15,9 +15,11 @@ from typing import TYPE_CHECKING, Any
 
 import py_trees
 
+from frog_bt.engine.walk import children, running_path
 from frog_bt.live.telemetry.site_map import poi_marks, tour_routes, zone_outlines
 from frog_bt.model import keys
 from frog_bt.model.outcomes import TourState
+from frog_bt.runtime.logctx import OwnedBy
 from frog_bt.runtime.status import phase
 
 if TYPE_CHECKING:
@@ -30,11 +32,16 @@ LOG_LINES = 50
 
 
 class LogLines(logging.Handler):
-    """The latest log lines of frog-bt, formatted as the log writes them."""
+    """The latest log lines of ``owner`` (an executive), formatted as the log writes them.
 
-    def __init__(self, size: int = LOG_LINES) -> None:
+    One handler per console; a record is ``owner``'s when it was logged in the context
+    the executive marked as its own (:mod:`frog_bt.runtime.logctx`), so another executive
+    in the same process, and the command line around them, do not show here."""
+
+    def __init__(self, owner: object, size: int = LOG_LINES) -> None:
         super().__init__(logging.INFO)
         self.lines: deque[str] = deque(maxlen=size)
+        self.addFilter(OwnedBy(owner))
         self.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s",
                                             "%H:%M:%S"))
 
@@ -58,23 +65,14 @@ class StopClock:
         return None if self.since is None else now - self.since
 
 
-def running_path(root: Behaviour) -> list[str]:
+def running_names(root: Behaviour) -> list[str]:
     """The names from the root down the running children (what the robot is doing)."""
-    path, node = [root.name], root
-    while True:
-        children = [node.decorated] if isinstance(node, py_trees.decorators.Decorator) \
-            else list(getattr(node, "children", ()))
-        node = next((c for c in children if c.status == RUNNING), None)
-        if node is None:
-            return path
-        path.append(node.name)
+    return [node.name for node in running_path(root)]
 
 
 def tree(node: Behaviour) -> dict[str, Any]:
-    children = [node.decorated] if isinstance(node, py_trees.decorators.Decorator) \
-        else list(getattr(node, "children", ()))
     return {"name": node.name, "type": type(node).__name__, "status": node.status.value,
-            "children": [tree(c) for c in children]}
+            "children": [tree(c) for c in children(node)]}
 
 
 def site_map(executive: Executive) -> dict[str, Any]:
@@ -125,7 +123,7 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock
                   if pose is not None else None),
         "people": ([[p.position.x, p.position.y] for p in people.value.people]
                    if people is not None else []),
-        "path": running_path(core.root),
+        "path": running_names(core.root),
         "log": list(logs.lines),
         "time": now,
     }

@@ -18,12 +18,17 @@ import contextlib
 import logging
 from collections import deque
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import msgspec
 
 from frog_bt.config import AlertsCfg
 from frog_bt.model.channels import Alert
+from frog_bt.model.events import AlertChanged, Event
 from frog_bt.warning_limit import WarningLimiter
+
+if TYPE_CHECKING:
+    from frog_bt.runtime.observer import Host
 
 log = logging.getLogger(__name__)
 QUEUE = 256  # alert changes waiting to be posted
@@ -53,8 +58,15 @@ class Webhooks:
         if self.cfg.webhooks and self._task is None:
             self._task = asyncio.get_running_loop().create_task(self._run())
 
+    def attach(self, host: Host) -> None:
+        """An observer of the executive: it hears every alert change."""
+
+    def on_event(self, event: Event) -> None:
+        if type(event) is AlertChanged:
+            self.notify(event.t, event.alert)  # type: ignore[union-attr]
+
     def notify(self, _now: float, alert: Alert) -> None:
-        """Queue one alert change (an :class:`~frog_bt.runtime.alerts.AlertBook` listener)."""
+        """Queue one alert change."""
         if not self.cfg.webhooks:
             return
         if len(self._queue) >= QUEUE:

@@ -12,11 +12,11 @@ from typing import TYPE_CHECKING
 
 from frog_bt.live.telemetry.layout import TreeIndex
 from frog_bt.live.telemetry.rows import Rows
+from frog_bt.model.events import Event, LinksChanged
 from frog_bt.model.links import LinkStatus, changed
 
 if TYPE_CHECKING:
     from frog_bt.config import Site
-    from frog_bt.engine.core import Core
     from frog_bt.model.links import Links
     from frog_bt.runtime.observer import Host
     from frog_bt.tree.loader import LoadedTree
@@ -30,25 +30,30 @@ class TelemetryObserver(ABC):
         self.tree = tree
         self.index = TreeIndex.of(tree.root)
         self.rows = Rows(site, self.index, batch_ticks=batch_ticks, on_full=self._full)
-        self._core: Core | None = None
+        self._host: Host | None = None
         self._links: dict[str, LinkStatus] = {}
         self._closed = False
         self._flush_pending = False
 
     def attach(self, host: Host) -> None:
-        """The core's taps (one core per telemetry) and, live, each link's state."""
-        self.rows.attach(host.core)
-        self._core = host.core
-        if host.wire is not None:
-            host.wire.links.append(self.on_links)
+        """Follow the host's events and, live, each link's state."""
+        self.rows.attach(host)
+        self._host = host
         links = host.links
         if links is not None:
             self.on_links(host.clock.now() if host.clock.ready else 0.0, links)
 
+    def on_event(self, event: Event) -> None:
+        if type(event) is LinksChanged:
+            self.on_links(event.t, event.links)  # type: ignore[union-attr]
+        else:
+            self.rows.on_event(event)
+
     def on_links(self, t: float, links: Links) -> None:
         changes = changed(self._links, links)
         if changes and not self._closed:
-            self._write_links(self._core.ticks if self._core is not None else 0, t, changes)
+            core = self._host.core if self._host is not None else None
+            self._write_links(core.ticks if core is not None else 0, t, changes)
 
     def _full(self) -> None:
         """Rows are full (called inside a tick): write them once the tick is over, so that

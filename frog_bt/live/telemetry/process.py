@@ -157,9 +157,9 @@ class TelemetryProcess(TelemetryObserver):
                 self._stop_child(CLOSE_TIMEOUT)
                 self._start_child()
                 links, self._links = self._links, {}  # the new file's lanes start with them
-                if links and self._core is not None:
-                    self._send(("links", self._core.ticks, self._core.clock.now(),
-                                list(links.items())))
+                core = self._host.core if self._host is not None else None
+                if links and core is not None:
+                    self._send(("links", core.ticks, core.clock.now(), list(links.items())))
                     self._links = links
 
     def _send(self, item: Item) -> bool:

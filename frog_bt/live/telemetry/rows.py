@@ -26,12 +26,14 @@ import py_trees
 
 from frog_bt.live.telemetry.layout import TreeIndex
 from frog_bt.model import keys
+from frog_bt.model.events import Event, FrontendIn, FrontendOut, RobotCommand, RobotInput, Ticked
 from frog_bt.model.outcomes import Level
 from frog_bt.model.wire import INPUTS
 
 if TYPE_CHECKING:
     from frog_bt.config import Site
-    from frog_bt.engine.core import Core, Outgoing
+    from frog_bt.engine.core import Core
+    from frog_bt.runtime.observer import Host
 
 Status = py_trees.common.Status
 ENGAGEMENT_KEYS = (keys.ENGAGEMENT_METER, keys.ENGAGEMENT_DECISION)
@@ -76,7 +78,7 @@ class Rows:
         self.batch = Batch()
         self.batch_ticks = batch_ticks
         self.on_full = on_full
-        self.core: Core | None = None
+        self.host: Host | None = None
         self._behaviours = list(index.behaviours)
         self._position = {b: i for i, b in enumerate(self._behaviours)}  # by identity
         self._statuses: tuple[Status, ...] = ()
@@ -87,26 +89,33 @@ class Rows:
         self._ticks_since_drain = 0
         self._unstamped = False
 
-    def attach(self, core: Core) -> None:
-        self.core = core
-        taps = core.taps
-        taps.ros_in.append(self.ros_in)
-        taps.ros_out.append(self.ros_out)
-        taps.frontend_in.append(self.frontend_in)
-        taps.frontend_out.append(self.frontend_out)
-        taps.tick.append(self.tick)
+    def attach(self, host: Host) -> None:
+        """Follow ``host``'s events (its core now, whichever that is)."""
+        self.host = host
 
     def detach(self) -> None:
-        """Remove the taps from the core (after close nothing more is buffered)."""
-        core, self.core = self.core, None
-        if core is None:
-            return
-        taps = core.taps
-        for taps_list, tap in ((taps.ros_in, self.ros_in), (taps.ros_out, self.ros_out),
-                               (taps.frontend_in, self.frontend_in),
-                               (taps.frontend_out, self.frontend_out), (taps.tick, self.tick)):
-            if tap in taps_list:
-                taps_list.remove(tap)
+        """Stop following (after close nothing more is buffered)."""
+        self.host = None
+
+    @property
+    def core(self) -> Core | None:
+        return self.host.core if self.host is not None else None
+
+    def on_event(self, event: Event) -> None:
+        """One event of the host: a row for it, or the tree's changes after a tick."""
+        kind = type(event)
+        if kind is RobotInput:
+            self.ros_in(event)  # type: ignore[arg-type]
+        elif kind is Ticked:
+            core = self.core
+            if core is not None:
+                self.tick(core)
+        elif kind is RobotCommand:
+            self.ros_out(event)  # type: ignore[arg-type]
+        elif kind is FrontendOut:
+            self.frontend_out(event)  # type: ignore[arg-type]
+        elif kind is FrontendIn:
+            self.frontend_in(event)  # type: ignore[arg-type]
 
     def _stamp(self, t: float) -> tuple[int, float] | None:
         """(tick, t) for a row arriving now; None when detached. Before the clock has a
@@ -119,32 +128,35 @@ class Rows:
             return core.ticks + 1, math.nan
         return core.ticks + 1, t
 
-    # ------------------------------------------------------------ taps (t, channel, payload)
+    # ------------------------------------------------------------ events
 
-    def ros_in(self, t: float, topic: str, value: Any) -> None:
-        stamp = self._stamp(t)
-        if stamp is None:
+    def ros_in(self, event: RobotInput) -> None:
+        stamp = self._stamp(event.t)
+        if stamp is None or event.value is None:
             return
-        role = self.roles.get(topic)
+        value: Any = event.value
+        role = self.roles.get(event.topic)
         if role == "pose":
             self.batch.poses.append((*stamp, value.x, value.y, value.yaw))
         elif role is not None:
             self.batch.inputs.append((*stamp, role, value))
 
-    def ros_out(self, t: float, out: Outgoing) -> None:
-        stamp = self._stamp(t)
+    def ros_out(self, out: RobotCommand) -> None:
+        stamp = self._stamp(out.t)
         if stamp is not None:
             self.batch.outputs.append((*stamp, "ros", out.topic, out))
 
-    def frontend_out(self, t: float, type_: str, message: Any) -> None:
-        stamp = self._stamp(t)
+    def frontend_out(self, event: FrontendOut) -> None:
+        stamp = self._stamp(event.t)
         if stamp is not None:
-            self.batch.outputs.append((*stamp, "frontend", type_, message))
+            message = event.message
+            self.batch.outputs.append((*stamp, "frontend", message.type, message))
 
-    def frontend_in(self, t: float, type_: str, message: Any) -> None:
-        stamp = self._stamp(t)
+    def frontend_in(self, event: FrontendIn) -> None:
+        stamp = self._stamp(event.t)
         if stamp is not None:
-            self.batch.events.append((*stamp, type_, message))
+            message = event.message
+            self.batch.events.append((*stamp, message.type, message))
 
     def tick(self, core: Core) -> None:
         """After each tick: what changed in the tree, the notes, the engagement keys."""

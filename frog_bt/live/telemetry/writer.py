@@ -24,11 +24,12 @@ from frog_bt.live.telemetry.rows import Batch
 from frog_bt.live.telemetry.site_map import poi_marks, tour_routes, zone_outlines
 from frog_bt.model.frontend import message_fields
 from frog_bt.model.links import Health, LinkStatus
+from frog_bt.model.outcomes import DockingState
 from frog_bt.model.ros import Pose
 from frog_bt.model.wire import ABORTED, FAILED, Response
 
 if TYPE_CHECKING:
-    from frog_bt.engine.core import Outgoing
+    from frog_bt.model.events import RobotCommand
 
 Status = py_trees.common.Status
 TICK, TIME = "tick", "time"  # the timelines: tick number, project-clock time
@@ -293,7 +294,7 @@ class Writer:
                     goals.append((tick, 0, t, None))
             elif role == "docking_state" and value != self._docking:
                 self._docking = value
-                level = "WARN" if value == "failed" else "INFO"
+                level = "WARN" if value == DockingState.FAILED else "INFO"
                 ros_log.append((tick, t, level, f"docking state: {value}"))
         logs["log/ros/in"] = [(tick, t, level, "← robot " + text)
                               for tick, t, level, text in ros_log]
@@ -343,7 +344,7 @@ class Writer:
                 logs.setdefault("log/frontend/out", []).append(
                     (tick, t, level, "→ front end " + _describe(payload)))
                 continue
-            out: Outgoing = payload
+            out: RobotCommand = payload
             role = out.role
             text = f"{channel} {out.msg.get('data', '')}".rstrip()
             if role == "icl":  # stray samples after a stop must not bridge two sessions

@@ -19,37 +19,61 @@ opening of an idle file is no tour. A piece ends at ``tour ended`` (the robot is
 docked by then), or after ``tour aborted`` once the robot has driven back and docked
 (that drive is the tour's too), or at the end of the file.
 
-Channels read: ``/frontend/out`` (tour, start_poi, finish_poi, ask_tour),
-``/frontend/in`` (user_positive/negative, content_done), ``/GotoWayPoint``,
-``/ApproachPeopleFar``, ``/FROG_response``, ``/docking/dock``, ``/docking/state``,
-``/ICL_command``, ``/ICL_FaceDataStream``, ``/FROG_pose``, ``/diagnostic``,
-``/frog_bt/operator``, ``/frog_bt/alert`` and ``/frog_bt/primer`` (a rotated file: the
-front-end seqs sent just before it, so that a resend across the rotation is not taken
-for a new command). Topic names are the site's.
+Channels read, through the one decoder of recordings (:mod:`frog_bt.recordings.reader`):
+``/frontend/out`` (tour, start_poi, finish_poi, ask_tour), ``/frontend/in``
+(user_positive/negative, content_done), ``/GotoWayPoint``, ``/ApproachPeopleFar``,
+``/FROG_response``, ``/docking/dock``, ``/docking/state``, ``/ICL_command``,
+``/ICL_FaceDataStream``, ``/FROG_pose``, ``/diagnostic``, ``/frog_bt/operator``,
+``/frog_bt/alert`` and ``/frog_bt/primer`` (a rotated file: the front-end seqs sent just
+before it, so that a resend across the rotation is not taken for a new command). Topic
+names are the site's. A message that does not decode is counted (:attr:`FileFacts.bad`)
+and read past.
 """
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from frog_bt.config import Site
+from frog_bt.engine.operator import Command as OperatorCommand
 from frog_bt.maths.engagement import decide
-from frog_bt.model.ros import POSE
-from frog_bt.model.wire import SUCCEEDED
+from frog_bt.model.channels import ALERT, FRONTEND_IN, FRONTEND_OUT, OPERATOR, PRIMER, from_ns
+from frog_bt.model.channels import Alert as AlertMessage
+from frog_bt.model.channels import Operator as OperatorMessage
+from frog_bt.model.frontend import (
+    AskTour,
+    ContentDone,
+    FinishPoi,
+    FrontendMessage,
+    StartPoi,
+    Tour,
+    UserNegative,
+    UserPositive,
+)
+from frog_bt.model.outcomes import DiagnosticLevel, DockCommand, DockingState, FaceStream, TourState
+from frog_bt.model.ros import Diagnostics, FaceData, Pose
+from frog_bt.model.wire import SUCCEEDED, Response
 from frog_bt.recordings.mcapfile import RecordingError, open_recording
+from frog_bt.recordings.reader import (
+    FrontendIn,
+    FrontendOut,
+    Own,
+    Primed,
+    Reader,
+    Record,
+    RobotCommand,
+    RobotInput,
+)
 
-ERROR_LEVEL = 2  # diagnostic_msgs/DiagnosticStatus ERROR
 JUMP = 10.0  # metres: a pose step this long is a relocalisation, not a drive
-OWN = frozenset({"/frontend/in", "/frontend/out", "/frog_bt/operator", "/frog_bt/alert",
-                 "/frog_bt/primer"})
+OWN = (FRONTEND_IN, FRONTEND_OUT, OPERATOR, ALERT, PRIMER)
 ROS_ROLES = ("pose", "goto", "approach", "response", "dock", "docking_state", "icl", "faces",
              "diagnostic")
+BAD_NOTED = 3  # reasons of bad messages a file's facts keep (all are counted)
 
 
 @dataclass
@@ -128,6 +152,8 @@ class FileFacts:
     error: str = ""  # unreadable: why (the file is reported and skipped)
     recovered: str = ""  # a file cut short: what was read of it
     start: float = 0.0  # first message, seconds
+    bad: int = 0  # messages that did not decode (counted, read past)
+    bad_first: list[str] = field(default_factory=list)  # the first few: where and why
 
 
 def stop_of(site: Site) -> dict[str, str]:
@@ -140,8 +166,8 @@ def stop_of(site: Site) -> dict[str, str]:
     return out
 
 
-class _Reader:
-    """A state machine over one file's messages, in time order."""
+class _Pieces:
+    """A state machine over one file's records, in time order (:meth:`take` each)."""
 
     def __init__(self, path: str, site: Site) -> None:
         self.site = site
@@ -165,7 +191,6 @@ class _Reader:
         self.stop_of = stop_of(site)
         self.near = site.engagement.near
         self.edge = site.engagement.edge
-        self.topics = {site.topic(role): role for role in ROS_ROLES}
 
     def first(self, t: float) -> None:
         """The file's first message: a piece opens, in case the file opens inside a tour."""
@@ -176,6 +201,22 @@ class _Reader:
     def finish(self) -> list[Piece]:
         """The pieces, but an opening one that held nothing of a tour (an idle file's)."""
         return [p for p in self.out if p.started is not None or p.of_a_tour()]
+
+    def take(self, record: Record) -> None:
+        """One record of the file (acks, ticks and bad messages tell nothing here)."""
+        if isinstance(record, RobotInput):
+            self.robot_input(record)
+        elif isinstance(record, RobotCommand):
+            self.robot_command(record)
+        elif isinstance(record, FrontendOut):
+            self.frontend_out(record.t, record.seq, record.message)
+        elif isinstance(record, FrontendIn):
+            self.frontend_in(record.t, record.message)
+        elif isinstance(record, Primed):
+            self.primed = True  # a rotated file: the seqs sent just before it
+            self.seen.update(record.primer.frontend_out_seqs)
+        elif isinstance(record, Own):
+            self.own(record)
 
     def _current(self, t: float) -> Piece | None:
         """The piece open now (None between a tour's end and the next start), its last
@@ -192,58 +233,56 @@ class _Reader:
                 return stop
         return None
 
-    def frontend_out(self, t: float, msg: dict[str, Any]) -> None:
-        kind = msg.get("type")
-        seq = msg.get("seq")
-        if kind == "ack" or not isinstance(seq, int):
-            return
+    def frontend_out(self, t: float, seq: int, message: FrontendMessage) -> None:
         if seq in self.seen:
             return  # a resend (datagram loss): not a new command
         self.seen.add(seq)
-        if kind == "tour":
-            state = msg.get("state")
-            if state == "started":
-                self._started(t, seq)
-            elif state in ("ended", "aborted"):
-                piece = self._current(t)
-                if piece is not None:  # (None: said again after the tour's end)
-                    piece.ended, piece.reason = str(state), str(msg.get("reason") or "")
-                    piece.end_seq = seq
-                    if state == "aborted":
-                        self.back = piece  # the robot returns to its dock: still this tour's
-                if piece is not None and self.opening:
-                    # A tour file has no primer: this may be the tour before's end, resent
-                    # (rows.join tells by its seq); what follows goes into a new opening
-                    # piece, in case it is the open tour's.
-                    self.piece = Piece(self.path, None, 0, t, t)
-                    self.out.append(self.piece)
-                else:
-                    self.piece, self.opening = None, False
+        if isinstance(message, Tour):
+            self._tour(t, seq, message)
             return
         piece = self._current(t)
         if piece is None:
             return
-        if kind == "start_poi":
-            poi, part = str(msg.get("poi")), str(msg.get("part"))
+        if isinstance(message, StartPoi):
+            poi, part = message.poi, message.part
             stop = self._stop(poi)
             if part == "a" or stop is None:
-                stop = StopFacts(poi, str(msg.get("waypoint") or poi), face_stream=(
-                    poi in self.face_stops))
+                stop = StopFacts(poi, message.waypoint or poi,
+                                 face_stream=poi in self.face_stops)
                 piece.stops.append(stop)
                 stop.start = t
             if part not in stop.parts:
                 stop.parts += part
             if part == "b":
                 self._engagement(stop, t)
-        elif kind == "finish_poi":
-            stop = self._stop(str(msg.get("poi")))
+        elif isinstance(message, FinishPoi):
+            stop = self._stop(message.poi)
             if stop is not None:
                 stop.end = t
                 if "b" not in stop.parts:
                     self._engagement(stop, t)
-        elif kind == "ask_tour":
+        elif isinstance(message, AskTour):
             self.asked = True
             piece.invitations += 1
+
+    def _tour(self, t: float, seq: int, message: Tour) -> None:
+        state = TourState(message.state)
+        if state is TourState.STARTED:
+            self._started(t, seq)
+            return
+        piece = self._current(t)
+        if piece is not None:  # (None: said again after the tour's end)
+            piece.ended, piece.reason, piece.end_seq = state.value, message.reason, seq
+            if state is TourState.ABORTED:
+                self.back = piece  # the robot returns to its dock: still this tour's
+        if piece is not None and self.opening:
+            # A tour file has no primer: this may be the tour before's end, resent
+            # (rows.join tells by its seq); what follows goes into a new opening
+            # piece, in case it is the open tour's.
+            self.piece = Piece(self.path, None, 0, t, t)
+            self.out.append(self.piece)
+        else:
+            self.piece, self.opening = None, False
 
     def _started(self, t: float, seq: int) -> None:
         piece = self.piece
@@ -268,115 +307,110 @@ class _Reader:
             d = decide(np.asarray(levels), self.edge)
             stop.edge_engaged, stop.edge_total = d.engaged_votes, d.votes
 
-    def frontend_in(self, t: float, msg: dict[str, Any]) -> None:
-        kind = msg.get("type")
-        if kind == "content_done" and msg.get("part") == "a":
-            stop = self._stop(str(msg.get("poi")))
+    def frontend_in(self, t: float, message: FrontendMessage) -> None:
+        if isinstance(message, ContentDone) and message.part == "a":
+            stop = self._stop(message.poi)
             if stop is not None and stop.a_end is None:
                 stop.a_end = t  # the decision counts the samples up to here
-        if kind in ("user_positive", "user_negative") and self.piece is not None \
+        if isinstance(message, UserPositive | UserNegative) and self.piece is not None \
                 and self.asked:
             self.asked = False
             piece = self.piece
-            if kind == "user_positive":
+            if isinstance(message, UserPositive):
                 piece.accepted += 1
                 if piece.approached:
                     piece.visitors.append(piece.approached[-1])
             else:
                 piece.declined += 1
 
-    def ros(self, t: float, role: str, msg: dict[str, Any]) -> None:
+    def robot_command(self, command: RobotCommand) -> None:
         # the drive back after an abort is the aborted tour's
         piece = self.back if self.back is not None else self.piece
-        if role == "pose":
-            p = msg.get("pose", {}).get("position", {})
-            x, y = p.get("x"), p.get("y")
-            if isinstance(x, int | float) and isinstance(y, int | float):
-                if self.pose is not None and piece is not None:
-                    step = math.hypot(x - self.pose[0], y - self.pose[1])
-                    if step < JUMP:
-                        piece.distance += step
-                self.pose = (x, y)
-        elif role == "goto":
-            goal, self.approach = _waypoint(self.site, msg), False
+        t, role, value = command.t, command.role, command.value
+        if role == "goto" and isinstance(value, Pose):
+            goal, self.approach = self.site.waypoint_of(value), False
             if piece is not None:
                 piece.goals += 1
                 piece.nav_retries += goal == self.failed
                 piece.t1 = t
             self.goal, self.failed = goal, None
-        elif role == "approach":
+        elif role == "approach" and isinstance(value, int):
             self.approach, self.goal = True, None
             piece = self.piece
             if piece is not None:
                 piece.approaches += 1
-                person = msg.get("data")
-                if isinstance(person, int):
-                    piece.approached.append(person)
+                piece.approached.append(value)
                 piece.t1 = t
-        elif role == "response":
-            code = msg.get("data")
-            if code not in (2, 3, 4):
-                return
-            if self.approach:
-                self.approach = False
-                if code == SUCCEEDED and piece is not None:
-                    piece.approaches_ok += 1
-            elif self.goal is not None:
-                if code != SUCCEEDED:
-                    self.failed = self.goal
-                    if piece is not None:
-                        piece.failed_goals.append(self.goal)
-                self.goal = None
-        elif role == "dock":
-            command = msg.get("data")
-            if piece is not None and command == self.dock_failed:
+        elif role == "dock" and isinstance(value, str):
+            if piece is not None and value == self.dock_failed:
                 piece.dock_retries += 1
-            self.dock, self.dock_failed = str(command), None
-        elif role == "docking_state":
-            state = msg.get("data")
-            if state in ("docking", "undocking"):  # what is under way (a file may open here)
-                self.dock = "dock" if state == "docking" else "undock"
-            elif state == "failed" and self.dock is not None:
-                self.dock_failed = self.dock
-            elif state == "docked" and self.back is not None:
-                self.back.t1, self.back = t, None  # home after the abort: the tour is over
+            self.dock, self.dock_failed = value, None
         elif role == "icl":
-            on = msg.get("data") == "start"
+            on = value == FaceStream.START
             if on and not self.stream_on:
                 self.samples = []
             self.stream_on = on
-        elif role == "faces" and self.stream_on:
-            for face in msg.get("faces") or ():
-                try:
-                    if float(face["distance"]) <= self.near and face["facing"] is True:
-                        self.samples.append((t, float(face["engagement"])))
-                except (KeyError, TypeError, ValueError):
-                    continue
-        elif role == "diagnostic" and piece is not None:
-            for status in msg.get("status") or ():
-                if isinstance(status, dict) and status.get("level") == ERROR_LEVEL:
-                    name = f"{status.get('name')}: {status.get('message')}"
+
+    def robot_input(self, received: RobotInput) -> None:
+        piece = self.back if self.back is not None else self.piece
+        t, role, value = received.t, received.role, received.value
+        if role == "pose" and isinstance(value, Pose):
+            if self.pose is not None and piece is not None:
+                step = math.hypot(value.x - self.pose[0], value.y - self.pose[1])
+                if step < JUMP:
+                    piece.distance += step
+            self.pose = (value.x, value.y)
+        elif role == "response" and isinstance(value, int):
+            self._response(Response.of(value), piece)
+        elif role == "docking_state" and isinstance(value, str):
+            state = DockingState.of(value)
+            if state in (DockingState.DOCKING, DockingState.UNDOCKING):
+                # what is under way (a file may open here)
+                self.dock = DockCommand.DOCK if state is DockingState.DOCKING \
+                    else DockCommand.UNDOCK
+            elif state is DockingState.FAILED and self.dock is not None:
+                self.dock_failed = self.dock
+            elif state is DockingState.DOCKED and self.back is not None:
+                self.back.t1, self.back = t, None  # home after the abort: the tour is over
+        elif role == "faces" and self.stream_on and isinstance(value, FaceData):
+            self.samples.extend((t, face.engagement) for face in value.faces
+                                if face.distance <= self.near and face.facing)
+        elif role == "diagnostic" and piece is not None and isinstance(value, Diagnostics):
+            for status in value.statuses:
+                if status.level == DiagnosticLevel.ERROR:
+                    name = f"{status.name}: {status.message}"
                     if name not in piece.faults:
                         piece.faults.append(name)
 
-    def own(self, t: float, topic: str, msg: dict[str, Any]) -> None:
-        if topic == "/frog_bt/primer":  # a rotated file: the seqs sent just before it
-            self.primed = True
-            seqs = msg.get("frontend_out_seqs") or []
-            self.seen.update(s for s in seqs if isinstance(s, int))
+    def _response(self, response: Response | None, piece: Piece | None) -> None:
+        """A goal's or an approach's end (an active or unknown code changes nothing)."""
+        if response is None or not response.terminal:
             return
+        if self.approach:
+            self.approach = False
+            if response is SUCCEEDED and piece is not None:
+                piece.approaches_ok += 1
+        elif self.goal is not None:
+            if response is not SUCCEEDED:
+                self.failed = self.goal
+                if piece is not None:
+                    piece.failed_goals.append(self.goal)
+            self.goal = None
+
+    def own(self, record: Own) -> None:
         piece = self.piece
         if piece is None:
             return
-        if topic == "/frog_bt/operator":
-            command, ok = str(msg.get("command")), bool(msg.get("ok"))
-            piece.operator.append(f"{command} ({'ok' if ok else 'refused'})")
-            if command == "skip" and ok:
+        message = record.message
+        if isinstance(message, OperatorMessage):
+            ok = "ok" if message.ok else "refused"
+            piece.operator.append(f"{message.command} ({ok})")
+            if message.command == OperatorCommand.SKIP and message.ok:
                 at = self._skipping()
                 if at is not None:
                     piece.operator_skips.append(at)
-        elif topic == "/frog_bt/alert" and msg.get("state") == "raised":
-            piece.alerts.append(str(msg.get("kind")))
+        elif isinstance(message, AlertMessage) and message.state == "raised":
+            piece.alerts.append(message.kind)
 
     def _skipping(self) -> str | None:
         """The stop an operator's skip leaves: the one playing, or the one driven to."""
@@ -387,53 +421,28 @@ class _Reader:
         return self.stop_of.get(self.goal) if self.goal is not None else None
 
 
-def _waypoint(site: Site, msg: dict[str, Any]) -> str:
-    """The POI a goal names (position and orientation, as TourSummary matches it)."""
-    try:
-        pose = POSE.convert(msg)
-    except Exception:
-        return "?"
-    return site.waypoint_of(pose)
-
-
 def read_file(path: str, site: Site) -> FileFacts:
     """The tour pieces in one recording; any failure is an unreadable file, never a crash."""
     try:
         recording = open_recording(Path(path))
-        if "/frontend/out" not in recording.types:
-            return FileFacts(path, error="not a frog-bt tour recording (no /frontend/out)")
-        reader = _Reader(path, site)
-        ros = reader.topics
-        start = None
-        for topic, ns, data in recording.messages():
-            t = ns / 1e9
-            if start is None:
-                start = t
-                reader.first(t)
-            role = ros.get(topic)
-            if role is None and topic not in OWN:
-                continue
-            try:
-                msg = json.loads(data)
-            except ValueError:
-                continue
-            if not isinstance(msg, dict):
-                continue
-            if role is not None:
-                reader.ros(t, role, msg)
-            elif topic == "/frontend/out":
-                reader.frontend_out(t, msg)
-            elif topic == "/frontend/in":
-                reader.frontend_in(t, msg)
-            else:
-                reader.own(t, topic, msg)
+        if FRONTEND_OUT not in recording.types:
+            return FileFacts(path, error=f"not a frog-bt tour recording (no {FRONTEND_OUT})")
+        reader = Reader(site, only={*(site.topic(role) for role in ROS_ROLES), *OWN})
+        pieces = _Pieces(path, site)
+        start = from_ns(recording.start) if recording.start or recording.end else None
+        if start is not None:
+            pieces.first(start)
+        for record in reader.read(recording):
+            pieces.take(record)
         # An executive's first file: neither a tour file nor an idle file it rotated into
         # (those open with a primer); a file without our metadata is one whole run.
         kind = recording.metadata.get("frog_bt", {}).get("kind")
-        restarts = [start] if start is not None and kind != "tour" and not reader.primed \
+        restarts = [start] if start is not None and kind != "tour" and not pieces.primed \
             else []
-        return FileFacts(path, reader.finish(), restarts, recovered=recording.recovered,
-                         start=start or 0.0)
+        tally = reader.tally
+        return FileFacts(path, pieces.finish(), restarts, recovered=recording.recovered,
+                         start=start or 0.0, bad=tally.count,
+                         bad_first=tally.lines(start or 0.0)[:BAD_NOTED])
     except RecordingError as exc:
         return FileFacts(path, error=str(exc).replace(f"{path}: ", ""))
     except Exception as exc:  # a damaged file must not stop the corpus

@@ -1,0 +1,133 @@
+"""What the executive tells its observers: one typed event at a time.
+
+Every observer (recording, rotation, summary, status line, console, telemetry, webhooks)
+hears the executive through one call, ``on_event(event)``, where ``event`` is one of the
+Structs of :data:`Event`. This union is the one list of what the executive says; the
+recorder writes these same values, and :mod:`frog_bt.recordings.reader` reads them back.
+
+==================  =========================================================
+event               when
+==================  =========================================================
+:class:`RobotInput`     a message arrived on a subscribed robot topic
+:class:`RobotCommand`   a command went to the robot (goal, approach, face stream, dock)
+:class:`FrontendIn`     a new front-end event arrived (duplicates and acks are not new)
+:class:`FrontendOut`    a command went to the front end
+:class:`Datagram`       a UDP datagram crossed the front-end link (acks, resends included)
+:class:`Ticked`         the tree ticked once
+:class:`Blamed`         right after a command: the node that sent it, and what it read
+:class:`OperatorDone`   an operator command was applied or refused
+:class:`LinksChanged`   a link changed state
+:class:`AlertChanged`   an alert was raised, cleared or acknowledged
+==================  =========================================================
+
+Times are project-clock seconds. Values are the wire Structs' values (what the leaves
+see); ``RobotInput.raw`` and ``RobotCommand.msg`` are the rosbridge ``msg`` as it crossed
+the wire, for the recorder.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import msgspec
+
+from frog_bt.model.channels import Alert
+from frog_bt.model.frontend import FrontendMessage
+from frog_bt.model.goals import Goal
+from frog_bt.model.links import Links
+
+__all__ = ["AlertChanged", "Blamed", "Datagram", "Event", "FrontendIn", "FrontendOut",
+           "LinksChanged", "OperatorDone", "RobotCommand", "RobotInput", "Ticked"]
+
+TickStatus = Literal["INVALID", "RUNNING", "SUCCESS", "FAILURE"]
+
+
+class RobotInput(msgspec.Struct, frozen=True, tag=True):
+    """A message on a subscribed robot topic: its decoded value (None for a topic the
+    tree does not read, such as ``/clock``) and, live, the ``msg`` as received."""
+
+    t: float
+    topic: str
+    value: object = None
+    raw: msgspec.Raw | None = None
+
+
+class RobotCommand(msgspec.Struct, frozen=True, tag=True):
+    """A command to the robot: its output role and topic, the typed value, the ``msg``
+    sent, and the goal it carries (goto, approach; None for the others)."""
+
+    t: float
+    role: str
+    topic: str
+    value: object
+    msg: dict[str, Any]
+    goal: Goal | None = None
+
+
+class FrontendIn(msgspec.Struct, frozen=True, tag=True):
+    """A new front-end event, decoded."""
+
+    t: float
+    message: FrontendMessage
+
+
+class FrontendOut(msgspec.Struct, frozen=True, tag=True):
+    """A command to the front end (sent once here; the link resends it until acked)."""
+
+    t: float
+    message: FrontendMessage
+
+
+class Datagram(msgspec.Struct, frozen=True, tag=True):
+    """One UDP datagram in from the front-end host, or out to the front end."""
+
+    t: float
+    direction: Literal["in", "out"]
+    data: bytes
+
+
+class Ticked(msgspec.Struct, frozen=True, tag=True):
+    """The tree ticked: the tick's number (from 1) and the root's status after it."""
+
+    t: float
+    tick: int
+    status: TickStatus
+
+
+class Blamed(msgspec.Struct, frozen=True, tag=True):
+    """Right after a command: the tree node that sent it and the values it read."""
+
+    t: float
+    channel: str  # ROS topic or front-end message type
+    node: str
+    reads: dict[str, str] = {}
+
+
+class OperatorDone(msgspec.Struct, frozen=True, tag=True):
+    """An operator command and its answer; ``tick`` is the tick it came before."""
+
+    t: float
+    tick: int
+    command: str
+    ok: bool
+    text: str
+    id: str = ""  # ack_alert: the alert
+    by: str = ""  # who sent it: console, ctl, link (empty when unknown)
+
+
+class LinksChanged(msgspec.Struct, frozen=True, tag=True):
+    """The links' states now, after one of them changed."""
+
+    t: float
+    links: Links
+
+
+class AlertChanged(msgspec.Struct, frozen=True, tag=True):
+    """An alert was raised, cleared or acknowledged."""
+
+    t: float
+    alert: Alert
+
+
+Event = (RobotInput | RobotCommand | FrontendIn | FrontendOut | Datagram | Ticked | Blamed
+         | OperatorDone | LinksChanged | AlertChanged)
