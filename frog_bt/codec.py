@@ -41,8 +41,8 @@ def decode_error(exc: msgspec.MsgspecError) -> DecodeError:
     match = _AT.match(str(exc))
     assert match is not None  # the pattern matches any text
     path: list[str | int] = [
-        name if name else int(index)
-        for name, index in _STEP.findall(match["path"] or "")]
+        name if name else int(index) for name, index in _STEP.findall(match["path"] or "")
+    ]
     text = match["text"]
     missing = _MISSING.match(text)
     if missing:

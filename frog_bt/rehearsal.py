@@ -42,17 +42,25 @@ class Rehearsal:
     that is already running (a restart); it is then not stopped on exit.
     """
 
-    def __init__(self, scenario: Scenario | None, *, site: Site,
-                 tree: LoadedTree | None = None, sim: Simulator | None = None,
-                 listen: tuple[str, int] | None = None, sim_secret: str | None = None,
-                 prepare: Callable[[Executive], Any] | None = None,
-                 **executive_kwargs: Any) -> None:
+    def __init__(
+        self,
+        scenario: Scenario | None,
+        *,
+        site: Site,
+        tree: LoadedTree | None = None,
+        sim: Simulator | None = None,
+        listen: tuple[str, int] | None = None,
+        sim_secret: str | None = None,
+        prepare: Callable[[Executive], Any] | None = None,
+        **executive_kwargs: Any,
+    ) -> None:
         if sim is None:
             if scenario is None:
                 raise ValueError("a scenario, or a running simulator and its listen address")
             listen = (HOST, free_udp_port())
-            sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=listen,
-                            secret=sim_secret)
+            sim = Simulator(
+                scenario, rosbridge_port=0, frontend_port=0, executive=listen, secret=sim_secret
+            )
             self.own_sim = True
         else:
             if listen is None:
@@ -69,11 +77,16 @@ class Rehearsal:
     async def __aenter__(self) -> Rehearsal:
         if self.own_sim:
             await self.sim.start()
-        self.executive = Executive(self.site, self.tree, SimClock(),
-                                   rosbridge_url=self.sim.via
-                                   or f"ws://{HOST}:{self.sim.rosbridge_port}",
-                                   frontend=(HOST, self.sim.frontend_port), listen=self.listen,
-                                   sim_time=True, **self.executive_kwargs)
+        self.executive = Executive(
+            self.site,
+            self.tree,
+            SimClock(),
+            rosbridge_url=self.sim.via or f"ws://{HOST}:{self.sim.rosbridge_port}",
+            frontend=(HOST, self.sim.frontend_port),
+            listen=self.listen,
+            sim_time=True,
+            **self.executive_kwargs,
+        )
         if self.prepare is not None:
             self.prepare(self.executive)
         self.sim.follow(self._executive_time, self.executive.clock.sleep_until)

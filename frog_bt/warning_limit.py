@@ -17,9 +17,12 @@ WARN_INTERVAL = 5.0  # wall seconds between two warnings of one kind
 class WarningLimiter:
     """At most one warning per kind per ``interval`` seconds of ``wall`` time."""
 
-    def __init__(self, interval: float = WARN_INTERVAL,
-                 wall: Callable[[], float] = time.monotonic,
-                 logger: logging.Logger | None = None) -> None:
+    def __init__(
+        self,
+        interval: float = WARN_INTERVAL,
+        wall: Callable[[], float] = time.monotonic,
+        logger: logging.Logger | None = None,
+    ) -> None:
         self.interval = interval
         self._wall = wall
         self._log = logger or logging.getLogger(__name__)
@@ -41,6 +44,5 @@ class WarningLimiter:
         held = self.allow(kind)
         if held is None:
             return False
-        self._log.warning("%s", f"{message} ({held} more {kind} suppressed)" if held
-                          else message)
+        self._log.warning("%s", f"{message} ({held} more {kind} suppressed)" if held else message)
         return True

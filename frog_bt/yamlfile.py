@@ -21,8 +21,6 @@ from frog_bt.yamlmarks import Marks, mark_paths
 M = TypeVar("M", bound=BaseModel)
 
 
-
-
 def load_yaml(path: str | Path, error: type[DefinitionError]) -> Any:
     return load_yaml_marked(path, error)[0]
 
@@ -56,8 +54,14 @@ class PathError(ValueError):
         self.path = path
 
 
-def validate(model: type[M], data: Any, file: str | Path, error: type[DefinitionError],
-             context: dict[str, Any] | None = None, base: tuple[str | int, ...] = ()) -> M:
+def validate(
+    model: type[M],
+    data: Any,
+    file: str | Path,
+    error: type[DefinitionError],
+    context: dict[str, Any] | None = None,
+    base: tuple[str | int, ...] = (),
+) -> M:
     """``model`` validated from ``data``; the first error becomes a DefinitionError.
 
     ``base`` is the path of ``data`` inside the file.

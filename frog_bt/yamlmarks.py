@@ -14,8 +14,9 @@ __all__ = ["Marks", "line_of", "mark_paths"]
 Marks = dict[tuple[str | int, ...], tuple[int, int]]  # path in a file -> (line, column)
 
 
-def mark_paths(node: yaml.Node, path: tuple[str | int, ...],
-           out: dict[tuple[str | int, ...], tuple[int, int]]) -> None:
+def mark_paths(
+    node: yaml.Node, path: tuple[str | int, ...], out: dict[tuple[str | int, ...], tuple[int, int]]
+) -> None:
     out[path] = (node.start_mark.line + 1, node.start_mark.column + 1)
     if isinstance(node, yaml.MappingNode):
         for key, value in node.value:
@@ -26,8 +27,9 @@ def mark_paths(node: yaml.Node, path: tuple[str | int, ...],
             mark_paths(item, (*path, i), out)
 
 
-def line_of(file: str, path: tuple[str | int, ...], marks: Marks | None = None
-            ) -> tuple[int, int] | None:
+def line_of(
+    file: str, path: tuple[str | int, ...], marks: Marks | None = None
+) -> tuple[int, int] | None:
     """(line, column) of ``path`` in ``file``, or of its nearest ancestor there: from
     ``marks`` when given, else the file is read again (errors only: nothing is kept)."""
     if marks is None:

@@ -72,8 +72,11 @@ async def one(clients: int) -> dict[str, Any]:
             task.cancel()
         if people is not None:
             await people.close()
-    return {"tick_p50_us": statistics.median(ticks) / 1000, "ticks": len(ticks),
-            "latency_ms": [round(1000 * s, 1) for s in seen]}
+    return {
+        "tick_p50_us": statistics.median(ticks) / 1000,
+        "ticks": len(ticks),
+        "latency_ms": [round(1000 * s, 1) for s in seen],
+    }
 
 
 async def main(clients: int, runs: int, out: str | None = None) -> None:
@@ -85,17 +88,29 @@ async def main(clients: int, runs: int, out: str | None = None) -> None:
         latency += result["latency_ms"]
     p50_off, p50_on = statistics.median(off), statistics.median(on)
     print(f"tick p50, console off: {p50_off:.1f} us (runs {', '.join(f'{x:.1f}' for x in off)})")
-    print(f"tick p50, console on with {clients} pages: {p50_on:.1f} us "
-          f"(runs {', '.join(f'{x:.1f}' for x in on)}): {100 * (p50_on / p50_off - 1):+.1f} %")
+    print(
+        f"tick p50, console on with {clients} pages: {p50_on:.1f} us "
+        f"(runs {', '.join(f'{x:.1f}' for x in on)}): {100 * (p50_on / p50_off - 1):+.1f} %"
+    )
     if latency:
         latency.sort()
-        print(f"new phase to page: p50 {statistics.median(latency):.1f} ms, "
-              f"max {latency[-1]:.1f} ms over {len(latency)} deliveries")
-    emit({"clients": clients, "runs": runs, "tick_p50_off_us": p50_off,
-          "tick_p50_on_us": p50_on, "overhead_pct": 100 * (p50_on / p50_off - 1),
-          "latency_p50_ms": statistics.median(latency) if latency else None,
-          "latency_max_ms": latency[-1] if latency else None,
-          "deliveries": len(latency)}, out)
+        print(
+            f"new phase to page: p50 {statistics.median(latency):.1f} ms, "
+            f"max {latency[-1]:.1f} ms over {len(latency)} deliveries"
+        )
+    emit(
+        {
+            "clients": clients,
+            "runs": runs,
+            "tick_p50_off_us": p50_off,
+            "tick_p50_on_us": p50_on,
+            "overhead_pct": 100 * (p50_on / p50_off - 1),
+            "latency_p50_ms": statistics.median(latency) if latency else None,
+            "latency_max_ms": latency[-1] if latency else None,
+            "deliveries": len(latency),
+        },
+        out,
+    )
 
 
 if __name__ == "__main__":

@@ -46,10 +46,15 @@ async def serve(args: argparse.Namespace) -> None:
     pin_malloc_thresholds()  # as frog-bt run does
     site = load_site(args.config)
     tree = load_tree(site=site)
-    executive = Executive(site, tree, SimClock() if args.sim_time else WallClock(),
-                          rosbridge_url=args.rosbridge,
-                          frontend=parse_hostport(args.frontend),
-                          listen=parse_hostport(args.listen), sim_time=args.sim_time)
+    executive = Executive(
+        site,
+        tree,
+        SimClock() if args.sim_time else WallClock(),
+        rosbridge_url=args.rosbridge,
+        frontend=parse_hostport(args.frontend),
+        listen=parse_hostport(args.listen),
+        sim_time=args.sim_time,
+    )
     observers = attach_observers(executive, record=args.record, rerun=args.rerun)
     tours = 0
     plain_tick = executive.tick
@@ -59,16 +64,26 @@ async def serve(args: argparse.Namespace) -> None:
         plain_tick()
         if executive.outcome.tours != tours:
             tours = executive.outcome.tours
-            say("tour", tours=tours, ticks=executive.core.ticks, **memory_kb(),
-                child_rss_kb=children_rss_kb())
+            say(
+                "tour",
+                tours=tours,
+                ticks=executive.core.ticks,
+                **memory_kb(),
+                child_rss_kb=children_rss_kb(),
+            )
 
     executive.tick = tick  # type: ignore[method-assign]
 
     def stats() -> dict[str, Any]:
         client = executive.client.stats
-        return {"received": client.received, "malformed": client.malformed,
-                "ticks": executive.core.ticks, "tours": tours,
-                "connected": executive.client.link.connected, **memory_kb()}
+        return {
+            "received": client.received,
+            "malformed": client.malformed,
+            "ticks": executive.core.ticks,
+            "tours": tours,
+            "connected": executive.client.link.connected,
+            **memory_kb(),
+        }
 
     loop = asyncio.get_running_loop()
     reader = asyncio.StreamReader()

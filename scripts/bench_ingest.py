@@ -54,15 +54,28 @@ def frames(kind: str, count: int = 256) -> list[str]:
         if kind == "pose":
             topic, msg = "/FROG_pose", msgs.pose_stamped(100.0 + i * 0.01, 30.0, 0.0, 1.0, t)
         elif kind == "faces":
-            topic, msg = "/ICL_FaceDataStream", msgs.face_data(t, [
-                {"id": j, "engagement": 0.5 - 0.1 * j, "distance": 1.2 + j, "facing": True}
-                for j in range(3)])
+            topic, msg = (
+                "/ICL_FaceDataStream",
+                msgs.face_data(
+                    t,
+                    [
+                        {"id": j, "engagement": 0.5 - 0.1 * j, "distance": 1.2 + j, "facing": True}
+                        for j in range(3)
+                    ],
+                ),
+            )
         else:
-            topic, msg = "/UvA_PersonDetectionAndPose", msgs.person_detections(t, [
-                {"id": j, "position": (103.0 + j, 36.0), "orientation": 170.0 + 5 * j}
-                for j in range(3)])
-        out.append(json.dumps({"op": "publish", "topic": topic, "msg": msg},
-                              separators=(",", ":")))
+            topic, msg = (
+                "/UvA_PersonDetectionAndPose",
+                msgs.person_detections(
+                    t,
+                    [
+                        {"id": j, "position": (103.0 + j, 36.0), "orientation": 170.0 + 5 * j}
+                        for j in range(3)
+                    ],
+                ),
+            )
+        out.append(json.dumps({"op": "publish", "topic": topic, "msg": msg}, separators=(",", ":")))
     return out
 
 
@@ -98,8 +111,9 @@ def cpu_seconds(pid: int) -> float:
         return float("nan")
 
 
-async def one_flood(server: FakeRosbridge, child: Child, kind: str,
-                    seconds: float) -> dict[str, Any]:
+async def one_flood(
+    server: FakeRosbridge, child: Child, kind: str, seconds: float
+) -> dict[str, Any]:
     sender = Flood(server, frames(kind))
     await asyncio.sleep(WARMUP)
     cpu0, client_cpu0, sent0 = time.process_time(), cpu_seconds(child.proc.pid), sender.sent
@@ -111,9 +125,12 @@ async def one_flood(server: FakeRosbridge, child: Child, kind: str,
     await sender.stop()
     await asyncio.sleep(0.3)  # let the client drain what is in flight
     span = after["t"] - before["t"]
-    out = {"msg_per_s": (after["received"] - before["received"]) / span,
-           "server_sent_per_s": sent / span,
-           "server_cpu_share": cpu / span, "client_cpu_share": client_cpu / span}
+    out = {
+        "msg_per_s": (after["received"] - before["received"]) / span,
+        "server_sent_per_s": sent / span,
+        "server_cpu_share": cpu / span,
+        "client_cpu_share": client_cpu / span,
+    }
     if "ticks" in after:
         out["ticks_per_s"] = (after["ticks"] - before["ticks"]) / span
         out["rss_before_kb"], out["rss_after_kb"] = before["rss_kb"], after["rss_kb"]
@@ -141,10 +158,18 @@ async def measure(seconds: float, kinds: list[str]) -> dict[str, Any]:
     front_port = await front.open()
     try:
         # the executive, driving to POI0
-        child = await Child.start(sys.executable, SCRIPTS / "bench_executive.py",
-                                  "--config", SITE_FILE, "--rosbridge", server.url,
-                                  "--frontend", f"{LOOPBACK}:{front_port}",
-                                  "--listen", f"{LOOPBACK}:{listen}")
+        child = await Child.start(
+            sys.executable,
+            SCRIPTS / "bench_executive.py",
+            "--config",
+            SITE_FILE,
+            "--rosbridge",
+            server.url,
+            "--frontend",
+            f"{LOOPBACK}:{front_port}",
+            "--listen",
+            f"{LOOPBACK}:{listen}",
+        )
         await asyncio.wait_for(server.ready.wait(), 30)
         await server.publish("/docking/state", {"data": "docked"})
         front.send(FrontendIdle())
@@ -157,15 +182,14 @@ async def measure(seconds: float, kinds: list[str]) -> dict[str, Any]:
         result["executive"] = executive
         # roslibpy on the same server and the same floods
         if importlib.util.find_spec("roslibpy") is None:
-            result["roslibpy"] = {"skipped": "roslibpy is not installed: "
-                                             "pip install -e '.[bench]'"}
+            result["roslibpy"] = {"skipped": "roslibpy is not installed: pip install -e '.[bench]'"}
             return result
         server.ready.clear()
-        child = await Child.start(sys.executable, SCRIPTS / "bench_roslibpy.py",
-                                  "--port", str(server.port))
+        child = await Child.start(
+            sys.executable, SCRIPTS / "bench_roslibpy.py", "--port", str(server.port)
+        )
         await asyncio.wait_for(server.ready.wait(), 30)
-        result["roslibpy"] = {kind: await one_flood(server, child, kind, seconds)
-                              for kind in kinds}
+        result["roslibpy"] = {kind: await one_flood(server, child, kind, seconds) for kind in kinds}
         await child.finish()
     finally:
         front.close()

@@ -23,8 +23,7 @@ from typing import Any
 
 from bench_support import SCRIPTS
 
-SECTIONS = ("startup", "ticks", "reaction", "ingest", "replay", "memory", "console",
-            "report")
+SECTIONS = ("startup", "ticks", "reaction", "ingest", "replay", "memory", "console", "report")
 PHASES = ("waiting", "undocking", "recruiting", "driving", "content", "returning", "other")
 
 
@@ -33,17 +32,22 @@ def plan(quick: bool) -> dict[str, list[tuple[str, list[str]]]]:
     sizes = (6, 30) if quick else (6, 30, 100)
     return {
         "startup": [("startup", ["--runs", "3" if quick else "7", "--telemetry"])],
-        "ticks": [(f"{n}-{t}", ["--stops", str(n), "--telemetry", t])
-                  for n in sizes for t in ("off", "on")],
-        "reaction": [(t, ["--trials", "200" if quick else "1000", "--telemetry", t])
-                     for t in ("off", "on")],
+        "ticks": [
+            (f"{n}-{t}", ["--stops", str(n), "--telemetry", t])
+            for n in sizes
+            for t in ("off", "on")
+        ],
+        "reaction": [
+            (t, ["--trials", "200" if quick else "1000", "--telemetry", t]) for t in ("off", "on")
+        ],
         "ingest": [("ingest", ["--seconds", "1" if quick else "5"])],
         "replay": [("replay", ["--minutes", "10" if quick else "60"])],
         "memory": [("off", ["--tours", "10" if quick else "100"])]
         + ([] if quick else [("on", ["--tours", "30", "--telemetry", "on"])]),
         "console": [("console", ["--clients", "10", "--runs", "1" if quick else "3"])],
-        "report": [("report", ["--tours", "20" if quick else "100", "--runs", "1" if quick
-                               else "2"])],
+        "report": [
+            ("report", ["--tours", "20" if quick else "100", "--runs", "1" if quick else "2"])
+        ],
     }
 
 
@@ -53,13 +57,18 @@ def run_section(name: str, runs: list[tuple[str, list[str]]], tmp: Path) -> dict
         target = tmp / f"{name}-{label}.json"
         t0 = time.monotonic()
         print(f"  {name} {label} ...", end="", file=sys.stderr, flush=True)
-        done = subprocess.run([sys.executable, str(SCRIPTS / f"bench_{name}.py"), *args,
-                               "--out", str(target)], capture_output=True, text=True)
+        done = subprocess.run(
+            [sys.executable, str(SCRIPTS / f"bench_{name}.py"), *args, "--out", str(target)],
+            capture_output=True,
+            text=True,
+        )
         print(f" {time.monotonic() - t0:.0f} s", file=sys.stderr, flush=True)
         if done.returncode != 0 or not target.exists():
             out[label] = {"error": (done.stderr or done.stdout)[-3000:]}
-            print(f"    failed: {(done.stderr or done.stdout).strip().splitlines()[-1:]}",
-                  file=sys.stderr)
+            print(
+                f"    failed: {(done.stderr or done.stdout).strip().splitlines()[-1:]}",
+                file=sys.stderr,
+            )
             continue
         out[label] = json.loads(target.read_text(encoding="utf-8"))
     return out
@@ -69,13 +78,18 @@ def machine() -> dict[str, Any]:
     model = ""
     try:
         with open("/proc/cpuinfo", encoding="ascii", errors="replace") as f:
-            model = next((line.split(":", 1)[1].strip() for line in f
-                          if line.startswith("model name")), "")
+            model = next(
+                (line.split(":", 1)[1].strip() for line in f if line.startswith("model name")), ""
+            )
     except OSError:
         pass
-    return {"platform": platform.platform(), "python": platform.python_version(),
-            "cpus": os.cpu_count(), "cpu_model": model,
-            "load_before": os.getloadavg() if hasattr(os, "getloadavg") else None}
+    return {
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "cpus": os.cpu_count(),
+        "cpu_model": model,
+        "load_before": os.getloadavg() if hasattr(os, "getloadavg") else None,
+    }
 
 
 # ------------------------------------------------------------------ budgets
@@ -95,12 +109,27 @@ class Rows:
     def __init__(self) -> None:
         self.rows: list[dict[str, Any]] = []
 
-    def add(self, what: str, value: float | None, unit: str, budget: str,
-            met: Callable[[float], bool] | None, fmt: str = "{:.0f}") -> None:
+    def add(
+        self,
+        what: str,
+        value: float | None,
+        unit: str,
+        budget: str,
+        met: Callable[[float], bool] | None,
+        fmt: str = "{:.0f}",
+    ) -> None:
         ok = None if value is None or met is None else bool(met(value))
         text = "n/a" if value is None else fmt.format(value) + unit
-        self.rows.append({"what": what, "value": value, "unit": unit.strip(), "text": text,
-                          "budget": budget, "met": ok})
+        self.rows.append(
+            {
+                "what": what,
+                "value": value,
+                "unit": unit.strip(),
+                "text": text,
+                "budget": budget,
+                "met": ok,
+            }
+        )
 
 
 def budgets(results: dict[str, Any]) -> list[dict[str, Any]]:
@@ -110,71 +139,150 @@ def budgets(results: dict[str, Any]) -> list[dict[str, Any]]:
     for n in sizes:
         on, off = get(ticks, f"{n}-on", "all", "p50_us"), get(ticks, f"{n}-off", "all", "p50_us")
         stops = f"{n} stops, {get(ticks, f'{n}-on', 'nodes') or '?'} nodes"
-        rows.add(f"tick p50, telemetry on ({stops})", on, " µs", "≤ 150 µs",
-                 lambda v: v <= 150)
+        rows.add(f"tick p50, telemetry on ({stops})", on, " µs", "≤ 150 µs", lambda v: v <= 150)
         if on is not None and off:
-            rows.add(f"telemetry overhead on tick p50 ({n} stops)", 100 * (on / off - 1), " %",
-                     "≤ 15 %", lambda v: v <= 15)
-        rows.add(f"telemetry writing after the ticks, per tick ({n} stops)",
-                 get(ticks, f"{n}-on", "telemetry_write_us_per_tick"), " µs", "(off the tick)",
-                 None)
+            rows.add(
+                f"telemetry overhead on tick p50 ({n} stops)",
+                100 * (on / off - 1),
+                " %",
+                "≤ 15 %",
+                lambda v: v <= 15,
+            )
+        rows.add(
+            f"telemetry writing after the ticks, per tick ({n} stops)",
+            get(ticks, f"{n}-on", "telemetry_write_us_per_tick"),
+            " µs",
+            "(off the tick)",
+            None,
+        )
     if len(sizes) > 1:
         small, large = sizes[0], sizes[-1]
         for t in ("off", "on"):
             a = get(ticks, f"{small}-{t}", "all", "p50_us")
             b = get(ticks, f"{large}-{t}", "all", "p50_us")
             if a and b:
-                rows.add(f"tick p50 {large} vs {small} stops, telemetry {t}", b / a, " x",
-                         "≈ 1 x (active path)", lambda v: v <= 1.25, "{:.2f}")
+                rows.add(
+                    f"tick p50 {large} vs {small} stops, telemetry {t}",
+                    b / a,
+                    " x",
+                    "≈ 1 x (active path)",
+                    lambda v: v <= 1.25,
+                    "{:.2f}",
+                )
     for t in ("off", "on") if "reaction" in results else ():
         for kind in ("response 2 -> start_poi", "user_positive -> /GotoWayPoint"):
             value = get(results, "reaction", t, kind, "p99_us")
-            rows.add(f"reaction p99 {kind}, telemetry {t}",
-                     None if value is None else value / 1000, " ms", "≤ 5 ms",
-                     lambda v: v <= 5, "{:.2f}")
+            rows.add(
+                f"reaction p99 {kind}, telemetry {t}",
+                None if value is None else value / 1000,
+                " ms",
+                "≤ 5 ms",
+                lambda v: v <= 5,
+                "{:.2f}",
+            )
     ingest = get(results, "ingest", "ingest") or {}
     for kind in ("pose", "faces", "persons") if ingest else ():
         ours = get(ingest, "executive", kind, "msg_per_s")
         theirs = get(ingest, "roslibpy", kind, "msg_per_s")
-        rows.add(f"ingestion, {kind} flood", ours, " msg/s", "≥ 5,000 msg/s",
-                 lambda v: v >= 5000, "{:,.0f}")
+        rows.add(
+            f"ingestion, {kind} flood",
+            ours,
+            " msg/s",
+            "≥ 5,000 msg/s",
+            lambda v: v >= 5000,
+            "{:,.0f}",
+        )
         if ours and theirs:
-            rows.add(f"ingestion vs roslibpy, {kind} flood", ours / theirs, " x", "≥ 2 x",
-                     lambda v: v >= 2, "{:.2f}")
+            rows.add(
+                f"ingestion vs roslibpy, {kind} flood",
+                ours / theirs,
+                " x",
+                "≥ 2 x",
+                lambda v: v >= 2,
+                "{:.2f}",
+            )
     if "replay" in results:
         minutes = (get(results, "replay", "replay", "recording", "sim_s") or 0) / 60
-        for key, label in (("plain", f"replay of {minutes:.0f} recorded minutes"),
-                           ("rrd", f"replay of {minutes:.0f} recorded minutes, with .rrd")):
-            rows.add(label, get(results, "replay", "replay", key, "command_speed_x"),
-                     " x real time", "≥ 500 x", lambda v: v >= 500)
+        for key, label in (
+            ("plain", f"replay of {minutes:.0f} recorded minutes"),
+            ("rrd", f"replay of {minutes:.0f} recorded minutes, with .rrd"),
+        ):
+            rows.add(
+                label,
+                get(results, "replay", "replay", key, "command_speed_x"),
+                " x real time",
+                "≥ 500 x",
+                lambda v: v >= 500,
+            )
     if "startup" in results:
         for stat in ("p50", "max"):
-            rows.add(f"start-up to connected and subscribed, {stat}",
-                     get(results, "startup", "startup", "plain", stat), " s", "≤ 1.5 s",
-                     lambda v: v <= 1.5, "{:.2f}")
+            rows.add(
+                f"start-up to connected and subscribed, {stat}",
+                get(results, "startup", "startup", "plain", stat),
+                " s",
+                "≤ 1.5 s",
+                lambda v: v <= 1.5,
+                "{:.2f}",
+            )
     mem = get(results, "memory", "off") or {}
     if "growth_pct" in mem:
-        rows.add(f"RSS growth, tour 1 -> {mem['tours']} ({mem['rss_first_kb'] / 1024:.1f} -> "
-                 f"{mem['rss_last_kb'] / 1024:.1f} MiB)", mem["growth_pct"], " %", "≤ 5 %",
-                 lambda v: v <= 5, "{:.1f}")
+        rows.add(
+            f"RSS growth, tour 1 -> {mem['tours']} ({mem['rss_first_kb'] / 1024:.1f} -> "
+            f"{mem['rss_last_kb'] / 1024:.1f} MiB)",
+            mem["growth_pct"],
+            " %",
+            "≤ 5 %",
+            lambda v: v <= 5,
+            "{:.1f}",
+        )
     mem_on = get(results, "memory", "on") or {}
     if "growth_pct" in mem_on:
-        rows.add(f"RSS growth with telemetry, tour 1 -> {mem_on['tours']} "
-                 f"({mem_on['rss_first_kb'] / 1024:.1f} -> {mem_on['rss_last_kb'] / 1024:.1f}"
-                 " MiB)", mem_on["growth_pct"], " %", "≤ 5 %", lambda v: v <= 5, "{:.1f}")
+        rows.add(
+            f"RSS growth with telemetry, tour 1 -> {mem_on['tours']} "
+            f"({mem_on['rss_first_kb'] / 1024:.1f} -> {mem_on['rss_last_kb'] / 1024:.1f}"
+            " MiB)",
+            mem_on["growth_pct"],
+            " %",
+            "≤ 5 %",
+            lambda v: v <= 5,
+            "{:.1f}",
+        )
     console = get(results, "console", "console") or {}
     if "overhead_pct" in console:
-        rows.add(f"console overhead on tick p50, {console['clients']} pages",
-                 console["overhead_pct"], " %", "≤ 5 %", lambda v: v <= 5, "{:.1f}")
-        rows.add("console: a new phase reaches every page, max", console["latency_max_ms"],
-                 " ms", "≤ 500 ms", lambda v: v <= 500, "{:.1f}")
+        rows.add(
+            f"console overhead on tick p50, {console['clients']} pages",
+            console["overhead_pct"],
+            " %",
+            "≤ 5 %",
+            lambda v: v <= 5,
+            "{:.1f}",
+        )
+        rows.add(
+            "console: a new phase reaches every page, max",
+            console["latency_max_ms"],
+            " ms",
+            "≤ 500 ms",
+            lambda v: v <= 500,
+            "{:.1f}",
+        )
     rep = get(results, "report", "report") or {}
     if "report_vs_plain_read" in rep:
-        rows.add(f"report throughput vs reading every message with mcap ({rep['tours']} "
-                 "tours)", 100 * rep["report_vs_plain_read"], " %", "≥ 50 %",
-                 lambda v: v >= 50, "{:.0f}")
-        rows.add("report --jobs 2 vs one job", rep["two_jobs_speedup"], " x", "≥ 1.6 x",
-                 lambda v: v >= 1.6, "{:.2f}")
+        rows.add(
+            f"report throughput vs reading every message with mcap ({rep['tours']} tours)",
+            100 * rep["report_vs_plain_read"],
+            " %",
+            "≥ 50 %",
+            lambda v: v >= 50,
+            "{:.0f}",
+        )
+        rows.add(
+            "report --jobs 2 vs one job",
+            rep["two_jobs_speedup"],
+            " x",
+            "≥ 1.6 x",
+            lambda v: v >= 1.6,
+            "{:.2f}",
+        )
     return rows.rows
 
 
@@ -182,8 +290,9 @@ def budgets(results: dict[str, Any]) -> list[dict[str, Any]]:
 
 
 def table(headers: list[str], rows: list[list[str]]) -> str:
-    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h)
-              for i, h in enumerate(headers)]
+    widths = [
+        max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(headers)
+    ]
     line = "  ".join(f"{{:<{w}}}" for w in widths)
     out = [line.format(*headers), line.format(*("-" * w for w in widths))]
     out += [line.format(*r) for r in rows]
@@ -193,8 +302,12 @@ def table(headers: list[str], rows: list[list[str]]) -> str:
 def report(results: dict[str, Any], rows: list[dict[str, Any]]) -> str:
     parts = ["", "Budgets (goals read off this table, never asserted)", ""]
     mark = {True: "met", False: "MISSED", None: "-"}
-    parts.append(table(["what", "figure", "budget", ""],
-                       [[r["what"], r["text"], r["budget"], mark[r["met"]]] for r in rows]))
+    parts.append(
+        table(
+            ["what", "figure", "budget", ""],
+            [[r["what"], r["text"], r["budget"], mark[r["met"]]] for r in rows],
+        )
+    )
     ticks = results.get("ticks", {})
     if ticks:
         labels = [k for k in ticks if "all" in ticks[k]]
@@ -207,19 +320,28 @@ def report(results: dict[str, Any], rows: list[dict[str, Any]]) -> str:
             if any(c != "-" for c in cells):
                 body.append([phase, *cells])
         heads = ["tick µs p50 / p99 (n)"] + [
-            f"{k.split('-')[0]} stops, tel. {k.split('-')[1]}" for k in labels]
+            f"{k.split('-')[0]} stops, tel. {k.split('-')[1]}" for k in labels
+        ]
         parts += ["", table(heads, body)]
     ingest = get(results, "ingest", "ingest") or {}
     if ingest.get("executive"):
         body = []
         for kind in ("pose", "faces", "persons"):
             e, r = ingest["executive"].get(kind, {}), (ingest.get("roslibpy") or {}).get(kind, {})
-            body.append([kind, f"{e.get('msg_per_s', 0):,.0f}", f"{e.get('ticks_per_s', 0):.0f}",
-                         f"{e.get('rss_before_kb', 0) / 1024:.1f} -> "
-                         f"{e.get('rss_after_kb', 0) / 1024:.1f}",
-                         f"{r['msg_per_s']:,.0f}" if r else "n/a"])
-        parts += ["", table(["flood", "executive msg/s", "ticks/s", "RSS MiB",
-                             "roslibpy msg/s"], body)]
+            body.append(
+                [
+                    kind,
+                    f"{e.get('msg_per_s', 0):,.0f}",
+                    f"{e.get('ticks_per_s', 0):.0f}",
+                    f"{e.get('rss_before_kb', 0) / 1024:.1f} -> "
+                    f"{e.get('rss_after_kb', 0) / 1024:.1f}",
+                    f"{r['msg_per_s']:,.0f}" if r else "n/a",
+                ]
+            )
+        parts += [
+            "",
+            table(["flood", "executive msg/s", "ticks/s", "RSS MiB", "roslibpy msg/s"], body),
+        ]
         skipped = get(ingest, "roslibpy", "skipped")
         if skipped:
             parts.append(f"(no roslibpy column: {skipped})")
@@ -229,20 +351,34 @@ def report(results: dict[str, Any], rows: list[dict[str, Any]]) -> str:
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="scripts/bench", description=__doc__.splitlines()[0])
     p.add_argument("--quick", action="store_true", help="smaller samples: about a minute")
-    p.add_argument("--json", type=Path, default=Path("bench.json"), metavar="PATH",
-                   help="where to write the results (default: bench.json)")
-    p.add_argument("--only", metavar="SECTION[,SECTION]",
-                   help=f"run only these sections ({', '.join(SECTIONS)})")
+    p.add_argument(
+        "--json",
+        type=Path,
+        default=Path("bench.json"),
+        metavar="PATH",
+        help="where to write the results (default: bench.json)",
+    )
+    p.add_argument(
+        "--only",
+        metavar="SECTION[,SECTION]",
+        help=f"run only these sections ({', '.join(SECTIONS)})",
+    )
     args = p.parse_args(argv)
     chosen = SECTIONS if not args.only else tuple(s for s in args.only.split(",") if s)
     unknown = [s for s in chosen if s not in SECTIONS]
     if unknown:
         p.error(f"unknown section {unknown[0]!r} (known: {', '.join(SECTIONS)})")
     started = time.monotonic()
-    results: dict[str, Any] = {"machine": machine(), "quick": args.quick,
-                               "started": dt.datetime.now(dt.UTC).isoformat(timespec="seconds")}
-    print(f"frog-bt bench{' --quick' if args.quick else ''} on {results['machine']['cpus']} "
-          f"CPUs ({results['machine']['cpu_model'] or platform.machine()})", file=sys.stderr)
+    results: dict[str, Any] = {
+        "machine": machine(),
+        "quick": args.quick,
+        "started": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
+    }
+    print(
+        f"frog-bt bench{' --quick' if args.quick else ''} on {results['machine']['cpus']} "
+        f"CPUs ({results['machine']['cpu_model'] or platform.machine()})",
+        file=sys.stderr,
+    )
     failed = False
     with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
         for name, runs in plan(args.quick).items():

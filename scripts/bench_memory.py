@@ -42,13 +42,27 @@ async def measure(tours: int, speed: float, telemetry: str, workdir: Path) -> di
     from frog_bt.sim import Simulator
 
     listen = (LOOPBACK, free_port())
-    sim = Simulator(scenario({**FAST_TOURS, "speed": speed}), host=LOOPBACK, rosbridge_port=0,
-                    frontend_port=0, executive=listen)
+    sim = Simulator(
+        scenario({**FAST_TOURS, "speed": speed}),
+        host=LOOPBACK,
+        rosbridge_port=0,
+        frontend_port=0,
+        executive=listen,
+    )
     await sim.start()
-    argv: list[Any] = [sys.executable, SCRIPTS / "bench_executive.py", "--config", SITE_FILE,
-                       "--rosbridge", f"ws://{LOOPBACK}:{sim.rosbridge_port}",
-                       "--frontend", f"{LOOPBACK}:{sim.frontend_port}",
-                       "--listen", f"{LOOPBACK}:{listen[1]}", "--sim-time"]
+    argv: list[Any] = [
+        sys.executable,
+        SCRIPTS / "bench_executive.py",
+        "--config",
+        SITE_FILE,
+        "--rosbridge",
+        f"ws://{LOOPBACK}:{sim.rosbridge_port}",
+        "--frontend",
+        f"{LOOPBACK}:{sim.frontend_port}",
+        "--listen",
+        f"{LOOPBACK}:{listen[1]}",
+        "--sim-time",
+    ]
     if telemetry in ("on", "record"):
         argv += ["--record", workdir / "recordings"]  # one file per tour, as on the robot
     if telemetry in ("on", "rerun"):
@@ -64,14 +78,19 @@ async def measure(tours: int, speed: float, telemetry: str, workdir: Path) -> di
         await sim.stop()
     first, last = marks[0], marks[-1]
     return {
-        "tours": len(marks), "speed": speed, "telemetry": telemetry,
-        "sim_s": sim.clock.now() - sim0, "wall_s": time.monotonic() - wall0,
-        "rss_first_kb": first["rss_kb"], "rss_last_kb": last["rss_kb"],
+        "tours": len(marks),
+        "speed": speed,
+        "telemetry": telemetry,
+        "sim_s": sim.clock.now() - sim0,
+        "wall_s": time.monotonic() - wall0,
+        "rss_first_kb": first["rss_kb"],
+        "rss_last_kb": last["rss_kb"],
         "growth_pct": 100.0 * (last["rss_kb"] - first["rss_kb"]) / first["rss_kb"],
         "hwm_kb": last.get("hwm_kb"),
         "rss_kb_by_tour": [m["rss_kb"] for m in marks],
-        "growth_from_tour_10_pct": 100.0 * (last["rss_kb"] - marks[min(9, len(marks) - 1)][
-            "rss_kb"]) / marks[min(9, len(marks) - 1)]["rss_kb"],
+        "growth_from_tour_10_pct": 100.0
+        * (last["rss_kb"] - marks[min(9, len(marks) - 1)]["rss_kb"])
+        / marks[min(9, len(marks) - 1)]["rss_kb"],
         "child_rss_kb_by_tour": [m.get("child_rss_kb", 0) for m in marks],
         "sim_dropped_frames": sim._rosbridge.dropped,
     }
@@ -81,8 +100,12 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--tours", type=int, default=100)
     p.add_argument("--speed", type=float, default=300.0, help="sim-time speed factor")
-    p.add_argument("--telemetry", choices=("on", "off", "record", "rerun"), default="off",
-                   help="on: --record DIR and --rerun save:FILE.rrd; or either alone")
+    p.add_argument(
+        "--telemetry",
+        choices=("on", "off", "record", "rerun"),
+        default="off",
+        help="on: --record DIR and --rerun save:FILE.rrd; or either alone",
+    )
     p.add_argument("--out")
     args = p.parse_args()
     import tempfile

@@ -106,8 +106,7 @@ class Director:
         if target in self.stops:
             with_visitor = target == self.stops[0]
             people = [{"id": 7, "position": self.near()}] if with_visitor else []
-            await self.server.publish("/PeopleUPO", {
-                "header": self.header(now), "people": people})
+            await self.server.publish("/PeopleUPO", {"header": self.header(now), "people": people})
             self.lost = not with_visitor
             t0 = await self.server.publish("/FROG_response", {"data": 2})
             if with_visitor:
@@ -121,17 +120,27 @@ class Director:
     @staticmethod
     def header(t: float) -> dict[str, Any]:
         secs = math.floor(t)
-        return {"seq": 0, "stamp": {"secs": secs, "nsecs": int((t - secs) * 1e9)},
-                "frame_id": "map"}
+        return {
+            "seq": 0,
+            "stamp": {"secs": secs, "nsecs": int((t - secs) * 1e9)},
+            "frame_id": "map",
+        }
 
     def pose(self, t: float) -> dict[str, Any]:
         x, y = self.robot
-        return {"header": self.header(t), "pose": {"position": {"x": x, "y": y, "z": 0.0},
-                "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}}
+        return {
+            "header": self.header(t),
+            "pose": {
+                "position": {"x": x, "y": y, "z": 0.0},
+                "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
+            },
+        }
 
     def persons(self, t: float) -> dict[str, Any]:
-        return {"header": self.header(t), "persons": [
-            {"id": 7, "position": self.near(), "orientation": 180.0}]}
+        return {
+            "header": self.header(t),
+            "persons": [{"id": 7, "position": self.near(), "orientation": 180.0}],
+        }
 
     async def sensors(self) -> None:
         """Pose and person detections at 10 Hz, as the robot publishes them."""
@@ -175,8 +184,12 @@ async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]
     from frog_bt.model.wire import INPUTS
 
     plain = {"content": True, "face_stream": False, "projector": False, "check_follower": True}
-    site_path = synthetic_site(7, workdir, flags=plain, over={"follow": {"grace": 0.0},
-                                                           "recruit": {"approach_interval": 0.0}})
+    site_path = synthetic_site(
+        7,
+        workdir,
+        flags=plain,
+        over={"follow": {"grace": 0.0}, "recruit": {"approach_interval": 0.0}},
+    )
     site = load_site(site_path)
     director = Director(site, trials)
     director.server.expect = len(INPUTS)
@@ -184,12 +197,29 @@ async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]
     listen = free_port()
     director.frontend = FakeFrontend((LOOPBACK, listen), director.on_command)
     frontend_port = await director.frontend.open()
-    argv = [str(FROG_BT), "run", "--config", str(site_path), "--rosbridge", director.server.url,
-            "--frontend", f"{LOOPBACK}:{frontend_port}", "--listen", f"{LOOPBACK}:{listen}",
-            "--checkpoint", "none", "--fresh", "--quiet"]
+    argv = [
+        str(FROG_BT),
+        "run",
+        "--config",
+        str(site_path),
+        "--rosbridge",
+        director.server.url,
+        "--frontend",
+        f"{LOOPBACK}:{frontend_port}",
+        "--listen",
+        f"{LOOPBACK}:{listen}",
+        "--checkpoint",
+        "none",
+        "--fresh",
+        "--quiet",
+    ]
     if telemetry:
-        argv += ["--record", str(workdir / "reaction.mcap"),
-                 "--rerun", f"save:{workdir / 'reaction.rrd'}"]
+        argv += [
+            "--record",
+            str(workdir / "reaction.mcap"),
+            "--rerun",
+            f"save:{workdir / 'reaction.rrd'}",
+        ]
     proc = await asyncio.create_subprocess_exec(*argv)
     sensors = None
     wall0 = time.monotonic()
@@ -209,7 +239,9 @@ async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]
         director.frontend.close()
         await director.server.stop()
     return {
-        "trials": trials, "telemetry": telemetry, "wall_s": time.monotonic() - wall0,
+        "trials": trials,
+        "telemetry": telemetry,
+        "wall_s": time.monotonic() - wall0,
         "errors": director.errors[:5],
         **{kind: summary_us(values[WARMUP:]) for kind, values in director.samples.items()},
     }

@@ -75,20 +75,32 @@ def main() -> None:
         plain_s, messages = best(lambda: plain_read(files), a.runs)
         one_s, tours = best(lambda: report(files, 1), a.runs)
         two_s, _ = best(lambda: report(files, 2), a.runs)
-    out = {"files": len(files), "tours": tours, "mb": round(size, 1), "messages": messages,
-           "plain_read_s": round(plain_s, 2), "report_1_job_s": round(one_s, 2),
-           "report_2_jobs_s": round(two_s, 2),
-           "report_vs_plain_read": round(plain_s / one_s, 2),
-           "two_jobs_speedup": round(one_s / two_s, 2),
-           "year_of_one_robot_s": round(YEAR * two_s / max(tours, 1), 0)}
+    out = {
+        "files": len(files),
+        "tours": tours,
+        "mb": round(size, 1),
+        "messages": messages,
+        "plain_read_s": round(plain_s, 2),
+        "report_1_job_s": round(one_s, 2),
+        "report_2_jobs_s": round(two_s, 2),
+        "report_vs_plain_read": round(plain_s / one_s, 2),
+        "two_jobs_speedup": round(one_s / two_s, 2),
+        "year_of_one_robot_s": round(YEAR * two_s / max(tours, 1), 0),
+    }
     print(f"{len(files)} files, {tours} tours, {size:.0f} MB, {messages:,} messages")
     print(f"plain read (mcap):  {plain_s:6.2f} s  {size / plain_s:6.1f} MB/s")
-    print(f"report, 1 job:      {one_s:6.2f} s  {size / one_s:6.1f} MB/s  "
-          f"({100 * plain_s / one_s:.0f} % of the plain read)")
-    print(f"report, 2 jobs:     {two_s:6.2f} s  {size / two_s:6.1f} MB/s  "
-          f"({one_s / two_s:.2f}x one job)")
-    print(f"a year of one robot ({YEAR} tours): about {out['year_of_one_robot_s'] / 60:.1f} "
-          "min with 2 jobs")
+    print(
+        f"report, 1 job:      {one_s:6.2f} s  {size / one_s:6.1f} MB/s  "
+        f"({100 * plain_s / one_s:.0f} % of the plain read)"
+    )
+    print(
+        f"report, 2 jobs:     {two_s:6.2f} s  {size / two_s:6.1f} MB/s  "
+        f"({one_s / two_s:.2f}x one job)"
+    )
+    print(
+        f"a year of one robot ({YEAR} tours): about {out['year_of_one_robot_s'] / 60:.1f} "
+        "min with 2 jobs"
+    )
     emit(out, a.out)
 
 

@@ -40,18 +40,29 @@ def main() -> None:
             for _ in range(200):
                 t = np.arange(50) + k
                 k += 50
-                times = [rr.TimeColumn("tick", sequence=t), rr.TimeColumn(
-                    "time", timestamp=(t * 100_000_000).astype("datetime64[ns]"))]
+                times = [
+                    rr.TimeColumn("tick", sequence=t),
+                    rr.TimeColumn("time", timestamp=(t * 100_000_000).astype("datetime64[ns]")),
+                ]
                 if args.kind == "text":
-                    rec.send_columns("log/a", indexes=times, columns=rr.TextLog.columns(
-                        text=[f"row {i} of the log" for i in t]))
+                    rec.send_columns(
+                        "log/a",
+                        indexes=times,
+                        columns=rr.TextLog.columns(text=[f"row {i} of the log" for i in t]),
+                    )
                 elif args.kind == "points":
-                    rec.send_columns("map/robot", indexes=times, columns=rr.Points2D.columns(
-                        positions=np.random.rand(50, 2)))
+                    rec.send_columns(
+                        "map/robot",
+                        indexes=times,
+                        columns=rr.Points2D.columns(positions=np.random.rand(50, 2)),
+                    )
                 else:
                     for lane in range(20):
-                        rec.send_columns(f"bt/{lane}", indexes=times, columns=rr.Scalars.columns(
-                            scalars=np.random.rand(50)))
+                        rec.send_columns(
+                            f"bt/{lane}",
+                            indexes=times,
+                            columns=rr.Scalars.columns(scalars=np.random.rand(50)),
+                        )
             rec.flush()
             rss.append(memory_kb().get("rss_kb", 0))
             if args.rotate:
@@ -59,9 +70,16 @@ def main() -> None:
                 rec = rr.RecordingStream("frog-bt-bench")
                 rec.save(str(Path(tmp) / f"{block + 1}.rrd"))
         rec.disconnect()
-    emit({"kind": args.kind, "rotate": args.rotate, "rows_per_block": 10_000,
-          "rss_kb": rss, "growth_kb_per_block": (rss[-1] - rss[0]) / max(len(rss) - 1, 1)},
-         args.out)
+    emit(
+        {
+            "kind": args.kind,
+            "rotate": args.rotate,
+            "rows_per_block": 10_000,
+            "rss_kb": rss,
+            "growth_kb_per_block": (rss[-1] - rss[0]) / max(len(rss) - 1, 1),
+        },
+        args.out,
+    )
 
 
 if __name__ == "__main__":

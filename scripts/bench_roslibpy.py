@@ -44,8 +44,9 @@ def main() -> None:
         if line.strip() == "stats":
             with lock:
                 n = received
-            sys.stdout.write(json.dumps({"event": "stats", "received": n,
-                                         "t": time.monotonic()}) + "\n")
+            sys.stdout.write(
+                json.dumps({"event": "stats", "received": n, "t": time.monotonic()}) + "\n"
+            )
             sys.stdout.flush()
     ros.terminate()
 

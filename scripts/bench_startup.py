@@ -48,10 +48,21 @@ async def startup_runs(runs: int, extra: list[str]) -> dict[str, Any]:
             server.ready.clear()
             t0 = time.perf_counter_ns()
             proc = await asyncio.create_subprocess_exec(
-                str(FROG_BT), "run", "--rosbridge", server.url,
-                "--frontend", f"{LOOPBACK}:{frontend_port}", "--listen", f"{LOOPBACK}:{listen}",
-                "--checkpoint", "none", "--quiet", *extra,
-                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                str(FROG_BT),
+                "run",
+                "--rosbridge",
+                server.url,
+                "--frontend",
+                f"{LOOPBACK}:{frontend_port}",
+                "--listen",
+                f"{LOOPBACK}:{listen}",
+                "--checkpoint",
+                "none",
+                "--quiet",
+                *extra,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+            )
             try:
                 await asyncio.wait_for(server.ready.wait(), 30)
                 times.append((server.ready_ns - t0) / 1e9)
@@ -66,9 +77,11 @@ async def startup_runs(runs: int, extra: list[str]) -> dict[str, Any]:
 
 def import_time() -> float:
     """Seconds for a fresh interpreter to import what ``frog-bt run`` needs."""
-    code = ("import frog_bt.commands.run, frog_bt.runtime.executive, frog_bt.runtime.status; "
-            "from frog_bt.config import load_site; from frog_bt.behaviours import load_tree; "
-            "load_tree(site=load_site())")
+    code = (
+        "import frog_bt.commands.run, frog_bt.runtime.executive, frog_bt.runtime.status; "
+        "from frog_bt.config import load_site; from frog_bt.behaviours import load_tree; "
+        "load_tree(site=load_site())"
+    )
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-c", code], check=True)
     loaded = time.perf_counter() - t0
@@ -80,17 +93,21 @@ def import_time() -> float:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--runs", type=int, default=7)
-    p.add_argument("--telemetry", action="store_true",
-                   help="also time a start with --record and --rerun save:")
+    p.add_argument(
+        "--telemetry", action="store_true", help="also time a start with --record and --rerun save:"
+    )
     p.add_argument("--out")
     args = p.parse_args()
     result: dict[str, Any] = {"runs": args.runs}
     result["plain"] = asyncio.run(startup_runs(args.runs, []))
     if args.telemetry:
         with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
-            result["telemetry"] = asyncio.run(startup_runs(
-                max(2, args.runs // 2),
-                ["--record", f"{tmp}/s.mcap", "--rerun", f"save:{tmp}/s.rrd"]))
+            result["telemetry"] = asyncio.run(
+                startup_runs(
+                    max(2, args.runs // 2),
+                    ["--record", f"{tmp}/s.mcap", "--rerun", f"save:{tmp}/s.rrd"],
+                )
+            )
     result["imports_and_checks_s"] = min(import_time() for _ in range(3))
     emit(result, args.out)
 

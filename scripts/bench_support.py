@@ -43,17 +43,25 @@ def summary_us(samples_ns: Iterable[int]) -> dict[str, float]:
     values = sorted(samples_ns)
     if not values:
         return {"n": 0}
-    return {"n": len(values), "p50_us": percentile(values, 0.50) / 1e3,
-            "p99_us": percentile(values, 0.99) / 1e3,
-            "mean_us": sum(values) / len(values) / 1e3, "max_us": values[-1] / 1e3}
+    return {
+        "n": len(values),
+        "p50_us": percentile(values, 0.50) / 1e3,
+        "p99_us": percentile(values, 0.99) / 1e3,
+        "mean_us": sum(values) / len(values) / 1e3,
+        "max_us": values[-1] / 1e3,
+    }
 
 
 def summary(values: Iterable[float]) -> dict[str, float]:
     ordered = sorted(values)
     if not ordered:
         return {"n": 0}
-    return {"n": len(ordered), "p50": percentile(ordered, 0.5), "min": ordered[0],
-            "max": ordered[-1]}
+    return {
+        "n": len(ordered),
+        "p50": percentile(ordered, 0.5),
+        "min": ordered[0],
+        "max": ordered[-1],
+    }
 
 
 # ------------------------------------------------------------------ memory
@@ -80,8 +88,13 @@ def memory_kb(pid: int | str = "self") -> dict[str, int]:
 # ------------------------------------------------------------------ sites and scenarios
 
 
-def synthetic_site(stops: int, directory: Path, *, flags: dict[str, Any] | None = None,
-                   over: dict[str, Any] | None = None) -> Path:
+def synthetic_site(
+    stops: int,
+    directory: Path,
+    *,
+    flags: dict[str, Any] | None = None,
+    over: dict[str, Any] | None = None,
+) -> Path:
     """A copy of ``config/site.yaml`` whose tour has ``stops`` synthetic stops.
 
     The stops ``S000``, ``S001``, ... lie on a lattice 8 m apart (rows of ten, driven
@@ -99,10 +112,16 @@ def synthetic_site(stops: int, directory: Path, *, flags: dict[str, Any] | None 
         row, col = divmod(i, 10)
         col = col if row % 2 == 0 else 9 - col
         name = f"S{i:03d}"
-        pois[name] = {"x": 60.0 + 8.0 * col, "y": 45.0 + 8.0 * row, "z": 0.0, "w": 1.0,
-                      "name": f"Synthetic stop {i}"}
-        new_stops.append({"poi": name, **(flags if flags is not None
-                                           else pattern[i % len(pattern)])})
+        pois[name] = {
+            "x": 60.0 + 8.0 * col,
+            "y": 45.0 + 8.0 * row,
+            "z": 0.0,
+            "w": 1.0,
+            "name": f"Synthetic stop {i}",
+        }
+        new_stops.append(
+            {"poi": name, **(flags if flags is not None else pattern[i % len(pattern)])}
+        )
     data["pois"] = pois
     data["variants"] = {}
     tour["stops"] = new_stops
@@ -152,8 +171,11 @@ class FakeRosbridge:
     taken just before the frame is written.
     """
 
-    def __init__(self, on_publish: Callable[[str, Any, int], None] | None = None,
-                 expect_subscriptions: int = 0) -> None:
+    def __init__(
+        self,
+        on_publish: Callable[[str, Any, int], None] | None = None,
+        expect_subscriptions: int = 0,
+    ) -> None:
         self.on_publish = on_publish
         self.expect = expect_subscriptions
         self.subscribed: dict[str, str] = {}
@@ -167,8 +189,7 @@ class FakeRosbridge:
     async def start(self) -> None:
         from websockets.asyncio.server import serve
 
-        self._server = await serve(self._handle, LOOPBACK, 0, compression=None,
-                                   max_size=1 << 22)
+        self._server = await serve(self._handle, LOOPBACK, 0, compression=None, max_size=1 << 22)
         self.port = next(iter(self._server.sockets)).getsockname()[1]
 
     @property
@@ -196,8 +217,11 @@ class FakeRosbridge:
                         self.on_publish(obj["topic"], obj["msg"], t)
                 elif op == "subscribe":
                     self.subscribed[obj["topic"]] = obj.get("type", "")
-                    if self.expect and len(self.subscribed) >= self.expect \
-                            and not self.ready.is_set():
+                    if (
+                        self.expect
+                        and len(self.subscribed) >= self.expect
+                        and not self.ready.is_set()
+                    ):
                         self.ready_ns = t
                         self.ready.set()
         except ConnectionClosed:
@@ -208,8 +232,9 @@ class FakeRosbridge:
 
     async def publish(self, topic: str, msg: Any) -> int:
         """Send one ``publish`` to the client; the time just before it is written."""
-        return await self.send_text(json.dumps({"op": "publish", "topic": topic, "msg": msg},
-                                               separators=(",", ":")))
+        return await self.send_text(
+            json.dumps({"op": "publish", "topic": topic, "msg": msg}, separators=(",", ":"))
+        )
 
     async def send_text(self, text: str) -> int:
         from websockets.exceptions import ConnectionClosed
@@ -232,8 +257,9 @@ class FakeFrontend(asyncio.DatagramProtocol):
     datagram is read; :meth:`send` returns the time just before an event is written.
     """
 
-    def __init__(self, executive: tuple[str, int],
-                 on_command: Callable[[Any, int], None] | None = None) -> None:
+    def __init__(
+        self, executive: tuple[str, int], on_command: Callable[[Any, int], None] | None = None
+    ) -> None:
         from frog_bt.frontend.protocol import Endpoint
         from frog_bt.model.frontend import COMMANDS
 
@@ -245,7 +271,8 @@ class FakeFrontend(asyncio.DatagramProtocol):
     async def open(self, port: int = 0) -> int:
         loop = asyncio.get_running_loop()
         self.transport, _ = await loop.create_datagram_endpoint(
-            lambda: self, local_addr=(LOOPBACK, port))
+            lambda: self, local_addr=(LOOPBACK, port)
+        )
         return int(self.transport.get_extra_info("sockname")[1])
 
     def datagram_received(self, data: bytes, addr: tuple[str, int]) -> None:  # type: ignore[override]
@@ -281,8 +308,12 @@ class Child:
     @classmethod
     async def start(cls, *argv: str | Path, env: dict[str, str] | None = None) -> Child:
         proc = await asyncio.create_subprocess_exec(
-            *map(str, argv), stdin=asyncio.subprocess.PIPE, stdout=asyncio.subprocess.PIPE,
-            env={**os.environ, **(env or {})}, cwd=ROOT)
+            *map(str, argv),
+            stdin=asyncio.subprocess.PIPE,
+            stdout=asyncio.subprocess.PIPE,
+            env={**os.environ, **(env or {})},
+            cwd=ROOT,
+        )
         return cls(proc)
 
     async def _read(self) -> None:
@@ -329,4 +360,3 @@ def emit(result: dict[str, Any], out: str | None) -> None:
         Path(out).write_text(text, encoding="utf-8")
     else:
         print(text)
-

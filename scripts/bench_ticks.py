@@ -33,18 +33,35 @@ from bench_support import (
     synthetic_site,
 )
 
-RECRUIT = {"SeekVisitor", "ApproachVisitor", "StartIntroduction", "AskTour", "WaitAnswer",
-           "WaitEvent"}
+RECRUIT = {
+    "SeekVisitor",
+    "ApproachVisitor",
+    "StartIntroduction",
+    "AskTour",
+    "WaitAnswer",
+    "WaitEvent",
+}
 CONTENT = {"VisitorFollows", "PlayContent", "FinishPoi", "Engaged", "SkipStop", "Skipped"}
 PHASES = ("waiting", "undocking", "recruiting", "driving", "content", "returning", "other")
 
 # Short content and a fast clock (as the end-to-end tests), but long enough phases for
 # percentiles: the front end says idle after 20 s, the visitor turns up after 60 s.
 SCENARIO: dict[str, Any] = {
-    "speed": 400.0, "content": {"default": 10, "introduction": 8},
+    "speed": 400.0,
+    "content": {"default": 10, "introduction": 8},
     "frontend": {"idle_at": 20.0},
-    "visitors": [{"id": 7, "position": [103.0, 36.0], "facing": True, "answer": "positive",
-                  "faces": "engaged", "follow": True, "after_tour": "leave", "appear_at": 60.0}],
+    "visitors": [
+        {
+            "id": 7,
+            "position": [103.0, 36.0],
+            "facing": True,
+            "answer": "positive",
+            "faces": "engaged",
+            "follow": True,
+            "after_tour": "leave",
+            "appear_at": 60.0,
+        }
+    ],
 }
 
 
@@ -80,13 +97,25 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
     tree = load_tree(site=site)
     nodes = sum(1 for _ in tree.nodes())
     listen = ("127.0.0.1", free_port())
-    sim = Simulator(scenario(SCENARIO), rosbridge_port=0, frontend_port=0, executive=listen,
-                    pois=load_pois(site_path))
+    sim = Simulator(
+        scenario(SCENARIO),
+        rosbridge_port=0,
+        frontend_port=0,
+        executive=listen,
+        pois=load_pois(site_path),
+    )
     small_log(sim)
     await sim.start()
-    executive = Executive(site, tree, SimClock(), rosbridge_url=f"ws://127.0.0.1:{sim.rosbridge_port}",
-                          frontend=("127.0.0.1", sim.frontend_port), listen=listen,
-                          sim_time=True, once=True)
+    executive = Executive(
+        site,
+        tree,
+        SimClock(),
+        rosbridge_url=f"ws://127.0.0.1:{sim.rosbridge_port}",
+        frontend=("127.0.0.1", sim.frontend_port),
+        listen=listen,
+        sim_time=True,
+        once=True,
+    )
     observers: list[Any] = []
     writes: list[int] = []
     if telemetry != "off":  # as frog-bt run --record FILE --rerun save:FILE attaches them
@@ -95,8 +124,10 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
 
         pin_malloc_thresholds()
         observers = attach_observers(
-            executive, record=workdir / "ticks.mcap" if telemetry != "rerun" else None,
-            rerun=f"save:{workdir / 'ticks.rrd'}" if telemetry != "record" else None)
+            executive,
+            record=workdir / "ticks.mcap" if telemetry != "rerun" else None,
+            rerun=f"save:{workdir / 'ticks.rrd'}" if telemetry != "record" else None,
+        )
         tel = observers[-1]
         if hasattr(tel, "_next_step"):  # written in-process (no fork): time its steps too
             plain_step = tel._next_step
@@ -140,8 +171,13 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
     wall = time.monotonic() - wall0
     every = [dt for values in samples.values() for dt in values]
     return {
-        "stops": stops, "telemetry": telemetry, "nodes": nodes, "outcome": outcome.reason,
-        "tours": outcome.tours, "sim_s": sim.clock.now() - sim0, "wall_s": wall,
+        "stops": stops,
+        "telemetry": telemetry,
+        "nodes": nodes,
+        "outcome": outcome.reason,
+        "tours": outcome.tours,
+        "sim_s": sim.clock.now() - sim0,
+        "wall_s": wall,
         "observers_close_s": close_s if observers else 0.0,
         "all": summary_us(every),
         "phases": {p: summary_us(samples[p]) for p in PHASES if samples.get(p)},
@@ -154,8 +190,12 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--stops", type=int, default=7)
-    p.add_argument("--telemetry", choices=("on", "off", "record", "rerun"), default="off",
-                   help="on: --record FILE and --rerun save:FILE.rrd; or either alone")
+    p.add_argument(
+        "--telemetry",
+        choices=("on", "off", "record", "rerun"),
+        default="off",
+        help="on: --record FILE and --rerun save:FILE.rrd; or either alone",
+    )
     p.add_argument("--out", help="write the JSON result here (default: stdout)")
     args = p.parse_args()
     with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:

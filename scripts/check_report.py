@@ -51,9 +51,25 @@ def main() -> int:
     n = len(kinds)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp)
-        subprocess.run([sys.executable, "-m", "frog_bt", "report", str(a.corpus), "--jobs",
-                        a.jobs, "--quiet", "-o", str(out / "r.html"), "--csv",
-                        str(out / "r.csv"), "--parquet", str(out / "r.parquet")], check=True)
+        subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "frog_bt",
+                "report",
+                str(a.corpus),
+                "--jobs",
+                a.jobs,
+                "--quiet",
+                "-o",
+                str(out / "r.html"),
+                "--csv",
+                str(out / "r.csv"),
+                "--parquet",
+                str(out / "r.parquet"),
+            ],
+            check=True,
+        )
         page = Totals()
         page.feed((out / "r.html").read_text())
         t = json.loads(page.text)
@@ -76,37 +92,58 @@ def main() -> int:
         sigma = math.sqrt(p * (1 - p) / trials)
         ok = abs(got - p) <= 3 * sigma + 1e-9
         failures += not ok
-        print(f"{'ok  ' if ok else 'FAIL'} {what}: {got:.3f}, seeded {p:.3f} "
-              f"(± {3 * sigma:.3f})")
+        print(f"{'ok  ' if ok else 'FAIL'} {what}: {got:.3f}, seeded {p:.3f} (± {3 * sigma:.3f})")
 
     check("HTML: tours", t["tours"], n)
     check("HTML: plots embedded", page.images >= 5, True)
     check("CSV rows", len(rows), n)
-    check("Parquet rows = CSV rows", [(r["tour"], r["ended"]) for r in parquet],
-          [(int(r["tour"]), r["ended"]) for r in rows])
+    check(
+        "Parquet rows = CSV rows",
+        [(r["tour"], r["ended"]) for r in parquet],
+        [(int(r["tour"]), r["ended"]) for r in rows],
+    )
     check("completed", t["completed"], n - kinds.count("fault"))
-    check("aborted tours are the faults", [r["ended"] == "aborted" for r in rows],
-          [k == "fault" for k in kinds])
-    check("invitations", t["invitations"],
-          n + kinds.count("declines") + kinds.count("wander_off"))
+    check(
+        "aborted tours are the faults",
+        [r["ended"] == "aborted" for r in rows],
+        [k == "fault" for k in kinds],
+    )
+    check("invitations", t["invitations"], n + kinds.count("declines") + kinds.count("wander_off"))
     check("invitations declined", t["invitations_declined"], kinds.count("declines"))
     for poi, rate in t["part_b_rate"].items():
-        check(f"part b at {poi}", round(rate * t["gate_decisions"][poi]),
-              t["gate_decisions"][poi] - kinds.count("bored"))
-    check("tours per day", sorted(t["tours_per_day"].values()),
-          [manifest["tours_per_day"]] * manifest["days"])
+        check(
+            f"part b at {poi}",
+            round(rate * t["gate_decisions"][poi]),
+            t["gate_decisions"][poi] - kinds.count("bored"),
+        )
+    check(
+        "tours per day",
+        sorted(t["tours_per_day"].values()),
+        [manifest["tours_per_day"]] * manifest["days"],
+    )
     near("completion rate vs seeding", t["completion_rate"], 1 - weights["fault"], n)
     # a visitor who wanders off on the way to POI2 has heard POI1, and the next one
     # hears it again: one more (engaged) visit of POI1 per wanderer
-    check("visits of POI1 (the gate's decisions)", t["gate_decisions"]["POI1"],
-          t["gate_decisions"]["POI2"] + kinds.count("wander_off"))
+    check(
+        "visits of POI1 (the gate's decisions)",
+        t["gate_decisions"]["POI1"],
+        t["gate_decisions"]["POI2"] + kinds.count("wander_off"),
+    )
     for poi, rate in t["part_b_rate"].items():
         extra = weights["wander_off"] if poi == "POI1" else 0.0
-        near(f"part-b rate at {poi} vs seeding", rate, 1 - weights["bored"] / (1 + extra),
-             t["gate_decisions"][poi])
+        near(
+            f"part-b rate at {poi} vs seeding",
+            rate,
+            1 - weights["bored"] / (1 + extra),
+            t["gate_decisions"][poi],
+        )
     asked = 1 + weights["declines"] + weights["wander_off"]
-    near("invitation acceptance vs seeding", t["invitation_acceptance"],
-         1 - weights["declines"] / asked, t["invitations"])
+    near(
+        "invitation acceptance vs seeding",
+        t["invitation_acceptance"],
+        1 - weights["declines"] / asked,
+        t["invitations"],
+    )
     print(f"{n} tours: {'all checks hold' if not failures else f'{failures} failed'}")
     return 1 if failures else 0
 

@@ -29,11 +29,18 @@ from frog_bt.sim import scenario_from
 def shoot(url: str, out: Path) -> None:
     options = webdriver.ChromeOptions()
     options.binary_location = shutil.which("chromium") or "chromium"
-    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1280,1500",
-                "--hide-scrollbars", "--no-proxy-server"):
+    for arg in (
+        "--headless=new",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--window-size=1280,1500",
+        "--hide-scrollbars",
+        "--no-proxy-server",
+    ):
         options.add_argument(arg)
-    driver = webdriver.Chrome(service=Service(shutil.which("chromedriver") or "chromedriver"),
-                              options=options)
+    driver = webdriver.Chrome(
+        service=Service(shutil.which("chromedriver") or "chromedriver"), options=options
+    )
     try:
         driver.get(url)
         wait = WebDriverWait(driver, 60, poll_frequency=0.1)
@@ -49,15 +56,16 @@ async def main(out: Path) -> None:
     site = load_site()
     rehearsal = Rehearsal(scenario_from("default", {"speed": 20.0}), site=site)
     async with rehearsal:
-        people = await start_people(rehearsal.executive,
-                                    ConsoleSettings("127.0.0.1", 0, "screenshot-token"), [])
+        people = await start_people(
+            rehearsal.executive, ConsoleSettings("127.0.0.1", 0, "screenshot-token"), []
+        )
         try:
-            await rehearsal.sim.wait_for(lambda r: r.channel == "start_poi"
-                                         and r.payload.get("poi") == "POI2", 120)
+            await rehearsal.sim.wait_for(
+                lambda r: r.channel == "start_poi" and r.payload.get("poi") == "POI2", 120
+            )
             rehearsal.sim.world.battery.percentage = 23.0
             assert people.console is not None
-            await asyncio.to_thread(shoot, f"http://127.0.0.1:{people.console.bound_port}/",
-                                    out)
+            await asyncio.to_thread(shoot, f"http://127.0.0.1:{people.console.bound_port}/", out)
         finally:
             rehearsal.executive.stop("screenshot taken")
             await people.close()

@@ -39,10 +39,22 @@ from datetime import datetime, timedelta
 from pathlib import Path
 from typing import Any
 
-KINDS: dict[str, float] = {"engaged": 0.40, "bored": 0.20, "declines": 0.15,
-                           "wander_off": 0.10, "nav_failure": 0.10, "fault": 0.05}
-SCENARIO = {"engaged": "default", "bored": "bored", "declines": "declines",
-            "wander_off": "wander_off", "nav_failure": "nav_failure", "fault": "fault"}
+KINDS: dict[str, float] = {
+    "engaged": 0.40,
+    "bored": 0.20,
+    "declines": 0.15,
+    "wander_off": 0.10,
+    "nav_failure": 0.10,
+    "fault": 0.05,
+}
+SCENARIO = {
+    "engaged": "default",
+    "bored": "bored",
+    "declines": "declines",
+    "wander_off": "wander_off",
+    "nav_failure": "nav_failure",
+    "fault": "fault",
+}
 FAST: dict[str, Any] = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
 FIRST_DAY = "2026-06-01"
 TZ = "+02:00"  # the site's summer time (Europe/Madrid)
@@ -66,16 +78,25 @@ def plan(days: int, per_day: int, seed: int) -> list[Seeded]:
     number = 0
     for d in range(days):
         day = first + timedelta(days=d)
-        starts = sorted(day + timedelta(minutes=rng.choice(
-            (rng.uniform(9 * 60, 12.5 * 60), rng.uniform(14.5 * 60, 18 * 60))))
-            for _ in range(per_day))
+        starts = sorted(
+            day
+            + timedelta(
+                minutes=rng.choice(
+                    (rng.uniform(9 * 60, 12.5 * 60), rng.uniform(14.5 * 60, 18 * 60))
+                )
+            )
+            for _ in range(per_day)
+        )
         for start in starts:
             number += 1
             kind = rng.choices(list(KINDS), weights=list(KINDS.values()))[0]
             start = start.replace(microsecond=0)
             name = f"{start:%Y%m%d-%H%M%S}-tour{number:04d}.mcap"
-            out.append(Seeded(number, f"{day:%Y-%m-%d}", start.isoformat(), kind,
-                              rng.randrange(1 << 30), name))
+            out.append(
+                Seeded(
+                    number, f"{day:%Y-%m-%d}", start.isoformat(), kind, rng.randrange(1 << 30), name
+                )
+            )
     return out
 
 
@@ -88,13 +109,16 @@ def record(tour: Seeded, directory: str) -> dict[str, Any]:
     from frog_bt.sim import scenario_from
 
     path = Path(directory) / tour.file
-    scenario = scenario_from(SCENARIO[tour.kind], {**FAST, "start_time": tour.start,
-                                                   "seed": tour.seed})
+    scenario = scenario_from(
+        SCENARIO[tour.kind], {**FAST, "start_time": tour.start, "seed": tour.seed}
+    )
 
     async def run() -> tuple[int, str]:
         recorder = Recorder(path)
         try:
-            async with Rehearsal(scenario, site=load_site(), prepare=lambda exe: attach_all(exe, [recorder])) as r:
+            async with Rehearsal(
+                scenario, site=load_site(), prepare=lambda exe: attach_all(exe, [recorder])
+            ) as r:
                 outcome = await r.finish(120.0)
         finally:
             recorder.close()
@@ -102,12 +126,18 @@ def record(tour: Seeded, directory: str) -> dict[str, Any]:
 
     t0 = time.monotonic()
     code, reason = asyncio.run(run())
-    return {"file": tour.file, "code": code, "reason": reason,
-            "wall_s": round(time.monotonic() - t0, 2), "bytes": path.stat().st_size}
+    return {
+        "file": tour.file,
+        "code": code,
+        "reason": reason,
+        "wall_s": round(time.monotonic() - t0, 2),
+        "bytes": path.stat().st_size,
+    }
 
 
-def make(out: Path, days: int, per_day: int, seed: int, jobs: int = 1,
-         progress: bool = False) -> dict[str, Any]:
+def make(
+    out: Path, days: int, per_day: int, seed: int, jobs: int = 1, progress: bool = False
+) -> dict[str, Any]:
     """Record the season into ``out`` and write ``out/corpus.json``; the manifest."""
     import multiprocessing
 
@@ -121,13 +151,18 @@ def make(out: Path, days: int, per_day: int, seed: int, jobs: int = 1,
         for done, future in enumerate(futures, 1):
             results.append(future.result())
             if progress:
-                print(f"\rcorpus: {done}/{len(tours)} tours", end="", file=sys.stderr,
-                      flush=True)
+                print(f"\rcorpus: {done}/{len(tours)} tours", end="", file=sys.stderr, flush=True)
     if progress:
         print(file=sys.stderr)
-    manifest = {"seed": seed, "days": days, "tours_per_day": per_day, "weights": KINDS,
-                "tours": [asdict(t) for t in tours], "runs": results,
-                "wall_s": round(time.monotonic() - t0, 1)}
+    manifest = {
+        "seed": seed,
+        "days": days,
+        "tours_per_day": per_day,
+        "weights": KINDS,
+        "tours": [asdict(t) for t in tours],
+        "runs": results,
+        "wall_s": round(time.monotonic() - t0, 1),
+    }
     (out / "corpus.json").write_text(json.dumps(manifest, indent=1) + "\n")
     return manifest
 
@@ -146,9 +181,12 @@ def main() -> None:
         kinds[t["kind"]] = kinds.get(t["kind"], 0) + 1
     failed = [r for r in manifest["runs"] if r["code"] != 0]
     size = sum(r["bytes"] for r in manifest["runs"])
-    print(f"corpus: {len(manifest['tours'])} tours in {a.out} ({size / 1e6:.0f} MB, "
-          f"{manifest['wall_s']:.0f} s): " + ", ".join(f"{n} {k}" for k, n in kinds.items())
-          + f"; {len(failed)} ended non-zero")
+    print(
+        f"corpus: {len(manifest['tours'])} tours in {a.out} ({size / 1e6:.0f} MB, "
+        f"{manifest['wall_s']:.0f} s): "
+        + ", ".join(f"{n} {k}" for k, n in kinds.items())
+        + f"; {len(failed)} ended non-zero"
+    )
 
 
 if __name__ == "__main__":

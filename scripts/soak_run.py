@@ -65,8 +65,15 @@ class Fault:
     done_at: float | None = None  # simulated time it was injected
 
 
-def schedule(tours: int, seed: int, *, rosbridge: float = 0.25, frontend: float = 0.15,
-             stale: float = 0.2, kill_every: int = 10) -> list[Fault]:
+def schedule(
+    tours: int,
+    seed: int,
+    *,
+    rosbridge: float = 0.25,
+    frontend: float = 0.15,
+    stale: float = 0.2,
+    kill_every: int = 10,
+) -> list[Fault]:
     """The faults of a soak of ``tours`` tours, from ``seed``: per tour, each kind with
     its probability; the battery once, in the middle tour; a kill every ``kill_every``
     tours (at a tour drawn within each block)."""
@@ -121,18 +128,23 @@ class Report:
             f"aborted ({reasons}), {self.resumed} resumed after a kill",
             f"  unaccounted {self.unaccounted}, visitors stranded {self.stranded}, front-end "
             f"commands lost {self.commands_lost} of {self.commands_sent}",
-            "  faults: " + ", ".join(f"{k} {n}" for k, n in self.faults.items())
+            "  faults: "
+            + ", ".join(f"{k} {n}" for k, n in self.faults.items())
             + f"; executive restarts {self.restarts}",
             f"  RSS {self.rss_kb[0] if self.rss_kb else 0} -> "
             f"{self.rss_kb[-1] if self.rss_kb else 0} kB ({growth}); "
             f"{self.sim_s / 3600:.1f} h simulated in {self.wall_s:.0f} s wall"
             + ("; TIMED OUT" if self.timed_out else ""),
-        ] + ([
-            f"  via {self.server}: {self.server_restarts} server restarts, the robot "
-            f"connected {self.robot_connections} times, {self.restarts_answered} restarts "
-            f"followed by commands reaching the robot; content parts started twice "
-            f"{self.content_started_twice}",
-        ] if self.server else [])
+        ] + (
+            [
+                f"  via {self.server}: {self.server_restarts} server restarts, the robot "
+                f"connected {self.robot_connections} times, {self.restarts_answered} restarts "
+                f"followed by commands reaching the robot; content parts started twice "
+                f"{self.content_started_twice}",
+            ]
+            if self.server
+            else []
+        )
 
 
 class Executive:
@@ -149,7 +161,8 @@ class Executive:
         self.starts += 1
         log = open(self.logs / f"executive-{self.starts}.log", "wb")  # noqa: SIM115
         self.proc = await asyncio.create_subprocess_exec(
-            *self.argv, stdin=asyncio.subprocess.DEVNULL, stdout=log, stderr=log, env=self.env)
+            *self.argv, stdin=asyncio.subprocess.DEVNULL, stdout=log, stderr=log, env=self.env
+        )
         log.close()
 
     async def kill(self) -> None:
@@ -183,12 +196,18 @@ class RealServer:
 
     async def _sh(self, name: str) -> None:
         proc = await asyncio.create_subprocess_exec(
-            "bash", str(self.scripts / name), str(self.port),
-            stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.PIPE)
+            "bash",
+            str(self.scripts / name),
+            str(self.port),
+            stdout=asyncio.subprocess.DEVNULL,
+            stderr=asyncio.subprocess.PIPE,
+        )
         _, err = await proc.communicate()
         if proc.returncode != 0:
-            raise RuntimeError(f"{name} {self.port}: exit {proc.returncode}: "
-                               f"{err.decode(errors='replace').strip()[-300:]}")
+            raise RuntimeError(
+                f"{name} {self.port}: exit {proc.returncode}: "
+                f"{err.decode(errors='replace').strip()[-300:]}"
+            )
 
     async def restart(self) -> None:
         t0 = time.monotonic()
@@ -199,10 +218,18 @@ class RealServer:
         self.restart_wall.append(time.monotonic() - t0)
 
 
-async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
-               faults: list[Fault] | None = None, wall_timeout: float = 3600.0,
-               via: str | None = None, server: RealServer | None = None,
-               secret: str | None = None) -> Report:
+async def soak(
+    tours: int,
+    seed: int,
+    workdir: Path,
+    *,
+    speed: float = 200.0,
+    faults: list[Fault] | None = None,
+    wall_timeout: float = 3600.0,
+    via: str | None = None,
+    server: RealServer | None = None,
+    secret: str | None = None,
+) -> Report:
     """``via``: the rosbridge server (a real one) between the executive and the simulated
     robot; ``server`` restarts it for each ``rosbridge`` fault; ``secret``: its rosauth."""
     from frog_bt.config import load_site
@@ -212,16 +239,33 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
     site = load_site()
     plan = faults if faults is not None else schedule(tours, seed)
     listen = (LOOPBACK, free_port())
-    sim = Simulator(scenario_from("default", {**SOAK_SCENARIO, "speed": speed, "seed": seed}),
-                    host=LOOPBACK, rosbridge_port=0, frontend_port=0, executive=listen,
-                    via=via, secret=secret)
+    sim = Simulator(
+        scenario_from("default", {**SOAK_SCENARIO, "speed": speed, "seed": seed}),
+        host=LOOPBACK,
+        rosbridge_port=0,
+        frontend_port=0,
+        executive=listen,
+        via=via,
+        secret=secret,
+    )
     await sim.start()
     record_dir = workdir / "recordings"
-    argv = [str(FROG_BT), "run", "--sim-time", "--quiet", "--record", str(record_dir),
-            "--checkpoint", str(workdir / "checkpoint.json"),
-            "--rosbridge", via or f"ws://{LOOPBACK}:{sim.rosbridge_port}",
-            "--frontend", f"{LOOPBACK}:{sim.frontend_port}",
-            "--listen", f"{LOOPBACK}:{listen[1]}"]
+    argv = [
+        str(FROG_BT),
+        "run",
+        "--sim-time",
+        "--quiet",
+        "--record",
+        str(record_dir),
+        "--checkpoint",
+        str(workdir / "checkpoint.json"),
+        "--rosbridge",
+        via or f"ws://{LOOPBACK}:{sim.rosbridge_port}",
+        "--frontend",
+        f"{LOOPBACK}:{sim.frontend_port}",
+        "--listen",
+        f"{LOOPBACK}:{listen[1]}",
+    ]
     executive = Executive(argv, workdir, {"FROG_ROSBRIDGE_SECRET": secret} if secret else {})
     report = Report(tours)
     state = {"tour": 0, "open": False, "started_at": 0.0}
@@ -238,8 +282,7 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
                 since_restart[0] = True
                 report.restarts_answered += 1
             return
-        if record.side == "frontend" and record.direction == "in" \
-                and record.channel == "start_poi":
+        if record.side == "frontend" and record.direction == "in" and record.channel == "start_poi":
             part = (str(record.payload.get("poi")), str(record.payload.get("part")))
             seq = record.payload.get("seq")
             if part in started_parts and started_parts[part] != seq:
@@ -297,10 +340,16 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
             if time.monotonic() > deadline:
                 report.timed_out = True
                 break
-            due = [f for f in pending if state["open"] and (
-                (f.tour == state["tour"] and sim.clock.now() - state["started_at"] >= f.delay)
-                # a real server's restart whose tour ended first goes into the next one
-                or (server is not None and f.kind == "rosbridge" and f.tour < state["tour"]))]
+            due = [
+                f
+                for f in pending
+                if state["open"]
+                and (
+                    (f.tour == state["tour"] and sim.clock.now() - state["started_at"] >= f.delay)
+                    # a real server's restart whose tour ended first goes into the next one
+                    or (server is not None and f.kind == "rosbridge" and f.tour < state["tour"])
+                )
+            ]
             for fault in due:
                 pending.remove(fault)
                 await inject(fault, sim, site, executive, killed_during_open, server)
@@ -334,8 +383,14 @@ async def soak(tours: int, seed: int, workdir: Path, *, speed: float = 200.0,
     return report
 
 
-async def inject(fault: Fault, sim: Any, site: Any, executive: Executive,
-                 killed_during_open: list[bool], server: RealServer | None = None) -> None:
+async def inject(
+    fault: Fault,
+    sim: Any,
+    site: Any,
+    executive: Executive,
+    killed_during_open: list[bool],
+    server: RealServer | None = None,
+) -> None:
     if fault.kind == "rosbridge" and server is not None:
         await server.restart()
     elif fault.kind == "rosbridge":
@@ -402,18 +457,35 @@ def main() -> None:
     p.add_argument("--speed", type=float, default=200.0, help="sim-time speed factor")
     p.add_argument("--keep", type=Path, help="keep the recordings and logs in this directory")
     p.add_argument("--out", help="write the report as JSON here")
-    p.add_argument("--via-rosbridge", metavar="URL",
-                   help="a real rosbridge_suite server (ws://127.0.0.1:PORT) between the "
-                        "executive and the simulated robot (frog-bt sim --via); each "
-                        "rosbridge fault restarts it with --server-scripts' stop.sh/start.sh")
-    p.add_argument("--server-scripts", type=Path, default=DEFAULT_SCRIPTS, metavar="DIR",
-                   help=f"the real server's start.sh and stop.sh (default {DEFAULT_SCRIPTS})")
-    p.add_argument("--server-restarts", type=int, default=20, metavar="N",
-                   help="with --via-rosbridge: restart the server at least N times, in as "
-                        "many tours (default 20)")
-    p.add_argument("--secret-file", type=Path, metavar="FILE",
-                   help="with --via-rosbridge: the server's rosauth secret (first line), for "
-                        "the executive and the robot (start.sh's FROG_RB_AUTH_SECRET_FILE)")
+    p.add_argument(
+        "--via-rosbridge",
+        metavar="URL",
+        help="a real rosbridge_suite server (ws://127.0.0.1:PORT) between the "
+        "executive and the simulated robot (frog-bt sim --via); each "
+        "rosbridge fault restarts it with --server-scripts' stop.sh/start.sh",
+    )
+    p.add_argument(
+        "--server-scripts",
+        type=Path,
+        default=DEFAULT_SCRIPTS,
+        metavar="DIR",
+        help=f"the real server's start.sh and stop.sh (default {DEFAULT_SCRIPTS})",
+    )
+    p.add_argument(
+        "--server-restarts",
+        type=int,
+        default=20,
+        metavar="N",
+        help="with --via-rosbridge: restart the server at least N times, in as "
+        "many tours (default 20)",
+    )
+    p.add_argument(
+        "--secret-file",
+        type=Path,
+        metavar="FILE",
+        help="with --via-rosbridge: the server's rosauth secret (first line), for "
+        "the executive and the robot (start.sh's FROG_RB_AUTH_SECRET_FILE)",
+    )
     args = p.parse_args()
     server = secret = faults = None
     if args.via_rosbridge:
@@ -424,15 +496,26 @@ def main() -> None:
         faults = schedule(args.tours, args.seed, rosbridge=0.0)
         # a server restart in each of the first N tours (a tour may well hold two)
         rng = random.Random(args.seed)
-        faults += [Fault(1 + i % args.tours, "rosbridge", rng.uniform(5.0, 40.0))
-                   for i in range(args.server_restarts)]
+        faults += [
+            Fault(1 + i % args.tours, "rosbridge", rng.uniform(5.0, 40.0))
+            for i in range(args.server_restarts)
+        ]
         faults.sort(key=lambda f: (f.tour, f.delay))
     with tempfile.TemporaryDirectory(prefix="frog-soak-") as tmp:
         workdir = args.keep or Path(tmp)
         workdir.mkdir(parents=True, exist_ok=True)
-        report = asyncio.run(soak(args.tours, args.seed, workdir, speed=args.speed,
-                                  faults=faults, via=args.via_rosbridge, server=server,
-                                  secret=secret))
+        report = asyncio.run(
+            soak(
+                args.tours,
+                args.seed,
+                workdir,
+                speed=args.speed,
+                faults=faults,
+                via=args.via_rosbridge,
+                server=server,
+                secret=secret,
+            )
+        )
     print("\n".join(report.lines()), file=sys.stderr)
     emit(asdict(report), args.out)
 

@@ -40,8 +40,9 @@ class Bench:
     links = None
     sim_time = False
 
-    def __init__(self, tree: LoadedTree | Path | str, site: Site | None = None,
-                 start: float = MORNING) -> None:
+    def __init__(
+        self, tree: LoadedTree | Path | str, site: Site | None = None, start: float = MORNING
+    ) -> None:
         self.site = site or load_site()
         if not isinstance(tree, LoadedTree):
             tree = load_tree(tree, self.site)
@@ -49,9 +50,14 @@ class Bench:
         self.published: list[tuple[str, dict[str, Any]]] = []
         self.sent: list[FrontendMessage] = []
         self.observers = Observers()
-        self.core = Core(self.site, tree, self.clock,
-                         lambda topic, msg: self.published.append((topic, msg)),
-                         lambda message: self.sent.append(message), emit=self.observers.emit)
+        self.core = Core(
+            self.site,
+            tree,
+            self.clock,
+            lambda topic, msg: self.published.append((topic, msg)),
+            lambda message: self.sent.append(message),
+            emit=self.observers.emit,
+        )
 
     # inputs
     def ros(self, role: str, value: Any) -> None:
@@ -64,12 +70,21 @@ class Bench:
         self.ros("pose", Pose(self.clock.now(), "map", x, y, 0.0, 1.0))
 
     def persons(self, *persons: tuple[int, float, float, float]) -> None:
-        self.ros("persons", PersonDetections(self.clock.now(), tuple(
-            PersonDetection(i, Point(x, y), o) for i, x, y, o in persons)))
+        self.ros(
+            "persons",
+            PersonDetections(
+                self.clock.now(),
+                tuple(PersonDetection(i, Point(x, y), o) for i, x, y, o in persons),
+            ),
+        )
 
     def people(self, *people: tuple[int, float, float]) -> None:
-        self.ros("people", TrackedPeople(self.clock.now(), tuple(
-            TrackedPerson(i, Point(x, y)) for i, x, y in people)))
+        self.ros(
+            "people",
+            TrackedPeople(
+                self.clock.now(), tuple(TrackedPerson(i, Point(x, y)) for i, x, y in people)
+            ),
+        )
 
     # time and ticks
     def tick(self, n: int = 1) -> py_trees.common.Status:

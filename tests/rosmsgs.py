@@ -27,6 +27,7 @@ def _decoder(codec: RosType[Any]) -> Any:
         if isinstance(msg, bytes | msgspec.Raw):
             return codec.decode(msg)
         return codec.convert(msg)
+
     return decode
 
 
@@ -44,6 +45,7 @@ encode_string = STRING.encode
 encode_clock = CLOCK.encode
 
 
-def encode_pose(x: float, y: float, qz: float, qw: float, stamp: float,
-                frame: str = "map") -> dict[str, Any]:
+def encode_pose(
+    x: float, y: float, qz: float, qw: float, stamp: float, frame: str = "map"
+) -> dict[str, Any]:
     return POSE.encode(Pose(stamp, frame, x, y, qz, qw))

@@ -39,8 +39,12 @@ def test_old_unreadable_or_foreign_checkpoints_are_not_resumed(tmp_path):
     path.write_text(json.dumps(old))
     assert load(path, max_age=900) is None
     assert load(path, max_age=2000) is not None
-    for text in ("not json", "[]", '{"version": 2, "done": ["start"]}',
-                 '{"version": 1, "done": [], "written": 0}'):
+    for text in (
+        "not json",
+        "[]",
+        '{"version": 2, "done": ["start"]}',
+        '{"version": 1, "done": [], "written": 0}',
+    ):
         path.write_text(text)
         assert load(path) is None
     assert load(tmp_path / "missing.json") is None
@@ -48,12 +52,15 @@ def test_old_unreadable_or_foreign_checkpoints_are_not_resumed(tmp_path):
 
 def test_default_checkpoints_are_per_site_config_and_listen_address(tmp_path):
     site_a, site_b = tmp_path / "a.yaml", tmp_path / "b.yaml"
-    paths = {default_path(site, listen, tmp_path)
-             for site in (site_a, site_b)
-             for listen in (("127.0.0.1", 5006), ("127.0.0.1", 5016))}
+    paths = {
+        default_path(site, listen, tmp_path)
+        for site in (site_a, site_b)
+        for listen in (("127.0.0.1", 5006), ("127.0.0.1", 5016))
+    }
     assert len(paths) == 4
     assert default_path(site_a, ("127.0.0.1", 5006), tmp_path) == default_path(
-        tmp_path / "." / "a.yaml", ("127.0.0.1", 5006), tmp_path)
+        tmp_path / "." / "a.yaml", ("127.0.0.1", 5006), tmp_path
+    )
 
 
 def test_a_claimed_checkpoint_cannot_be_claimed_again_until_released(tmp_path):
@@ -69,10 +76,11 @@ def test_resume_is_announced_where_the_tour_picks_up_and_how_old_it_is():
     stops = ["POI1", "POI2", "POI3"]
     done = ("start", "recruit", "stop 0")
     resume = Resume(frozenset(done), 7, done, 1000.0)
-    assert resume.announce(stops, now=1180.0) == (
-        "resuming the tour at POI2: checkpoint 3 min old")
+    assert resume.announce(stops, now=1180.0) == ("resuming the tour at POI2: checkpoint 3 min old")
     assert Resume(frozenset(), None, ("start", "recruit"), 1000.0).announce(stops, 1010.0) == (
-        "resuming the tour at POI1: checkpoint 10 s old")
+        "resuming the tour at POI1: checkpoint 10 s old"
+    )
     assert Resume(frozenset(), None, ("start",), 0.0).where(stops) == "at the recruitment"
     assert Resume(frozenset(), None, ("start", "recruit", "stop 2"), 0.0).where(stops) == (
-        "on the way back to the dock")
+        "on the way back to the dock"
+    )

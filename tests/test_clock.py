@@ -52,10 +52,13 @@ def test_sim_clock_times_nothing_before_the_first_clock_message():
     assert asyncio.run(main()) == (False, True, 1001.0)
 
 
-@pytest.mark.parametrize(("epoch", "local"), [
-    (1780302600.0, "2026-06-01 10:30 +0200"),  # summer time
-    (1768993200.0, "2026-01-21 12:00 +0100"),  # winter time
-])
+@pytest.mark.parametrize(
+    ("epoch", "local"),
+    [
+        (1780302600.0, "2026-06-01 10:30 +0200"),  # summer time
+        (1768993200.0, "2026-01-21 12:00 +0100"),  # winter time
+    ],
+)
 def test_time_of_day_is_europe_madrid(epoch, local):
     assert ManualClock(epoch).local_time().strftime("%Y-%m-%d %H:%M %z") == local
 

@@ -35,10 +35,18 @@ def test_windows_are_half_open_on_time():
     assert meter(s.window(2.0, 4.0)) == pytest.approx(-0.7)
 
 
-@pytest.mark.parametrize(("n", "expected"), [
-    (0, []), (1, [0]), (2, [0, 1]), (7, [0, 1, 5, 6]), (10, [0, 1, 8, 9]),
-    (20, [0, 1, 2, 17, 18, 19]), (100, [*range(15), *range(85, 100)]),
-])
+@pytest.mark.parametrize(
+    ("n", "expected"),
+    [
+        (0, []),
+        (1, [0]),
+        (2, [0, 1]),
+        (7, [0, 1, 5, 6]),
+        (10, [0, 1, 8, 9]),
+        (20, [0, 1, 2, 17, 18, 19]),
+        (100, [*range(15), *range(85, 100)]),
+    ],
+)
 def test_edge_indices_take_ceil_15_percent_from_each_end(n, expected):
     assert list(edge_indices(n, 0.15)) == expected
 

@@ -126,8 +126,14 @@ def test_parser() -> None:
 
 def test_msg_files_are_the_contract_definitions() -> None:
     expected = contract_blocks()
-    assert set(expected) == {"PersonDetections", "PersonDetection", "FaceData", "Face",
-                             "TrackedPeople", "TrackedPerson"}
+    assert set(expected) == {
+        "PersonDetections",
+        "PersonDetection",
+        "FaceData",
+        "Face",
+        "TrackedPeople",
+        "TrackedPerson",
+    }
     assert {p.name for p in MSG_DIR.iterdir()} == {f"{name}.msg" for name in expected}
     for name, text in expected.items():
         assert (MSG_DIR / f"{name}.msg").read_text() == text, name
@@ -190,8 +196,11 @@ def test_cmakelists() -> None:
 
 def test_wire_structs_have_the_msg_fields() -> None:
     """Each frog_msgs type has a codec whose wire Struct has exactly the .msg's fields."""
-    wires = {"Face": messages.Face, "PersonDetection": messages.PersonDetection,
-             "TrackedPerson": messages.TrackedPerson}
+    wires = {
+        "Face": messages.Face,
+        "PersonDetection": messages.PersonDetection,
+        "TrackedPerson": messages.TrackedPerson,
+    }
     for name in TOP_LEVEL:
         codec = messages.ROS_TYPES[f"frog_msgs/{name}"]
         assert codec.name == f"frog_msgs/{name}"
@@ -204,8 +213,7 @@ def test_wire_structs_have_the_msg_fields() -> None:
 
 
 def is_number(value: Any) -> bool:
-    return (not isinstance(value, bool) and isinstance(value, int | float)
-            and math.isfinite(value))
+    return not isinstance(value, bool) and isinstance(value, int | float) and math.isfinite(value)
 
 
 def check_json(value: Any, type_: str, path: str = "msg") -> None:
@@ -241,7 +249,8 @@ def check_json(value: Any, type_: str, path: str = "msg") -> None:
         fields = DEFS[name]
         assert isinstance(value, dict), f"{path}: expected an object, got {value!r}"
         assert set(value) == {f.name for f in fields}, (
-            f"{path}: fields {sorted(value)} != {name}.msg {[f.name for f in fields]}")
+            f"{path}: fields {sorted(value)} != {name}.msg {[f.name for f in fields]}"
+        )
         for f in fields:
             if f.array:
                 assert isinstance(value[f.name], list), f"{path}.{f.name}"
@@ -254,9 +263,14 @@ def check_json(value: Any, type_: str, path: str = "msg") -> None:
 def test_check_json_rejects_what_it_should() -> None:
     good = {"id": 1, "engagement": 0.5, "distance": 1.0, "facing": True}
     check_json(good, "frog_msgs/Face")
-    for bad in ({**good, "id": True}, {**good, "facing": 1}, {**good, "distance": "1"},
-                {**good, "extra": 0}, {k: v for k, v in good.items() if k != "id"},
-                {**good, "engagement": float("nan")}):
+    for bad in (
+        {**good, "id": True},
+        {**good, "facing": 1},
+        {**good, "distance": "1"},
+        {**good, "extra": 0},
+        {k: v for k, v in good.items() if k != "id"},
+        {**good, "engagement": float("nan")},
+    ):
         with pytest.raises(AssertionError):
             check_json(bad, "frog_msgs/Face")
 
@@ -267,44 +281,77 @@ def test_check_json_rejects_what_it_should() -> None:
 P = messages.Point
 STAMP = 1_700_000_123.25
 # Top-level message -> its builder in frog_bt.sim.msgs.
-BUILDERS = {"PersonDetections": "person_detections", "FaceData": "face_data",
-            "TrackedPeople": "tracked_people"}
+BUILDERS = {
+    "PersonDetections": "person_detections",
+    "FaceData": "face_data",
+    "TrackedPeople": "tracked_people",
+}
 
 
 @pytest.fixture(scope="module")
 def sim() -> Any:
     return pytest.importorskip(
-        "frog_bt.sim.msgs", reason="the simulator's frog_bt.sim.msgs is not importable")
+        "frog_bt.sim.msgs", reason="the simulator's frog_bt.sim.msgs is not importable"
+    )
 
 
 def sim_cases() -> Iterator[tuple[str, list[Any], bool]]:
     """(message, items, items are dataclasses)."""
-    yield "PersonDetections", [
-        messages.PersonDetection(7, P(1.5, -2.0, 0.25), 181.0),
-        messages.PersonDetection(8, P(3.0, 4.0, 0.0), 0.0),
-    ], True
-    yield "PersonDetections", [
-        {"id": 9, "position": {"x": 1, "y": 2, "z": 0}, "orientation": 90},
-    ], False
-    yield "FaceData", [
-        messages.Face(7, 0.4, 1.2, True), messages.Face(2, -1.0, 0.0, False),
-    ], True
-    yield "FaceData", [
-        {"id": 3, "engagement": 1, "distance": 2, "facing": True},
-    ], False
-    yield "TrackedPeople", [
-        messages.TrackedPerson(3, P(55.7, 85.4, 0.0)), messages.TrackedPerson(4, P(0.0, 0.0)),
-    ], True
-    yield "TrackedPeople", [
-        {"id": 5, "position": {"x": 1.0, "y": 2.0, "z": 3.0}},
-    ], False
+    yield (
+        "PersonDetections",
+        [
+            messages.PersonDetection(7, P(1.5, -2.0, 0.25), 181.0),
+            messages.PersonDetection(8, P(3.0, 4.0, 0.0), 0.0),
+        ],
+        True,
+    )
+    yield (
+        "PersonDetections",
+        [
+            {"id": 9, "position": {"x": 1, "y": 2, "z": 0}, "orientation": 90},
+        ],
+        False,
+    )
+    yield (
+        "FaceData",
+        [
+            messages.Face(7, 0.4, 1.2, True),
+            messages.Face(2, -1.0, 0.0, False),
+        ],
+        True,
+    )
+    yield (
+        "FaceData",
+        [
+            {"id": 3, "engagement": 1, "distance": 2, "facing": True},
+        ],
+        False,
+    )
+    yield (
+        "TrackedPeople",
+        [
+            messages.TrackedPerson(3, P(55.7, 85.4, 0.0)),
+            messages.TrackedPerson(4, P(0.0, 0.0)),
+        ],
+        True,
+    )
+    yield (
+        "TrackedPeople",
+        [
+            {"id": 5, "position": {"x": 1.0, "y": 2.0, "z": 3.0}},
+        ],
+        False,
+    )
 
 
 SIM_CASES = list(sim_cases())
 
 
-@pytest.mark.parametrize(("name", "items", "typed"), SIM_CASES,
-                         ids=[f"{c[0]}-{'dataclass' if c[2] else 'mapping'}" for c in SIM_CASES])
+@pytest.mark.parametrize(
+    ("name", "items", "typed"),
+    SIM_CASES,
+    ids=[f"{c[0]}-{'dataclass' if c[2] else 'mapping'}" for c in SIM_CASES],
+)
 def test_simulator_json_matches_msg(sim: Any, name: str, items: list[Any], typed: bool) -> None:
     build: Callable[..., dict] = getattr(sim, BUILDERS[name])
     msg = build(STAMP, items)
@@ -326,8 +373,11 @@ def test_simulator_json_with_no_items(sim: Any, name: str) -> None:
 
 # ------------------------------------------------------------------ decoders
 
-HEADER_SAMPLE = {"seq": 3, "stamp": {"secs": 1_700_000_000, "nsecs": 500_000_000},
-                 "frame_id": "map"}
+HEADER_SAMPLE = {
+    "seq": 3,
+    "stamp": {"secs": 1_700_000_000, "nsecs": 500_000_000},
+    "frame_id": "map",
+}
 
 
 class Samples:
@@ -355,8 +405,10 @@ class Samples:
             return copy.deepcopy(HEADER_SAMPLE)
         name = own_name(type_)
         assert name is not None, type_
-        return {f.name: [self.value(f.type) for _ in range(2)] if f.array else self.value(f.type)
-                for f in DEFS[name]}
+        return {
+            f.name: [self.value(f.type) for _ in range(2)] if f.array else self.value(f.type)
+            for f in DEFS[name]
+        }
 
 
 def assert_read(decoded: Any, value: Any, type_: str, path: str) -> None:
@@ -383,7 +435,8 @@ def assert_read(decoded: Any, value: Any, type_: str, path: str) -> None:
 
 def got_equal(decoded: Any, value: Any) -> bool:
     return (type(decoded) is type(value) and decoded == value) or (
-        isinstance(value, float) and decoded == pytest.approx(value))
+        isinstance(value, float) and decoded == pytest.approx(value)
+    )
 
 
 def leaf_paths(value: Any, prefix: tuple[str | int, ...] = ()) -> Iterator[tuple[str | int, ...]]:

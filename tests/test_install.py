@@ -25,9 +25,25 @@ def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
     for name in ("frog_bt", "trees", "config"):
         shutil.copytree(ROOT / name, src / name, symlinks=True, ignore=ignore)
     out = tmp_path_factory.mktemp("wheel")
-    subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps",
-                    "--no-build-isolation", "--no-index", "-w", str(out), str(src)],
-                   check=True, capture_output=True, text=True, timeout=120)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "wheel",
+            "-q",
+            "--no-deps",
+            "--no-build-isolation",
+            "--no-index",
+            "-w",
+            str(out),
+            str(src),
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     (whl,) = out.glob("frog_bt-*.whl")
     return whl
 
@@ -41,28 +57,57 @@ def installed(wheel: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     (lib,) = (env / "lib").glob("python3*/site-packages")
     deps = [p for p in site.getsitepackages() if Path(p).is_dir()]
     (lib / "_frog_deps.pth").write_text("\n".join(deps) + "\n")
-    subprocess.run([sys.executable, "-m", "pip", "--python", str(env / "bin" / "python"),
-                    "install", "-q", "--no-deps", "--no-index", str(wheel)],
-                   check=True, capture_output=True, text=True, timeout=120)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "--python",
+            str(env / "bin" / "python"),
+            "install",
+            "-q",
+            "--no-deps",
+            "--no-index",
+            str(wheel),
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     return env / "bin"
 
 
 def test_the_wheel_carries_the_tour_and_the_site_config(wheel: Path) -> None:
     names = zipfile.ZipFile(wheel).namelist()
-    for name in ("frog_bt/_trees/tour.yaml", "frog_bt/_trees/recruit.yaml",
-                 "frog_bt/_trees/visit_poi.yaml", "frog_bt/_site/site.yaml"):
+    for name in (
+        "frog_bt/_trees/tour.yaml",
+        "frog_bt/_trees/recruit.yaml",
+        "frog_bt/_trees/visit_poi.yaml",
+        "frog_bt/_site/site.yaml",
+    ):
         assert name in names
 
 
-def test_the_installed_command_renders_inits_and_runs_a_demo(installed: Path,
-                                                            tmp_path: Path) -> None:
+def test_the_installed_command_renders_inits_and_runs_a_demo(
+    installed: Path, tmp_path: Path
+) -> None:
     def frog(*argv: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:
-        return subprocess.run([str(installed / "frog-bt"), *argv], capture_output=True,
-                              text=True, timeout=timeout, cwd=tmp_path)
+        return subprocess.run(
+            [str(installed / "frog-bt"), *argv],
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            cwd=tmp_path,
+        )
 
-    where = subprocess.run([str(installed / "python"), "-c",
-                            "import frog_bt; print(frog_bt.__file__)"],
-                           capture_output=True, text=True, check=True, cwd=tmp_path)
+    where = subprocess.run(
+        [str(installed / "python"), "-c", "import frog_bt; print(frog_bt.__file__)"],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=tmp_path,
+    )
     assert Path(where.stdout.strip()).is_relative_to(installed.parent)  # not the checkout
 
     rendered = frog("render")
@@ -71,8 +116,10 @@ def test_the_installed_command_renders_inits_and_runs_a_demo(installed: Path,
 
     made = frog("init", "site")
     assert made.returncode == 0, made.stderr
-    tree, config = tmp_path / "site" / "trees" / "tour.yaml", tmp_path / "site" / "config" / \
-        "site.yaml"
+    tree, config = (
+        tmp_path / "site" / "trees" / "tour.yaml",
+        tmp_path / "site" / "config" / "site.yaml",
+    )
     assert tree.is_file() and config.is_file()
     recruit = tmp_path / "site" / "trees" / "recruit.yaml"
     recruit.write_text(recruit.read_text().replace("name: Recruit", "name: Find a guest"))
@@ -87,7 +134,20 @@ def test_the_installed_command_renders_inits_and_runs_a_demo(installed: Path,
     listed = frog("leaves", "--format", "json")
     assert listed.returncode == 0 and '"name": "SeekVisitor"' in listed.stdout
 
-    demo = frog("demo", "--quiet", "--speed", "300", "--rerun", "off", "--record", "d.mcap",
-                "--tree", str(tree), "--config", str(config), timeout=120)
+    demo = frog(
+        "demo",
+        "--quiet",
+        "--speed",
+        "300",
+        "--rerun",
+        "off",
+        "--record",
+        "d.mcap",
+        "--tree",
+        str(tree),
+        "--config",
+        str(config),
+        timeout=120,
+    )
     assert demo.returncode == 0, demo.stdout + demo.stderr
     assert "outcome:   tour ended docked, every stop visited" in demo.stdout

@@ -15,14 +15,20 @@ def record(level: int, msg: str) -> logging.LogRecord:
 def test_journal_lines_carry_their_level_as_a_syslog_prefix() -> None:
     fmt = JournalFormatter("%(levelname)s %(name)s: %(message)s")
     assert fmt.format(record(logging.WARNING, "alert battery_low raised")) == (
-        "<4>WARNING frog_bt.alerts: alert battery_low raised")
+        "<4>WARNING frog_bt.alerts: alert battery_low raised"
+    )
     assert fmt.format(record(logging.ERROR, "a\nb")).splitlines() == [
-        "<3>ERROR frog_bt.alerts: a", "<3>b"]
+        "<3>ERROR frog_bt.alerts: a",
+        "<3>b",
+    ]
 
 
 def test_json_lines_are_one_object_each() -> None:
     line = JsonFormatter().format(record(logging.INFO, "operator skip: done"))
     obj = json.loads(line)
     assert "\n" not in line
-    assert (obj["level"], obj["logger"], obj["msg"]) == ("INFO", "frog_bt.alerts",
-                                                         "operator skip: done")
+    assert (obj["level"], obj["logger"], obj["msg"]) == (
+        "INFO",
+        "frog_bt.alerts",
+        "operator skip: done",
+    )

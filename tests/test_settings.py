@@ -21,10 +21,18 @@ def parse(*argv: str) -> argparse.Namespace:
 
 
 def test_the_command_line_wins_then_the_environment_then_the_site() -> None:
-    site = RunCfg(rosbridge="ws://site:9090", frontend="10.0.0.1:5005", quiet=True,
-                  record="/srv/frog/recordings", log_format="json")
-    env = {"FROG_BT_ROSBRIDGE": "ws://env:9090", "FROG_BT_SIM_TIME": "yes",
-           "FROG_BT_LISTEN": "127.0.0.1:6000"}
+    site = RunCfg(
+        rosbridge="ws://site:9090",
+        frontend="10.0.0.1:5005",
+        quiet=True,
+        record="/srv/frog/recordings",
+        log_format="json",
+    )
+    env = {
+        "FROG_BT_ROSBRIDGE": "ws://env:9090",
+        "FROG_BT_SIM_TIME": "yes",
+        "FROG_BT_LISTEN": "127.0.0.1:6000",
+    }
     args = parse("--rosbridge", "ws://cli:9090")
     sources = fill(args, site, env)
     assert args.rosbridge == "ws://cli:9090"  # given: the command line's
@@ -32,8 +40,14 @@ def test_the_command_line_wins_then_the_environment_then_the_site() -> None:
     assert (args.frontend, args.quiet, args.log_format) == ("10.0.0.1:5005", True, "json")
     assert args.record == Path("/srv/frog/recordings")
     assert (args.once, args.fresh, args.watch, args.console) == (False, False, False, None)
-    assert sources == {"listen": "env", "sim_time": "env", "frontend": "site",
-                       "record": "site", "quiet": "site", "log_format": "site"}
+    assert sources == {
+        "listen": "env",
+        "sim_time": "env",
+        "frontend": "site",
+        "record": "site",
+        "quiet": "site",
+        "log_format": "site",
+    }
 
 
 def test_a_bad_flag_in_the_environment_names_the_variable() -> None:

@@ -48,8 +48,9 @@ class Corridor(msgspec.Struct, frozen=True):
 
 CORRIDOR_TYPE: RosType[tuple[bool, float]] = RosType(Corridor)
 # In frog_bt/model/wire.py, beside its topic: the input's key (its type is the value's Reading)
-CORRIDOR = input_key("/corridor", Reading[tuple[bool, float]],
-                     "whether the corridor ahead is clear, and its width")
+CORRIDOR = input_key(
+    "/corridor", Reading[tuple[bool, float]], "whether the corridor ahead is clear, and its width"
+)
 
 
 class CorridorClear(Leaf):
@@ -71,8 +72,9 @@ def corridor(monkeypatch: pytest.MonkeyPatch) -> Iterator[Input]:
     yield entry
 
 
-def test_a_new_input_reaches_its_leaf_through_the_table_alone(corridor: Input,
-                                                              tmp_path: Path) -> None:
+def test_a_new_input_reaches_its_leaf_through_the_table_alone(
+    corridor: Input, tmp_path: Path
+) -> None:
     bench = Bench(write_tree(tmp_path, "root: {type: CorridorClear}"))
     assert bench.tick() == RUNNING
     value = corridor.codec.decode(b'{"clear": false, "width": 0.4}')  # as rosbridge sends it
@@ -85,15 +87,19 @@ def test_a_new_input_reaches_its_leaf_through_the_table_alone(corridor: Input,
         corridor.codec.decode(b'{"clear": true, "width": "wide"}')
 
 
-def test_a_new_input_is_subscribed_recorded_and_simulated(corridor: Input,
-                                                          tmp_path: Path) -> None:
+def test_a_new_input_is_subscribed_recorded_and_simulated(corridor: Input, tmp_path: Path) -> None:
     site = load_site()
     tree = load_tree(write_tree(tmp_path, "root: {type: CorridorClear}"), site)
-    executive = Executive(site, tree, WallClock(), rosbridge_url="ws://127.0.0.1:9",
-                          frontend=("127.0.0.1", 9), listen=("127.0.0.1", 0))
+    executive = Executive(
+        site,
+        tree,
+        WallClock(),
+        rosbridge_url="ws://127.0.0.1:9",
+        frontend=("127.0.0.1", 9),
+        listen=("127.0.0.1", 0),
+    )
     executive.setup_wire()
-    assert executive.client.session.subscriptions["/lidar/corridor"].type == (
-        "frog_msgs/Corridor")
+    assert executive.client.session.subscriptions["/lidar/corridor"].type == ("frog_msgs/Corridor")
     schema = schema_for(corridor.type)
     assert schema["title"] == "frog_msgs/Corridor"
     assert schema["properties"]["clear"] == {"type": "boolean"}
@@ -103,9 +109,9 @@ def test_a_new_input_is_subscribed_recorded_and_simulated(corridor: Input,
     assert corridor.codec.decode(b'{"clear": true, "width": 1.5}') == (True, 1.5)
 
 
-def test_a_leaf_reading_a_key_no_input_writes_is_refused(tmp_path: Path,
-                                                         monkeypatch: pytest.MonkeyPatch
-                                                         ) -> None:
+def test_a_leaf_reading_a_key_no_input_writes_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setitem(FACTORY.leaves, "CorridorClear", CorridorClear)
     with pytest.raises(Exception, match="uses /corridor, which no key declaration knows"):
         load_tree(write_tree(tmp_path, "root: {type: CorridorClear}"), load_site())

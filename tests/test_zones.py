@@ -26,8 +26,9 @@ def test_hysteresis_stops_flapping_on_a_border():
 
 
 def test_first_listed_zone_wins_where_zones_meet():
-    m = Membership([Shape(points=SQUARE), Shape(points=((10, 0), (20, 0), (20, 10), (10, 10)))],
-                   hysteresis=1.0)
+    m = Membership(
+        [Shape(points=SQUARE), Shape(points=((10, 0), (20, 0), (20, 10), (10, 10)))], hysteresis=1.0
+    )
     assert m.update((15, 5)) == 1
     assert m.update((10.5, 5)) == 1  # within 1 m of the first: stays in the second
     assert m.update((9.0, 5)) == 0  # fully inside the first

@@ -25,8 +25,20 @@ from frog_bt.config import Site
 from frog_bt.engine.loaded import LoadedTree
 from frog_bt.tree.factory import NodeFactory
 
-__all__ = ["FACTORY", "docking", "engagement", "load_tree", "location", "navigation",
-           "operator", "projector", "recruit", "safety", "tour", "visit"]
+__all__ = [
+    "FACTORY",
+    "docking",
+    "engagement",
+    "load_tree",
+    "location",
+    "navigation",
+    "operator",
+    "projector",
+    "recruit",
+    "safety",
+    "tour",
+    "visit",
+]
 
 FACTORY = NodeFactory(LEAF_TYPES, DECORATOR_TYPES)
 

@@ -32,8 +32,12 @@ class Docking(GoalLeaf):
 
     class Params(Params):
         action: Literal["dock", "undock"] = Field(description="what to ask of the robot")
-        timeout: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
-            "seconds before it fails (default: site timeouts.dock / timeouts.undock)"))
+        timeout: float | None = Field(
+            None,
+            gt=0,
+            allow_inf_nan=False,
+            description=("seconds before it fails (default: site timeouts.dock / timeouts.undock)"),
+        )
 
     reads = (keys.DOCKING, keys.NOW)
 
@@ -62,15 +66,19 @@ class Docking(GoalLeaf):
             if state.value == BUSY[self.params.action]:
                 self.took = True
             if state.value == DockingState.FAILED and (
-                    self.took or state.at - self.sent_at >= FAILED_GRACE):
+                self.took or state.at - self.sent_at >= FAILED_GRACE
+            ):
                 return Failure.REFUSED
         return RUNNING
 
     def failed(self, why: Failure) -> None:
         action = self.params.action
-        self.ctx.note(f"{action}: no {TARGET[action]} within {self.timeout:g} s"
-                      if why is Failure.TIMED_OUT else f"{action} failed",
-                      incident=IncidentKind.DOCKING_FAILED)
+        self.ctx.note(
+            f"{action}: no {TARGET[action]} within {self.timeout:g} s"
+            if why is Failure.TIMED_OUT
+            else f"{action} failed",
+            incident=IncidentKind.DOCKING_FAILED,
+        )
 
     def progress(self) -> str:
         state = self.get(keys.DOCKING)

@@ -102,8 +102,11 @@ class DecideEngagement(Leaf):
     """
 
     class Params(Params):
-        about: str = Field("", description="what the decision is about, for notes and "
-                           "telemetry (the POI, or introduction)")
+        about: str = Field(
+            "",
+            description="what the decision is about, for notes and "
+            "telemetry (the POI, or introduction)",
+        )
 
     optional_reads = (keys.ENGAGEMENT,)
     writes = (keys.ENGAGED, keys.ENGAGEMENT_DECISION)

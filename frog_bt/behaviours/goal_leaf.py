@@ -62,8 +62,11 @@ class GoalLeaf(Leaf):
     def __init_subclass__(cls, **kwargs: object) -> None:
         super().__init_subclass__(**kwargs)
         declared = {k.name for k in (*cls.reads, *cls.optional_reads)}
-        needed = {keys.NOW.name: True, keys.GOAL.name: cls.poll is GoalLeaf.poll,
-                  keys.PAUSED.name: cls.waits_while_paused}
+        needed = {
+            keys.NOW.name: True,
+            keys.GOAL.name: cls.poll is GoalLeaf.poll,
+            keys.PAUSED.name: cls.waits_while_paused,
+        }
         missing = [name for name, need in needed.items() if need and name not in declared]
         if missing:
             raise TypeError(f"{cls.__name__} reads {', '.join(missing)} without declaring it")

@@ -106,8 +106,11 @@ class GuidedDrive(FrogDecorator):
             site = self.ctx.site
             target = site.pois.get(self.get(keys.WAYPOINT) or self.params.poi)
             radius = site.zones.arrival_radius(self.params.poi)
-            if (self._on and target is not None
-                    and math.hypot(p[0] - target.x, p[1] - target.y) <= radius):
+            if (
+                self._on
+                and target is not None
+                and math.hypot(p[0] - target.x, p[1] - target.y) <= radius
+            ):
                 self._follow_off(f"within {radius:g} m of {self.params.poi}")
             done: frozenset[str] = self.get(keys.SPECIAL_DONE) or frozenset()
             for spot, shape in self.spots:

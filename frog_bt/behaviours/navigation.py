@@ -38,8 +38,12 @@ class Navigate(GoalLeaf):
     """
 
     class Params(PoiParams):
-        timeout: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
-            "seconds before it fails (default: site timeouts.navigation)"))
+        timeout: float | None = Field(
+            None,
+            gt=0,
+            allow_inf_nan=False,
+            description=("seconds before it fails (default: site timeouts.navigation)"),
+        )
 
     reads = (keys.NOW, keys.GOAL)
     optional_reads = (keys.PAUSED,)
@@ -62,8 +66,10 @@ class Navigate(GoalLeaf):
         waypoint = site.waypoint_for(poi, clock.local_time().time())
         goal = self.ctx.actions.goto(waypoint, site.pois[waypoint])
         self.set(keys.WAYPOINT, waypoint)
-        self.ctx.note(f"go to {waypoint}" + (f" ({poi} at {clock.local_time():%H:%M})"
-                                             if waypoint != poi else ""))
+        self.ctx.note(
+            f"go to {waypoint}"
+            + (f" ({poi} at {clock.local_time():%H:%M})" if waypoint != poi else "")
+        )
         return goal
 
     def succeeded(self) -> None:
@@ -76,12 +82,16 @@ class Navigate(GoalLeaf):
         if why is Failure.REPLACED:
             self.ctx.note(f"navigation to {target} replaced by another goal")
         elif why is Failure.TIMED_OUT:
-            self.ctx.note(f"navigation to {target}: no arrival within {self.timeout:g} s",
-                          incident=IncidentKind.NAVIGATION_FAILED)
+            self.ctx.note(
+                f"navigation to {target}: no arrival within {self.timeout:g} s",
+                incident=IncidentKind.NAVIGATION_FAILED,
+            )
         else:
             assert self.latest is not None
-            self.ctx.note(f"navigation to {target} {self.latest.state()}",
-                          incident=IncidentKind.NAVIGATION_FAILED)
+            self.ctx.note(
+                f"navigation to {target} {self.latest.state()}",
+                incident=IncidentKind.NAVIGATION_FAILED,
+            )
 
     def progress(self) -> str:
         assert self.goal is not None and self.latest is not None
@@ -100,8 +110,11 @@ class SkipStop(Leaf):
 
     def update(self) -> Status:
         self.set(keys.SKIPPED, self.params.poi)
-        self.ctx.note(f"skipped {self.params.poi}: navigation kept failing",
-                      incident=IncidentKind.STOP_SKIPPED, subject=self.params.poi)
+        self.ctx.note(
+            f"skipped {self.params.poi}: navigation kept failing",
+            incident=IncidentKind.STOP_SKIPPED,
+            subject=self.params.poi,
+        )
         return SUCCESS
 
 

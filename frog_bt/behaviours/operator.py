@@ -41,8 +41,7 @@ class OperatorSkip(FrogDecorator):
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
         # An asked-for skip: py_trees' plain behaviour tick (update says SUCCESS, stop
         # stops the child) instead of the decorator's, which would tick the child first.
-        self._requested = (self.status == RUNNING
-                           and (self.get(keys.SKIP) or 0) > self.skips)
+        self._requested = self.status == RUNNING and (self.get(keys.SKIP) or 0) > self.skips
         if self._requested:
             yield from py_trees.behaviour.Behaviour.tick(self)
         else:
@@ -50,8 +49,11 @@ class OperatorSkip(FrogDecorator):
 
     def update(self) -> Status:
         if self._requested:
-            self.ctx.note(f"skipped {self.params.poi}: the operator asked",
-                          incident=IncidentKind.STOP_LEFT, subject=self.params.poi)
+            self.ctx.note(
+                f"skipped {self.params.poi}: the operator asked",
+                incident=IncidentKind.STOP_LEFT,
+                subject=self.params.poi,
+            )
             return SUCCESS
         return self.decorated.status
 

@@ -18,22 +18,31 @@ from frog_bt.model.outcomes import IncidentKind
 from frog_bt.model.ros import PersonDetection, Pose
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
 
-Timeout = Field(None, gt=0, allow_inf_nan=False,
-                description="seconds before it fails (default: the site's timeouts entry)")
+Timeout = Field(
+    None,
+    gt=0,
+    allow_inf_nan=False,
+    description="seconds before it fails (default: the site's timeouts entry)",
+)
 
 
-def facing_visitor(persons: tuple[PersonDetection, ...], pose: Pose, lo: float, hi: float,
-                   exclude: frozenset[int] = frozenset()) -> PersonDetection | None:
+def facing_visitor(
+    persons: tuple[PersonDetection, ...],
+    pose: Pose,
+    lo: float,
+    hi: float,
+    exclude: frozenset[int] = frozenset(),
+) -> PersonDetection | None:
     """The nearest person facing the robot (``lo < orientation < hi``), not in ``exclude``."""
     candidates = [p for p in persons if lo < p.orientation < hi and p.id not in exclude]
     if not candidates:
         return None
-    return min(candidates,
-               key=lambda p: (math.hypot(p.position.x - pose.x, p.position.y - pose.y), p.id))
+    return min(
+        candidates, key=lambda p: (math.hypot(p.position.x - pose.x, p.position.y - pose.y), p.id)
+    )
 
 
-def cooling_down(failed: dict[int, float] | None, now: float, retry_after: float
-                 ) -> frozenset[int]:
+def cooling_down(failed: dict[int, float] | None, now: float, retry_after: float) -> frozenset[int]:
     """People whose approach failed less than ``retry_after`` seconds before ``now``."""
     if not failed:
         return frozenset()
@@ -69,17 +78,20 @@ class SeekVisitor(Leaf):
             return RUNNING
         declined = self.get(keys.DECLINED) or frozenset()
         cooling = cooling_down(self.get(keys.APPROACH_FAILED), now, cfg.retry_after)
-        person = facing_visitor(persons.value.persons, pose.value, cfg.facing_min,
-                                cfg.facing_max, declined | cooling)
+        person = facing_visitor(
+            persons.value.persons, pose.value, cfg.facing_min, cfg.facing_max, declined | cooling
+        )
         if person is None:
             seen = len(persons.value.persons)
             self.feedback_message = f"{seen} seen, none facing" + (
-                f" but {', '.join(map(str, sorted(cooling)))} (approach failed)"
-                if cooling else "")
+                f" but {', '.join(map(str, sorted(cooling)))} (approach failed)" if cooling else ""
+            )
             return RUNNING
         self.set(keys.VISITOR, person.id)
-        self.ctx.note(f"visitor {person.id} faces the robot "
-                      f"({person.orientation:.0f} deg), nearest of {len(persons.value.persons)}")
+        self.ctx.note(
+            f"visitor {person.id} faces the robot "
+            f"({person.orientation:.0f} deg), nearest of {len(persons.value.persons)}"
+        )
         return SUCCESS
 
 
@@ -132,8 +144,11 @@ class ApproachVisitor(GoalLeaf):
         failed = {pid: at for pid, at in failed.items() if now - at < retry_after}
         failed[self.visitor] = now
         self.set(keys.APPROACH_FAILED, failed)
-        self.ctx.note(f"approach of visitor {self.visitor} {how}: seek again "
-                      f"(not them for {retry_after:g} s)", incident=IncidentKind.APPROACH_FAILED)
+        self.ctx.note(
+            f"approach of visitor {self.visitor} {how}: seek again "
+            f"(not them for {retry_after:g} s)",
+            incident=IncidentKind.APPROACH_FAILED,
+        )
 
 
 @register
@@ -201,6 +216,7 @@ class WaitAnswer(Leaf):
 
     def _decline(self, visitor: int, why: str) -> Status:
         self.set(keys.DECLINED, (self.get(keys.DECLINED) or frozenset()) | {visitor})
-        self.ctx.note(f"visitor {visitor} {why}: seek again",
-                      incident=IncidentKind.VISITOR_DECLINED)
+        self.ctx.note(
+            f"visitor {visitor} {why}: seek again", incident=IncidentKind.VISITOR_DECLINED
+        )
         return FAILURE

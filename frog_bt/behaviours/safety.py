@@ -28,8 +28,9 @@ from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
 log = logging.getLogger(__name__)
 
 
-def fresh_diagnostics(reading: Reading[Diagnostics] | None, now: float,
-                      max_age: float) -> Diagnostics | None:
+def fresh_diagnostics(
+    reading: Reading[Diagnostics] | None, now: float, max_age: float
+) -> Diagnostics | None:
     """The diagnostics if recent enough to act on, else None (stale data is not acted on)."""
     if reading is None or reading.age(now) > max_age:
         return None
@@ -63,18 +64,21 @@ class MustAbort(Leaf):
             self.ctx.note(f"abort the tour: {home.text}", incident=IncidentKind.TOUR_ABORTED)
             return SUCCESS
         cfg = self.ctx.site.safety
-        diagnostics = fresh_diagnostics(self.get(keys.DIAGNOSTICS), self.need(keys.NOW),
-                                        cfg.diagnostics_max_age)
+        diagnostics = fresh_diagnostics(
+            self.get(keys.DIAGNOSTICS), self.need(keys.NOW), cfg.diagnostics_max_age
+        )
         if diagnostics is None:
             self.feedback_message = "diagnostics stale or missing: not acted on"
             return FAILURE
         reason: AbortReason | None = None
         if diagnostics.faults:
-            reason = AbortReason(AbortCause.FAULT,
-                                 "electronics fault: " + "; ".join(diagnostics.faults))
+            reason = AbortReason(
+                AbortCause.FAULT, "electronics fault: " + "; ".join(diagnostics.faults)
+            )
         elif diagnostics.battery is not None and diagnostics.battery < cfg.battery_low:
-            reason = AbortReason(AbortCause.BATTERY, f"battery {diagnostics.battery:.0f}% "
-                                                     f"below {cfg.battery_low:g}%")
+            reason = AbortReason(
+                AbortCause.BATTERY, f"battery {diagnostics.battery:.0f}% below {cfg.battery_low:g}%"
+            )
         if reason is None:
             self.feedback_message = ""
             return FAILURE
@@ -113,8 +117,7 @@ class GiveUp(Leaf):
     def update(self) -> Status:
         cause = self.ctx.journal.last_incident()
         if cause is None:
-            cause = Incident(self.ctx.clock.now(), IncidentKind.GAVE_UP,
-                             "the tour cannot go on")
+            cause = Incident(self.ctx.clock.now(), IncidentKind.GAVE_UP, "the tour cannot go on")
         reason = cause.text
         self.ctx.send(Tour(TourState.ABORTED, reason))
         self.set(keys.TOUR_STATE, TourState.ABORTED)
@@ -182,8 +185,9 @@ class Checkpointed(FrogDecorator):
     """
 
     class Params(Params):
-        checkpoint: str = Field(min_length=1, description=(
-            "the part's name in the checkpoint (unique in the tree)"))
+        checkpoint: str = Field(
+            min_length=1, description=("the part's name in the checkpoint (unique in the tree)")
+        )
 
     optional_reads = (keys.VISITOR, keys.RESUME, keys.PROGRESS)
     writes = (keys.VISITOR, keys.RESUME, keys.PROGRESS)
@@ -222,6 +226,8 @@ class Checkpointed(FrogDecorator):
             return SUCCESS
         status = self.decorated.status
         if status == SUCCESS:
-            self.set(keys.PROGRESS, self._progress().complete(self.params.checkpoint,
-                                                              self.get(keys.VISITOR)))
+            self.set(
+                keys.PROGRESS,
+                self._progress().complete(self.params.checkpoint, self.get(keys.VISITOR)),
+            )
         return status

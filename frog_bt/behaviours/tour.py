@@ -30,16 +30,22 @@ class WaitFrontendIdle(Leaf):
     def update(self) -> Status:
         cfg = self.ctx.site.safety
         reading = self.get(keys.DIAGNOSTICS)
-        diagnostics = (reading.value if reading is not None
-                       and reading.age(self.need(keys.NOW)) <= cfg.diagnostics_max_age
-                       else None)
+        diagnostics = (
+            reading.value
+            if reading is not None and reading.age(self.need(keys.NOW)) <= cfg.diagnostics_max_age
+            else None
+        )
         if diagnostics is not None and diagnostics.faults:
             self.feedback_message = "fault: " + "; ".join(diagnostics.faults)
             return RUNNING
-        if (diagnostics is not None and diagnostics.battery is not None
-                and diagnostics.battery < cfg.battery_resume):
-            self.feedback_message = (f"charging: battery {diagnostics.battery:.0f}% "
-                                     f"< {cfg.battery_resume:g}%")
+        if (
+            diagnostics is not None
+            and diagnostics.battery is not None
+            and diagnostics.battery < cfg.battery_resume
+        ):
+            self.feedback_message = (
+                f"charging: battery {diagnostics.battery:.0f}% < {cfg.battery_resume:g}%"
+            )
             return RUNNING
         if self.get(keys.FRONTEND_READY):
             return SUCCESS
@@ -60,7 +66,8 @@ class TourStatus(Leaf):
 
     class Params(Params):
         state: Literal["started", "ended", "aborted"] = Field(
-            description="the tour state sent to the front end")
+            description="the tour state sent to the front end"
+        )
         reason: str = Field("", description="why (with aborted; default: the abort reason)")
 
     optional_reads = (keys.ABORT_REASON,)
@@ -97,11 +104,14 @@ class WaitEvent(Leaf):
 
     class Params(Params):
         event: Literal[tuple(EVENTS)] = Field(  # type: ignore[valid-type]
-            description="the front-end event waited for")
+            description="the front-end event waited for"
+        )
         timeout: Annotated[float, Field(gt=0, allow_inf_nan=False)] | TimeoutName = Field(
-            description="seconds, or the name of a site timeouts entry")
+            description="seconds, or the name of a site timeouts entry"
+        )
         on_timeout: Literal["failure", "success"] = Field(
-            "failure", description="what a wait that ran out returns")
+            "failure", description="what a wait that ran out returns"
+        )
 
     reads = (keys.EVENTS, keys.NOW)
 
@@ -117,9 +127,11 @@ class WaitEvent(Leaf):
             return SUCCESS
         if self.need(keys.NOW) - self.started >= self.timeout:
             success = self.params.on_timeout == "success"
-            self.ctx.note(f"no {self.params.event} within {self.timeout:g} s"
-                          + (": carrying on" if success else ""),
-                          incident=IncidentKind.EVENT_MISSING)
+            self.ctx.note(
+                f"no {self.params.event} within {self.timeout:g} s"
+                + (": carrying on" if success else ""),
+                incident=IncidentKind.EVENT_MISSING,
+            )
             return SUCCESS if success else FAILURE
         self.feedback_message = f"waiting for {self.params.event}"
         return RUNNING

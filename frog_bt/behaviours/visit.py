@@ -18,8 +18,9 @@ from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, 
 
 
 def someone_within(people: TrackedPeople, pose: Pose, radius: float) -> bool:
-    return any(math.hypot(p.position.x - pose.x, p.position.y - pose.y) <= radius
-               for p in people.people)
+    return any(
+        math.hypot(p.position.x - pose.x, p.position.y - pose.y) <= radius for p in people.people
+    )
 
 
 @register
@@ -36,11 +37,23 @@ class VisitorFollows(Leaf):
     """
 
     class Params(Params):
-        radius: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
-            "metres around the robot a follower is looked for (default: site follow.radius)"))
-        grace: float | None = Field(None, ge=0, allow_inf_nan=False, description=(
-            "seconds nobody may be seen before the visitor counts as lost "
-            "(default: site follow.grace)"))
+        radius: float | None = Field(
+            None,
+            gt=0,
+            allow_inf_nan=False,
+            description=(
+                "metres around the robot a follower is looked for (default: site follow.radius)"
+            ),
+        )
+        grace: float | None = Field(
+            None,
+            ge=0,
+            allow_inf_nan=False,
+            description=(
+                "seconds nobody may be seen before the visitor counts as lost "
+                "(default: site follow.grace)"
+            ),
+        )
 
     reads = (keys.PEOPLE, keys.POSE, keys.NOW)
 
@@ -55,20 +68,32 @@ class VisitorFollows(Leaf):
         pose = self.get(keys.POSE)
         now = self.need(keys.NOW)
         safety = self.ctx.site.safety
-        fresh = (people is not None and people.age(now) <= safety.people_max_age
-                 and pose is not None and pose.age(now) <= safety.pose_max_age)
+        fresh = (
+            people is not None
+            and people.age(now) <= safety.people_max_age
+            and pose is not None
+            and pose.age(now) <= safety.pose_max_age
+        )
         if fresh and people and pose and someone_within(people.value, pose.value, self.radius):
             return SUCCESS
         if now - self.started >= self.grace:
             if not fresh:
-                self.ctx.note("laser tracking or pose stale: assuming the visitor follows",
-                              incident=IncidentKind.STALE_INPUT)
+                self.ctx.note(
+                    "laser tracking or pose stale: assuming the visitor follows",
+                    incident=IncidentKind.STALE_INPUT,
+                )
                 return SUCCESS
-            self.ctx.note(f"nobody within {self.radius:g} m for {self.grace:g} s: "
-                          "visitor lost, back to recruit", incident=IncidentKind.VISITOR_LOST)
+            self.ctx.note(
+                f"nobody within {self.radius:g} m for {self.grace:g} s: "
+                "visitor lost, back to recruit",
+                incident=IncidentKind.VISITOR_LOST,
+            )
             return FAILURE
-        self.feedback_message = ("waiting for the visitor to catch up" if fresh
-                                 else "laser tracking or pose stale: waiting")
+        self.feedback_message = (
+            "waiting for the visitor to catch up"
+            if fresh
+            else "laser tracking or pose stale: waiting"
+        )
         return RUNNING
 
 
@@ -86,8 +111,14 @@ class PlayContent(Leaf):
 
     class Params(PoiParams):
         part: Literal["a", "b"] = Field("a", description="a: the content; b: its extension")
-        timeout: float | None = Field(None, gt=0, allow_inf_nan=False, description=(
-            "seconds before going on without content_done (default: site timeouts.content)"))
+        timeout: float | None = Field(
+            None,
+            gt=0,
+            allow_inf_nan=False,
+            description=(
+                "seconds before going on without content_done (default: site timeouts.content)"
+            ),
+        )
 
     reads = (keys.EVENTS, keys.NOW)
     optional_reads = (keys.WAYPOINT, keys.PAUSED)
@@ -130,8 +161,10 @@ class PlayContent(Leaf):
             self.ctx.send(StartPoi(p.poi, self.waypoint, p.part))
             self.ctx.note(f"front end restarted: {p.poi} part {p.part} sent again")
         if self.need(keys.NOW) - self.started >= self.timeout:
-            self.ctx.note(f"{p.poi} part {p.part}: no content_done within "
-                          f"{self.timeout:g} s, going on", incident=IncidentKind.CONTENT_TIMEOUT)
+            self.ctx.note(
+                f"{p.poi} part {p.part}: no content_done within {self.timeout:g} s, going on",
+                incident=IncidentKind.CONTENT_TIMEOUT,
+            )
             return SUCCESS
         self.feedback_message = f"playing {p.poi} part {p.part}"
         return RUNNING

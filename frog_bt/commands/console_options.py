@@ -21,10 +21,17 @@ DEFAULT_HOST = "127.0.0.1"
 
 
 def add_console_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--console", metavar="HOST:PORT",
-                   help="serve the operator's console (HTTP; PORT alone: on 127.0.0.1)")
-    p.add_argument("--console-token-file", metavar="FILE", type=Path,
-                   help="the staff token for commands (required off loopback)")
+    p.add_argument(
+        "--console",
+        metavar="HOST:PORT",
+        help="serve the operator's console (HTTP; PORT alone: on 127.0.0.1)",
+    )
+    p.add_argument(
+        "--console-token-file",
+        metavar="FILE",
+        type=Path,
+        help="the staff token for commands (required off loopback)",
+    )
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,14 +46,18 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
     token file that cannot be read or is empty, or a non-loopback address without one."""
     if not args.console:
         if args.console_token_file is not None:
-            raise UsageError("--console-token-file", args.console_token_file,
-                             "given without --console")
+            raise UsageError(
+                "--console-token-file", args.console_token_file, "given without --console"
+            )
         return None
     try:
         from frog_bt.live.console.server import is_loopback
     except ImportError as exc:
-        raise UsageError("--console", args.console, f"needs the console extra ({exc.name} is "
-                         "missing): pip install 'frog-bt[console]'") from None
+        raise UsageError(
+            "--console",
+            args.console,
+            f"needs the console extra ({exc.name} is missing): pip install 'frog-bt[console]'",
+        ) from None
 
     text = str(args.console)
     if text.isdigit() or text.startswith(":"):
@@ -58,14 +69,22 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
         try:
             token = path.read_text(encoding="utf-8").strip()
         except (OSError, UnicodeDecodeError) as exc:
-            raise UsageError("--console-token-file", path,
-                             f"cannot read it: {getattr(exc, 'strerror', None) or exc}") from None
+            raise UsageError(
+                "--console-token-file",
+                path,
+                f"cannot read it: {getattr(exc, 'strerror', None) or exc}",
+            ) from None
         if len(token) < 8:
-            raise UsageError("--console-token-file", path,
-                             "expected a token of at least 8 characters")
+            raise UsageError(
+                "--console-token-file", path, "expected a token of at least 8 characters"
+            )
     if token is None and not is_loopback(host):
-        raise UsageError("--console", args.console, f"{host} is not loopback: anyone on the "
-                         "network could steer the robot; give --console-token-file")
+        raise UsageError(
+            "--console",
+            args.console,
+            f"{host} is not loopback: anyone on the "
+            "network could steer the robot; give --console-token-file",
+        )
     return ConsoleSettings(host, port, token)
 
 
@@ -79,8 +98,11 @@ async def start_console(executive: Executive, settings: ConsoleSettings) -> Cons
         await console.start()
     except OSError as exc:
         await console.close()
-        raise UsageError("--console", f"{settings.host}:{settings.port}",
-                         f"cannot listen there: {exc.strerror or exc}") from None
+        raise UsageError(
+            "--console",
+            f"{settings.host}:{settings.port}",
+            f"cannot listen there: {exc.strerror or exc}",
+        ) from None
     return console
 
 
@@ -98,8 +120,9 @@ class People:
         await self.webhooks.close(1.0)
 
 
-async def start_people(executive: Executive, settings: ConsoleSettings | None,
-                       observers: Sequence[object]) -> People:
+async def start_people(
+    executive: Executive, settings: ConsoleSettings | None, observers: Sequence[object]
+) -> People:
     from frog_bt.live.console.webhooks import Webhooks
     from frog_bt.runtime import logctx
 

@@ -24,15 +24,27 @@ DEFAULT_CONSOLE = "http://127.0.0.1:8080"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("command", choices=[*(c.value for c in Command), "status"],
-                   help="what to do (status: print the robot's state)")
+    p.add_argument(
+        "command",
+        choices=[*(c.value for c in Command), "status"],
+        help="what to do (status: print the robot's state)",
+    )
     p.add_argument("id", nargs="?", help="with ack_alert: the alert's id")
-    p.add_argument("--console", metavar="URL", default=DEFAULT_CONSOLE,
-                   help=f"the console's address (default: {DEFAULT_CONSOLE})")
-    p.add_argument("--token-file", metavar="FILE", type=Path,
-                   help="the staff token (the console's --console-token-file)")
-    p.add_argument("--timeout", type=float, default=10.0,
-                   help="seconds to wait for the answer (default: 10)")
+    p.add_argument(
+        "--console",
+        metavar="URL",
+        default=DEFAULT_CONSOLE,
+        help=f"the console's address (default: {DEFAULT_CONSOLE})",
+    )
+    p.add_argument(
+        "--token-file",
+        metavar="FILE",
+        type=Path,
+        help="the staff token (the console's --console-token-file)",
+    )
+    p.add_argument(
+        "--timeout", type=float, default=10.0, help="seconds to wait for the answer (default: 10)"
+    )
 
 
 def _fail(text: str) -> int:
@@ -49,16 +61,19 @@ def run(args: argparse.Namespace) -> int:
         try:
             headers["Authorization"] = "Bearer " + args.token_file.read_text("utf-8").strip()
         except (OSError, UnicodeDecodeError) as exc:
-            return _fail(f"--token-file {args.token_file}: cannot read it: "
-                         f"{getattr(exc, 'strerror', None) or exc}")
+            return _fail(
+                f"--token-file {args.token_file}: cannot read it: "
+                f"{getattr(exc, 'strerror', None) or exc}"
+            )
     if args.command == "ack_alert" and not args.id:
         return _fail("ack_alert needs the alert's id (frog-bt ctl status lists them)")
     if args.command == "status":
         request = urllib.request.Request(f"{base}/api/state", headers=headers)
     else:
         body = {"command": args.command, **({"id": args.id} if args.id else {})}
-        request = urllib.request.Request(f"{base}/api/command", method="POST",
-                                         data=json.dumps(body).encode(), headers=headers)
+        request = urllib.request.Request(
+            f"{base}/api/command", method="POST", data=json.dumps(body).encode(), headers=headers
+        )
     try:
         with urllib.request.urlopen(request, timeout=args.timeout) as response:
             answer = json.loads(response.read())

@@ -35,17 +35,34 @@ if TYPE_CHECKING:
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--scenario", default="default", metavar="NAME|FILE",
-                   help="simulator scenario (default: default)")
+    p.add_argument(
+        "--scenario",
+        default="default",
+        metavar="NAME|FILE",
+        help="simulator scenario (default: default)",
+    )
     p.add_argument("--speed", type=float, help="sim-time speed factor (default: the scenario's)")
     add_tree_and_config(p)
-    p.add_argument("--timeout", type=float, default=300.0,
-                   help="give up after this many wall seconds (default: 300)")
-    p.add_argument("--record", type=Path, default=Path("frog-demo.mcap"), metavar="FILE.mcap",
-                   help="MCAP recording of the tour (default: frog-demo.mcap)")
-    p.add_argument("--rerun", default="save:frog-demo.rrd", metavar="SPEC",
-                   help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve | off "
-                   "(default: save:frog-demo.rrd)")
+    p.add_argument(
+        "--timeout",
+        type=float,
+        default=300.0,
+        help="give up after this many wall seconds (default: 300)",
+    )
+    p.add_argument(
+        "--record",
+        type=Path,
+        default=Path("frog-demo.mcap"),
+        metavar="FILE.mcap",
+        help="MCAP recording of the tour (default: frog-demo.mcap)",
+    )
+    p.add_argument(
+        "--rerun",
+        default="save:frog-demo.rrd",
+        metavar="SPEC",
+        help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve | off "
+        "(default: save:frog-demo.rrd)",
+    )
     add_console_arguments(p)
     p.add_argument("--quiet", action="store_true", help="no live status line")
 
@@ -68,8 +85,7 @@ def run(args: argparse.Namespace) -> int:
     return asyncio.run(_demo(site, tree, scenario, args))
 
 
-async def _demo(site: Site, tree: LoadedTree, scenario: Scenario,
-                args: argparse.Namespace) -> int:
+async def _demo(site: Site, tree: LoadedTree, scenario: Scenario, args: argparse.Namespace) -> int:
     from frog_bt.commands.run import attach_observers
     from frog_bt.live.summary import TourSummary
     from frog_bt.rehearsal import Rehearsal
@@ -93,8 +109,7 @@ async def _demo(site: Site, tree: LoadedTree, scenario: Scenario,
     try:
         async with rehearsal:
             try:
-                people = await start_people(rehearsal.executive, console_settings(args),
-                                            observers)
+                people = await start_people(rehearsal.executive, console_settings(args), observers)
             except UsageError as exc:
                 print(f"frog-bt: {exc}", file=sys.stderr)
                 rehearsal.executive.stop(str(exc), 2)
@@ -103,20 +118,26 @@ async def _demo(site: Site, tree: LoadedTree, scenario: Scenario,
                 outcome = await rehearsal.finish(args.timeout)
             except TimeoutError:
                 outcome = rehearsal.executive.outcome
-                outcome.code, outcome.reason = 1, (f"no docked finish within {args.timeout:g} s "
-                                                   "of wall time")
+                outcome.code, outcome.reason = (
+                    1,
+                    (f"no docked finish within {args.timeout:g} s of wall time"),
+                )
     finally:
         if people is not None:
             await people.close()
         close_all(observers)
     clock = rehearsal.executive.clock
     wall, simulated = time.monotonic() - wall0, rehearsal.sim.clock.now() - sim0
-    print(f"frog-bt demo: scenario {args.scenario!r}, started "
-          f"{scenario.start_time.astimezone(clock.tz):%Y-%m-%d %H:%M} local time")
+    print(
+        f"frog-bt demo: scenario {args.scenario!r}, started "
+        f"{scenario.start_time.astimezone(clock.tz):%Y-%m-%d %H:%M} local time"
+    )
     for line in summary.lines(rehearsal.executive.link.stats):
         print("  " + line)
-    print(f"  time:      {simulated / 60:.1f} min simulated in {wall:.1f} s "
-          f"({simulated / max(wall, 1e-9):.0f}x real time)")
+    print(
+        f"  time:      {simulated / 60:.1f} min simulated in {wall:.1f} s "
+        f"({simulated / max(wall, 1e-9):.0f}x real time)"
+    )
     if outcome.code:
         print(f"frog-bt: {outcome.reason}", file=sys.stderr)
         return outcome.code

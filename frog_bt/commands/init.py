@@ -24,11 +24,17 @@ from frog_bt import resources
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("dir", type=Path, metavar="DIR", help="where to write trees/ and config/")
     p.add_argument("--force", action="store_true", help="overwrite files that exist")
-    p.add_argument("--service", action="store_true",
-                   help="also write DIR/frog-bt.service, a systemd unit for the executive")
-    p.add_argument("--user", default=None,
-                   help="the user the service runs as (default: you; 'frog' when you are "
-                   "root: the executive needs no root)")
+    p.add_argument(
+        "--service",
+        action="store_true",
+        help="also write DIR/frog-bt.service, a systemd unit for the executive",
+    )
+    p.add_argument(
+        "--user",
+        default=None,
+        help="the user the service runs as (default: you; 'frog' when you are "
+        "root: the executive needs no root)",
+    )
 
 
 UNIT = """\
@@ -76,11 +82,16 @@ def unit_text(target: Path, user: str | None = None) -> str:
 
 def copies(target: Path) -> list[tuple[Path, Path]]:
     """(packaged file, where it goes) for every file ``init`` writes."""
-    out = [(src, target / "trees" / src.name)
-           for src in sorted([*resources.tree_dir().glob("*.yaml"),
-                              *resources.tree_dir().glob("*.schema.json")])]
-    for src in (resources.site_dir() / resources.SITE_FILE,
-                *resources.site_dir().glob("*.schema.json")):
+    out = [
+        (src, target / "trees" / src.name)
+        for src in sorted(
+            [*resources.tree_dir().glob("*.yaml"), *resources.tree_dir().glob("*.schema.json")]
+        )
+    ]
+    for src in (
+        resources.site_dir() / resources.SITE_FILE,
+        *resources.site_dir().glob("*.schema.json"),
+    ):
         out.append((src, target / "config" / src.name))
     return out
 
@@ -90,9 +101,11 @@ def run(args: argparse.Namespace) -> int:
     if not args.force:
         existing = [dst for _, dst in plan if dst.exists()]
         if existing:
-            print(f"frog-bt: {existing[0]}: exists; give --force to overwrite "
-                  f"({len(existing)} file{'s' if len(existing) > 1 else ''} would be)",
-                  file=sys.stderr)
+            print(
+                f"frog-bt: {existing[0]}: exists; give --force to overwrite "
+                f"({len(existing)} file{'s' if len(existing) > 1 else ''} would be)",
+                file=sys.stderr,
+            )
             return 2
     service = args.dir / "frog-bt.service"
     if args.service and service.exists() and not args.force:
@@ -113,12 +126,16 @@ def run(args: argparse.Namespace) -> int:
     for _, dst in plan:
         print(f"wrote {dst}")
     tree, site = args.dir / "trees" / resources.TREE_FILE, args.dir / "config" / resources.SITE_FILE
-    print(f"\nEdit them, then:\n  frog-bt render --tree {tree} --config {site}\n"
-          f"  frog-bt demo --tree {tree} --config {site}\n"
-          f"  frog-bt run --tree {tree} --config {site} ...")
+    print(
+        f"\nEdit them, then:\n  frog-bt render --tree {tree} --config {site}\n"
+        f"  frog-bt demo --tree {tree} --config {site}\n"
+        f"  frog-bt run --tree {tree} --config {site} ..."
+    )
     if args.service:
-        print(f"wrote {service}\n\nInstall the service (it runs as an ordinary user):\n"
-              f"  sudo cp {service.resolve()} /etc/systemd/system/\n"
-              "  sudo systemctl daemon-reload && sudo systemctl enable --now frog-bt\n"
-              "  journalctl -u frog-bt -f")
+        print(
+            f"wrote {service}\n\nInstall the service (it runs as an ordinary user):\n"
+            f"  sudo cp {service.resolve()} /etc/systemd/system/\n"
+            "  sudo systemctl daemon-reload && sudo systemctl enable --now frog-bt\n"
+            "  journalctl -u frog-bt -f"
+        )
     return 0

@@ -20,8 +20,12 @@ from frog_bt.tree.catalogue import as_json, as_markdown, catalogue
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--format", choices=("markdown", "json"), default="markdown",
-                   help="output format (default: markdown)")
+    p.add_argument(
+        "--format",
+        choices=("markdown", "json"),
+        default="markdown",
+        help="output format (default: markdown)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:

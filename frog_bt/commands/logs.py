@@ -14,8 +14,13 @@ import logging
 import os
 import sys
 
-PRIORITY = {logging.CRITICAL: 2, logging.ERROR: 3, logging.WARNING: 4, logging.INFO: 6,
-            logging.DEBUG: 7}  # syslog priorities, as sd-daemon(3) prefixes them
+PRIORITY = {
+    logging.CRITICAL: 2,
+    logging.ERROR: 3,
+    logging.WARNING: 4,
+    logging.INFO: 6,
+    logging.DEBUG: 7,
+}  # syslog priorities, as sd-daemon(3) prefixes them
 
 
 class JournalFormatter(logging.Formatter):
@@ -27,8 +32,12 @@ class JournalFormatter(logging.Formatter):
 
 class JsonFormatter(logging.Formatter):
     def format(self, record: logging.LogRecord) -> str:
-        out = {"t": round(record.created, 3), "level": record.levelname,
-               "logger": record.name, "msg": record.getMessage()}
+        out = {
+            "t": round(record.created, 3),
+            "level": record.levelname,
+            "logger": record.name,
+            "msg": record.getMessage(),
+        }
         if record.exc_info:
             out["exc"] = self.formatException(record.exc_info)
         return json.dumps(out, ensure_ascii=False)

@@ -15,10 +15,13 @@ from typing import Any
 from frog_bt.config import Site
 from frog_bt.errors import UsageError
 
-TREE_HELP = ("tour tree (default: the packaged tour, trees/tour.yaml; "
-             "'frog-bt init DIR' copies it to edit)")
-CONFIG_HELP = ("site configuration (default: the packaged config/site.yaml; "
-               "'frog-bt init DIR' copies it to edit)")
+TREE_HELP = (
+    "tour tree (default: the packaged tour, trees/tour.yaml; 'frog-bt init DIR' copies it to edit)"
+)
+CONFIG_HELP = (
+    "site configuration (default: the packaged config/site.yaml; "
+    "'frog-bt init DIR' copies it to edit)"
+)
 
 
 def add_tree_and_config(p: argparse.ArgumentParser, *, tree: bool = True) -> None:
@@ -31,8 +34,13 @@ def add_tree_and_config(p: argparse.ArgumentParser, *, tree: bool = True) -> Non
 def add_tree_argument(p: argparse.ArgumentParser) -> None:
     """``[TREE]`` or ``--tree FILE``, and ``--config FILE`` (render, check)."""
     p.add_argument("tree", nargs="?", type=Path, metavar="TREE", help=TREE_HELP)
-    p.add_argument("--tree", dest="tree_option", type=Path, metavar="FILE",
-                   help="the same as TREE, as the other commands take it")
+    p.add_argument(
+        "--tree",
+        dest="tree_option",
+        type=Path,
+        metavar="FILE",
+        help="the same as TREE, as the other commands take it",
+    )
     p.add_argument("--config", type=Path, metavar="FILE", help=CONFIG_HELP)
 
 
@@ -82,8 +90,7 @@ def rerun_spec(spec: str | None, option: str = "--rerun") -> str | None:
         except UsageError as exc:
             raise UsageError(option, spec, exc.detail) from None
     elif kind not in ("spawn", "connect", "serve"):
-        raise UsageError(option, spec, "expected spawn, save:FILE.rrd, connect[:URL], serve "
-                                       "or off")
+        raise UsageError(option, spec, "expected spawn, save:FILE.rrd, connect[:URL], serve or off")
     return spec
 
 
@@ -95,7 +102,9 @@ def read_secret(site: Site) -> str | None:
         try:
             secret = Path(links.secret_file).read_text(encoding="utf-8").strip()
         except OSError as exc:
-            raise UsageError("links.secret_file", links.secret_file,
-                             f"cannot read the rosbridge secret: {exc.strerror or exc}"
-                             ) from None
+            raise UsageError(
+                "links.secret_file",
+                links.secret_file,
+                f"cannot read the rosbridge secret: {exc.strerror or exc}",
+            ) from None
     return secret or None

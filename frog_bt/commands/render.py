@@ -36,15 +36,24 @@ FORMATS = ("ascii", "unicode", "dot", "svg", "png", "mermaid", "btcpp")
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_tree_argument(p)
-    p.add_argument("-f", "--format", choices=FORMATS, default="ascii",
-                   help="output format (default: ascii)")
-    p.add_argument("-o", "--output", type=Path, metavar="FILE",
-                   help="write to FILE instead of stdout")
-    p.add_argument("--keys", action="store_true",
-                   help="show each node's blackboard keys (reads, optional reads?, writes)")
-    p.add_argument("--rankdir", choices=("TB", "LR"), default="LR",
-                   help="graph direction for dot, svg, png and mermaid: LR left-to-right "
-                   "(default: a whole tour stays legible) or TB top-down")
+    p.add_argument(
+        "-f", "--format", choices=FORMATS, default="ascii", help="output format (default: ascii)"
+    )
+    p.add_argument(
+        "-o", "--output", type=Path, metavar="FILE", help="write to FILE instead of stdout"
+    )
+    p.add_argument(
+        "--keys",
+        action="store_true",
+        help="show each node's blackboard keys (reads, optional reads?, writes)",
+    )
+    p.add_argument(
+        "--rankdir",
+        choices=("TB", "LR"),
+        default="LR",
+        help="graph direction for dot, svg, png and mermaid: LR left-to-right "
+        "(default: a whole tour stays legible) or TB top-down",
+    )
 
 
 def btcpp_xml(path: Path | None, site: Any) -> str:
@@ -81,8 +90,9 @@ def run(args: argparse.Namespace) -> int:
     data = btcpp_xml(path, site).encode("utf-8") if args.format == "btcpp" else None
     try:
         if data is None:
-            data = draw(render.outline(tree.root), args.format, keys=args.keys,
-                        rankdir=args.rankdir)
+            data = draw(
+                render.outline(tree.root), args.format, keys=args.keys, rankdir=args.rankdir
+            )
     except render.GraphvizError as exc:
         print(f"frog-bt: {exc}", file=sys.stderr)
         return 1

@@ -44,29 +44,54 @@ BAR = 30
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("files", type=Path, nargs="+", metavar="FILE_OR_DIR",
-                   help="recording(s) to replay: MCAP files, or directories of them")
+    p.add_argument(
+        "files",
+        type=Path,
+        nargs="+",
+        metavar="FILE_OR_DIR",
+        help="recording(s) to replay: MCAP files, or directories of them",
+    )
     add_tree_and_config(p)
-    p.add_argument("--rerun", metavar="SPEC",
-                   help="rerun telemetry of the replay: spawn | save:FILE.rrd | connect:URL | "
-                   "serve (default: off)")
+    p.add_argument(
+        "--rerun",
+        metavar="SPEC",
+        help="rerun telemetry of the replay: spawn | save:FILE.rrd | connect:URL | "
+        "serve (default: off)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--format", choices=("text", "json"), default="text",
-                   help="one recording's report: text for people, json for scripts")
-    p.add_argument("--jobs", type=int, default=1, metavar="N",
-                   help="corpus: recordings replayed at a time, in processes (default 1)")
-    p.add_argument("--report", type=Path, metavar="FILE.json",
-                   help="corpus: write every tour's row and the summary as JSON")
-    p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="corpus: run on this dask.distributed scheduler (tcp://HOST:PORT) "
-                        "instead of local processes (pip install 'frog-bt[fleet]')")
+    p.add_argument(
+        "--format",
+        choices=("text", "json"),
+        default="text",
+        help="one recording's report: text for people, json for scripts",
+    )
+    p.add_argument(
+        "--jobs",
+        type=int,
+        default=1,
+        metavar="N",
+        help="corpus: recordings replayed at a time, in processes (default 1)",
+    )
+    p.add_argument(
+        "--report",
+        type=Path,
+        metavar="FILE.json",
+        help="corpus: write every tour's row and the summary as JSON",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="corpus: run on this dask.distributed scheduler (tcp://HOST:PORT) "
+        "instead of local processes (pip install 'frog-bt[fleet]')",
+    )
 
 
 class Progress:
     """A one-line progress bar on a terminal: percent of the recording's time covered."""
 
-    def __init__(self, start: float, end: float, out: TextIO,
-                 wall: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self, start: float, end: float, out: TextIO, wall: Callable[[], float] = time.monotonic
+    ) -> None:
         self.start, self.span = start, max(end - start, 1e-9)
         self.out = out
         self._wall = wall
@@ -80,8 +105,10 @@ class Progress:
         self._drawn = now
         frac = min(max((t - self.start) / self.span, 0.0), 1.0)
         filled = round(frac * BAR)
-        self.out.write(f"\rreplay [{'#' * filled}{'-' * (BAR - filled)}] {frac:4.0%} "
-                       f"{t - self.start:7.1f}/{self.span:.1f} s")
+        self.out.write(
+            f"\rreplay [{'#' * filled}{'-' * (BAR - filled)}] {frac:4.0%} "
+            f"{t - self.start:7.1f}/{self.span:.1f} s"
+        )
         self.out.flush()
         self._shown = True
 
@@ -92,8 +119,13 @@ class Progress:
 
 
 def run(args: argparse.Namespace) -> int:
-    if (len(args.files) > 1 or args.files[0].is_dir() or args.report or args.jobs != 1
-            or args.scheduler):
+    if (
+        len(args.files) > 1
+        or args.files[0].is_dir()
+        or args.report
+        or args.jobs != 1
+        or args.scheduler
+    ):
         return run_corpus(args)
     args.file = args.files[0]
     return run_one(args)
@@ -140,8 +172,9 @@ def run_corpus(args: argparse.Namespace) -> int:
     totals = summary(rows)
     print(summary_line(totals))
     if args.report is not None:
-        args.report.write_text(json.dumps(
-            {"tours": [r.as_dict() for r in rows], "summary": totals}, indent=1) + "\n")
+        args.report.write_text(
+            json.dumps({"tours": [r.as_dict() for r in rows], "summary": totals}, indent=1) + "\n"
+        )
     return 0 if totals["identical"] == totals["tours"] else 1
 
 
@@ -151,25 +184,40 @@ def report(result: Any, site: Any) -> dict[str, Any]:
 
     div = result.divergence
     out: dict[str, Any] = {
-        "identical": div is None, "start": result.start, "end": result.end,
-        "inputs": result.inputs, "ticks": result.ticks,
-        "ros_commands": result.ros_commands, "frontend_commands": result.frontend_commands,
-        "exact_ticks": result.exact, "recovered": result.recovered,
+        "identical": div is None,
+        "start": result.start,
+        "end": result.end,
+        "inputs": result.inputs,
+        "ticks": result.ticks,
+        "ros_commands": result.ros_commands,
+        "frontend_commands": result.frontend_commands,
+        "exact_ticks": result.exact,
+        "recovered": result.recovered,
         "operator_commands": result.operator_commands,
-        "bad_messages": result.bad_count, "bad": result.bad}
+        "bad_messages": result.bad_count,
+        "bad": result.bad,
+    }
     if div is not None:
+
         def side(command: Any) -> dict[str, Any] | None:
             if command is None:
                 return None
-            return {"at": command.t - result.start, "channel": command.channel,
-                    "payload": command.payload, "node": command.node,
-                    "reads": command.reads}
+            return {
+                "at": command.t - result.start,
+                "channel": command.channel,
+                "payload": command.payload,
+                "node": command.node,
+                "reads": command.reads,
+            }
 
         out["divergence"] = {
-            "number": div.number, "at": div.t - result.start,
+            "number": div.number,
+            "at": div.t - result.start,
             "differs": differences(div.expected, div.got, site),
             "what": what_differs(div.expected, div.got, site),
-            "recorded": side(div.expected), "replayed": side(div.got)}
+            "recorded": side(div.expected),
+            "replayed": side(div.got),
+        }
     return out
 
 
@@ -182,8 +230,9 @@ class CountBar:
 
     def __call__(self, done: int, total: int) -> None:
         filled = round(done / max(total, 1) * BAR)
-        self.out.write(f"\r{self.label} [{'#' * filled}{'-' * (BAR - filled)}] "
-                       f"{done}/{total} {self.unit}")
+        self.out.write(
+            f"\r{self.label} [{'#' * filled}{'-' * (BAR - filled)}] {done}/{total} {self.unit}"
+        )
         self.out.flush()
 
     def clear(self) -> None:
@@ -243,11 +292,16 @@ def run_one(args: argparse.Namespace) -> int:
     if div is None:
         print(f"identical: {commands}")
     else:
-        print(f"divergence at {local_time(div.t)} (+{div.t - result.start:.1f} s into the "
-              f"recording), command {div.number}:")
+        print(
+            f"divergence at {local_time(div.t)} (+{div.t - result.start:.1f} s into the "
+            f"recording), command {div.number}:"
+        )
         for label, command in (("expected", div.expected), ("got", div.got)):
-            text = "nothing" if command is None else (
-                f"{command}  (at +{command.t - result.start:.1f} s)")
+            text = (
+                "nothing"
+                if command is None
+                else (f"{command}  (at +{command.t - result.start:.1f} s)")
+            )
             print(f"  {label + ':':9} {text}")
         print(f"  {'differs:':9} {differences(div.expected, div.got, site)}")
         for label, command in (("recorded", div.expected), ("replayed", div.got)):
@@ -257,7 +311,9 @@ def run_one(args: argparse.Namespace) -> int:
                     print(f"  {'':9}   {key} = {value}")
     simulated = result.covered - result.start
     wall = result.wall
-    print(f"replayed {simulated:.1f} of {result.end - result.start:.1f} s recorded in "
-          f"{wall:.2f} s wall ({simulated / max(wall, 1e-9):.0f}x real time): "
-          f"{result.inputs} inputs, {result.ticks} ticks, {commands}")
+    print(
+        f"replayed {simulated:.1f} of {result.end - result.start:.1f} s recorded in "
+        f"{wall:.2f} s wall ({simulated / max(wall, 1e-9):.0f}x real time): "
+        f"{result.inputs} inputs, {result.ticks} ticks, {commands}"
+    )
     return 0 if div is None else 1

@@ -31,19 +31,34 @@ from frog_bt.commands.options import add_tree_and_config
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("files", type=Path, nargs="+", metavar="FILE_OR_DIR",
-                   help="recordings: MCAP files, or directories of them")
+    p.add_argument(
+        "files",
+        type=Path,
+        nargs="+",
+        metavar="FILE_OR_DIR",
+        help="recordings: MCAP files, or directories of them",
+    )
     add_tree_and_config(p, tree=False)
-    p.add_argument("-o", "--output", type=Path, metavar="FILE.html",
-                   help="write the HTML report here")
+    p.add_argument(
+        "-o", "--output", type=Path, metavar="FILE.html", help="write the HTML report here"
+    )
     p.add_argument("--csv", type=Path, metavar="FILE", help="write the rows as CSV")
     p.add_argument("--parquet", type=Path, metavar="FILE", help="write the rows as Parquet")
-    p.add_argument("--json", type=Path, metavar="FILE",
-                   help="write the totals and the rows as JSON")
-    p.add_argument("--jobs", type=int, default=1, metavar="N",
-                   help="files read at a time, in processes (default 1)")
-    p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="run on this dask.distributed scheduler (tcp://HOST:PORT) instead")
+    p.add_argument(
+        "--json", type=Path, metavar="FILE", help="write the totals and the rows as JSON"
+    )
+    p.add_argument(
+        "--jobs",
+        type=int,
+        default=1,
+        metavar="N",
+        help="files read at a time, in processes (default 1)",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on this dask.distributed scheduler (tcp://HOST:PORT) instead",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -73,15 +88,13 @@ def run(args: argparse.Namespace) -> int:
         return 2
     missing = [str(f) for f in args.files if not f.exists()]
     if missing:
-        print(f"frog-bt report: no such file or directory: {', '.join(missing)}",
-              file=sys.stderr)
+        print(f"frog-bt report: no such file or directory: {', '.join(missing)}", file=sys.stderr)
         return 2
     files = recordings(args.files)
     if not files:
         print("frog-bt report: no recordings (*.mcap) found", file=sys.stderr)
         return 2
-    bar = None if args.quiet or not sys.stderr.isatty() else CountBar(sys.stderr, "report",
-                                                                       "files")
+    bar = None if args.quiet or not sys.stderr.isatty() else CountBar(sys.stderr, "report", "files")
     try:
         with executor(args.jobs, args.scheduler) as pool:
             facts = read_corpus(files, site, pool, bar)
@@ -97,23 +110,33 @@ def run(args: argparse.Namespace) -> int:
         if f.recovered and not f.error:
             print(f"frog-bt report: {f.file}: {f.recovered}", file=sys.stderr)
         if f.bad and not f.error:
-            print(f"frog-bt report: {f.file}: {f.bad} message(s) did not decode, read past "
-                  f"({'; '.join(f.bad_first)})", file=sys.stderr)
+            print(
+                f"frog-bt report: {f.file}: {f.bad} message(s) did not decode, read past "
+                f"({'; '.join(f.bad_first)})",
+                file=sys.stderr,
+            )
     rows = tour_rows([f for f in facts if not f.error], site)
     face_stops = [s.poi for s in site.tour.stops if s.face_stream]
     t = totals(rows, face_stops, unreadable=len(skipped))
     rate = t["completion_rate"]
-    print(f"frog-bt report: {len(files)} files, {t['tours']} tours, {t['completed']} "
-          f"completed ({'-' if rate is None else f'{100 * rate:.1f} %'}), "
-          f"{t['resumed']} resumed, {len(skipped)} skipped")
+    print(
+        f"frog-bt report: {len(files)} files, {t['tours']} tours, {t['completed']} "
+        f"completed ({'-' if rate is None else f'{100 * rate:.1f} %'}), "
+        f"{t['resumed']} resumed, {len(skipped)} skipped"
+    )
     try:
         if args.csv:
             outputs.write_csv(rows, args.csv)
         if args.parquet:
             outputs.write_parquet(rows, args.parquet)
         if args.json:
-            args.json.write_text(json.dumps({"totals": t, "tours": [r.as_dict() for r in rows],
-                                             "skipped": skipped}, indent=1) + "\n")
+            args.json.write_text(
+                json.dumps(
+                    {"totals": t, "tours": [r.as_dict() for r in rows], "skipped": skipped},
+                    indent=1,
+                )
+                + "\n"
+            )
         if args.output:
             outputs.write_html(rows, t, args.output, "FROG tours: what they tell", skipped)
     except outputs.MissingExtra as exc:

@@ -20,14 +20,20 @@ def compare_lanes(rec: Any, replay: Any, site: Any) -> None:
 
     def command(side: str, c: Any) -> None:
         at(c.t)
-        rec.log(f"/log/replay/{side}",
-                rr.TextLog(f"{side}: {describe(c, site)}  [{c.node or '?'}]", level="INFO"))
+        rec.log(
+            f"/log/replay/{side}",
+            rr.TextLog(f"{side}: {describe(c, site)}  [{c.node or '?'}]", level="INFO"),
+        )
 
     def divergence(d: Any) -> None:
         at(d.t)
-        rec.log("/log/replay/divergence", rr.TextLog(
-            f"divergence, command {d.number}: {differences(d.expected, d.got, site)}",
-            level="ERROR"))
+        rec.log(
+            "/log/replay/divergence",
+            rr.TextLog(
+                f"divergence, command {d.number}: {differences(d.expected, d.got, site)}",
+                level="ERROR",
+            ),
+        )
 
     replay.on_command.append(command)
     replay.on_divergence.append(divergence)

@@ -54,38 +54,77 @@ if TYPE_CHECKING:
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_tree_and_config(p)
-    p.add_argument("--rosbridge", metavar="URL", help="rosbridge URL (default: from config, "
-                   "ws://127.0.0.1:9090)")
-    p.add_argument("--frontend", metavar="HOST:PORT",
-                   help="where the front end listens (default: 127.0.0.1:5005)")
-    p.add_argument("--listen", metavar="HOST:PORT",
-                   help="where the executive listens for the front end (default: 127.0.0.1:5006)")
-    p.add_argument("--sim-time", action="store_true", default=None,
-                   help="take time from /clock (ROS use_sim_time); nothing is timed before it")
-    p.add_argument("--record", metavar="FILE.mcap|DIR", type=Path,
-                   help="record every message in and out: to one MCAP file (FILE.mcap), or "
-                   "to DIR, one file per tour and idle period within the site config's "
-                   "recording.max_bytes (oldest deleted first)")
-    p.add_argument("--rerun", metavar="SPEC",
-                   help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve "
-                   "(default: off)")
-    p.add_argument("--once", action="store_true", default=None,
-                   help="exit 0 after one tour ends docked; non-zero when it cannot go on")
-    p.add_argument("--checkpoint", type=Path, metavar="FILE",
-                   help=f"tour progress, so that a restart resumes the tour (default: one file "
-                   f"per site config and listen address in {STATE_DIR}); 'none' disables it")
-    p.add_argument("--fresh", action="store_true", default=None,
-                   help="ignore the checkpoint: start a fresh tour")
-    p.add_argument("--watch", action="store_true", default=None,
-                   help="re-check the tree and config files when they change; a valid change "
-                   "takes over when the robot is docked and idle, a bad one is reported and "
-                   "the running tree stays")
+    p.add_argument(
+        "--rosbridge",
+        metavar="URL",
+        help="rosbridge URL (default: from config, ws://127.0.0.1:9090)",
+    )
+    p.add_argument(
+        "--frontend",
+        metavar="HOST:PORT",
+        help="where the front end listens (default: 127.0.0.1:5005)",
+    )
+    p.add_argument(
+        "--listen",
+        metavar="HOST:PORT",
+        help="where the executive listens for the front end (default: 127.0.0.1:5006)",
+    )
+    p.add_argument(
+        "--sim-time",
+        action="store_true",
+        default=None,
+        help="take time from /clock (ROS use_sim_time); nothing is timed before it",
+    )
+    p.add_argument(
+        "--record",
+        metavar="FILE.mcap|DIR",
+        type=Path,
+        help="record every message in and out: to one MCAP file (FILE.mcap), or "
+        "to DIR, one file per tour and idle period within the site config's "
+        "recording.max_bytes (oldest deleted first)",
+    )
+    p.add_argument(
+        "--rerun",
+        metavar="SPEC",
+        help="rerun telemetry: spawn | save:FILE.rrd | connect:URL | serve (default: off)",
+    )
+    p.add_argument(
+        "--once",
+        action="store_true",
+        default=None,
+        help="exit 0 after one tour ends docked; non-zero when it cannot go on",
+    )
+    p.add_argument(
+        "--checkpoint",
+        type=Path,
+        metavar="FILE",
+        help=f"tour progress, so that a restart resumes the tour (default: one file "
+        f"per site config and listen address in {STATE_DIR}); 'none' disables it",
+    )
+    p.add_argument(
+        "--fresh",
+        action="store_true",
+        default=None,
+        help="ignore the checkpoint: start a fresh tour",
+    )
+    p.add_argument(
+        "--watch",
+        action="store_true",
+        default=None,
+        help="re-check the tree and config files when they change; a valid change "
+        "takes over when the robot is docked and idle, a bad one is reported and "
+        "the running tree stays",
+    )
     add_console_arguments(p)
     p.add_argument("--quiet", action="store_true", default=None, help="no live status line")
     p.add_argument("-v", "--verbose", action="store_true", help="log at debug level")
-    p.add_argument("--log-format", choices=("text", "json"), default=None,
-                   help="text (levels as syslog prefixes under systemd) or one JSON object "
-                   "per line (default: text)")
+    p.add_argument(
+        "--log-format",
+        choices=("text", "json"),
+        default=None,
+        help="text (levels as syslog prefixes under systemd) or one JSON object "
+        "per line (default: text)",
+    )
 
 
 @dataclass(frozen=True, slots=True)
@@ -128,8 +167,9 @@ def record_target(path: Path) -> Path:
     if path.suffix == ".mcap" and not path.is_dir():
         return writable_file(path, "--record")
     if path.exists() and not path.is_dir():
-        raise UsageError("--record", path, "is a file but not .mcap; expected FILE.mcap or "
-                         "a directory")
+        raise UsageError(
+            "--record", path, "is a file but not .mcap; expected FILE.mcap or a directory"
+        )
     parent = path.parent if not path.exists() else path
     if not parent.is_dir():
         raise UsageError("--record", path, f"cannot write there: {parent} does not exist")
@@ -140,8 +180,10 @@ def record_target(path: Path) -> Path:
 
 def banner(args: argparse.Namespace, settings: Settings) -> list[str]:
     """What this executive runs and where it talks, for the first lines of its output."""
+
     def shown(path: Path | None) -> str:
         return str(path) if path is not None else "off"
+
     return [
         f"frog-bt {__version__}: tree {args.tree or DEFAULT_TREE}, "
         f"config {args.config or DEFAULT_CONFIG}",
@@ -156,8 +198,9 @@ def banner(args: argparse.Namespace, settings: Settings) -> list[str]:
 __all__ = ["add_arguments", "attach_observers", "read_secret", "run"]
 
 
-def attach_observers(executive: Executive, *, record: Path | None, rerun: str | None
-                     ) -> list[Observer]:
+def attach_observers(
+    executive: Executive, *, record: Path | None, rerun: str | None
+) -> list[Observer]:
     """Recorder and telemetry, each imported only when asked for, attached; the caller
     closes them (:func:`~frog_bt.runtime.observer.close_all`)."""
     observers: list[Observer] = []
@@ -173,8 +216,7 @@ def attach_observers(executive: Executive, *, record: Path | None, rerun: str | 
         from frog_bt.live.telemetry import Telemetry, process
 
         if process.available():  # rerun in a process of its own: off the tick, its memory
-            observers.append(process.TelemetryProcess(rerun, executive.site,
-                                                      executive.core.tree))
+            observers.append(process.TelemetryProcess(rerun, executive.site, executive.core.tree))
         else:
             observers.append(Telemetry.open(rerun, executive.site, executive.core.tree))
     return attach_all(executive, observers)
@@ -190,8 +232,12 @@ def run(args: argparse.Namespace) -> int:
         tree = load_tree(args.tree, site)
         settings = resolve(args, site)
         if args.watch and settings.rerun:
-            raise UsageError("--watch", "", "cannot be combined with --rerun (the viewer's "
-                             "tree layout is fixed when it starts)")
+            raise UsageError(
+                "--watch",
+                "",
+                "cannot be combined with --rerun (the viewer's "
+                "tree layout is fixed when it starts)",
+            )
         console = console_settings(args)
         lock = claim_checkpoint(settings.checkpoint) if settings.checkpoint else None
     except FrogError as exc:
@@ -213,8 +259,13 @@ def run(args: argparse.Namespace) -> int:
             lock.close()
 
 
-async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Settings,
-                console: ConsoleSettings | None = None) -> int:
+async def _main(
+    args: argparse.Namespace,
+    site: Site,
+    tree: Any,
+    settings: Settings,
+    console: ConsoleSettings | None = None,
+) -> int:
     from frog_bt.runtime.executive import Executive
     from frog_bt.runtime.memory import pin_malloc_thresholds
 
@@ -223,10 +274,19 @@ async def _main(args: argparse.Namespace, site: Site, tree: Any, settings: Setti
     from frog_bt.runtime.status import StatusLine
 
     clock = SimClock() if args.sim_time else WallClock()
-    executive = Executive(site, tree, clock, rosbridge_url=settings.url,
-                          frontend=settings.frontend, listen=settings.listen,
-                          sim_time=args.sim_time, secret=settings.secret, once=args.once,
-                          fresh=args.fresh, checkpoint=settings.checkpoint)
+    executive = Executive(
+        site,
+        tree,
+        clock,
+        rosbridge_url=settings.url,
+        frontend=settings.frontend,
+        listen=settings.listen,
+        sim_time=args.sim_time,
+        secret=settings.secret,
+        once=args.once,
+        fresh=args.fresh,
+        checkpoint=settings.checkpoint,
+    )
     loop = asyncio.get_running_loop()
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)

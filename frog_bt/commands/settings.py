@@ -39,8 +39,9 @@ def tree_and_config(args: argparse.Namespace, env: Mapping[str, str] | None = No
             setattr(args, option, Path(env[env_name(option)]))
 
 
-def fill(args: argparse.Namespace, run: RunCfg, env: Mapping[str, str] | None = None
-         ) -> dict[str, str]:
+def fill(
+    args: argparse.Namespace, run: RunCfg, env: Mapping[str, str] | None = None
+) -> dict[str, str]:
     """Fill every option the command line left out (None) from the environment or
     ``run``; where each came from (``env``, ``site``), for the banner."""
     env = os.environ if env is None else env

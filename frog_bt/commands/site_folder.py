@@ -51,6 +51,8 @@ def apply(args: argparse.Namespace, start: Path | None = None) -> list[Path]:
         args.config = folder / SITE
         taken.append(args.config)
     if taken:
-        print(f"frog-bt: site folder {folder}: using {', '.join(str(p) for p in taken)}",
-              file=sys.stderr)
+        print(
+            f"frog-bt: site folder {folder}: using {', '.join(str(p) for p in taken)}",
+            file=sys.stderr,
+        )
     return taken

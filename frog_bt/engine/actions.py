@@ -83,8 +83,11 @@ class Actions:
         known = Response.of(code)
         if goal is None or known is None:
             self.stale_responses += 1
-            log.debug("ignored /FROG_response %d: %s", code,
-                      "nothing pending" if known is not None else "unknown code")
+            log.debug(
+                "ignored /FROG_response %d: %s",
+                code,
+                "nothing pending" if known is not None else "unknown code",
+            )
             return None
         goal = replace(goal, code=known, answered_at=at)
         self.pending = None if goal.done else goal

@@ -70,9 +70,11 @@ class Inputs:
     def __init__(self, table: dict[str, Input]) -> None:
         self.table = table
         self.latest: dict[Key[Any], Reading[Any] | None] = {
-            i.key: None for i in table.values() if i.keep is Keep.LATEST}
+            i.key: None for i in table.values() if i.keep is Keep.LATEST
+        }
         self.pending: dict[Key[Any], list[tuple[Any, Any]]] = {
-            i.key: [] for i in table.values() if i.keep is not Keep.LATEST}
+            i.key: [] for i in table.values() if i.keep is not Keep.LATEST
+        }
         self.events: list[tuple[FrontendMessage, float]] = []
 
     def add(self, inp: Input, value: Any, at: float) -> None:

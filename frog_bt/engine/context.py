@@ -29,7 +29,8 @@ class Context:
     send: Callable[[FrontendMessage], None]
     journal: Journal
 
-    def note(self, text: str, incident: IncidentKind | None = None, subject: str = ""
-             ) -> Incident | None:
+    def note(
+        self, text: str, incident: IncidentKind | None = None, subject: str = ""
+    ) -> Incident | None:
         """Record a decision and its reason in the journal (see :meth:`Journal.note`)."""
         return self.journal.note(text, incident, subject)

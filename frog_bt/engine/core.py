@@ -54,10 +54,16 @@ __all__ = ["Core", "Emit"]
 
 
 class Core:
-    def __init__(self, site: Site, tree: LoadedTree, clock: Clock,
-                 publish: Callable[[str, dict[str, Any]], None],
-                 send: Callable[[FrontendMessage], None], emit: Emit | None = None,
-                 standing: Standing | None = None) -> None:
+    def __init__(
+        self,
+        site: Site,
+        tree: LoadedTree,
+        clock: Clock,
+        publish: Callable[[str, dict[str, Any]], None],
+        send: Callable[[FrontendMessage], None],
+        emit: Emit | None = None,
+        standing: Standing | None = None,
+    ) -> None:
         self.site = site
         self.tree = tree
         self.clock = clock
@@ -111,12 +117,18 @@ class Core:
         engagement vote and its samples before ``PlayContent`` or ``FinishPoi``)."""
         node = self.trace.current()
         self.blamed = self.who(node)
-        deciders = [node, *reversed([d for d in self.trace.decided if d is not node
-                                     and _near(d, node)])] if node is not None else []
+        deciders = (
+            [node, *reversed([d for d in self.trace.decided if d is not node and _near(d, node)])]
+            if node is not None
+            else []
+        )
         reads: dict[str, str] = {}
         for decider in deciders:
-            seen = (*getattr(decider, "reads", ()), *getattr(decider, "optional_reads", ()),
-                    *(getattr(decider, "writes", ()) if decider is not node else ()))
+            seen = (
+                *getattr(decider, "reads", ()),
+                *getattr(decider, "optional_reads", ()),
+                *(getattr(decider, "writes", ()) if decider is not node else ()),
+            )
             for key in seen:  # a decider's conclusions too (the engagement decision)
                 if key is not keys.NOW and key.name not in reads:
                     reads[key.name] = _short(self.board.get(key))
@@ -175,8 +187,11 @@ class Core:
 
     def _stops_now(self) -> list[str]:
         """The stops being visited or driven to now (what a skip would leave)."""
-        return [n.params.poi for n in self.stops  # type: ignore[attr-defined]
-                if n.status is Status.RUNNING]
+        return [
+            n.params.poi
+            for n in self.stops  # type: ignore[attr-defined]
+            if n.status is Status.RUNNING
+        ]
 
     def command(self, command: Command, by: str = "") -> Answer:
         """Apply an operator command now: call it between ticks (it takes effect in the
@@ -184,8 +199,9 @@ class Core:
         now = self.clock.now()
         answer = self.operator.apply(command, now)
         if self.emit is not None:
-            self.emit(OperatorDone(now, self.ticks + 1, command.value, answer.ok, answer.text,
-                                   by=by))
+            self.emit(
+                OperatorDone(now, self.ticks + 1, command.value, answer.ok, answer.text, by=by)
+            )
         return answer
 
     # ------------------------------------------------------------ ticking

@@ -38,8 +38,9 @@ class Journal:
         self.incident_total = 0  # incidents ever recorded (the list keeps the latest)
         self.tally = Tally()  # the one count of incidents
 
-    def note(self, text: str, incident: IncidentKind | None = None, subject: str = ""
-             ) -> Incident | None:
+    def note(
+        self, text: str, incident: IncidentKind | None = None, subject: str = ""
+    ) -> Incident | None:
         """Record a decision and its reason; ``incident`` marks one a summary must list
         (returned)."""
         now = self._clock.now()
@@ -65,7 +66,7 @@ class Journal:
         still keeps): how a reader takes each once, counting with :attr:`incident_total`."""
         if seen >= self.incident_total:
             return []
-        return self.incidents[seen - self.incident_total:]
+        return self.incidents[seen - self.incident_total :]
 
     def last_incident(self) -> Incident | None:
         return self.incidents[-1] if self.incidents else None

@@ -73,8 +73,7 @@ class Observed:
         if self.scope is not None and self._board is not None:
             self._board.clear_scope(self.scope)
 
-    def stop(self, new_status: py_trees.common.Status = py_trees.common.Status.INVALID
-             ) -> None:
+    def stop(self, new_status: py_trees.common.Status = py_trees.common.Status.INVALID) -> None:
         trace = self._trace
         if trace is None:
             super().stop(new_status)  # type: ignore[misc]
@@ -94,6 +93,7 @@ def attach(root: Behaviour, log: list[Behaviour]) -> None:
     cannot report (a tree not built by the loader)."""
     for node in root.iterate():
         if not isinstance(node, Observed):
-            raise TypeError(f"{node.name}: {type(node).__name__} is not an observed frog-bt "
-                            "node type")
+            raise TypeError(
+                f"{node.name}: {type(node).__name__} is not an observed frog-bt node type"
+            )
         node.stop_log = log

@@ -53,8 +53,9 @@ class Operator:
     ``stops`` gives the stops the tree is at or driving to now (the running
     ``OperatorSkip`` nodes' POIs, innermost last)."""
 
-    def __init__(self, board: Board, standing: Standing, stops: Callable[[], Iterable[str]],
-                 pause_max: float) -> None:
+    def __init__(
+        self, board: Board, standing: Standing, stops: Callable[[], Iterable[str]], pause_max: float
+    ) -> None:
         self.board = board
         self.standing = standing  # the pause timer and the journal outlive this tree
         self.journal = standing.journal
@@ -76,16 +77,16 @@ class Operator:
         """Check ``command`` against the tour now and apply it to the board."""
         answer = self._decide(command, now)
         if answer.ok:
-            self.journal.note(f"operator: {command}: {answer.text}", IncidentKind.OPERATOR,
-                              subject=command.value)
+            self.journal.note(
+                f"operator: {command}: {answer.text}", IncidentKind.OPERATOR, subject=command.value
+            )
         return answer
 
     def _decide(self, command: Command, now: float) -> Answer:
         board = self.board
         if command is Command.HOME:
             if not self._touring():
-                return Answer(False, "no tour is running: the robot is at the dock or going "
-                                     "there")
+                return Answer(False, "no tour is running: the robot is at the dock or going there")
             if board.get(keys.HOME) is not None or board.get(keys.ABORT_REASON) is not None:
                 return Answer(False, "the tour is already ending: the robot is going home")
             board.set(keys.HOME, SENT_HOME)
@@ -106,8 +107,9 @@ class Operator:
                 return Answer(False, "no tour is running (service_off keeps the robot docked)")
             board.set(keys.PAUSED, True)
             self.standing.paused_since = now
-            return Answer(True, f"pausing at the next step (at most {self.pause_max:g} s, "
-                                "then the tour ends)")
+            return Answer(
+                True, f"pausing at the next step (at most {self.pause_max:g} s, then the tour ends)"
+            )
         if command is Command.RESUME:
             if not board.get(keys.PAUSED):
                 return Answer(False, "not paused")
@@ -117,8 +119,12 @@ class Operator:
             if not board.get(keys.IN_SERVICE):
                 return Answer(False, "already out of service")
             board.set(keys.IN_SERVICE, False)
-            return Answer(True, "out of service: this tour finishes, then no new tour starts"
-                          if self._touring() else "out of service: no new tour starts")
+            return Answer(
+                True,
+                "out of service: this tour finishes, then no new tour starts"
+                if self._touring()
+                else "out of service: no new tour starts",
+            )
         if command is Command.SERVICE_ON:
             if board.get(keys.IN_SERVICE):
                 return Answer(False, "already in service")
@@ -140,6 +146,9 @@ class Operator:
         reason = AbortReason(AbortCause.OPERATOR, f"paused longer than {self.pause_max:g} s")
         if self.board.get(keys.HOME) is None and self.board.get(keys.ABORT_REASON) is None:
             self.board.set(keys.HOME, reason)
-        self.journal.note(f"pause ran out after {self.pause_max:g} s: ending the tour",
-                          IncidentKind.OPERATOR, subject="pause")
+        self.journal.note(
+            f"pause ran out after {self.pause_max:g} s: ending the tour",
+            IncidentKind.OPERATOR,
+            subject="pause",
+        )
         return reason

@@ -39,6 +39,7 @@ Address = tuple[str, int]
 # (direction "in" | "out", datagram, clock time): a tap for recordings (CONTRACT §6).
 DatagramTap = Callable[[str, bytes, float], None]
 
+
 class AddressError(OSError):
     """The link cannot use an address: ``which`` is ``"listen"`` (cannot bind) or
     ``"peer"`` (cannot resolve the front end's host); the message says why."""
@@ -124,24 +125,27 @@ class FrontendLink:
         loop = asyncio.get_running_loop()
         try:
             transport, _ = await loop.create_datagram_endpoint(
-                lambda: _DatagramProtocol(self), local_addr=self.listen)
+                lambda: _DatagramProtocol(self), local_addr=self.listen
+            )
         except OSError as exc:
-            raise AddressError("listen", self.listen, "cannot listen there: " + _why(exc)
-                               ) from exc
+            raise AddressError("listen", self.listen, "cannot listen there: " + _why(exc)) from exc
         self._transport = transport
         try:
             host = await _resolve(loop, self.peer, transport.get_extra_info("socket").family)
         except OSError as exc:
             self.close()
-            raise AddressError("peer", self.peer, "cannot resolve the host: " + _why(exc)
-                               ) from exc
+            raise AddressError("peer", self.peer, "cannot resolve the host: " + _why(exc)) from exc
         # Compare and send by IP: datagram sources are reported as IPs, never names.
         self._endpoint.peer_host = host
         self._peer_addr = (host, self.peer[1])
         self._resender = loop.create_task(self._resend_loop(), name="frontend-resend")
         self._resender.add_done_callback(_report_crash)
-        log.info("front-end link listening on %s:%d, peer %s:%d",
-                 self.listen[0], self.listen_port, *self.peer)
+        log.info(
+            "front-end link listening on %s:%d, peer %s:%d",
+            self.listen[0],
+            self.listen_port,
+            *self.peer,
+        )
 
     def close(self) -> None:
         """Stop resending and close the socket; idempotent. Pending commands are dropped."""
@@ -226,8 +230,9 @@ class FrontendLink:
         data = self._endpoint.send(message, now)
         self._sendto(data, self._peer_addr, now)
         deadline = self._endpoint.next_deadline
-        if deadline is not None and (self._sleeping_until is None
-                                     or deadline < self._sleeping_until):
+        if deadline is not None and (
+            self._sleeping_until is None or deadline < self._sleeping_until
+        ):
             self._wakeup.set()
 
     def _sendto(self, data: bytes, addr: tuple, now: float) -> None:
@@ -282,13 +287,16 @@ class FrontendLink:
             self._sendto(received.reply, addr, now)
         if self._endpoint.stats.foreign != foreign:
             self._warnings.warn(
-                "foreign", f"dropped a datagram from {addr[0]}:{addr[1]} "
-                           f"(front end is {self._endpoint.peer_host})")
+                "foreign",
+                f"dropped a datagram from {addr[0]}:{addr[1]} "
+                f"(front end is {self._endpoint.peer_host})",
+            )
         if received.error is not None:
             size = f"{len(data)} bytes" if len(data) <= MAX_DATAGRAM else "oversized"
             self._warnings.warn(
-                "malformed", f"malformed front-end datagram ({size}) from "
-                             f"{addr[0]}:{addr[1]}: {received.error}")
+                "malformed",
+                f"malformed front-end datagram ({size}) from {addr[0]}:{addr[1]}: {received.error}",
+            )
         if received.message is not None and self.on_message is not None:
             try:
                 self.on_message(received.message)

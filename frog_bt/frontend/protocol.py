@@ -126,8 +126,9 @@ class Endpoint:
             return Received()
         if len(data) > MAX_DATAGRAM:
             self.stats.malformed += 1
-            return Received(error=DecodeError(f"datagram of {len(data)} bytes exceeds "
-                                              f"{MAX_DATAGRAM}"))
+            return Received(
+                error=DecodeError(f"datagram of {len(data)} bytes exceeds {MAX_DATAGRAM}")
+            )
         try:
             seq, message = self._decoder.decode(data)
         except DecodeError as exc:
@@ -141,15 +142,21 @@ class Endpoint:
         reply = encode_datagram("ack", seq)
         self._prune(now)
         restart = seq < self._highest and (
-            message.type in self.restart_types or (seq == 1 and seq not in self._seen))
+            message.type in self.restart_types or (seq == 1 and seq not in self._seen)
+        )
         if seq in self._seen and not restart:
             self.stats.duplicates += 1
             return Received(reply=reply)
         if restart:
             # Only a valid message may reset the numbering: garbage must not.
             self.stats.peer_restarts += 1
-            log.info("peer %s restarted: %s seq %d after seq %d; forgetting seen seqs",
-                     self.peer_host, message.type, seq, self._highest)
+            log.info(
+                "peer %s restarted: %s seq %d after seq %d; forgetting seen seqs",
+                self.peer_host,
+                message.type,
+                seq,
+                self._highest,
+            )
             self.forget_seen()
         self._seen[seq] = now
         self._highest = max(self._highest, seq)
@@ -199,8 +206,9 @@ class Endpoint:
             if p.sends >= self.max_sends:
                 del self._pending[seq]
                 self.stats.unacked += 1
-                log.warning("front end never acked %s (seq %d) after %d sends",
-                            p.message.type, seq, p.sends)
+                log.warning(
+                    "front end never acked %s (seq %d) after %d sends", p.message.type, seq, p.sends
+                )
                 continue
             p.sends += 1
             p.next_send = now + self.resend_after

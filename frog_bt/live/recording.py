@@ -92,6 +92,7 @@ PRIMER_DATAGRAMS = 16  # recent datagrams in, so that their resends stay duplica
 PRIMER_SEQS = 64  # recent seqs out, so that resends of earlier commands are not new ones
 HELD_LIMIT = 10_000  # messages held before the first /clock
 
+
 def _dumps(msg: Any) -> bytes:
     return json.dumps(msg, separators=(",", ":")).encode()
 
@@ -132,9 +133,14 @@ class Recorder:
     logged once and stops the recording; it never reaches the tick path.
     """
 
-    def __init__(self, path: Path, *, chunk_size: int = CHUNK_SIZE,
-                 flush_every: float = FLUSH_EVERY,
-                 metadata: dict[str, str] | None = None) -> None:
+    def __init__(
+        self,
+        path: Path,
+        *,
+        chunk_size: int = CHUNK_SIZE,
+        flush_every: float = FLUSH_EVERY,
+        metadata: dict[str, str] | None = None,
+    ) -> None:
         self._chunk_size = chunk_size
         self._flush_every = flush_every
         # Messages wait in _incoming until the event loop's current callback (a tick, an
@@ -157,9 +163,14 @@ class Recorder:
         self._latest_raw: dict[str, tuple[float, bytes]] = {}
         self._clock_raw: bytes | None = None
         self._handlers: dict[type, Callable[[Any], None]] = {
-            RobotInput: self._ros_in, RobotCommand: self._ros_out, Datagram: self._datagram,
-            Ticked: self._tick, Blamed: self._blame, OperatorDone: self._operator,
-            AlertChanged: self._alert}
+            RobotInput: self._ros_in,
+            RobotCommand: self._ros_out,
+            Datagram: self._datagram,
+            Ticked: self._tick,
+            Blamed: self._blame,
+            OperatorDone: self._operator,
+            AlertChanged: self._alert,
+        }
         self._frontend_in: deque[bytes] = deque(maxlen=PRIMER_DATAGRAMS)
         self._frontend_out_seqs: deque[int] = deque(maxlen=PRIMER_SEQS)
         self.messages = 0
@@ -201,8 +212,9 @@ class Recorder:
         site = host.site
         for role, topic in (*INPUTS.items(), *OUTPUTS.items()):
             self.channel(site.topic(role), topic.type)
-        self._latest_topics = frozenset(site.topic(role) for role, inp in INPUTS.items()
-                                        if inp.keep is Keep.LATEST)
+        self._latest_topics = frozenset(
+            site.topic(role) for role, inp in INPUTS.items() if inp.keep is Keep.LATEST
+        )
         if host.sim_time:
             self._clock_topic = CLOCK.name
             self.channel(CLOCK.name, CLOCK.type)
@@ -291,12 +303,18 @@ class Recorder:
         return channels.encode(channels.Tree("BehaviorTree.CPP v4", str(tree_file), xml))
 
     def _blame(self, event: Blamed) -> None:
-        self._write(BLAME, event.t, channels.encode(channels.Blame(
-            event.channel, event.node, event.reads)))
+        self._write(
+            BLAME, event.t, channels.encode(channels.Blame(event.channel, event.node, event.reads))
+        )
 
     def _operator(self, event: OperatorDone) -> None:
-        self._write(OPERATOR, event.t, channels.encode(channels.Operator(
-            event.tick, event.command, event.ok, event.text, event.id)))
+        self._write(
+            OPERATOR,
+            event.t,
+            channels.encode(
+                channels.Operator(event.tick, event.command, event.ok, event.text, event.id)
+            ),
+        )
 
     def _alert(self, event: AlertChanged) -> None:
         """An alert raised, cleared or acknowledged."""
@@ -399,15 +417,21 @@ class Recorder:
 
     def primer(self, frontend_ready: bool) -> bytes:
         """A :data:`PRIMER` message: what the executive carries from before now."""
-        return channels.encode(channels.Primer(
-            inputs=[channels.PrimerInput(topic, t, msgspec.Raw(data))
-                    for topic, (t, data) in sorted(self._latest_raw.items())],
-            frontend_ready=frontend_ready,
-            frontend_in=[d.decode("utf-8", "replace") for d in self._frontend_in],
-            frontend_out_seqs=list(self._frontend_out_seqs)))
+        return channels.encode(
+            channels.Primer(
+                inputs=[
+                    channels.PrimerInput(topic, t, msgspec.Raw(data))
+                    for topic, (t, data) in sorted(self._latest_raw.items())
+                ],
+                frontend_ready=frontend_ready,
+                frontend_in=[d.decode("utf-8", "replace") for d in self._frontend_in],
+                frontend_out_seqs=list(self._frontend_out_seqs),
+            )
+        )
 
-    def rotate(self, path: Path, metadata: dict[str, str] | None = None,
-               primer: bytes | None = None) -> None:
+    def rotate(
+        self, path: Path, metadata: dict[str, str] | None = None, primer: bytes | None = None
+    ) -> None:
         """Finish this file and go on in ``path``: it starts with the tree, the last
         /clock and ``primer`` (on :data:`PRIMER`), stamped now."""
         if self.closed:
@@ -443,8 +467,9 @@ class Recorder:
             log.error("recording to %s: %s", self.path, exc)
         self.closed = True
         if self._held:
-            log.warning("recording: %d messages before the first /clock were never stamped",
-                        len(self._held))
+            log.warning(
+                "recording: %d messages before the first /clock were never stamped", len(self._held)
+            )
             self._held = []
         if self.dropped:
             log.warning("recording: %d messages before the first /clock dropped", self.dropped)

@@ -118,11 +118,11 @@ class RecordingDir:
             self._rename_first()
         state, before = core.board.get(keys.TOUR_STATE), self._tour_state
         self._tour_state = state
-        if (self.kind == "idle" and state is TourState.STARTED
-                and before is not TourState.STARTED):
+        if self.kind == "idle" and state is TourState.STARTED and before is not TourState.STARTED:
             lead_in = self.path.name if self.path is not None else ""
-            self._rotate("tour", {"kind": "tour", "tour": str(self.number),
-                                  "lead_in": lead_in}, None)
+            self._rotate(
+                "tour", {"kind": "tour", "tour": str(self.number), "lead_in": lead_in}, None
+            )
         elif core.root.status == Status.SUCCESS:
             if self.kind == "tour":
                 self.number += 1
@@ -169,8 +169,11 @@ class RecordingDir:
             if total <= self.max_bytes:
                 return
             if current in paths:
-                log.warning("recording budget %d bytes: %s alone is over it; nothing "
-                            "older left to delete", self.max_bytes, current)
+                log.warning(
+                    "recording budget %d bytes: %s alone is over it; nothing older left to delete",
+                    self.max_bytes,
+                    current,
+                )
                 return
             for path in paths:
                 try:
@@ -180,8 +183,12 @@ class RecordingDir:
                     continue
                 total -= sizes[path]
                 self.deleted.append(path)
-                log.warning("recording budget %d bytes: deleted %s (%d bytes)",
-                            self.max_bytes, path.name, sizes[path])
+                log.warning(
+                    "recording budget %d bytes: deleted %s (%d bytes)",
+                    self.max_bytes,
+                    path.name,
+                    sizes[path],
+                )
 
     def close(self) -> None:
         if self.recorder is not None:

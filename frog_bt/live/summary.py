@@ -69,8 +69,7 @@ class TourSummary:
             self.approached.append(out.value)
 
     def _ros_in(self, event: RobotInput) -> None:
-        if (event.topic == self.site.topic("response") and event.value == SUCCEEDED
-                and self._goal):
+        if event.topic == self.site.topic("response") and event.value == SUCCEEDED and self._goal:
             self.visited.append(self._goal)
             self._goal = None
 
@@ -78,8 +77,7 @@ class TourSummary:
         if isinstance(message, StartPoi):
             self.content.append((message.poi, message.waypoint, message.part))
         elif isinstance(message, Tour) and message.state != "started":
-            self.tours.append(message.state + (f": {message.reason}" if message.reason
-                                               else ""))
+            self.tours.append(message.state + (f": {message.reason}" if message.reason else ""))
 
     def _frontend_in(self, message: FrontendMessage) -> None:
         if isinstance(message, UserPositive) and self.approached:
@@ -130,14 +128,21 @@ class TourSummary:
     def lines(self, frontend: Any = None) -> list[str]:
         """The summary, one line each; ``frontend`` (the link's stats) adds its restarts
         and the commands it never acked."""
-        played = ", ".join(f"{poi} {part}" + (f" ({wp})" if wp != poi else "")
-                           for poi, wp, part in self.content) or "none"
+        played = (
+            ", ".join(
+                f"{poi} {part}" + (f" ({wp})" if wp != poi else "")
+                for poi, wp, part in self.content
+            )
+            or "none"
+        )
         out = [
             f"route:     {' -> '.join(self.visited) or 'nowhere'}",
             f"content:   {played}",
             f"visitors:  {_visitors(self.approached, self.recruited)}",
-            *(f"{'engaged?' if i == 0 else '':<10} {about}: {d.describe()}"
-              for i, (about, d) in enumerate(self.decisions)),
+            *(
+                f"{'engaged?' if i == 0 else '':<10} {about}: {d.describe()}"
+                for i, (about, d) in enumerate(self.decisions)
+            ),
         ]
         if self.resumed:
             out.append(f"resumed:   {self.resumed}")
@@ -147,10 +152,13 @@ class TourSummary:
         if frontend is not None and frontend.unacked:
             counts["front-end commands never acked"] = frontend.unacked
         if counts:
-            out.append("problems:  " + "; ".join(f"{kind} ({n})" if n > 1 else kind
-                                                 for kind, n in counts.items()))
-            out += [f"{'':<10} {i.text}" for i in self.incidents[-MAX_LISTED:]
-                    if i.kind != "resumed"]
+            out.append(
+                "problems:  "
+                + "; ".join(f"{kind} ({n})" if n > 1 else kind for kind, n in counts.items())
+            )
+            out += [
+                f"{'':<10} {i.text}" for i in self.incidents[-MAX_LISTED:] if i.kind != "resumed"
+            ]
         out.append(f"outcome:   {self.verdict()}")
         return out
 
@@ -171,5 +179,8 @@ def _visitors(approached: list[int], recruited: list[int]) -> str:
     times = Counter(approached)
     people = [f"{pid}" + (f" ({n} times)" if n > 1 else "") for pid, n in times.items()]
     text = f"approached {_words(people)}"
-    return text + (f"; recruited {_words(list(dict.fromkeys(recruited)))}" if recruited
-                   else "; nobody recruited")
+    return text + (
+        f"; recruited {_words(list(dict.fromkeys(recruited)))}"
+        if recruited
+        else "; nobody recruited"
+    )

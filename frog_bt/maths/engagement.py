@@ -52,8 +52,10 @@ class Decision:
             return "no face data"
         verdict = "engaged" if self.engaged else "not engaged"
         tie = " (tie)" if self.tie else ""
-        return (f"{verdict}{tie}: {self.engaged_votes} of {self.votes} edge samples engaged, "
-                f"{self.stored} stored")
+        return (
+            f"{verdict}{tie}: {self.engaged_votes} of {self.votes} edge samples engaged, "
+            f"{self.stored} stored"
+        )
 
 
 def vote(levels: np.ndarray) -> tuple[int, int]:

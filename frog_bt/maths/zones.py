@@ -48,8 +48,7 @@ class Shape:
         if point_in_polygon(p, self.points):
             return 0.0
         n = len(self.points)
-        return min(_segment_distance(p, self.points[i], self.points[(i + 1) % n])
-                   for i in range(n))
+        return min(_segment_distance(p, self.points[i], self.points[(i + 1) % n]) for i in range(n))
 
     def contains(self, p: Point) -> bool:
         return self.outside_by(p) <= 0.0

@@ -41,8 +41,7 @@ class EventLog:
     def since(self, index: int) -> Iterator[Event]:
         return (e for e in self._events if e.index > index)
 
-    def first_since(self, index: int, type_: type[FrontendMessage], **fields: Any
-                    ) -> Event | None:
+    def first_since(self, index: int, type_: type[FrontendMessage], **fields: Any) -> Event | None:
         for event in self.since(index):
             msg = event.message
             if isinstance(msg, type_) and all(getattr(msg, k) == v for k, v in fields.items()):

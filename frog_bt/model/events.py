@@ -36,8 +36,19 @@ from frog_bt.model.frontend import FrontendMessage
 from frog_bt.model.goals import Goal
 from frog_bt.model.links import Links
 
-__all__ = ["AlertChanged", "Blamed", "Datagram", "Event", "FrontendIn", "FrontendOut",
-           "LinksChanged", "OperatorDone", "RobotCommand", "RobotInput", "Ticked"]
+__all__ = [
+    "AlertChanged",
+    "Blamed",
+    "Datagram",
+    "Event",
+    "FrontendIn",
+    "FrontendOut",
+    "LinksChanged",
+    "OperatorDone",
+    "RobotCommand",
+    "RobotInput",
+    "Ticked",
+]
 
 TickStatus = Literal["INVALID", "RUNNING", "SUCCESS", "FAILURE"]
 
@@ -129,5 +140,15 @@ class AlertChanged(msgspec.Struct, frozen=True, tag=True):
     alert: Alert
 
 
-Event = (RobotInput | RobotCommand | FrontendIn | FrontendOut | Datagram | Ticked | Blamed
-         | OperatorDone | LinksChanged | AlertChanged)
+Event = (
+    RobotInput
+    | RobotCommand
+    | FrontendIn
+    | FrontendOut
+    | Datagram
+    | Ticked
+    | Blamed
+    | OperatorDone
+    | LinksChanged
+    | AlertChanged
+)

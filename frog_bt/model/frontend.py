@@ -112,8 +112,18 @@ class ContentDone(FrontendMessage, frozen=True):
 
 COMMANDS: dict[str, type[FrontendMessage]] = {
     cls.type: cls
-    for cls in (StartIntroduction, AskTour, StartPoi, FinishPoi, Engagement, FollowMe, Volume,
-                SpecialContent, Projector, Tour)
+    for cls in (
+        StartIntroduction,
+        AskTour,
+        StartPoi,
+        FinishPoi,
+        Engagement,
+        FollowMe,
+        Volume,
+        SpecialContent,
+        Projector,
+        Tour,
+    )
 }
 EVENTS: dict[str, type[FrontendMessage]] = {
     cls.type: cls
@@ -138,8 +148,15 @@ class Ack(msgspec.Struct, frozen=True, tag_field="type", tag="ack"):
 
 def _datagram(cls: type[FrontendMessage]) -> type[msgspec.Struct]:
     """``cls`` as a whole datagram: its fields, ``seq``, and ``type`` as the union's tag."""
-    return msgspec.defstruct(f"{cls.__name__}Datagram", [("seq", Seq)], bases=(cls,),
-                             tag_field="type", tag=cls.type, frozen=True, kw_only=True)
+    return msgspec.defstruct(
+        f"{cls.__name__}Datagram",
+        [("seq", Seq)],
+        bases=(cls,),
+        tag_field="type",
+        tag=cls.type,
+        frozen=True,
+        kw_only=True,
+    )
 
 
 class DatagramDecoder:
@@ -161,8 +178,9 @@ class DatagramDecoder:
         return datagram.seq, cls(*(getattr(datagram, f) for f in cls.__struct_fields__))
 
 
-def decode_message(obj: dict[str, Any] | bytes,
-                   table: dict[str, type[FrontendMessage]]) -> FrontendMessage:
+def decode_message(
+    obj: dict[str, Any] | bytes, table: dict[str, type[FrontendMessage]]
+) -> FrontendMessage:
     """The typed message for a datagram (its bytes, or its JSON object) whose ``type``
     is in ``table``; other fields than the message's own are ignored."""
     type_ = obj.get("type") if isinstance(obj, dict) else decode_envelope(obj).type

@@ -34,12 +34,26 @@ from frog_bt.model.wire import (
     RESPONSES,
 )
 
-__all__ = ["ALL", "DIAGNOSTICS", "DOCKING", "FACES", "PEOPLE", "PERSONS", "POSE",
-           "RESPONSES", "Key", "Reading", "Scope", "Source", "by_name"]
+__all__ = [
+    "ALL",
+    "DIAGNOSTICS",
+    "DOCKING",
+    "FACES",
+    "PEOPLE",
+    "PERSONS",
+    "POSE",
+    "RESPONSES",
+    "Key",
+    "Reading",
+    "Scope",
+    "Source",
+    "by_name",
+]
 
 
-def _key(name: str, type_: type[T], source: Source, scope: Scope, doc: str,
-         lasting: bool = False) -> Key[T]:
+def _key(
+    name: str, type_: type[T], source: Source, scope: Scope, doc: str, lasting: bool = False
+) -> Key[T]:
     return Key(name, type_, source, scope, doc, lasting)
 
 
@@ -48,61 +62,144 @@ IN, L, E = Source.INPUT, Source.LEAF, Source.EXECUTIVE
 
 # -- written before each tick, with the inputs
 NOW = _key("/now", float, IN, Scope.PROCESS, "project-clock time of this tick (s)")
-EVENTS = _key("/events", EventLog, IN, Scope.PROCESS, "the front end's events, in order", lasting=True)
-FRONTEND_READY = _key("/frontend_ready", bool, IN, Scope.PROCESS,
-                      "a frontend_idle arrived since the last tour started or ended", lasting=True)
-GOAL = _key("/goal", Goal, IN, Scope.PROCESS,
-            "the newest goal or approach sent, with its latest /FROG_response")
+EVENTS = _key(
+    "/events", EventLog, IN, Scope.PROCESS, "the front end's events, in order", lasting=True
+)
+FRONTEND_READY = _key(
+    "/frontend_ready",
+    bool,
+    IN,
+    Scope.PROCESS,
+    "a frontend_idle arrived since the last tour started or ended",
+    lasting=True,
+)
+GOAL = _key(
+    "/goal",
+    Goal,
+    IN,
+    Scope.PROCESS,
+    "the newest goal or approach sent, with its latest /FROG_response",
+)
 
 # -- the tour's bookkeeping
-TOUR_STATE = _key("/tour_state", TourState, L, Scope.PROCESS, "the latest tour state sent", lasting=True)
-TOUR_REASON = _key("/tour_reason", str, L, Scope.PROCESS, "and its reason (with aborted)", lasting=True)
-PROGRESS = _key("/progress", Progress, L, Scope.PROCESS,
-                "checkpoints done this tour (the executive saves each new value)", lasting=True)
-RESUME = _key("/resume", Resume, E, Scope.PROCESS,
-              "what a tour resumed from a checkpoint skips (set at start-up)", lasting=True)
-RESUMED = _key("/resumed", str, L, Scope.PROCESS,
-               "how the tour was resumed, in words (resuming the tour at POI4: ...)", lasting=True)
-GAVE_UP = _key("/gave_up", Incident, L, Scope.PROCESS,
-               "why the tree gave up: the executive stops with it")
-ABORT_REASON = _key("/abort_reason", AbortReason, L, Scope.PROCESS,
-                    "why the running tour is being aborted (latched until cleared)")
-ABORT_REASON_LAST = _key("/abort_reason_last", AbortReason, L, Scope.PROCESS,
-                         "the last abort's reason, once done", lasting=True)
+TOUR_STATE = _key(
+    "/tour_state", TourState, L, Scope.PROCESS, "the latest tour state sent", lasting=True
+)
+TOUR_REASON = _key(
+    "/tour_reason", str, L, Scope.PROCESS, "and its reason (with aborted)", lasting=True
+)
+PROGRESS = _key(
+    "/progress",
+    Progress,
+    L,
+    Scope.PROCESS,
+    "checkpoints done this tour (the executive saves each new value)",
+    lasting=True,
+)
+RESUME = _key(
+    "/resume",
+    Resume,
+    E,
+    Scope.PROCESS,
+    "what a tour resumed from a checkpoint skips (set at start-up)",
+    lasting=True,
+)
+RESUMED = _key(
+    "/resumed",
+    str,
+    L,
+    Scope.PROCESS,
+    "how the tour was resumed, in words (resuming the tour at POI4: ...)",
+    lasting=True,
+)
+GAVE_UP = _key(
+    "/gave_up", Incident, L, Scope.PROCESS, "why the tree gave up: the executive stops with it"
+)
+ABORT_REASON = _key(
+    "/abort_reason",
+    AbortReason,
+    L,
+    Scope.PROCESS,
+    "why the running tour is being aborted (latched until cleared)",
+)
+ABORT_REASON_LAST = _key(
+    "/abort_reason_last",
+    AbortReason,
+    L,
+    Scope.PROCESS,
+    "the last abort's reason, once done",
+    lasting=True,
+)
 
-ICL = _key("/icl", bool, L, Scope.PROCESS,
-           "the face data stream is on (its scope's own: no other scope clears it)")
+ICL = _key(
+    "/icl",
+    bool,
+    L,
+    Scope.PROCESS,
+    "the face data stream is on (its scope's own: no other scope clears it)",
+)
 
 # -- the operator's requests (written between ticks from the console or frog-bt ctl)
-HOME = _key("/home", AbortReason, E, Scope.TOUR,
-            "an operator asked the robot home: end the tour politely and dock")
-SKIP = _key("/skip", int, E, Scope.TOUR,
-            "skip requests this tour: a stop seeing the count grow is left for the next")
-PAUSED = _key("/paused", bool, E, Scope.PROCESS,
-              "an operator paused the tour: no new drive, no new content", lasting=True)
-IN_SERVICE = _key("/in_service", bool, E, Scope.PROCESS,
-                  "the robot may start tours (false: finish this one, then stay docked)", lasting=True)
+HOME = _key(
+    "/home",
+    AbortReason,
+    E,
+    Scope.TOUR,
+    "an operator asked the robot home: end the tour politely and dock",
+)
+SKIP = _key(
+    "/skip",
+    int,
+    E,
+    Scope.TOUR,
+    "skip requests this tour: a stop seeing the count grow is left for the next",
+)
+PAUSED = _key(
+    "/paused",
+    bool,
+    E,
+    Scope.PROCESS,
+    "an operator paused the tour: no new drive, no new content",
+    lasting=True,
+)
+IN_SERVICE = _key(
+    "/in_service",
+    bool,
+    E,
+    Scope.PROCESS,
+    "the robot may start tours (false: finish this one, then stay docked)",
+    lasting=True,
+)
 
 # -- one tour
 DECLINED = _key("/declined", frozenset, L, Scope.TOUR, "visitor ids who said no this tour")
-APPROACH_FAILED = _key("/approach_failed", dict, L, Scope.TOUR,
-                       "visitor id -> project time an approach of them failed")
-SPECIAL_DONE = _key("/special_done", frozenset, L, Scope.TOUR,
-                    "special-content spots announced this tour")
+APPROACH_FAILED = _key(
+    "/approach_failed", dict, L, Scope.TOUR, "visitor id -> project time an approach of them failed"
+)
+SPECIAL_DONE = _key(
+    "/special_done", frozenset, L, Scope.TOUR, "special-content spots announced this tour"
+)
 VISITOR = _key("/visitor", int, L, Scope.TOUR, "the tracked id of the visitor being guided")
 TARGET = _key("/target", str, L, Scope.TOUR, "the logical POI being driven to")
 WAYPOINT = _key("/waypoint", str, L, Scope.TOUR, "its time-of-day variant (POI1b)")
 
 # -- one stop (and the introduction: a recruitment clears them too)
-ENGAGEMENT = _key("/engagement", Samples, L, Scope.STOP,
-                  "the face stream's engagement samples")
-ENGAGEMENT_METER = _key("/engagement_meter", float, L, Scope.STOP,
-                        "the latest engagement meter level (null: an empty window)")
-ENGAGED = _key("/engaged", bool, L, Scope.STOP,
-               "the engagement decision (None: no face data)")
+ENGAGEMENT = _key("/engagement", Samples, L, Scope.STOP, "the face stream's engagement samples")
+ENGAGEMENT_METER = _key(
+    "/engagement_meter",
+    float,
+    L,
+    Scope.STOP,
+    "the latest engagement meter level (null: an empty window)",
+)
+ENGAGED = _key("/engaged", bool, L, Scope.STOP, "the engagement decision (None: no face data)")
 ENGAGEMENT_DECISION: Key[tuple[str, Decision]] = Key(
-    "/engagement_decision", tuple[str, Decision], L, Scope.STOP,
-    "(about, decision): the vote behind /engaged")
+    "/engagement_decision",
+    tuple[str, Decision],
+    L,
+    Scope.STOP,
+    "(about, decision): the vote behind /engaged",
+)
 SKIPPED = _key("/skipped", str, L, Scope.STOP, "the stop being skipped, if any")
 
 # Every key declared above, by name (the tour's own and the wire table's inputs).

@@ -47,11 +47,17 @@ class LinkStatus(enum.StrEnum):
 
 
 _HEALTH = {
-    LinkStatus.CONNECTED: Health.OK, LinkStatus.ACKING: Health.OK, LinkStatus.WALL: Health.OK,
-    LinkStatus.SIM: Health.OK, LinkStatus.CONNECTING: Health.WAIT,
-    LinkStatus.RECONNECTING: Health.WAIT, LinkStatus.NOT_HEARD: Health.WAIT,
-    LinkStatus.SILENT: Health.BAD, LinkStatus.WAITING: Health.BAD,
-    LinkStatus.CLOSED: Health.OFF}
+    LinkStatus.CONNECTED: Health.OK,
+    LinkStatus.ACKING: Health.OK,
+    LinkStatus.WALL: Health.OK,
+    LinkStatus.SIM: Health.OK,
+    LinkStatus.CONNECTING: Health.WAIT,
+    LinkStatus.RECONNECTING: Health.WAIT,
+    LinkStatus.NOT_HEARD: Health.WAIT,
+    LinkStatus.SILENT: Health.BAD,
+    LinkStatus.WAITING: Health.BAD,
+    LinkStatus.CLOSED: Health.OFF,
+}
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,13 +67,11 @@ class Links:
     clock: LinkStatus
 
     def items(self) -> tuple[tuple[str, LinkStatus], ...]:
-        return (("rosbridge", self.rosbridge), ("frontend", self.frontend),
-                ("clock", self.clock))
+        return (("rosbridge", self.rosbridge), ("frontend", self.frontend), ("clock", self.clock))
 
     def text(self) -> str:
         """``rosbridge connected, front end silent, clock /clock``."""
-        return (f"rosbridge {self.rosbridge}, front end {self.frontend}, "
-                f"clock {self.clock}")
+        return f"rosbridge {self.rosbridge}, front end {self.frontend}, clock {self.clock}"
 
 
 def changed(seen: dict[str, LinkStatus], links: Links) -> list[tuple[str, LinkStatus]]:
@@ -85,12 +89,16 @@ def rosbridge_state(link: Any, was_connected: bool) -> LinkStatus:
     return LinkStatus.RECONNECTING if was_connected else LinkStatus.CONNECTING
 
 
-def frontend_state(oldest_pending: float | None, last_heard: float | None, now: float
-                   ) -> LinkStatus:
+def frontend_state(
+    oldest_pending: float | None, last_heard: float | None, now: float
+) -> LinkStatus:
     """``silent`` when a command has waited more than :data:`SILENT_AFTER` for its ack
     and nothing came from the front end since it was sent."""
-    if (oldest_pending is not None and now - oldest_pending > SILENT_AFTER
-            and (last_heard is None or last_heard < oldest_pending)):
+    if (
+        oldest_pending is not None
+        and now - oldest_pending > SILENT_AFTER
+        and (last_heard is None or last_heard < oldest_pending)
+    ):
         return LinkStatus.SILENT
     return LinkStatus.ACKING if last_heard is not None else LinkStatus.NOT_HEARD
 
@@ -106,7 +114,8 @@ def states(executive: Any) -> tuple[LinkStatus, LinkStatus, LinkStatus]:
     clock = executive.clock
     link = executive.link
     ready = bool(clock.ready)
-    return (rosbridge_state(executive.client.link, executive.was_connected),
-            frontend_state(link.oldest_pending, link.last_heard, clock.now() if ready else 0.0),
-            clock_state(executive.sim_time, ready))
-
+    return (
+        rosbridge_state(executive.client.link, executive.was_connected),
+        frontend_state(link.oldest_pending, link.last_heard, clock.now() if ready else 0.0),
+        clock_state(executive.sim_time, ready),
+    )

@@ -54,9 +54,12 @@ class IncidentKind(enum.StrEnum):
         return _LEVELS.get(self, Level.WARN)
 
 
-_LEVELS = {IncidentKind.RESUMED: Level.INFO, IncidentKind.OPERATOR: Level.INFO,
-           IncidentKind.STOP_LEFT: Level.INFO,
-           IncidentKind.GAVE_UP: Level.ERROR}
+_LEVELS = {
+    IncidentKind.RESUMED: Level.INFO,
+    IncidentKind.OPERATOR: Level.INFO,
+    IncidentKind.STOP_LEFT: Level.INFO,
+    IncidentKind.GAVE_UP: Level.ERROR,
+}
 
 
 class AbortCause(enum.StrEnum):

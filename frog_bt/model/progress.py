@@ -36,8 +36,12 @@ class Progress:
         return Progress(done, self.visitor if visitor is None else visitor)
 
     def to_json(self, written: float) -> dict[str, object]:
-        return {"version": VERSION, "done": list(self.done), "visitor": self.visitor,
-                "written": written}
+        return {
+            "version": VERSION,
+            "done": list(self.done),
+            "visitor": self.visitor,
+            "written": written,
+        }
 
 
 EMPTY = Progress()
@@ -69,8 +73,11 @@ class Resume:
         done_stops = [int(n.split()[1]) for n in self.order if re.fullmatch(r"stop \d+", n)]
         if done_stops:
             following = max(done_stops) + 1
-            return (f"at {stops[following]}" if following < len(stops)
-                    else "on the way back to the dock")
+            return (
+                f"at {stops[following]}"
+                if following < len(stops)
+                else "on the way back to the dock"
+            )
         if "recruit" in self.order:
             return f"at {stops[0]}" if stops else "after recruiting"
         return "at the recruitment"

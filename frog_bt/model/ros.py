@@ -206,8 +206,10 @@ class PoseStamped(msgspec.Struct, frozen=True, kw_only=True):
 
     @classmethod
     def of(cls, pose: Pose) -> PoseStamped:
-        return cls(header=header(pose.stamp, pose.frame_id),
-                   pose=PoseBody(Point(pose.x, pose.y), Quaternion(z=pose.qz, w=pose.qw)))
+        return cls(
+            header=header(pose.stamp, pose.frame_id),
+            pose=PoseBody(Point(pose.x, pose.y), Quaternion(z=pose.qz, w=pose.qw)),
+        )
 
 
 class Int32Msg(msgspec.Struct, frozen=True):
@@ -244,8 +246,7 @@ class DiagnosticArray(msgspec.Struct, frozen=True, kw_only=True):
         faults: list[str] = []
         for i, status in enumerate(self.status):
             if status.level >= 2:
-                faults.append(f"{status.name}: {status.message}" if status.message
-                              else status.name)
+                faults.append(f"{status.name}: {status.message}" if status.message else status.name)
             if status.name == "battery":
                 for j, kv in enumerate(status.values):
                     if kv.key == "percentage":
@@ -358,4 +359,5 @@ PEOPLE: RosType[TrackedPeople] = RosType(TrackedPeopleMsg)
 CLOCK: RosType[float] = RosType(ClockMsg)
 
 ROS_TYPES: dict[str, RosType[Any]] = {
-    t.name: t for t in (POSE, INT32, STRING, DIAGNOSTICS, PERSONS, FACES, PEOPLE, CLOCK)}
+    t.name: t for t in (POSE, INT32, STRING, DIAGNOSTICS, PERSONS, FACES, PEOPLE, CLOCK)
+}

@@ -35,8 +35,7 @@ from frog_bt.model.ros import (
     TrackedPeople,
 )
 
-__all__ = ["CLOCK", "COMMANDS", "EVENTS", "INPUTS", "OUTPUTS", "Input", "Keep", "Response",
-           "Topic"]
+__all__ = ["CLOCK", "COMMANDS", "EVENTS", "INPUTS", "OUTPUTS", "Input", "Keep", "Response", "Topic"]
 
 
 class Keep(enum.Enum):
@@ -75,15 +74,23 @@ class Input(Topic):
 
 # The inputs' keys: a Reading (value, time received), or None before any message.
 POSE = input_key("/pose", Reading[Pose], "the robot's pose in the map frame")
-RESPONSES = input_key("/responses", tuple[tuple[int, float], ...],
-                      "/FROG_response codes received since the last tick: (code, t)")
-DOCKING = input_key("/docking", Reading[str], "the docking state (a DockingState word: docked, undocking, ...)")
-DIAGNOSTICS = input_key("/diagnostics", Reading[Diagnostics],
-                        "battery level and electronics faults")
-PERSONS = input_key("/persons", Reading[PersonDetections],
-                    "people the camera sees, with their orientation")
-FACES = input_key("/faces", tuple[tuple[float, Face], ...],
-                  "face samples received since the last tick: (t, face)")
+RESPONSES = input_key(
+    "/responses",
+    tuple[tuple[int, float], ...],
+    "/FROG_response codes received since the last tick: (code, t)",
+)
+DOCKING = input_key(
+    "/docking", Reading[str], "the docking state (a DockingState word: docked, undocking, ...)"
+)
+DIAGNOSTICS = input_key(
+    "/diagnostics", Reading[Diagnostics], "battery level and electronics faults"
+)
+PERSONS = input_key(
+    "/persons", Reading[PersonDetections], "people the camera sees, with their orientation"
+)
+FACES = input_key(
+    "/faces", tuple[tuple[float, Face], ...], "face samples received since the last tick: (t, face)"
+)
 PEOPLE = input_key("/people", Reading[TrackedPeople], "people the laser tracks")
 
 # role -> input; roles are what the code and site.yaml refer to.
@@ -93,8 +100,14 @@ INPUTS: dict[str, Input] = {
     "docking_state": Input("/docking/state", msgs.STRING, DOCKING),
     "diagnostic": Input("/diagnostic", msgs.DIAGNOSTICS, DIAGNOSTICS),
     "persons": Input("/UvA_PersonDetectionAndPose", msgs.PERSONS, PERSONS),
-    "faces": Input("/ICL_FaceDataStream", msgs.FACES, FACES, Keep.SAMPLES, tick=False,
-                   items=lambda data: data.faces),
+    "faces": Input(
+        "/ICL_FaceDataStream",
+        msgs.FACES,
+        FACES,
+        Keep.SAMPLES,
+        tick=False,
+        items=lambda data: data.faces,
+    ),
     "people": Input("/PeopleUPO", msgs.PEOPLE, PEOPLE, tick=False),
 }
 CLOCK = Topic("/clock", msgs.CLOCK)  # sim time only; sets the clock, not the blackboard
@@ -104,6 +117,7 @@ OUTPUTS: dict[str, Topic] = {
     "icl": Topic("/ICL_command", msgs.STRING),
     "dock": Topic("/docking/dock", msgs.STRING),
 }
+
 
 class Response(enum.IntEnum):
     """``/FROG_response`` codes (CONTRACT §1); ``word`` is the name people read."""

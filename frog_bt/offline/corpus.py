@@ -48,9 +48,11 @@ class TourRow:
             return f"{self.file}: identical"
         if self.status == "unreadable":
             return f"{self.file}: unreadable: {self.reason}"
-        return (f"{self.file}: diverged at +{self.at:.1f} s, command {self.number}: "
-                f"{self.differs} (recorded: {self.recorded_node or '?'}; replayed: "
-                f"{self.replayed_node or '?'})")
+        return (
+            f"{self.file}: diverged at +{self.at:.1f} s, command {self.number}: "
+            f"{self.differs} (recorded: {self.recorded_node or '?'}; replayed: "
+            f"{self.replayed_node or '?'})"
+        )
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -87,18 +89,31 @@ def replay_file(path: str, tree: str | None, site: Site) -> TourRow:
     recorded = div.expected.node if div.expected else ""
     replayed = div.got.node if div.got else ""
     node = (replayed or recorded or "?").split(" (")[0]
-    return TourRow(path, "diverged", at=div.t - result.start, number=div.number,
-                   differs=diff, recorded_node=recorded, replayed_node=replayed,
-                   signature=f"{node}: {what_differs(div.expected, div.got, site)}",
-                   recovered=recovered, **bad)
+    return TourRow(
+        path,
+        "diverged",
+        at=div.t - result.start,
+        number=div.number,
+        differs=diff,
+        recorded_node=recorded,
+        replayed_node=replayed,
+        signature=f"{node}: {what_differs(div.expected, div.got, site)}",
+        recovered=recovered,
+        **bad,
+    )
 
 
-def replay_corpus(files: list[Path], tree: Path | None, site: Site,
-                  executor: Executor, progress: Callable[[int, int], None] | None = None
-                  ) -> Iterator[TourRow]:
+def replay_corpus(
+    files: list[Path],
+    tree: Path | None,
+    site: Site,
+    executor: Executor,
+    progress: Callable[[int, int], None] | None = None,
+) -> Iterator[TourRow]:
     """One row per recording, in order, replayed through ``executor``."""
-    futures = [executor.submit(replay_file, str(f), str(tree) if tree else None, site)
-               for f in files]
+    futures = [
+        executor.submit(replay_file, str(f), str(tree) if tree else None, site) for f in files
+    ]
     for done, future in enumerate(futures, 1):
         row = future.result()
         if progress is not None:
@@ -109,11 +124,14 @@ def replay_corpus(files: list[Path], tree: Path | None, site: Site,
 def summary(rows: list[TourRow]) -> dict[str, Any]:
     diverged = [r for r in rows if r.status == "diverged"]
     groups = Counter(r.signature for r in diverged)
-    return {"tours": len(rows), "identical": sum(r.status == "identical" for r in rows),
-            "diverged": len(diverged),
-            "unreadable": sum(r.status == "unreadable" for r in rows),
-            "recovered": sum(bool(r.recovered) for r in rows),
-            "by_signature": dict(groups.most_common())}
+    return {
+        "tours": len(rows),
+        "identical": sum(r.status == "identical" for r in rows),
+        "diverged": len(diverged),
+        "unreadable": sum(r.status == "unreadable" for r in rows),
+        "recovered": sum(bool(r.recovered) for r in rows),
+        "by_signature": dict(groups.most_common()),
+    }
 
 
 def summary_line(s: dict[str, Any]) -> str:

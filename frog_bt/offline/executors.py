@@ -18,16 +18,18 @@ class ExecutorError(FrogError):
 
 
 @contextlib.contextmanager
-def executor(jobs: int, scheduler: str | None = None, *,
-             connect_timeout: float = 10.0) -> Iterator[Executor]:
+def executor(
+    jobs: int, scheduler: str | None = None, *, connect_timeout: float = 10.0
+) -> Iterator[Executor]:
     """Processes (forked where the platform allows: workers start with the modules
     already imported), or a dask.distributed client's executor."""
     if scheduler is not None:
         try:
             from distributed import Client
         except ImportError:
-            raise ExecutorError("--scheduler needs dask.distributed: "
-                                "pip install 'frog-bt[fleet]'") from None
+            raise ExecutorError(
+                "--scheduler needs dask.distributed: pip install 'frog-bt[fleet]'"
+            ) from None
         try:
             client = Client(scheduler, timeout=connect_timeout)
         except (OSError, TimeoutError) as exc:

@@ -137,8 +137,10 @@ class Replay:
         self.outputs = {site.topic(role) for role in OUTPUTS}
         missing = sorted({FRONTEND_IN, FRONTEND_OUT, *self.outputs} - set(self.types))
         if missing:
-            raise ReplayError(f"{self.path}: not a frog-bt recording for this configuration: "
-                              f"no channel {', '.join(missing)}")
+            raise ReplayError(
+                f"{self.path}: not a frog-bt recording for this configuration: "
+                f"no channel {', '.join(missing)}"
+            )
         self.start = from_ns(self.files[0].start)
         self.end = from_ns(self.files[-1].end)
         self.sim_time = CLOCK.name in self.types
@@ -146,8 +148,9 @@ class Replay:
         self.period = 1.0 / site.executive.tick_hz
         self.clock = ManualClock(None)
         self.observers = Observers()  # attach with attach_all(replay, [...]) before run()
-        self.core = Core(site, tree, self.clock, self._publish, self._send,
-                         emit=self.observers.emit)
+        self.core = Core(
+            site, tree, self.clock, self._publish, self._send, emit=self.observers.emit
+        )
         self.reader = Reader(site)  # the one decoder; its tally counts the bad messages
         self.endpoint = Endpoint(self._peer, EVENTS)  # the same dedup as the live link
         self._expected: deque[Command] = deque()
@@ -159,20 +162,31 @@ class Replay:
         self._seqs: set[int] = set()
         self._compared = 0
         self._next_tick = 0.0
-        self.result = ReplayResult(self.start, self.end, self.start, exact=self.exact,
-                                   recovered=self.recovered)
+        self.result = ReplayResult(
+            self.start, self.end, self.start, exact=self.exact, recovered=self.recovered
+        )
 
     # ------------------------------------------------------------ outputs of the replayed tree
 
     def _publish(self, topic: str, msg: dict[str, Any]) -> None:
-        self._got.append(Command(self.clock.now(), topic, without_stamp(plain(msg)),
-                                 self.core.blamed, self.core.blamed_reads))
+        self._got.append(
+            Command(
+                self.clock.now(),
+                topic,
+                without_stamp(plain(msg)),
+                self.core.blamed,
+                self.core.blamed_reads,
+            )
+        )
         self._compare()
 
     def _send(self, message: FrontendMessage) -> None:
         payload = plain({"type": message.type, **message_fields(message)})
-        self._got.append(Command(self.clock.now(), FRONTEND_OUT, payload, self.core.blamed,
-                                 self.core.blamed_reads))
+        self._got.append(
+            Command(
+                self.clock.now(), FRONTEND_OUT, payload, self.core.blamed, self.core.blamed_reads
+            )
+        )
         self._compare()
 
     def _compare(self) -> None:
@@ -252,8 +266,7 @@ class Replay:
 
     def _on_ros(self, record: RobotInput) -> None:
         self.result.inputs += 1
-        if self.core.on_ros(record.topic, record.value) and not self.exact \
-                and self.clock.ready:
+        if self.core.on_ros(record.topic, record.value) and not self.exact and self.clock.ready:
             self._tick()
 
     def _on_datagram(self, data: bytes) -> None:
@@ -272,8 +285,11 @@ class Replay:
         self._seqs.add(record.seq)
         self.result.frontend_commands += 1
         message = record.message
-        self._expect(Command(record.t, FRONTEND_OUT,
-                             plain({"type": message.type, **message_fields(message)})))
+        self._expect(
+            Command(
+                record.t, FRONTEND_OUT, plain({"type": message.type, **message_fields(message)})
+            )
+        )
 
     def _expect(self, command: Command) -> None:
         self._last_expected = command
@@ -302,8 +318,9 @@ class Replay:
         last = self._last_expected
         if last is None:
             return
-        if blame.channel == last.channel or (last.channel == FRONTEND_OUT
-                                             and last.payload.get("type") == blame.channel):
+        if blame.channel == last.channel or (
+            last.channel == FRONTEND_OUT and last.payload.get("type") == blame.channel
+        ):
             last.node = blame.node
             last.reads = dict(blame.reads)
 
@@ -317,11 +334,17 @@ class Replay:
             return
         self.result.operator_commands += 1
         answer = self.core.command(command)
-        self._last_expected = Command(t, OPERATOR, {"command": recorded.command,
-                                                   "ok": recorded.ok, "did": recorded.text})
+        self._last_expected = Command(
+            t, OPERATOR, {"command": recorded.command, "ok": recorded.ok, "did": recorded.text}
+        )
         self._expected.append(self._last_expected)
-        self._got.append(Command(self.clock.now(), OPERATOR, {
-            "command": command.value, "ok": answer.ok, "did": answer.text}))
+        self._got.append(
+            Command(
+                self.clock.now(),
+                OPERATOR,
+                {"command": command.value, "ok": answer.ok, "did": answer.text},
+            )
+        )
         self._compare()
 
     # ------------------------------------------------------------ time and ticks
@@ -365,8 +388,9 @@ class Replay:
 def _datagram_in(record: Record) -> bytes | None:
     """The datagram from the front end a record is (an event, an ack, or one that did not
     decode); None for any other record."""
-    if isinstance(record, FrontendIn) or (isinstance(record, FrontendAck)
-                                          and record.direction == "in"):
+    if isinstance(record, FrontendIn) or (
+        isinstance(record, FrontendAck) and record.direction == "in"
+    ):
         return record.raw
     if isinstance(record, Bad) and record.channel == FRONTEND_IN:
         return record.raw

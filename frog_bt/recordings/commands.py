@@ -48,8 +48,10 @@ def chain(path: Path) -> list[RecordingFile]:
         return [recording]
     before = Path(path).parent / lead_in
     if not before.is_file():
-        raise ReplayError(f"{path}: continues {lead_in}, which is gone (deleted by the "
-                          "recording budget?); it cannot be replayed without it")
+        raise ReplayError(
+            f"{path}: continues {lead_in}, which is gone (deleted by the "
+            "recording budget?); it cannot be replayed without it"
+        )
     return [open_recording(before), recording]
 
 
@@ -103,8 +105,11 @@ def differences(expected: Command | None, got: Command | None, site: Site) -> st
     (a, fa), (b, fb) = _fields(expected, site), _fields(got, site)
     if a != b:
         return f"{describe(expected, site)} → {describe(got, site)}"
-    changed = [f"{k} {_short_value(fa.get(k))} → {_short_value(fb.get(k))}"
-               for k in sorted(set(fa) | set(fb)) if fa.get(k) != fb.get(k)]
+    changed = [
+        f"{k} {_short_value(fa.get(k))} → {_short_value(fb.get(k))}"
+        for k in sorted(set(fa) | set(fb))
+        if fa.get(k) != fb.get(k)
+    ]
     return "; ".join(changed) or "the same fields (at another time)"
 
 

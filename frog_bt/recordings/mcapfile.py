@@ -28,8 +28,16 @@ from mcap.stream_reader import StreamReader
 from frog_bt.errors import FrogError
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
-READ_ERRORS = (McapError, ValueError, EOFError, OSError, IndexError, struct.error, KeyError,
-               RuntimeError)  # what a damaged file makes the mcap reader raise
+READ_ERRORS = (
+    McapError,
+    ValueError,
+    EOFError,
+    OSError,
+    IndexError,
+    struct.error,
+    KeyError,
+    RuntimeError,
+)  # what a damaged file makes the mcap reader raise
 
 
 class RecordingError(FrogError):
@@ -106,12 +114,19 @@ def _summarised(path: Path, stream: IO[bytes]) -> RecordingFile | None:
     except READ_ERRORS:
         return None
     schemas = summary.schemas
-    types = {ch.topic: schemas[ch.schema_id].name if ch.schema_id in schemas else ""
-             for ch in summary.channels.values()}
+    types = {
+        ch.topic: schemas[ch.schema_id].name if ch.schema_id in schemas else ""
+        for ch in summary.channels.values()
+    }
     stats = summary.statistics
-    return RecordingFile(path, types, stats.message_start_time if stats else 0,
-                         stats.message_end_time if stats else 0, metadata,
-                         ours=header.library.startswith("frog-bt"))
+    return RecordingFile(
+        path,
+        types,
+        stats.message_start_time if stats else 0,
+        stats.message_end_time if stats else 0,
+        metadata,
+        ours=header.library.startswith("frog-bt"),
+    )
 
 
 def _recover(path: Path) -> RecordingFile:
@@ -145,6 +160,13 @@ def _recover(path: Path) -> RecordingFile:
     if not types:
         raise RecordingError(f"{path}: damaged MCAP file, nothing readable in it")
     seconds = (end - start) / 1e9 if count else 0.0
-    return RecordingFile(path, types, start, end, metadata, ours=ours, messages_read=count,
-                         recovered=f"cut short (no summary or footer): recovered {count} "
-                                   f"messages, {seconds:.1f} s")
+    return RecordingFile(
+        path,
+        types,
+        start,
+        end,
+        metadata,
+        ours=ours,
+        messages_read=count,
+        recovered=f"cut short (no summary or footer): recovered {count} messages, {seconds:.1f} s",
+    )

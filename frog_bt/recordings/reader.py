@@ -62,17 +62,30 @@ from frog_bt.model.ros import (
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.recordings.mcapfile import READ_ERRORS, RecordingFile
 
-__all__ = ["BAD_KEPT", "CLOCK_ROLE", "Bad", "FrontendAck", "FrontendIn", "FrontendOut",
-           "Own", "OwnMessage", "Primed", "Reader", "Record", "RobotCommand", "RobotInput",
-           "RosValue", "Tally"]
+__all__ = [
+    "BAD_KEPT",
+    "CLOCK_ROLE",
+    "Bad",
+    "FrontendAck",
+    "FrontendIn",
+    "FrontendOut",
+    "Own",
+    "OwnMessage",
+    "Primed",
+    "Reader",
+    "Record",
+    "RobotCommand",
+    "RobotInput",
+    "RosValue",
+    "Tally",
+]
 
 BAD_KEPT = 20  # bad messages whose reasons a tally keeps (all are counted)
 CLOCK_ROLE = "clock"  # the role of /clock among the inputs (sim time only)
 
 RosValue = Pose | Diagnostics | PersonDetections | FaceData | TrackedPeople | int | float | str
 """What a wire Struct's ``value()`` gives: what the leaves see."""
-OwnMessage = (channels.Tick | channels.Blame | channels.Tree | channels.Operator
-              | channels.Alert)
+OwnMessage = channels.Tick | channels.Blame | channels.Tree | channels.Operator | channels.Alert
 
 # Errors a message can make decoding raise (DecodeError from the Structs; the others
 # from a value() that computes on what it decoded): a bad message, not a crash.
@@ -203,15 +216,17 @@ class Reader:
     all by default. :attr:`tally` counts bad and unread messages over every file read.
     """
 
-    def __init__(self, site: Site, *, only: Collection[str] | None = None,
-                 keep: int = BAD_KEPT) -> None:
+    def __init__(
+        self, site: Site, *, only: Collection[str] | None = None, keep: int = BAD_KEPT
+    ) -> None:
         self.only = None if only is None else frozenset(only)
         self.tally = Tally(keep)
         self._inputs = {site.topic(role): role for role in INPUTS}
         self._inputs[CLOCK.name] = CLOCK_ROLE
         self._outputs = {site.topic(role): role for role in OUTPUTS}
         self._codecs: dict[str, RosType[Any]] = {
-            role: topic.codec for role, topic in (*INPUTS.items(), *OUTPUTS.items())}
+            role: topic.codec for role, topic in (*INPUTS.items(), *OUTPUTS.items())
+        }
         self._codecs[CLOCK_ROLE] = CLOCK.codec
 
     def read_all(self, recordings: Iterable[RecordingFile]) -> Iterator[Record]:
@@ -283,8 +298,9 @@ class Reader:
             return lambda t, data: Own(t, topic, channels.decode(topic, data))
         return None
 
-    def _ros(self, topic: str, schema: str, role: str, make: type[RobotInput | RobotCommand]
-             ) -> Decode:
+    def _ros(
+        self, topic: str, schema: str, role: str, make: type[RobotInput | RobotCommand]
+    ) -> Decode:
         """A robot topic's decoder: its role's RosType (what the executive decoded it
         with live); a channel whose schema names another ROS type is all bad."""
         codec = self._codecs[role]
@@ -323,8 +339,9 @@ class Reader:
                 continue  # not an input of this site's table: nothing to prime
             raw = bytes(entry.msg)
             try:
-                inputs.append(RobotInput(entry.t, entry.topic, role,
-                                         self._codecs[role].decode(raw), raw))
+                inputs.append(
+                    RobotInput(entry.t, entry.topic, role, self._codecs[role].decode(raw), raw)
+                )
             except _DECODE_ERRORS as exc:
                 bad.append(Bad(t, PRIMER, f"inputs[{i}] ({entry.topic}): {_reason(exc)}", raw))
         return Primed(t, primer, tuple(inputs), tuple(bad))
@@ -332,14 +349,14 @@ class Reader:
 
 def _frontend_in(t: float, data: bytes) -> FrontendIn | FrontendAck:
     seq, message = _EVENTS.decode(data)
-    return FrontendAck(t, "in", seq, data) if message is None else FrontendIn(t, seq, message,
-                                                                              data)
+    return FrontendAck(t, "in", seq, data) if message is None else FrontendIn(t, seq, message, data)
 
 
 def _frontend_out(t: float, data: bytes) -> FrontendOut | FrontendAck:
     seq, message = _COMMANDS.decode(data)
-    return FrontendAck(t, "out", seq, data) if message is None else FrontendOut(t, seq,
-                                                                                message, data)
+    return (
+        FrontendAck(t, "out", seq, data) if message is None else FrontendOut(t, seq, message, data)
+    )
 
 
 def _reason(exc: Exception) -> str:

@@ -94,8 +94,9 @@ class RosbridgeClient:
         if queue_limit < 1:
             raise ValueError(f"queue_limit must be >= 1, got {queue_limit}")
         if not 0 < backoff_initial <= backoff_max:
-            raise ValueError(f"need 0 < backoff_initial <= backoff_max, got "
-                             f"{backoff_initial}, {backoff_max}")
+            raise ValueError(
+                f"need 0 < backoff_initial <= backoff_max, got {backoff_initial}, {backoff_max}"
+            )
         self.url = url
         self.backoff_initial = backoff_initial
         self.backoff_max = backoff_max
@@ -138,8 +139,9 @@ class RosbridgeClient:
     def unadvertise(self, topic: str) -> None:
         self._enqueue(self.session.unadvertise(topic))
 
-    def subscribe(self, topic: str, type: str, throttle_rate: int = 0,
-                  queue_length: int = 0) -> None:
+    def subscribe(
+        self, topic: str, type: str, throttle_rate: int = 0, queue_length: int = 0
+    ) -> None:
         """Subscribe; messages arrive decoded by ``ROS_TYPES[type]``.
 
         Raises ValueError for a type with no decoder (a programming error).
@@ -167,7 +169,8 @@ class RosbridgeClient:
         """Run the connect loop in a task (idempotent); returns the task."""
         if self._run_task is None:
             self._run_task = asyncio.get_running_loop().create_task(
-                self.run(), name=f"rosbridge {self.url}")
+                self.run(), name=f"rosbridge {self.url}"
+            )
         return self._run_task
 
     async def run(self) -> None:
@@ -239,8 +242,9 @@ class RosbridgeClient:
             up_at: float | None = None
             delay = 0.0
             try:
-                async with connect(self.url, proxy=None, max_size=_MAX_WS_MESSAGE,
-                                   open_timeout=10, close_timeout=2) as ws:
+                async with connect(
+                    self.url, proxy=None, max_size=_MAX_WS_MESSAGE, open_timeout=10, close_timeout=2
+                ) as ws:
                     up_at = time.monotonic()
                     self._on_up(ws)
                     error = await self._serve(ws)
@@ -258,7 +262,8 @@ class RosbridgeClient:
                 self._ws = None
                 # A connection worked if the server said anything on it, or if it stayed up.
                 stable = up_at is not None and (
-                    self._heard > 0 or time.monotonic() - up_at >= self.stable_after)
+                    self._heard > 0 or time.monotonic() - up_at >= self.stable_after
+                )
                 if stable:
                     delays = backoff_delays(self.backoff_initial, self.backoff_max)  # reset
                     attempt = 1
@@ -266,8 +271,12 @@ class RosbridgeClient:
                     attempt += 1
                 delay = next(delays)
                 # A server refuses an auth by closing at once, having sent nothing.
-                refused = (up_at is not None and not stable and not self._closing
-                           and self.session.secret is not None)
+                refused = (
+                    up_at is not None
+                    and not stable
+                    and not self._closing
+                    and self.session.secret is not None
+                )
                 self._on_down(error, attempt, time.monotonic() + delay, refused)
             if self._closing:
                 return
@@ -328,8 +337,13 @@ class RosbridgeClient:
         log.info("rosbridge %s: connected", self.url)
         self._set_link(True, None)
 
-    def _on_down(self, error: str | None, attempt: int = 0, retry_at: float | None = None,
-                 refused: bool = False) -> None:
+    def _on_down(
+        self,
+        error: str | None,
+        attempt: int = 0,
+        retry_at: float | None = None,
+        refused: bool = False,
+    ) -> None:
         pending = list(self._outbox)
         self._outbox.clear()
         self.session.on_disconnected()
@@ -350,8 +364,9 @@ class RosbridgeClient:
             self._set_link(False, error, attempt, retry_at, refused)
         elif error is not None:
             self.stats.connect_failures += 1
-            self._link = replace(self._link, last_error=error, attempt=attempt,
-                                 retry_at=retry_at, refused=False)
+            self._link = replace(
+                self._link, last_error=error, attempt=attempt, retry_at=retry_at, refused=False
+            )
             self._warn("connect", "rosbridge %s: cannot connect: %s", self.url, error)
 
     def _requeue(self, text: str) -> None:
@@ -361,10 +376,17 @@ class RosbridgeClient:
         with contextlib.suppress(ValueError):  # unadvertised meanwhile: drop it
             self.session.publish(frame["topic"], frame["msg"])
 
-    def _set_link(self, connected: bool, error: str | None, attempt: int = 0,
-                  retry_at: float | None = None, refused: bool = False) -> None:
-        self._link = LinkState(connected, time.monotonic(), self.stats.reconnects, error,
-                               attempt, retry_at, refused)
+    def _set_link(
+        self,
+        connected: bool,
+        error: str | None,
+        attempt: int = 0,
+        retry_at: float | None = None,
+        refused: bool = False,
+    ) -> None:
+        self._link = LinkState(
+            connected, time.monotonic(), self.stats.reconnects, error, attempt, retry_at, refused
+        )
         if self.on_link is not None:
             try:
                 self.on_link(self._link)
@@ -420,9 +442,13 @@ class RosbridgeClient:
     def _note_dropped(self, before: int) -> None:
         self.stats.dropped = self.session.dropped
         if self.session.dropped > before:
-            self._warn("queue", "rosbridge %s: link down, publish queue full (%d), "
-                       "%d dropped in all", self.url, self.session.queue_limit,
-                       self.session.dropped)
+            self._warn(
+                "queue",
+                "rosbridge %s: link down, publish queue full (%d), %d dropped in all",
+                self.url,
+                self.session.queue_limit,
+                self.session.dropped,
+            )
 
     def _warn(self, key: str, fmt: str, *args: Any) -> None:
         held = self._throttle.allow(key)

@@ -88,8 +88,15 @@ def dumps(obj: dict[str, Any]) -> str:
     return encode(obj).decode()
 
 
-def auth_frame(secret: str, client: str, dest: str, t: float, ttl: float = 60.0,
-               level: str = "admin", rand: str | None = None) -> dict[str, Any]:
+def auth_frame(
+    secret: str,
+    client: str,
+    dest: str,
+    t: float,
+    ttl: float = 60.0,
+    level: str = "admin",
+    rand: str | None = None,
+) -> dict[str, Any]:
     """The rosauth ``auth`` op (rosbridge v2): a SHA-512 MAC over the shared secret.
 
     ``t`` and ``end`` go out as plain numbers of seconds: rosbridge builds
@@ -98,12 +105,21 @@ def auth_frame(secret: str, client: str, dest: str, t: float, ttl: float = 60.0,
     """
     rand = rand if rand is not None else secrets.token_hex(8)
     end = t + ttl
-    return {"op": "auth", "mac": auth_mac(secret, client, dest, rand, t, level, end),
-            "client": client, "dest": dest, "rand": rand, "t": t, "level": level, "end": end}
+    return {
+        "op": "auth",
+        "mac": auth_mac(secret, client, dest, rand, t, level, end),
+        "client": client,
+        "dest": dest,
+        "rand": rand,
+        "t": t,
+        "level": level,
+        "end": end,
+    }
 
 
-def auth_mac(secret: str, client: str, dest: str, rand: str, t: float, level: str,
-             end: float) -> str:
+def auth_mac(
+    secret: str, client: str, dest: str, rand: str, t: float, level: str, end: float
+) -> str:
     """rosauth's MAC: hex SHA-512 of secret + client + dest + rand + whole seconds of ``t``
     + level + whole seconds of ``end``."""
     text = f"{secret}{client}{dest}{rand}{math.floor(t)}{level}{math.floor(end)}"
@@ -141,12 +157,17 @@ class Session:
         return f"{op}:{topic}:{next(self._ids)}"
 
     def _advertise_frame(self, topic: str, type_: str) -> str:
-        return dumps({"op": "advertise", "id": self._id("advertise", topic),
-                      "topic": topic, "type": type_})
+        return dumps(
+            {"op": "advertise", "id": self._id("advertise", topic), "topic": topic, "type": type_}
+        )
 
     def _subscribe_frame(self, sub: Subscription) -> str:
-        frame: dict[str, Any] = {"op": "subscribe", "id": self._id("subscribe", sub.topic),
-                                 "topic": sub.topic, "type": sub.type}
+        frame: dict[str, Any] = {
+            "op": "subscribe",
+            "id": self._id("subscribe", sub.topic),
+            "topic": sub.topic,
+            "type": sub.type,
+        }
         if sub.throttle_rate:
             frame["throttle_rate"] = sub.throttle_rate
         if sub.queue_length:
@@ -154,8 +175,9 @@ class Session:
         return dumps(frame)
 
     def _publish_frame(self, topic: str, msg: Any) -> str:
-        return dumps({"op": "publish", "id": self._id("publish", topic), "topic": topic,
-                      "msg": msg})
+        return dumps(
+            {"op": "publish", "id": self._id("publish", topic), "topic": topic, "msg": msg}
+        )
 
     def advertise(self, topic: str, type_: str) -> list[str]:
         self.advertised[topic] = type_
@@ -167,11 +189,11 @@ class Session:
         self._queue = deque(item for item in self._queue if item[0] != topic)
         if self.advertised.pop(topic, None) is None or not self.connected:
             return []
-        return [dumps({"op": "unadvertise", "id": self._id("unadvertise", topic),
-                       "topic": topic})]
+        return [dumps({"op": "unadvertise", "id": self._id("unadvertise", topic), "topic": topic})]
 
-    def subscribe(self, topic: str, type_: str, throttle_rate: int = 0,
-                  queue_length: int = 0) -> list[str]:
+    def subscribe(
+        self, topic: str, type_: str, throttle_rate: int = 0, queue_length: int = 0
+    ) -> list[str]:
         sub = Subscription(topic, type_, throttle_rate, queue_length)
         self.subscriptions[topic] = sub
         return [self._subscribe_frame(sub)] if self.connected else []
@@ -179,8 +201,7 @@ class Session:
     def unsubscribe(self, topic: str) -> list[str]:
         if self.subscriptions.pop(topic, None) is None or not self.connected:
             return []
-        return [dumps({"op": "unsubscribe", "id": self._id("unsubscribe", topic),
-                       "topic": topic})]
+        return [dumps({"op": "unsubscribe", "id": self._id("unsubscribe", topic), "topic": topic})]
 
     def publish(self, topic: str, msg: Any) -> list[str]:
         """Frame for a publish, or queue it (bounded) while disconnected.

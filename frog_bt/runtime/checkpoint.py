@@ -56,8 +56,9 @@ def claim(path: Path, option: str = "--checkpoint") -> IO[str]:
         path.parent.mkdir(parents=True, exist_ok=True)
         handle = open(lock_path, "a+", encoding="utf-8")  # noqa: SIM115 - held open
     except (FileExistsError, NotADirectoryError):
-        raise UsageError(option, path, f"cannot write there: {path.parent} is not a directory"
-                         ) from None
+        raise UsageError(
+            option, path, f"cannot write there: {path.parent} is not a directory"
+        ) from None
     except OSError as exc:
         raise UsageError(option, path, f"cannot write there: {exc.strerror or exc}") from None
     try:
@@ -66,8 +67,12 @@ def claim(path: Path, option: str = "--checkpoint") -> IO[str]:
         handle.seek(0)
         holder = handle.read().strip() or "?"
         handle.close()
-        raise UsageError(option, path, f"in use by another running executive (pid {holder}); "
-                         "give each executive its own --checkpoint") from None
+        raise UsageError(
+            option,
+            path,
+            f"in use by another running executive (pid {holder}); "
+            "give each executive its own --checkpoint",
+        ) from None
     handle.seek(0)
     handle.truncate()
     handle.write(str(os.getpid()))

@@ -62,10 +62,21 @@ class Outcome:
 
 
 class Executive:
-    def __init__(self, site: Site, tree: LoadedTree, clock: Clock, *,
-                 rosbridge_url: str, frontend: tuple[str, int], listen: tuple[str, int],
-                 sim_time: bool = False, secret: str | None = None, once: bool = False,
-                 checkpoint: Path | None = None, fresh: bool = False) -> None:
+    def __init__(
+        self,
+        site: Site,
+        tree: LoadedTree,
+        clock: Clock,
+        *,
+        rosbridge_url: str,
+        frontend: tuple[str, int],
+        listen: tuple[str, int],
+        sim_time: bool = False,
+        secret: str | None = None,
+        once: bool = False,
+        checkpoint: Path | None = None,
+        fresh: bool = False,
+    ) -> None:
         if sim_time and not isinstance(clock, ManualClock):
             raise ValueError("sim time needs a ManualClock (SimClock)")
         self.site = site
@@ -74,10 +85,17 @@ class Executive:
         self.once = once
         self.outcome = Outcome()
         self.observers = Observers()  # every observer, told each event (on_event)
-        self.client = RosbridgeClient(rosbridge_url, secret=secret, on_input=self._on_ros,
-                                      on_link=self._on_link)
-        self.link = FrontendLink(listen, frontend, clock, inbound=EVENTS,
-                                 on_message=self._on_event, on_datagram=self._on_datagram)
+        self.client = RosbridgeClient(
+            rosbridge_url, secret=secret, on_input=self._on_ros, on_link=self._on_link
+        )
+        self.link = FrontendLink(
+            listen,
+            frontend,
+            clock,
+            inbound=EVENTS,
+            on_message=self._on_event,
+            on_datagram=self._on_datagram,
+        )
         self.standing = Standing(clock)  # what outlives a tree: each core gets it
         self.core = self._core(site, tree)
         self.checkpoint = checkpoint
@@ -100,8 +118,15 @@ class Executive:
 
     def _core(self, site: Site, tree: LoadedTree) -> Core:
         """A core for ``tree``, on this executive's links, observers and standing state."""
-        return Core(site, tree, self.clock, self.client.publish, self.link.send,
-                    emit=self.observers.emit, standing=self.standing)
+        return Core(
+            site,
+            tree,
+            self.clock,
+            self.client.publish,
+            self.link.send,
+            emit=self.observers.emit,
+            standing=self.standing,
+        )
 
     def emit(self, event: Event) -> None:
         """Tell every observer."""
@@ -129,13 +154,17 @@ class Executive:
             self._refusals = self._refusals + 1 if state.refused else 0
             if self._refusals >= 3 and self.once:
                 self.stop("rosbridge refused authentication (check the secret)", 1)
-        elif (state.reconnects > 0 and actions.pending is not None
-              and actions.pending is self._pending_at_loss):
+        elif (
+            state.reconnects > 0
+            and actions.pending is not None
+            and actions.pending is self._pending_at_loss
+        ):
             # A goal sent before the loss may have been answered while we could not hear:
             # send it again. One issued while down went out from the queue just now.
             actions.resend_pending()
-            self.core.ctx.note(f"link back: re-sent {actions.pending.kind} to "
-                               f"{actions.pending.target}")
+            self.core.ctx.note(
+                f"link back: re-sent {actions.pending.kind} to {actions.pending.target}"
+            )
         self.check_links()
         self._wake.set()
 
@@ -213,9 +242,10 @@ class Executive:
     def status_text(self, countdown: bool = True) -> str:
         """The live status: the rosbridge link while it keeps the tree waiting, else the tree;
         then the alerts not yet acknowledged (``countdown``: a terminal's, see link_line)."""
-        line = (link_line(self.client.url, self.client.link, self.clock.ready,
-                          countdown=countdown)
-                or f"{status_line(self.core)} | {self.links.text()}")
+        line = (
+            link_line(self.client.url, self.client.link, self.clock.ready, countdown=countdown)
+            or f"{status_line(self.core)} | {self.links.text()}"
+        )
         alerts = [a.kind for a in self.staff.book.shown() if a.state == "raised"]
         return line + (f" | ALERT: {', '.join(alerts)}" if alerts else "")
 
@@ -272,8 +302,11 @@ class Executive:
     def idle(self) -> bool:
         """Docked, and no tour running: a safe point to swap the tree."""
         docking = self.core.inputs.latest.get(INPUTS["docking_state"].key)
-        return (self.core.board.get(keys.TOUR_STATE) is not TourState.STARTED
-                and docking is not None and docking.value == DockingState.DOCKED)
+        return (
+            self.core.board.get(keys.TOUR_STATE) is not TourState.STARTED
+            and docking is not None
+            and docking.value == DockingState.DOCKED
+        )
 
     def _swap_tree(self) -> None:
         assert self._swap is not None
@@ -305,8 +338,9 @@ class Executive:
                 save_checkpoint(self.checkpoint, progress)
             except OSError as exc:  # a full disk must not stop the tour; warn once a minute
                 self._checkpoint_warnings.warn(
-                    "checkpoint", f"cannot write the checkpoint {self.checkpoint}: "
-                                  f"{exc.strerror or exc}")
+                    "checkpoint",
+                    f"cannot write the checkpoint {self.checkpoint}: {exc.strerror or exc}",
+                )
         if status == Status.SUCCESS:
             board = self.core.board
             if board.get(keys.TOUR_STATE) is TourState.ABORTED:

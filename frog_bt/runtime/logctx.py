@@ -20,8 +20,9 @@ from typing import TypeVar
 
 T = TypeVar("T")
 
-_OWNER: contextvars.ContextVar[object | None] = contextvars.ContextVar("frog_bt_log_owner",
-                                                                      default=None)
+_OWNER: contextvars.ContextVar[object | None] = contextvars.ContextVar(
+    "frog_bt_log_owner", default=None
+)
 
 
 def mark(owner: object) -> None:

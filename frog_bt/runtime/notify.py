@@ -23,8 +23,12 @@ STATUS_EVERY = 1.0  # seconds between two STATUS= at most
 
 
 class Notifier:
-    def __init__(self, address: str | None, watchdog_usec: int | None = None,
-                 clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self,
+        address: str | None,
+        watchdog_usec: int | None = None,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
         self.address = "\0" + address[1:] if address and address.startswith("@") else address
         self.ping_every = watchdog_usec / 2e6 if watchdog_usec else None
         self.clock = clock
@@ -59,8 +63,11 @@ class Notifier:
             self.dropped += 1  # systemd's queue is full for now: this one is lost, not all
         except OSError as exc:
             self._failed = True
-            log.warning("systemd notify socket %s: %s; not notifying any more",
-                        self.address.lstrip("\0"), exc.strerror or exc)
+            log.warning(
+                "systemd notify socket %s: %s; not notifying any more",
+                self.address.lstrip("\0"),
+                exc.strerror or exc,
+            )
 
     def ready(self, status: str = "") -> None:
         self.send("READY=1", *([f"STATUS={status}"] if status else []))

@@ -66,8 +66,11 @@ class Staff:
         except TimeoutError:
             if queued in self._queue:
                 self._queue.remove(queued)
-                return Answer(False, "the executive is not ticking now (is the robot "
-                                     "reachable?): nothing was changed")
+                return Answer(
+                    False,
+                    "the executive is not ticking now (is the robot "
+                    "reachable?): nothing was changed",
+                )
             return await answer  # applied meanwhile
 
     def before_tick(self) -> None:
@@ -78,16 +81,28 @@ class Staff:
             if queued.command is Command.ACK_ALERT:
                 now = core.clock.now()
                 ack = self.book.acknowledge(queued.alert_id, now)
-                answer = (Answer(True, f"alert {ack.id} acknowledged") if ack is not None
-                          else Answer(False, f"no alert {queued.alert_id!r} to acknowledge"))
+                answer = (
+                    Answer(True, f"alert {ack.id} acknowledged")
+                    if ack is not None
+                    else Answer(False, f"no alert {queued.alert_id!r} to acknowledge")
+                )
                 core.journal.note(f"operator: ack_alert {queued.alert_id}: {answer.text}")
-                self.executive.emit(OperatorDone(now, core.ticks + 1, queued.command.value,
-                                                 answer.ok, answer.text, queued.alert_id))
+                self.executive.emit(
+                    OperatorDone(
+                        now,
+                        core.ticks + 1,
+                        queued.command.value,
+                        answer.ok,
+                        answer.text,
+                        queued.alert_id,
+                    )
+                )
             else:
                 answer = core.command(queued.command)
             # a person steered the robot: always in the log (warning level reaches it)
-            log.warning("operator %s: %s%s", queued.command, "" if answer.ok else "refused: ",
-                        answer.text)
+            log.warning(
+                "operator %s: %s%s", queued.command, "" if answer.ok else "refused: ", answer.text
+            )
             if not queued.answer.done():
                 queued.answer.set_result(answer)
 
@@ -129,8 +144,11 @@ class Staff:
             self._seeking_since = None
         site = exe.site
         diagnostics = board.get(keys.DIAGNOSTICS)
-        fresh = (diagnostics.value if diagnostics is not None
-                 and diagnostics.age(now) <= site.safety.diagnostics_max_age else None)
+        fresh = (
+            diagnostics.value
+            if diagnostics is not None and diagnostics.age(now) <= site.safety.diagnostics_max_age
+            else None
+        )
         gave_up = board.get(keys.GAVE_UP)
         rosbridge = self.link_since.get("rosbridge")
         frontend = self.link_since.get("frontend")
@@ -138,12 +156,17 @@ class Staff:
             now=now,
             battery=fresh.battery if fresh is not None else None,
             faults=tuple(fresh.faults) if fresh is not None else (),
-            rosbridge_down_since=(rosbridge[1] if rosbridge is not None
-                                  and rosbridge[0] is not LinkStatus.CONNECTED else None),
-            frontend_silent_since=(frontend[1] if frontend is not None
-                                   and frontend[0] is LinkStatus.SILENT else None),
+            rosbridge_down_since=(
+                rosbridge[1]
+                if rosbridge is not None and rosbridge[0] is not LinkStatus.CONNECTED
+                else None
+            ),
+            frontend_silent_since=(
+                frontend[1] if frontend is not None and frontend[0] is LinkStatus.SILENT else None
+            ),
             seeking_since=self._seeking_since,
             gave_up=gave_up.text if gave_up is not None else "",
             docking_gave_up=gave_up is not None and gave_up.kind is IncidentKind.DOCKING_FAILED,
             stops_given_up=tuple(core.journal.tally.stops_given_up()),  # until the next tour
-            pause_ran_out=self._pause_ran_out)
+            pause_ran_out=self._pause_ran_out,
+        )

@@ -54,8 +54,13 @@ def milestone(attempt: int) -> int:
         scale *= 10
 
 
-def link_line(url: str, link: LinkState, clock_ready: bool = True,
-              now: float | None = None, countdown: bool = True) -> str | None:
+def link_line(
+    url: str,
+    link: LinkState,
+    clock_ready: bool = True,
+    now: float | None = None,
+    countdown: bool = True,
+) -> str | None:
     """What the rosbridge link is doing, while it keeps the tree from running; else None.
     ``now``: the monotonic time the countdown is counted from (default: now). Without
     ``countdown`` (a journal, not a terminal) the line is a state: no "next in", and the
@@ -64,24 +69,34 @@ def link_line(url: str, link: LinkState, clock_ready: bool = True,
         return None if clock_ready else f"rosbridge: connected to {url}, waiting for /clock"
     attempt = link.attempt if countdown else milestone(link.attempt)
     now = time.monotonic() if now is None else now
-    retry_in = (None if link.retry_at is None or not countdown
-                else max(0.0, link.retry_at - now))
-    detail = ", ".join(part for part in (
-        (f"attempt {attempt}" if countdown else f"{attempt}+ attempts") if attempt else "",
-        f"next in {retry_in:.1f} s" if retry_in is not None else "") if part)
+    retry_in = None if link.retry_at is None or not countdown else max(0.0, link.retry_at - now)
+    detail = ", ".join(
+        part
+        for part in (
+            (f"attempt {attempt}" if countdown else f"{attempt}+ attempts") if attempt else "",
+            f"next in {retry_in:.1f} s" if retry_in is not None else "",
+        )
+        if part
+    )
     error = _plain_error(link.last_error) if link.last_error else ""
-    return (f"rosbridge: connecting to {url}" + (f" ({detail})" if detail else "")
-            + (f": {error}" if error else ""))
+    return (
+        f"rosbridge: connecting to {url}"
+        + (f" ({detail})" if detail else "")
+        + (f": {error}" if error else "")
+    )
 
 
 def _plain_error(error: str) -> str:
     """``ConnectionRefusedError: [Errno 111] Connect call failed ...`` -> ``connection refused``."""
     lowered = error.lower()
-    for needle, words in (("authentication refused", "closed at once: authentication refused? "
-                           "(check the secret)"),
-                          ("refused", "connection refused"), ("timed out", "timed out"),
-                          ("name or service not known", "unknown host"),
-                          ("no route", "no route to host"), ("unreachable", "unreachable")):
+    for needle, words in (
+        ("authentication refused", "closed at once: authentication refused? (check the secret)"),
+        ("refused", "connection refused"),
+        ("timed out", "timed out"),
+        ("name or service not known", "unknown host"),
+        ("no route", "no route to host"),
+        ("unreachable", "unreachable"),
+    ):
         if needle in lowered:
             return words
     return error[:80]
@@ -109,8 +124,12 @@ def status_line(core: Core) -> str:
 class StatusLine:
     """Draws ``source()`` (default: :func:`status_line` of the core ticked)."""
 
-    def __init__(self, out: TextIO = sys.stderr, interval: float = 0.2,
-                 source: Callable[[], str] | None = None) -> None:
+    def __init__(
+        self,
+        out: TextIO = sys.stderr,
+        interval: float = 0.2,
+        source: Callable[[], str] | None = None,
+    ) -> None:
         self.out = out
         self.tty = out.isatty()
         self.interval = interval

@@ -41,10 +41,16 @@ def _stamp(path: Path) -> Stamp:
 
 
 class Watch:
-    def __init__(self, tree_path: Path | None, config_path: Path | None, tree: LoadedTree,
-                 accept: Callable[[Site, LoadedTree], None], *,
-                 refuse: Callable[[list[str]], None] | None = None,
-                 interval: float = 1.0) -> None:
+    def __init__(
+        self,
+        tree_path: Path | None,
+        config_path: Path | None,
+        tree: LoadedTree,
+        accept: Callable[[Site, LoadedTree], None],
+        *,
+        refuse: Callable[[list[str]], None] | None = None,
+        interval: float = 1.0,
+    ) -> None:
         self.tree_path = tree_path
         self.config_path = config_path
         self.accept = accept

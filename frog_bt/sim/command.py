@@ -136,45 +136,88 @@ def describe(record: Record) -> str:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--scenario", default="default", metavar="NAME|FILE",
-                        help="built-in scenario name or YAML file (default: default)")
-    parser.add_argument("--speed", type=_speed, metavar="X",
-                        help="speed factor, simulated seconds per real second "
-                             "(default: the scenario's)")
-    parser.add_argument("--rosbridge", type=_address, default=("127.0.0.1", 9090),
-                        metavar="HOST:PORT",
-                        help="where the rosbridge server listens (default 127.0.0.1:9090)")
-    parser.add_argument("--frontend", type=_address, default=("127.0.0.1", 5005),
-                        metavar="HOST:PORT",
-                        help="where the simulated front end listens (default 127.0.0.1:5005)")
-    parser.add_argument("--executive", type=_address, default=("127.0.0.1", 5006),
-                        metavar="HOST:PORT",
-                        help="where the executive listens for the front end "
-                             "(default 127.0.0.1:5006)")
-    parser.add_argument("--config", type=Path, default=None, metavar="FILE",
-                        help="site configuration with the POI table (default: the packaged "
-                        "config/site.yaml; 'frog-bt init DIR' copies it to edit)")
-    parser.add_argument("--secret", default=None,
-                        help="rosauth secret: clients of the simulator's server must "
-                             "authenticate with it; with --via, the simulator does")
+    parser.add_argument(
+        "--scenario",
+        default="default",
+        metavar="NAME|FILE",
+        help="built-in scenario name or YAML file (default: default)",
+    )
+    parser.add_argument(
+        "--speed",
+        type=_speed,
+        metavar="X",
+        help="speed factor, simulated seconds per real second (default: the scenario's)",
+    )
+    parser.add_argument(
+        "--rosbridge",
+        type=_address,
+        default=("127.0.0.1", 9090),
+        metavar="HOST:PORT",
+        help="where the rosbridge server listens (default 127.0.0.1:9090)",
+    )
+    parser.add_argument(
+        "--frontend",
+        type=_address,
+        default=("127.0.0.1", 5005),
+        metavar="HOST:PORT",
+        help="where the simulated front end listens (default 127.0.0.1:5005)",
+    )
+    parser.add_argument(
+        "--executive",
+        type=_address,
+        default=("127.0.0.1", 5006),
+        metavar="HOST:PORT",
+        help="where the executive listens for the front end (default 127.0.0.1:5006)",
+    )
+    parser.add_argument(
+        "--config",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="site configuration with the POI table (default: the packaged "
+        "config/site.yaml; 'frog-bt init DIR' copies it to edit)",
+    )
+    parser.add_argument(
+        "--secret",
+        default=None,
+        help="rosauth secret: clients of the simulator's server must "
+        "authenticate with it; with --via, the simulator does",
+    )
     where = parser.add_mutually_exclusive_group()
-    where.add_argument("--via", default=None, metavar="ws://HOST:PORT",
-                       help="serve no rosbridge: be the robot as a client of this rosbridge "
-                            "server (a real rosbridge_suite, say); the executive connects "
-                            "to the same server")
-    where.add_argument("--play", type=Path, metavar="FILE.mcap",
-                       help="serve a recorded tour's robot-side inputs on the recording's own "
-                            "clock, and its front-end events over UDP, open loop; say where a "
-                            "new executive's commands differ from the recorded ones")
-    where.add_argument("--relay", action="store_true",
-                       help="only a rosbridge server with no robot inside, on --rosbridge: "
-                            "publishes from one client go to the others' subscriptions "
-                            "(a stand-in for rosbridge_suite, for --via)")
-    parser.add_argument("--loop", action="store_true",
-                        help="with --play: play the recording again from its start, for ever "
-                             "(the clock goes on forward)")
-    parser.add_argument("--log", action="store_true",
-                        help="print every message as it is sent or received, one line each")
+    where.add_argument(
+        "--via",
+        default=None,
+        metavar="ws://HOST:PORT",
+        help="serve no rosbridge: be the robot as a client of this rosbridge "
+        "server (a real rosbridge_suite, say); the executive connects "
+        "to the same server",
+    )
+    where.add_argument(
+        "--play",
+        type=Path,
+        metavar="FILE.mcap",
+        help="serve a recorded tour's robot-side inputs on the recording's own "
+        "clock, and its front-end events over UDP, open loop; say where a "
+        "new executive's commands differ from the recorded ones",
+    )
+    where.add_argument(
+        "--relay",
+        action="store_true",
+        help="only a rosbridge server with no robot inside, on --rosbridge: "
+        "publishes from one client go to the others' subscriptions "
+        "(a stand-in for rosbridge_suite, for --via)",
+    )
+    parser.add_argument(
+        "--loop",
+        action="store_true",
+        help="with --play: play the recording again from its start, for ever "
+        "(the clock goes on forward)",
+    )
+    parser.add_argument(
+        "--log",
+        action="store_true",
+        help="print every message as it is sent or received, one line each",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -198,6 +241,7 @@ def run(args: argparse.Namespace) -> int:
     if args.via is not None:
         from websockets.exceptions import InvalidURI
         from websockets.uri import parse_uri
+
         try:
             parse_uri(args.via)
         except InvalidURI:
@@ -217,9 +261,17 @@ def run(args: argparse.Namespace) -> int:
 async def _serve(args: argparse.Namespace, scenario: Scenario, pois: dict) -> int:
     from frog_bt.sim.simulator import Simulator
 
-    sim = Simulator(scenario, host=args.rosbridge[0], rosbridge_port=args.rosbridge[1],
-                    frontend_host=args.frontend[0], frontend_port=args.frontend[1],
-                    executive=args.executive, pois=pois, secret=args.secret, via=args.via)
+    sim = Simulator(
+        scenario,
+        host=args.rosbridge[0],
+        rosbridge_port=args.rosbridge[1],
+        frontend_host=args.frontend[0],
+        frontend_port=args.frontend[1],
+        executive=args.executive,
+        pois=pois,
+        secret=args.secret,
+        via=args.via,
+    )
     if args.log:
         sim.log.add_listener(lambda record: print(describe(record), flush=True))
     try:
@@ -227,12 +279,18 @@ async def _serve(args: argparse.Namespace, scenario: Scenario, pois: dict) -> in
     except OSError as exc:
         print(f"frog-bt sim: cannot listen: {exc}", file=sys.stderr)
         return 1
-    bridge = (f"robot via rosbridge {args.via}" if args.via is not None
-              else f"rosbridge ws://{args.rosbridge[0]}:{sim.rosbridge_port}")
-    print(f"frog-bt sim: {bridge}, "
-          f"front end udp {args.frontend[0]}:{sim.frontend_port} -> executive "
-          f"{args.executive[0]}:{args.executive[1]}, scenario {sim.scenario.name or '?'}, "
-          f"{sim.speed:g}x from {sim.scenario.start_time.isoformat()}", flush=True)
+    bridge = (
+        f"robot via rosbridge {args.via}"
+        if args.via is not None
+        else f"rosbridge ws://{args.rosbridge[0]}:{sim.rosbridge_port}"
+    )
+    print(
+        f"frog-bt sim: {bridge}, "
+        f"front end udp {args.frontend[0]}:{sim.frontend_port} -> executive "
+        f"{args.executive[0]}:{args.executive[1]}, scenario {sim.scenario.name or '?'}, "
+        f"{sim.speed:g}x from {sim.scenario.start_time.isoformat()}",
+        flush=True,
+    )
     stopping = _stop_on_signals()
     clock = asyncio.create_task(sim.wait_clock_stopped())
     await asyncio.wait([stopping, clock], return_when=asyncio.FIRST_COMPLETED)
@@ -243,8 +301,10 @@ async def _serve(args: argparse.Namespace, scenario: Scenario, pois: dict) -> in
     except Exception as exc:  # the time loop died of a bug; it was logged
         print(f"frog-bt sim: simulation failed: {exc!r}", file=sys.stderr)
         return 1
-    print(f"frog-bt sim: stopped at {sim.clock.local_time().isoformat(timespec='seconds')}",
-          flush=True)
+    print(
+        f"frog-bt sim: stopped at {sim.clock.local_time().isoformat(timespec='seconds')}",
+        flush=True,
+    )
     return 0
 
 
@@ -267,8 +327,11 @@ async def _relay(args: argparse.Namespace) -> int:
     except OSError as exc:
         print(f"frog-bt sim: cannot listen: {exc}", file=sys.stderr)
         return 1
-    print(f"frog-bt sim: relaying rosbridge ws://{args.rosbridge[0]}:{server.port} "
-          f"(no robot inside{'; clients authenticate' if args.secret else ''})", flush=True)
+    print(
+        f"frog-bt sim: relaying rosbridge ws://{args.rosbridge[0]}:{server.port} "
+        f"(no robot inside{'; clients authenticate' if args.secret else ''})",
+        flush=True,
+    )
     await _stop_on_signals()
     await server.stop()
     print("frog-bt sim: stopped", flush=True)
@@ -290,29 +353,44 @@ async def _play(args: argparse.Namespace) -> int:
     def differ(text: str) -> None:
         print(f"frog-bt sim: the executive parted from the recording {text}", flush=True)
 
-    player = Player(played, site, host=args.rosbridge[0], rosbridge_port=args.rosbridge[1],
-                    frontend_host=args.frontend[0], frontend_port=args.frontend[1],
-                    executive=args.executive, speed=speed, loop=args.loop,
-                    secret=args.secret, on_difference=differ)
+    player = Player(
+        played,
+        site,
+        host=args.rosbridge[0],
+        rosbridge_port=args.rosbridge[1],
+        frontend_host=args.frontend[0],
+        frontend_port=args.frontend[1],
+        executive=args.executive,
+        speed=speed,
+        loop=args.loop,
+        secret=args.secret,
+        on_difference=differ,
+    )
     try:
         await player.start()
     except OSError as exc:
         print(f"frog-bt sim: cannot listen: {exc}", file=sys.stderr)
         return 1
-    print(f"frog-bt sim: playing {', '.join(played.files)} ({len(played.inputs)} inputs, "
-          f"{len(played.events)} front-end events, {played.end - played.start:.0f} s) at "
-          f"{speed:g}x{' in a loop' if args.loop else ''}: rosbridge "
-          f"ws://{args.rosbridge[0]}:{player.rosbridge.port}, front end udp "
-          f"{args.frontend[0]}:{player.udp.port} -> executive "
-          f"{args.executive[0]}:{args.executive[1]}; it starts when an executive subscribes "
-          "(at most a minute from now)", flush=True)
+    print(
+        f"frog-bt sim: playing {', '.join(played.files)} ({len(played.inputs)} inputs, "
+        f"{len(played.events)} front-end events, {played.end - played.start:.0f} s) at "
+        f"{speed:g}x{' in a loop' if args.loop else ''}: rosbridge "
+        f"ws://{args.rosbridge[0]}:{player.rosbridge.port}, front end udp "
+        f"{args.frontend[0]}:{player.udp.port} -> executive "
+        f"{args.executive[0]}:{args.executive[1]}; it starts when an executive subscribes "
+        "(at most a minute from now)",
+        flush=True,
+    )
     stopping = _stop_on_signals()
     over = asyncio.create_task(player.over.wait())
     clock = asyncio.create_task(player.wait())
     await asyncio.wait([stopping, over, clock], return_when=asyncio.FIRST_COMPLETED)
     if over.done() and not stopping.done():
-        print(f"frog-bt sim: the recording is over; {player.summary()}; the clock goes on "
-              "until interrupted", flush=True)
+        print(
+            f"frog-bt sim: the recording is over; {player.summary()}; the clock goes on "
+            "until interrupted",
+            flush=True,
+        )
         await asyncio.wait([stopping, clock], return_when=asyncio.FIRST_COMPLETED)
     for task in (stopping, over, clock):
         task.cancel()

@@ -84,9 +84,14 @@ class Comparison:
         if same(expected, command):
             return None
         assert queue is not None
-        swapped = next((i for i, later in enumerate(queue)
-                        if later.t - expected.t <= REORDER_WINDOW and same(later, command)),
-                       None)
+        swapped = next(
+            (
+                i
+                for i, later in enumerate(queue)
+                if later.t - expected.t <= REORDER_WINDOW and same(later, command)
+            ),
+            None,
+        )
         if swapped is not None:  # the same command, a moment earlier than recorded: the
             del queue[swapped]  # one it passed is still to come
             queue.appendleft(expected)
@@ -112,8 +117,10 @@ class Comparison:
         if self.first:
             text += f"; first difference {self.first}"
         if self.meter:
-            text += (f"; engagement meter: {self.meter} readings, {self.meter_differ} off by "
-                     f"more than {METER_TOLERANCE:g} (its windows move with tick timing)")
+            text += (
+                f"; engagement meter: {self.meter} readings, {self.meter_differ} off by "
+                f"more than {METER_TOLERANCE:g} (its windows move with tick timing)"
+            )
         return text
 
 
@@ -131,6 +138,9 @@ def same(expected: Command, got: Command) -> bool:
         return True
     if stream(expected) == stream(got) == "meter":
         a, b = expected.payload.get("level"), got.payload.get("level")
-        return (isinstance(a, int | float) and isinstance(b, int | float)
-                and abs(a - b) <= METER_TOLERANCE)
+        return (
+            isinstance(a, int | float)
+            and isinstance(b, int | float)
+            and abs(a - b) <= METER_TOLERANCE
+        )
     return False

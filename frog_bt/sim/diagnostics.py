@@ -26,12 +26,16 @@ class Battery:
         self.percentage = min(100.0, max(0.0, self.percentage + rate * dt / 3600.0))
 
     def status(self) -> DiagnosticStatus:
-        return DiagnosticStatus(0, "battery", "", "frog",
-                                (KeyValue("percentage", f"{self.percentage:.1f}"),))
+        return DiagnosticStatus(
+            0, "battery", "", "frog", (KeyValue("percentage", f"{self.percentage:.1f}"),)
+        )
 
 
 def active_faults(faults: Iterable[FaultSpec], elapsed: float) -> list[DiagnosticStatus]:
     """Statuses of the faults active ``elapsed`` seconds after the scenario start."""
     t = elapsed + 1e-9  # a step time of 2.9999999 is 3
-    return [DiagnosticStatus(f.level, f.name, f.message, "frog")
-            for f in faults if f.at <= t and (f.duration is None or t < f.at + f.duration)]
+    return [
+        DiagnosticStatus(f.level, f.name, f.message, "frog")
+        for f in faults
+        if f.at <= t and (f.duration is None or t < f.at + f.duration)
+    ]

@@ -50,8 +50,9 @@ class Docking:
         allowed = self.spec.dock_failures if command == "dock" else self.spec.undock_failures
         fails = self._attempts[command] <= allowed
         if command == "dock" and not near_dock and not self.docked:
-            log.info("dock requested %.1f m or more from the dock: it will fail",
-                     self.spec.dock_range)
+            log.info(
+                "dock requested %.1f m or more from the dock: it will fail", self.spec.dock_range
+            )
             fails = True
         duration = self.spec.dock_time if command == "dock" else self.spec.undock_time
         self._process = _Process(command, duration, fails)

@@ -54,8 +54,13 @@ class _Timer:
 class FrontendModel:
     """Scripted front-end behaviour; ``answer()`` says whether the visitor says yes."""
 
-    def __init__(self, scenario: Scenario, peer_host: str, answer: Callable[[], bool],
-                 notify: Notify | None = None) -> None:
+    def __init__(
+        self,
+        scenario: Scenario,
+        peer_host: str,
+        answer: Callable[[], bool],
+        notify: Notify | None = None,
+    ) -> None:
         self.scenario = scenario
         self.spec = scenario.frontend
         self.peer_host = peer_host
@@ -84,8 +89,7 @@ class FrontendModel:
         self.silences.append((start, end))
 
     def silent(self, now: float) -> bool:
-        return self.spec.silent or any(a - EPSILON <= now < b - EPSILON
-                                       for a, b in self.silences)
+        return self.spec.silent or any(a - EPSILON <= now < b - EPSILON for a, b in self.silences)
 
     # ------------------------------------------------------------ inbound
 

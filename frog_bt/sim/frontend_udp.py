@@ -31,8 +31,13 @@ class _Protocol(asyncio.DatagramProtocol):
 class FrontendSocket:
     """A UDP socket bound to ``host:port`` that sends to ``executive``."""
 
-    def __init__(self, host: str, port: int, executive: Address,
-                 on_datagram: Callable[[bytes, Address], None]) -> None:
+    def __init__(
+        self,
+        host: str,
+        port: int,
+        executive: Address,
+        on_datagram: Callable[[bytes, Address], None],
+    ) -> None:
         self.host = host
         self.port = port
         self.executive = executive
@@ -43,11 +48,16 @@ class FrontendSocket:
     async def open(self) -> None:
         loop = asyncio.get_running_loop()
         transport, _ = await loop.create_datagram_endpoint(
-            lambda: _Protocol(self.on_datagram), local_addr=(self.host, self.port))
+            lambda: _Protocol(self.on_datagram), local_addr=(self.host, self.port)
+        )
         self._transport = transport
         self.port = transport.get_extra_info("sockname")[1]
-        log.info("front end listening on udp %s:%d, sending to %s:%d",
-                 self.host, self.port, *self.executive)
+        log.info(
+            "front end listening on udp %s:%d, sending to %s:%d",
+            self.host,
+            self.port,
+            *self.executive,
+        )
 
     @property
     def address(self) -> Address | None:

@@ -53,15 +53,18 @@ def _item(cls: type[S], item: Any) -> S:
     if isinstance(obj.get("position"), tuple | list):
         obj["position"] = dict(zip("xyz", obj["position"], strict=False))
     if "values" in obj:
-        obj["values"] = [dict(zip(("key", "value"), kv, strict=True))
-                         if not isinstance(kv, Mapping) else kv for kv in obj["values"]]
+        obj["values"] = [
+            dict(zip(("key", "value"), kv, strict=True)) if not isinstance(kv, Mapping) else kv
+            for kv in obj["values"]
+        ]
     return convert(obj, cls)
 
 
 def person_detections(stamp: float, persons: Iterable[Any]) -> dict[str, Any]:
     """``frog_msgs/PersonDetections``: ``{header, persons: [{id, position, orientation}]}``."""
-    return PERSONS.encode(PersonDetections(
-        stamp, tuple(_item(PersonDetection, p) for p in persons)))
+    return PERSONS.encode(
+        PersonDetections(stamp, tuple(_item(PersonDetection, p) for p in persons))
+    )
 
 
 def face_data(stamp: float, faces: Iterable[Any]) -> dict[str, Any]:

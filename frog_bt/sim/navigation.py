@@ -54,8 +54,9 @@ class RobotPose:
         return math.hypot(x - self.x, y - self.y)
 
 
-def drive(x: float, y: float, gx: float, gy: float, speed: float,
-          dt: float) -> tuple[float, float, bool]:
+def drive(
+    x: float, y: float, gx: float, gy: float, speed: float, dt: float
+) -> tuple[float, float, bool]:
     """Position after driving ``dt`` seconds towards (gx, gy), and whether it has arrived."""
     dist = math.hypot(gx - x, gy - y)
     step = speed * dt
@@ -88,8 +89,7 @@ class Navigator:
         self.active: Goal | None = None
         self._used: dict[int, int] = {}  # failure rule index -> goals it has failed
 
-    def new_goal(self, x: float, y: float, qz: float, qw: float,
-                 pois: frozenset[str]) -> Goal:
+    def new_goal(self, x: float, y: float, qz: float, qw: float, pois: frozenset[str]) -> Goal:
         """Accept a goal (replacing any active one) and decide whether a rule fails it."""
         self.goals += 1
         goal = Goal(self.goals, x, y, qz, qw, pois)
@@ -98,8 +98,13 @@ class Navigator:
                 self._used[i] = self._used.get(i, 0) + 1
                 goal.fail_code = FAILED if rule.result == "failed" else ABORTED
                 goal.fail_after = rule.after
-                log.info("goal %d (%s) will end %d after %.1f s by scenario", goal.number,
-                         ",".join(sorted(pois)) or "no POI", goal.fail_code, rule.after)
+                log.info(
+                    "goal %d (%s) will end %d after %.1f s by scenario",
+                    goal.number,
+                    ",".join(sorted(pois)) or "no POI",
+                    goal.fail_code,
+                    rule.after,
+                )
                 break
         self.active = goal
         return goal

@@ -42,7 +42,13 @@ LEAVE_SECONDS = 20.0
 RETURN_ID_STEP = 1000
 
 HIDDEN, PRESENT, WITH_ROBOT, FOLLOWING, LEAVING, GONE = (
-    "hidden", "present", "with_robot", "following", "leaving", "gone")
+    "hidden",
+    "present",
+    "with_robot",
+    "following",
+    "leaving",
+    "gone",
+)
 VISIBLE = (PRESENT, WITH_ROBOT, FOLLOWING, LEAVING)
 
 
@@ -85,8 +91,9 @@ class Visitor:
 class Crowd:
     """All visitors, and which one is the current visitor (the one approached)."""
 
-    def __init__(self, specs: Iterable[VisitorSpec], seed: int = 0,
-                 detection_range: float = 15.0) -> None:
+    def __init__(
+        self, specs: Iterable[VisitorSpec], seed: int = 0, detection_range: float = 15.0
+    ) -> None:
         self.seed = seed
         self.detection_range = detection_range
         self.visitors: dict[int, Visitor] = {}
@@ -98,10 +105,17 @@ class Crowd:
         vid = spec.id + RETURN_ID_STEP * generation
         appears_now = spec.appear_at is not None and spec.appear_at <= 0
         state = PRESENT if generation or appears_now else HIDDEN
-        visitor = Visitor(spec, vid, spec.position.x, spec.position.y, state,
-                          spec.detected_orientation,
-                          [] if isinstance(spec.approach, str) else list(spec.approach),
-                          EngagementScript(spec.faces, vid, self.seed), generation)
+        visitor = Visitor(
+            spec,
+            vid,
+            spec.position.x,
+            spec.position.y,
+            state,
+            spec.detected_orientation,
+            [] if isinstance(spec.approach, str) else list(spec.approach),
+            EngagementScript(spec.faces, vid, self.seed),
+            generation,
+        )
         self.visitors[vid] = visitor
         return visitor
 
@@ -111,8 +125,9 @@ class Crowd:
 
     # ------------------------------------------------------------ time
 
-    def step(self, elapsed: float, dt: float, robot: RobotPose,
-             moved: tuple[float, float] = (0.0, 0.0)) -> None:
+    def step(
+        self, elapsed: float, dt: float, robot: RobotPose, moved: tuple[float, float] = (0.0, 0.0)
+    ) -> None:
         """Appear, follow, wander off at a time, walk away; ``elapsed`` since the start.
 
         ``moved`` is how far the robot drove this step (x, y): followers keep
@@ -120,13 +135,22 @@ class Crowd:
         """
         travelled = math.hypot(*moved)
         for v in list(self.visitors.values()):
-            if v.state == HIDDEN and v.spec.appear_at is not None and v.generation == 0 \
-                    and elapsed + 1e-9 >= v.spec.appear_at:
+            if (
+                v.state == HIDDEN
+                and v.spec.appear_at is not None
+                and v.generation == 0
+                and elapsed + 1e-9 >= v.spec.appear_at
+            ):
                 v.state = PRESENT
                 log.info("visitor %d appears at (%.1f, %.1f)", v.id, v.x, v.y)
             wander = v.spec.wander_off
-            if wander is not None and wander.at is not None and not v.wandered \
-                    and elapsed + 1e-9 >= wander.at and v.state in (PRESENT, WITH_ROBOT, FOLLOWING):
+            if (
+                wander is not None
+                and wander.at is not None
+                and not v.wandered
+                and elapsed + 1e-9 >= wander.at
+                and v.state in (PRESENT, WITH_ROBOT, FOLLOWING)
+            ):
                 self._wander(v, robot)
             if v.state == FOLLOWING and travelled > 1e-9:
                 v.x = robot.x - FOLLOW_DISTANCE * moved[0] / travelled
@@ -142,13 +166,18 @@ class Crowd:
     # ------------------------------------------------------------ sensors
 
     def _in_range(self, robot: RobotPose) -> list[Visitor]:
-        return [v for v in self.visitors.values()
-                if v.visible and robot.distance_to(v.x, v.y) <= self.detection_range]
+        return [
+            v
+            for v in self.visitors.values()
+            if v.visible and robot.distance_to(v.x, v.y) <= self.detection_range
+        ]
 
     def detections(self, robot: RobotPose) -> list[PersonDetection]:
         """What the camera sees (``/UvA_PersonDetectionAndPose``)."""
-        return [PersonDetection(v.id, Point(v.x, v.y, 0.0), v.orientation)
-                for v in self._in_range(robot)]
+        return [
+            PersonDetection(v.id, Point(v.x, v.y, 0.0), v.orientation)
+            for v in self._in_range(robot)
+        ]
 
     def tracked(self, robot: RobotPose) -> list[TrackedPerson]:
         """What the laser tracks (``/PeopleUPO``)."""
@@ -166,8 +195,11 @@ class Crowd:
     def approach_outcome(self, vid: int, robot: RobotPose) -> str | None:
         """Scripted result of approaching ``vid`` (None: no such person in view)."""
         v = self.visitors.get(vid)
-        if v is None or v.state not in (PRESENT, WITH_ROBOT, FOLLOWING) \
-                or robot.distance_to(v.x, v.y) > self.detection_range:
+        if (
+            v is None
+            or v.state not in (PRESENT, WITH_ROBOT, FOLLOWING)
+            or robot.distance_to(v.x, v.y) > self.detection_range
+        ):
             return None
         if isinstance(v.spec.approach, str):
             return v.spec.approach
@@ -206,8 +238,13 @@ class Crowd:
         """The robot was sent to ``pois``: visitors scripted to wander off then do."""
         for v in self.visitors.values():
             wander = v.spec.wander_off
-            if wander is not None and wander.heading_to is not None and not v.wandered \
-                    and v.state in (WITH_ROBOT, FOLLOWING) and poi_matches(wander.heading_to, pois):
+            if (
+                wander is not None
+                and wander.heading_to is not None
+                and not v.wandered
+                and v.state in (WITH_ROBOT, FOLLOWING)
+                and poi_matches(wander.heading_to, pois)
+            ):
                 self._wander(v, robot)
 
     def tour_over(self, robot: RobotPose) -> None:

@@ -113,8 +113,13 @@ def load(path: Path, site: Site) -> Played:
             elif isinstance(record, FrontendOut) and record.seq not in seqs:  # not a resend
                 seqs.add(record.seq)
                 message = record.message
-                commands.append(Command(record.t, FRONTEND_OUT, plain(
-                    {"type": message.type, **message_fields(message)})))
+                commands.append(
+                    Command(
+                        record.t,
+                        FRONTEND_OUT,
+                        plain({"type": message.type, **message_fields(message)}),
+                    )
+                )
             elif isinstance(record, Primed) and recording is recordings[0] and not inputs:
                 # the inputs' latest messages from before the file, given at its start
                 inputs.extend((record.t, i.topic, i.msg()) for i in record.inputs)
@@ -123,22 +128,45 @@ def load(path: Path, site: Site) -> Played:
     tally = reader.tally
     start = from_ns(recordings[0].start)
     if tally.count:
-        log.warning("%d recorded message(s) did not decode and are not played; first: %s",
-                    tally.count, tally.first[0].line(start))
+        log.warning(
+            "%d recorded message(s) did not decode and are not played; first: %s",
+            tally.count,
+            tally.first[0].line(start),
+        )
     types = dict(served)
     types[CLOCK.name] = CLOCK.type
-    return Played([str(r.path) for r in recordings], start, from_ns(recordings[-1].end),
-                  inputs, events, commands, types, tally.count, tally.lines(start)[:BAD_TOLD])
+    return Played(
+        [str(r.path) for r in recordings],
+        start,
+        from_ns(recordings[-1].end),
+        inputs,
+        events,
+        commands,
+        types,
+        tally.count,
+        tally.lines(start)[:BAD_TOLD],
+    )
 
 
 class Player:
     """Serves a :class:`Played` recording; see the module docstring."""
 
-    def __init__(self, played: Played, site: Site, *, host: str, rosbridge_port: int,
-                 frontend_host: str, frontend_port: int, executive: Address,
-                 speed: float = 1.0, loop: bool = False, secret: str | None = None,
-                 on_difference: Callable[[str], None] | None = None,
-                 wait_max: float = WAIT_MAX) -> None:
+    def __init__(
+        self,
+        played: Played,
+        site: Site,
+        *,
+        host: str,
+        rosbridge_port: int,
+        frontend_host: str,
+        frontend_port: int,
+        executive: Address,
+        speed: float = 1.0,
+        loop: bool = False,
+        secret: str | None = None,
+        on_difference: Callable[[str], None] | None = None,
+        wait_max: float = WAIT_MAX,
+    ) -> None:
         self.played = played
         self.wait_max = wait_max
         self.speed = speed
@@ -146,8 +174,13 @@ class Player:
         self.now = played.start
         self.comparison = Comparison(site, played.commands, start=played.start)
         self.on_difference = on_difference
-        self.rosbridge = RosbridgeServer(BridgeServer(secret, played.types), host,
-                                         rosbridge_port, self._on_incoming, lambda: self.now)
+        self.rosbridge = RosbridgeServer(
+            BridgeServer(secret, played.types),
+            host,
+            rosbridge_port,
+            self._on_incoming,
+            lambda: self.now,
+        )
         self.udp = FrontendSocket(frontend_host, frontend_port, executive, self._on_datagram)
         self.inputs_sent = 0
         self.events_sent = 0
@@ -184,10 +217,14 @@ class Player:
         passes = f" ({self.passes} whole passes)" if self.loop else ""
         bad = ""
         if self.played.bad:
-            bad = (f"; {self.played.bad} recorded message(s) did not decode, not played "
-                   f"({'; '.join(self.played.bad_first)})")
-        return (f"played {self.inputs_sent} inputs and {self.events_sent} front-end "
-                f"events{passes}; {self.comparison.line()}{bad}")
+            bad = (
+                f"; {self.played.bad} recorded message(s) did not decode, not played "
+                f"({'; '.join(self.played.bad_first)})"
+            )
+        return (
+            f"played {self.inputs_sent} inputs and {self.events_sent} front-end "
+            f"events{passes}; {self.comparison.line()}{bad}"
+        )
 
     async def _wait_for_executive(self) -> None:
         """Until a client subscribes to a topic it serves (then a moment for its other

@@ -107,10 +107,14 @@ def publish_frame(topic: str, msg: Any) -> str:
 class BridgeServer:
     """All clients of one rosbridge server; ``topic_types`` are the server's own topics."""
 
-    def __init__(self, secret: str | None = None,
-                 topic_types: Mapping[str, str] | None = None, *,
-                 auth_time: Callable[[], float] = time.time,
-                 allowed_time_delta: float = 5.0) -> None:
+    def __init__(
+        self,
+        secret: str | None = None,
+        topic_types: Mapping[str, str] | None = None,
+        *,
+        auth_time: Callable[[], float] = time.time,
+        allowed_time_delta: float = 5.0,
+    ) -> None:
         self.secret = secret
         self.auth_time = auth_time
         self.allowed_time_delta = allowed_time_delta
@@ -171,8 +175,10 @@ class BridgeServer:
                 # rospy.Time(msg["t"]) raises: the real server logs "Unknown operation:
                 # auth" and waits for the next frame, which then closes the connection.
                 self.stats.auth_failures += 1
-                log.warning("client %d: auth with t/end not numbers of seconds: "
-                            "Unknown operation: auth", state.id)
+                log.warning(
+                    "client %d: auth with t/end not numbers of seconds: Unknown operation: auth",
+                    state.id,
+                )
                 return []
             if self._auth_ok(frame, float(t), float(end)):  # type: ignore[arg-type]
                 state.authenticated = True
@@ -246,8 +252,12 @@ class BridgeServer:
             values = {"type": self._all_topic_types().get(str(args.get("topic", "")), "")}
         else:
             values, result = f"service {service} is not available in the simulator", False
-        reply: dict[str, Any] = {"op": "service_response", "service": service,
-                                 "values": values, "result": result}
+        reply: dict[str, Any] = {
+            "op": "service_response",
+            "service": service,
+            "values": values,
+            "result": result,
+        }
         if "id" in frame:
             reply["id"] = frame["id"]
         return [Send(state.id, dumps(reply))]
@@ -269,8 +279,11 @@ class BridgeServer:
             sub = client.subscriptions.get(topic)
             if sub is None or not client.authenticated:
                 continue
-            if sub.throttle_rate and sub.last_sent is not None \
-                    and now - sub.last_sent < sub.throttle_rate / 1000.0 - 1e-6:
+            if (
+                sub.throttle_rate
+                and sub.last_sent is not None
+                and now - sub.last_sent < sub.throttle_rate / 1000.0 - 1e-6
+            ):
                 self.stats.throttled += 1
                 continue
             sub.last_sent = now
@@ -331,8 +344,12 @@ def _count(frame: dict[str, Any], key: str) -> int:
     value = frame.get(key, 0)
     if value is None:
         return 0
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
-            or value < 0:
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int | float)
+        or not math.isfinite(value)
+        or value < 0
+    ):
         raise DecodeError(f"expected a number >= 0, got {value!r}"[:200], (key,))
     return int(value)
 

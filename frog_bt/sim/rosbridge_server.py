@@ -37,8 +37,14 @@ class _Connection:
 class RosbridgeServer:
     """Listens on ``host:port`` (0: any free port; :attr:`port` gives the bound one)."""
 
-    def __init__(self, protocol: BridgeServer, host: str, port: int,
-                 on_incoming: Callable[[Incoming], None], now: Callable[[], float]) -> None:
+    def __init__(
+        self,
+        protocol: BridgeServer,
+        host: str,
+        port: int,
+        on_incoming: Callable[[Incoming], None],
+        now: Callable[[], float],
+    ) -> None:
         self.protocol = protocol
         self.host = host
         self.port = port
@@ -71,8 +77,9 @@ class RosbridgeServer:
         if self._server is not None:
             return
         # No permessage-deflate: loopback needs no compression, and it costs per frame.
-        self._server = await serve(self._handle, self.host, self.port, max_size=MAX_FRAME_BYTES,
-                                   compression=None)
+        self._server = await serve(
+            self._handle, self.host, self.port, max_size=MAX_FRAME_BYTES, compression=None
+        )
         self.port = next(iter(self._server.sockets)).getsockname()[1]
         log.info("rosbridge listening on ws://%s:%d", self.host, self.port)
 

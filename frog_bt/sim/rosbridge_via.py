@@ -40,8 +40,15 @@ class RosbridgeVia:
     ``on_incoming`` as :class:`Incoming` (client :data:`VIA_CLIENT`).
     """
 
-    def __init__(self, url: str, publishes: Mapping[str, str], commands: Mapping[str, str],
-                 on_incoming: Callable[[Incoming], None], *, secret: str | None = None) -> None:
+    def __init__(
+        self,
+        url: str,
+        publishes: Mapping[str, str],
+        commands: Mapping[str, str],
+        on_incoming: Callable[[Incoming], None],
+        *,
+        secret: str | None = None,
+    ) -> None:
         self.url = url
         self.publishes = dict(publishes)
         self.commands = dict(commands)
@@ -50,8 +57,9 @@ class RosbridgeVia:
         self.received = 0
         self.malformed = 0
         self.lost = 0  # published while the server was away
-        self._client = RosbridgeClient(url, secret=secret, on_raw=self._on_raw,
-                                       on_link=self._on_link, backoff_max=2.0)
+        self._client = RosbridgeClient(
+            url, secret=secret, on_raw=self._on_raw, on_link=self._on_link, backoff_max=2.0
+        )
         for topic, type_ in self.publishes.items():
             self._client.advertise(topic, type_)
         for topic, type_ in self.commands.items():
@@ -105,7 +113,6 @@ class RosbridgeVia:
     def _on_link(self, state: LinkState) -> None:
         if state.connected:
             self.connections += 1
-            log.info("sim: connected to rosbridge %s (connection %d)", self.url,
-                     self.connections)
+            log.info("sim: connected to rosbridge %s (connection %d)", self.url, self.connections)
         else:
             log.info("sim: rosbridge %s lost (%s)", self.url, state.last_error or "closed")

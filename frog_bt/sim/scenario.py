@@ -164,17 +164,26 @@ class VisitorSpec(_Model):
         expected = f"expected one of {', '.join(FACE_PROFILES)}, or a list of numbers in [-1, 1]"
         if isinstance(value, str) and value in FACE_PROFILES:
             return value
-        if isinstance(value, list | tuple) and value and all(
-                isinstance(v, int | float) and not isinstance(v, bool)
-                and math.isfinite(v) and -1 <= v <= 1 for v in value):
+        if (
+            isinstance(value, list | tuple)
+            and value
+            and all(
+                isinstance(v, int | float)
+                and not isinstance(v, bool)
+                and math.isfinite(v)
+                and -1 <= v <= 1
+                for v in value
+            )
+        ):
             return tuple(float(v) for v in value)
         raise ValueError(f"{expected}, got {value!r}"[:200])
 
     @model_validator(mode="after")
     def _orientation_or_facing(self) -> VisitorSpec:
         if self.orientation is not None and self.facing is not None:
-            raise ValueError("give orientation (degrees, 180 = facing the robot) or facing, "
-                             "not both")
+            raise ValueError(
+                "give orientation (degrees, 180 = facing the robot) or facing, not both"
+            )
         return self
 
     @property
@@ -205,8 +214,9 @@ class FrontendSpec(_Model):
     def _intervals(cls, value: list[tuple[float, float]]) -> list[tuple[float, float]]:
         for i, (start, end) in enumerate(value):
             if not end > start:
-                raise PathError((i,), f"expected [start, end] with end > start, got "
-                                      f"[{start:g}, {end:g}]")
+                raise PathError(
+                    (i,), f"expected [start, end] with end > start, got [{start:g}, {end:g}]"
+                )
         return value
 
     def silences(self) -> list[tuple[float, float]]:
@@ -258,12 +268,14 @@ class Scenario(_Model):
                     if part not in ("a", "b"):
                         raise PathError((key, part), 'unknown part; expected "a" or "b"')
                     if seconds is not None and not _positive(seconds):
-                        raise PathError((key, part),
-                                        f"expected seconds > 0, got {seconds!r}"[:200])
+                        raise PathError((key, part), f"expected seconds > 0, got {seconds!r}"[:200])
                 out[key] = ContentParts(**item)
             else:
-                what = "seconds > 0" if key in ("default", "introduction") else \
-                    "seconds > 0 or {a: seconds, b: seconds}"
+                what = (
+                    "seconds > 0"
+                    if key in ("default", "introduction")
+                    else "seconds > 0 or {a: seconds, b: seconds}"
+                )
                 raise PathError((key,), f"expected {what}, got {item!r}"[:200])
         return out
 
@@ -298,8 +310,12 @@ class Scenario(_Model):
 
 
 def _positive(value: Any) -> bool:
-    return (isinstance(value, int | float) and not isinstance(value, bool)
-            and math.isfinite(value) and value > 0)
+    return (
+        isinstance(value, int | float)
+        and not isinstance(value, bool)
+        and math.isfinite(value)
+        and value > 0
+    )
 
 
 # ------------------------------------------------------------------ loading
@@ -323,8 +339,12 @@ def _resolve(path_or_name: str | Path, relative_to: Path | None = None) -> Path:
     if relative_to is not None and not path.is_absolute():
         path = relative_to / path
     if looks_like_name and not path.exists():
-        raise ConfigError(text, (), "no such scenario; expected a built-in name "
-                          f"({', '.join(builtin_scenarios())}) or a YAML file path")
+        raise ConfigError(
+            text,
+            (),
+            "no such scenario; expected a built-in name "
+            f"({', '.join(builtin_scenarios())}) or a YAML file path",
+        )
     return path
 
 
@@ -333,8 +353,9 @@ def _raw(path: Path, depth: int = 0) -> dict[str, Any]:
     if data is None:
         data = {}
     if not isinstance(data, dict):
-        raise ConfigError(str(path), (), f"expected a mapping of scenario keys, got "
-                          f"{type(data).__name__}")
+        raise ConfigError(
+            str(path), (), f"expected a mapping of scenario keys, got {type(data).__name__}"
+        )
     base_ref = data.pop("extends", None)
     if base_ref is None:
         return data
@@ -358,8 +379,9 @@ def merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def scenario_from(base: str | Path = "default", overrides: dict[str, Any] | None = None
-                  ) -> Scenario:
+def scenario_from(
+    base: str | Path = "default", overrides: dict[str, Any] | None = None
+) -> Scenario:
     """Scenario ``base`` with ``overrides`` on top (mappings merge, lists replace)."""
     data = load_scenario(base).model_dump(mode="json")
     return parse_scenario(merge(data, overrides or {}), f"{base} + overrides")

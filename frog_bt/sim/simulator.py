@@ -51,12 +51,19 @@ REPUBLISH_AFTER = 0.05  # wall seconds waiting before /clock is published again
 class Simulator:
     """The simulated robot (rosbridge server) and front end (UDP) of one scenario."""
 
-    def __init__(self, scenario: Scenario, *, host: str = "127.0.0.1",
-                 rosbridge_port: int = 9090, frontend_port: int = 5005,
-                 executive: tuple[str, int] = ("127.0.0.1", 5006),
-                 pois: Mapping[str, PoiPose] | None = None,
-                 secret: str | None = None, frontend_host: str | None = None,
-                 via: str | None = None) -> None:
+    def __init__(
+        self,
+        scenario: Scenario,
+        *,
+        host: str = "127.0.0.1",
+        rosbridge_port: int = 9090,
+        frontend_port: int = 5005,
+        executive: tuple[str, int] = ("127.0.0.1", 5006),
+        pois: Mapping[str, PoiPose] | None = None,
+        secret: str | None = None,
+        frontend_host: str | None = None,
+        via: str | None = None,
+    ) -> None:
         self.scenario = scenario
         self.speed = scenario.speed
         self._follow: Callable[[], float | None] | None = None
@@ -72,17 +79,19 @@ class Simulator:
         self.via = via
         self._rosbridge: RosbridgeServer | RosbridgeVia
         if via is None:
-            self._rosbridge = RosbridgeServer(self.bridge, host, rosbridge_port,
-                                              self._on_incoming, self.clock.now)
+            self._rosbridge = RosbridgeServer(
+                self.bridge, host, rosbridge_port, self._on_incoming, self.clock.now
+            )
         else:  # the robot as a client of an existing server (secret: to authenticate)
             robot = {t.name: t.type for t in (*INPUTS.values(), CLOCK)}
             commands = {t.name: t.type for t in OUTPUTS.values()}
-            self._rosbridge = RosbridgeVia(via, robot, commands, self._on_incoming,
-                                           secret=secret)
-        self.frontend = FrontendModel(scenario, executive[0], self._visitor_says_yes,
-                                      self._on_frontend_traffic)
-        self._udp = FrontendSocket(frontend_host or host, frontend_port,
-                                   (executive[0], executive[1]), self._on_datagram)
+            self._rosbridge = RosbridgeVia(via, robot, commands, self._on_incoming, secret=secret)
+        self.frontend = FrontendModel(
+            scenario, executive[0], self._visitor_says_yes, self._on_frontend_traffic
+        )
+        self._udp = FrontendSocket(
+            frontend_host or host, frontend_port, (executive[0], executive[1]), self._on_datagram
+        )
         self._loop_task: asyncio.Task[None] | None = None
         self._dropped: dict[str, float] = {}  # topic -> simulated time its drop-out ends
         self._loss_rng = random.Random(scenario.seed)
@@ -142,8 +151,7 @@ class Simulator:
         """Drop all rosbridge clients and stop listening; the world keeps running.
         (Only for the simulator's own server: ``via`` a server, restart that server.)"""
         if self.via is not None:
-            raise RuntimeError("the simulator serves no rosbridge: it is a client of "
-                               f"{self.via}")
+            raise RuntimeError(f"the simulator serves no rosbridge: it is a client of {self.via}")
         await self._rosbridge.stop()
 
     async def start_rosbridge(self) -> None:
@@ -161,9 +169,12 @@ class Simulator:
 
     # ------------------------------------------------------------ time
 
-    def follow(self, executive_time: Callable[[], float | None] | None,
-               wait_until: Callable[[float], Awaitable[Any]] | None = None,
-               lead: float = 0.5) -> None:
+    def follow(
+        self,
+        executive_time: Callable[[], float | None] | None,
+        wait_until: Callable[[float], Awaitable[Any]] | None = None,
+        lead: float = 0.5,
+    ) -> None:
         """Run at most ``lead`` simulated seconds ahead of ``executive_time()`` (the
         executive's clock; None while it does not follow, e.g. disconnected).
         ``wait_until(t)`` resolves once the executive's clock reaches ``t`` (without it

@@ -25,15 +25,24 @@ def load_pois(path: str | Path = DEFAULT_CONFIG) -> dict[str, PoiPose]:
     return {name: (p.x, p.y, p.z, p.w) for name, p in load_site(path).pois.items()}
 
 
-def pois_at(pois: Mapping[str, PoiPose], x: float, y: float,
-            radius: float = MATCH_RADIUS) -> frozenset[str]:
+def pois_at(
+    pois: Mapping[str, PoiPose], x: float, y: float, radius: float = MATCH_RADIUS
+) -> frozenset[str]:
     """Names of every POI within ``radius`` of (x, y) (POI1a and POI1b share a spot)."""
-    return frozenset(name for name, (px, py, _, _) in pois.items()
-                     if math.hypot(px - x, py - y) <= radius)
+    return frozenset(
+        name for name, (px, py, _, _) in pois.items() if math.hypot(px - x, py - y) <= radius
+    )
 
 
 def poi_matches(spec: str, names: Iterable[str]) -> bool:
     """True when scenario POI ``spec`` is one of ``names`` or a variant of it (POI2 ~ POI2b)."""
-    return any(name == spec or (len(name) == len(spec) + 1 and name.startswith(spec)
-                                and name[-1].isalpha() and name[-1].islower())
-               for name in names)
+    return any(
+        name == spec
+        or (
+            len(name) == len(spec) + 1
+            and name.startswith(spec)
+            and name[-1].isalpha()
+            and name[-1].islower()
+        )
+        for name in names
+    )

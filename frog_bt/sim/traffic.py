@@ -81,15 +81,23 @@ class MessageLog(Sequence[Record]):
 
     def received(self, channel: str | None = None, side: str | None = None) -> list[Record]:
         """What the simulator received (the executive sent), optionally on one channel/side."""
-        return [r for r in self._records if r.direction == "in"
-                and (channel is None or r.channel == channel)
-                and (side is None or r.side == side)]
+        return [
+            r
+            for r in self._records
+            if r.direction == "in"
+            and (channel is None or r.channel == channel)
+            and (side is None or r.side == side)
+        ]
 
     def sent(self, channel: str | None = None, side: str | None = None) -> list[Record]:
         """What the simulator sent, optionally on one channel/side."""
-        return [r for r in self._records if r.direction == "out"
-                and (channel is None or r.channel == channel)
-                and (side is None or r.side == side)]
+        return [
+            r
+            for r in self._records
+            if r.direction == "out"
+            and (channel is None or r.channel == channel)
+            and (side is None or r.side == side)
+        ]
 
     async def wait_for(self, predicate: Predicate, timeout: float) -> Record:
         """The first record (already logged, or still to come) satisfying ``predicate``.

@@ -42,8 +42,9 @@ log = logging.getLogger(__name__)
 
 Out = tuple[str, dict[str, Any]]
 POSE, RESPONSE, DOCKING_STATE, DIAGNOSTIC, PERSONS, FACES, PEOPLE = (
-    INPUTS[k].name for k in
-    ("pose", "response", "docking_state", "diagnostic", "persons", "faces", "people"))
+    INPUTS[k].name
+    for k in ("pose", "response", "docking_state", "diagnostic", "persons", "faces", "people")
+)
 GOTO, APPROACH, ICL, DOCK = (OUTPUTS[k].name for k in ("goto", "approach", "icl", "dock"))
 OUTCOME_CODES = {"succeeded": SUCCEEDED, "failed": FAILED, "aborted": ABORTED}
 
@@ -82,11 +83,16 @@ def check_pois(scenario: Scenario, pois: Mapping[str, PoiPose]) -> None:
     known = ", ".join(sorted(pois))
     where = scenario.name or "<scenario>"
     refs: list[tuple[tuple[str | int, ...], str]] = [(("robot", "start"), scenario.robot.start)]
-    refs += [(("navigation", "failures", i, "poi"), f.poi)
-             for i, f in enumerate(scenario.navigation.failures) if f.poi is not None]
-    refs += [(("visitors", i, "wander_off", "heading_to"), v.wander_off.heading_to)
-             for i, v in enumerate(scenario.visitors)
-             if v.wander_off is not None and v.wander_off.heading_to is not None]
+    refs += [
+        (("navigation", "failures", i, "poi"), f.poi)
+        for i, f in enumerate(scenario.navigation.failures)
+        if f.poi is not None
+    ]
+    refs += [
+        (("visitors", i, "wander_off", "heading_to"), v.wander_off.heading_to)
+        for i, v in enumerate(scenario.visitors)
+        if v.wander_off is not None and v.wander_off.heading_to is not None
+    ]
     for path, name in refs:
         if not poi_matches(name, pois):
             raise ConfigError(where, path, f"unknown POI {name!r} (known: {known})")
@@ -95,8 +101,9 @@ def check_pois(scenario: Scenario, pois: Mapping[str, PoiPose]) -> None:
 class World:
     """Robot, dock, battery and visitors of one scenario, at time ``now``."""
 
-    def __init__(self, scenario: Scenario, pois: Mapping[str, PoiPose],
-                 start: float | None = None) -> None:
+    def __init__(
+        self, scenario: Scenario, pois: Mapping[str, PoiPose], start: float | None = None
+    ) -> None:
         check_pois(scenario, pois)
         self.scenario = scenario
         self.pois = dict(pois)
@@ -105,8 +112,11 @@ class World:
         dock = self.pois[scenario.robot.start]
         self.dock_pose = RobotPose.from_quaternion(*dock)
         spec_pose = scenario.robot.pose
-        self.pose = (RobotPose(spec_pose.x, spec_pose.y, math.radians(spec_pose.yaw))
-                     if spec_pose is not None else RobotPose.from_quaternion(*dock))
+        self.pose = (
+            RobotPose(spec_pose.x, spec_pose.y, math.radians(spec_pose.yaw))
+            if spec_pose is not None
+            else RobotPose.from_quaternion(*dock)
+        )
         self.navigator = Navigator(scenario.navigation)
         self.docking = Docking(scenario.docking, scenario.robot.docked)
         self.battery = Battery(scenario.battery)
@@ -114,11 +124,20 @@ class World:
         self.faces_on = False
         self.approach: Approach | None = None
         self.malformed = 0
-        self._rates = {POSE: Rate(0.1), PERSONS: Rate(0.2), PEOPLE: Rate(0.2),
-                       FACES: Rate(0.1), DIAGNOSTIC: Rate(1.0), DOCKING_STATE: Rate(1.0)}
+        self._rates = {
+            POSE: Rate(0.1),
+            PERSONS: Rate(0.2),
+            PEOPLE: Rate(0.2),
+            FACES: Rate(0.1),
+            DIAGNOSTIC: Rate(1.0),
+            DOCKING_STATE: Rate(1.0),
+        }
         self._handlers: dict[str, Callable[[Any], list[Out]]] = {
-            GOTO: self._on_goto, APPROACH: self._on_approach, ICL: self._on_icl,
-            DOCK: self._on_dock}
+            GOTO: self._on_goto,
+            APPROACH: self._on_approach,
+            ICL: self._on_icl,
+            DOCK: self._on_dock,
+        }
 
     # ------------------------------------------------------------ state
 
@@ -201,8 +220,10 @@ class World:
 
     def _on_dock(self, msg: Any) -> list[Out]:
         command = ros.STRING.convert(msg)
-        near = self.pose.distance_to(self.dock_pose.x, self.dock_pose.y) \
+        near = (
+            self.pose.distance_to(self.dock_pose.x, self.dock_pose.y)
             <= self.scenario.docking.dock_range
+        )
         if command in ("dock", "undock"):
             self.navigator.cancel()
             self.approach = None

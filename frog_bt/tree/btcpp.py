@@ -38,8 +38,12 @@ from frog_bt.tree.catalogue import NodeType, catalogue
 from frog_bt.tree.factory import NodeFactory
 from frog_bt.yamlfile import load_yaml
 
-CONTROLS = {("Sequence", True): "Sequence", ("Sequence", False): "ReactiveSequence",
-            ("Selector", True): "Fallback", ("Selector", False): "ReactiveFallback"}
+CONTROLS = {
+    ("Sequence", True): "Sequence",
+    ("Sequence", False): "ReactiveSequence",
+    ("Selector", True): "Fallback",
+    ("Selector", False): "ReactiveFallback",
+}
 FROM_CONTROL = {v: k for k, v in CONTROLS.items()}
 RETRY, FORCE = "RetryUntilSuccessful", "ForceSuccess"
 # frog-bt types whose name is a different BT.CPP built-in: exported under another name
@@ -90,8 +94,14 @@ class _Exporter:
             out = []
             for i, stop in enumerate(stops):
                 extra = {**stop.model_dump(), "index": i, **data.get("with", {})}
-                out += self.node({"include": data["include"], "with": extra,
-                                  **({"when": data["when"]} if "when" in data else {})}, load)
+                out += self.node(
+                    {
+                        "include": data["include"],
+                        "with": extra,
+                        **({"when": data["when"]} if "when" in data else {}),
+                    },
+                    load,
+                )
             return out
         if "include" in data:
             target = str(data["include"])
@@ -103,21 +113,29 @@ class _Exporter:
             _when(element, data.get("when"))
             return [element]
         type_ = data["type"]
-        params = {k: v for k, v in data.items()
-                  if k not in ("type", "name", "when", "child", "children", "memory")}
+        params = {
+            k: v
+            for k, v in data.items()
+            if k not in ("type", "name", "when", "child", "children", "memory")
+        }
         scope = params.pop("scope", None)
         if type_ in ("Sequence", "Selector"):
             element = ET.Element(CONTROLS[(type_, bool(data["memory"]))])
         elif type_ == "Parallel":
-            element = ET.Element("Parallel", {
-                "success_count": "1" if params.pop("policy", "all") == "one" else "-1",
-                "failure_count": "1"})
+            element = ET.Element(
+                "Parallel",
+                {
+                    "success_count": "1" if params.pop("policy", "all") == "one" else "-1",
+                    "failure_count": "1",
+                },
+            )
             if params.pop("synchronise", True) is False:
                 element.set("synchronise", "false")  # no BT.CPP equivalent (docs/TREES.md)
         elif type_ == "Retry":
             attempts = params.pop("attempts", None)
-            element = ET.Element(RETRY, {"num_attempts": "-1" if attempts is None
-                                         else _text(attempts)})
+            element = ET.Element(
+                RETRY, {"num_attempts": "-1" if attempts is None else _text(attempts)}
+            )
         elif type_ == "FailureIsSuccess":
             element = ET.Element(FORCE)
         else:
@@ -151,14 +169,20 @@ def _model(types: set[str], factory: NodeFactory) -> ET.Element:
             port.text = param.meaning or param.type
         if node.doc:
             ET.SubElement(element, "MetadataFields").append(
-                ET.Element("Metadata", {"description": node.doc.split("\n\n")[0]}))
+                ET.Element("Metadata", {"description": node.doc.split("\n\n")[0]})
+            )
     return model
 
 
-def to_xml(tree_path: Path, site: Site | None, factory: NodeFactory,
-           documents: dict[str, Any] | None = None) -> str:
+def to_xml(
+    tree_path: Path,
+    site: Site | None,
+    factory: NodeFactory,
+    documents: dict[str, Any] | None = None,
+) -> str:
     """The tree file at ``tree_path`` (and what it includes) as BT.CPP v4 XML; with
     ``documents`` (an imported XML's), those instead of the files."""
+
     def load(target: str, base: Path = tree_path.parent) -> dict[str, Any]:
         if documents is not None:
             return documents[Path(target).stem]
@@ -204,15 +228,19 @@ def _from_element(element: ET.Element) -> dict[str, Any]:
             type_, memory = FROM_CONTROL[tag]
             data = {"type": type_, "memory": memory}
         elif tag == "Parallel":
-            data = {"type": "Parallel",
-                    "policy": "one" if attrs.pop("success_count", "-1") == "1" else "all"}
+            data = {
+                "type": "Parallel",
+                "policy": "one" if attrs.pop("success_count", "-1") == "1" else "all",
+            }
             attrs.pop("failure_count", None)
             if attrs.pop("synchronise", "true") == "false":
                 data["synchronise"] = False
         elif tag == RETRY:
             attempts = _value(attrs.pop("num_attempts", "-1"))
-            data = {"type": "Retry",
-                    "attempts": None if isinstance(attempts, int) and attempts < 0 else attempts}
+            data = {
+                "type": "Retry",
+                "attempts": None if isinstance(attempts, int) and attempts < 0 else attempts,
+            }
         elif tag == FORCE:
             data = {"type": "FailureIsSuccess"}
         else:

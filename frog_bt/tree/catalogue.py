@@ -60,8 +60,7 @@ def _type_name(annotation: Any) -> str:
 def _params(model: type[BaseModel]) -> tuple[Param, ...]:
     out = []
     for name, info in model.model_fields.items():
-        default = "required" if info.is_required() else info.get_default(
-            call_default_factory=True)
+        default = "required" if info.is_required() else info.get_default(call_default_factory=True)
         if default is PydanticUndefined:
             default = "required"
         out.append(Param(name, _type_name(info.annotation), default, info.description or ""))
@@ -74,18 +73,26 @@ def _names(keys: tuple[Key[Any], ...]) -> tuple[str, ...]:
 
 def _node(cls: Any, kind: str) -> NodeType:
     children = {"composite": "children", "decorator": "child"}.get(kind, "")
-    return NodeType(cls.__name__, kind, _params(cls.Params),
-                    _names(getattr(cls, "reads", ())), _names(getattr(cls, "optional_reads", ())),
-                    _names(getattr(cls, "writes", ())), inspect.cleandoc(cls.__doc__ or ""),
-                    children)
+    return NodeType(
+        cls.__name__,
+        kind,
+        _params(cls.Params),
+        _names(getattr(cls, "reads", ())),
+        _names(getattr(cls, "optional_reads", ())),
+        _names(getattr(cls, "writes", ())),
+        inspect.cleandoc(cls.__doc__ or ""),
+        children,
+    )
 
 
 def catalogue(factory: NodeFactory) -> list[NodeType]:
     """Every node type of ``factory``, composites first, then decorators and leaves by
     name."""
-    return [*(_node(factory.composites[n], "composite") for n in factory.composites),
-            *(_node(factory.decorators[n], "decorator") for n in sorted(factory.decorators)),
-            *(_node(factory.leaves[n], "leaf") for n in sorted(factory.leaves))]
+    return [
+        *(_node(factory.composites[n], "composite") for n in factory.composites),
+        *(_node(factory.decorators[n], "decorator") for n in sorted(factory.decorators)),
+        *(_node(factory.leaves[n], "leaf") for n in sorted(factory.leaves)),
+    ]
 
 
 @dataclass(frozen=True, slots=True)
@@ -99,8 +106,10 @@ class KeyInfo:
 
 def key_catalogue() -> list[KeyInfo]:
     """Every key a tree can read or write, by name."""
-    return [KeyInfo(k.name, k.type_name, k.source.value, k.scope.name.lower(), k.doc)
-            for _, k in sorted(by_name().items())]
+    return [
+        KeyInfo(k.name, k.type_name, k.source.value, k.scope.name.lower(), k.doc)
+        for _, k in sorted(by_name().items())
+    ]
 
 
 def as_json(nodes: list[NodeType]) -> str:
@@ -114,8 +123,11 @@ def _cell(text: str) -> str:
 def as_markdown(nodes: list[NodeType]) -> str:
     """One section per node type: its docstring, a parameter table and its keys."""
     out: list[str] = []
-    for kind, title in (("composite", "Composites"), ("decorator", "Decorators and scopes"),
-                        ("leaf", "Leaves")):
+    for kind, title in (
+        ("composite", "Composites"),
+        ("decorator", "Decorators and scopes"),
+        ("leaf", "Leaves"),
+    ):
         out.append(f"### {title}\n")
         for node in (n for n in nodes if n.kind == kind):
             out.append(f"#### `{node.name}`\n")
@@ -126,8 +138,9 @@ def as_markdown(nodes: list[NodeType]) -> str:
                 out.append("|---|---|---|---|")
                 for p in node.params:
                     default = "required" if p.default == "required" else f"`{p.default!r}`"
-                    out.append(f"| `{p.name}` | {_cell(p.type)} | {_cell(default)} | "
-                               f"{_cell(p.meaning)} |")
+                    out.append(
+                        f"| `{p.name}` | {_cell(p.type)} | {_cell(default)} | {_cell(p.meaning)} |"
+                    )
                 out.append("")
             keys = []
             if node.children:
@@ -142,13 +155,16 @@ def as_markdown(nodes: list[NodeType]) -> str:
                 line = "; ".join(keys)
                 out.append(line[0].upper() + line[1:] + ".\n")
     out.append("### Keys\n")
-    out.append("Every value a tree reads or writes (`frog_bt/model/keys.py`, and the "
-               "robot's inputs in `frog_bt/model/wire.py`). A value lives as long as its scope: "
-               "starting a scope clears its keys and those of narrower scopes "
-               "(tour > visitor > stop).\n")
+    out.append(
+        "Every value a tree reads or writes (`frog_bt/model/keys.py`, and the "
+        "robot's inputs in `frog_bt/model/wire.py`). A value lives as long as its scope: "
+        "starting a scope clears its keys and those of narrower scopes "
+        "(tour > visitor > stop).\n"
+    )
     out.append("| key | type | written by | scope | meaning |")
     out.append("|---|---|---|---|---|")
     for k in key_catalogue():
-        out.append(f"| `{k.name}` | {_cell(k.type)} | {k.source} | {k.scope} | "
-                   f"{_cell(k.meaning)} |")
+        out.append(
+            f"| `{k.name}` | {_cell(k.type)} | {k.source} | {k.scope} | {_cell(k.meaning)} |"
+        )
     return "\n".join(out).rstrip() + "\n"

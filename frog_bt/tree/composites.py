@@ -20,8 +20,10 @@ from frog_bt.tree.node import Params
 
 Behaviour = py_trees.behaviour.Behaviour
 ScopeName = Literal["tour", "visitor", "stop"]
-SCOPE_DOC = ("the scope this part starts: its values (and narrower ones) are cleared each "
-             "time it starts (tour, visitor, stop)")
+SCOPE_DOC = (
+    "the scope this part starts: its values (and narrower ones) are cleared each "
+    "time it starts (tour, visitor, stop)"
+)
 
 
 class _Composite(Observed):
@@ -48,8 +50,9 @@ class Sequence(_Composite, py_trees.composites.Sequence):
     fails."""
 
     class Params(Params):
-        memory: bool = Field(description="true: resume at the running child; false: "
-                                         "re-check every child each tick")
+        memory: bool = Field(
+            description="true: resume at the running child; false: re-check every child each tick"
+        )
         scope: ScopeName | None = Field(None, description=SCOPE_DOC)
 
 
@@ -58,8 +61,9 @@ class Selector(_Composite, py_trees.composites.Selector):
     fail."""
 
     class Params(Params):
-        memory: bool = Field(description="true: resume at the running child; false: try "
-                                         "from the first each tick")
+        memory: bool = Field(
+            description="true: resume at the running child; false: try from the first each tick"
+        )
         scope: ScopeName | None = Field(None, description=SCOPE_DOC)
 
 
@@ -68,17 +72,25 @@ class Parallel(_Composite, py_trees.composites.Parallel):
 
     class Params(Params):
         policy: Literal["all", "one"] = Field(
-            "all", description="SUCCESS when all children / one child succeed")
-        synchronise: bool = Field(True, description="with policy all: a succeeded child is "
-                                                    "not ticked again")
+            "all", description="SUCCESS when all children / one child succeed"
+        )
+        synchronise: bool = Field(
+            True, description="with policy all: a succeeded child is not ticked again"
+        )
         scope: ScopeName | None = Field(None, description=SCOPE_DOC)
 
     @classmethod
     def _make(cls, name: str, params: Any, children: list[Behaviour]) -> _Composite:
-        policy = (py_trees.common.ParallelPolicy.SuccessOnAll(synchronise=params.synchronise)
-                  if params.policy == "all" else py_trees.common.ParallelPolicy.SuccessOnOne())
+        policy = (
+            py_trees.common.ParallelPolicy.SuccessOnAll(synchronise=params.synchronise)
+            if params.policy == "all"
+            else py_trees.common.ParallelPolicy.SuccessOnOne()
+        )
         return cls(name, policy=policy, children=children)
 
 
 COMPOSITES: dict[str, type[_Composite]] = {
-    "Sequence": Sequence, "Selector": Selector, "Parallel": Parallel}
+    "Sequence": Sequence,
+    "Selector": Selector,
+    "Parallel": Parallel,
+}

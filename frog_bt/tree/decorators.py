@@ -33,8 +33,9 @@ class FrogDecorator(Observed, Declared, py_trees.decorators.Decorator):
     parameters lists that class among its bases and maps the parameters to its
     constructor's in :meth:`base_kwargs`."""
 
-    def __init__(self, name: str, child: py_trees.behaviour.Behaviour,
-                 params: BaseModel | None = None) -> None:
+    def __init__(
+        self, name: str, child: py_trees.behaviour.Behaviour, params: BaseModel | None = None
+    ) -> None:
         params = params if params is not None else type(self).Params()
         super().__init__(name=name, child=child, **self.base_kwargs(params))
         self._declare(params)
@@ -65,8 +66,9 @@ class Retry(FrogDecorator, py_trees.decorators.Retry):
     """
 
     class Params(Params):
-        attempts: int | None = Field(None, ge=1, description=(
-            "runs in all (null: until it succeeds)"))
+        attempts: int | None = Field(
+            None, ge=1, description=("runs in all (null: until it succeeds)")
+        )
 
     def base_kwargs(self, params: Any) -> dict[str, Any]:
         return {"num_failures": params.attempts or math.inf}
@@ -83,8 +85,9 @@ class Timeout(FrogDecorator):
     """
 
     class Params(Params):
-        seconds: float = Field(gt=0, allow_inf_nan=False, description=(
-            "project-clock seconds the child may run"))
+        seconds: float = Field(
+            gt=0, allow_inf_nan=False, description=("project-clock seconds the child may run")
+        )
 
     def initialise(self) -> None:
         self.deadline = self.ctx.clock.now() + self.params.seconds

@@ -28,8 +28,9 @@ D = TypeVar("D", bound=type[FrogDecorator])
 class NodeFactory:
     """Composites, decorators and leaves by the name a tree file gives them."""
 
-    def __init__(self, leaves: Iterable[type[Leaf]] = (),
-                 decorators: Iterable[type[FrogDecorator]] = ()) -> None:
+    def __init__(
+        self, leaves: Iterable[type[Leaf]] = (), decorators: Iterable[type[FrogDecorator]] = ()
+    ) -> None:
         self.composites = dict(COMPOSITES)
         self.decorators: dict[str, type[FrogDecorator]] = dict(DECORATORS)
         self.leaves: dict[str, type[Leaf]] = {}
@@ -60,8 +61,7 @@ class NodeFactory:
 
     def type_of(self, name: str) -> type[Behaviour]:
         """The class a type name stands for; KeyError for an unknown one."""
-        found = (self.composites.get(name) or self.decorators.get(name)
-                 or self.leaves.get(name))
+        found = self.composites.get(name) or self.decorators.get(name) or self.leaves.get(name)
         if found is None:
             raise KeyError(name)
         return found

@@ -64,8 +64,14 @@ def gaps(root: Behaviour) -> list[Gap]:
     def need(node: Behaviour, have: Keys, lost: dict[Key[Any], Scope]) -> None:
         for key in getattr(node, "reads", ()):
             if key not in have:
-                found.append(Gap(node, key, tuple(w for w in writers.get(key, ())
-                                                  if w is not node), lost.get(key)))
+                found.append(
+                    Gap(
+                        node,
+                        key,
+                        tuple(w for w in writers.get(key, ()) if w is not node),
+                        lost.get(key),
+                    )
+                )
 
     def visit(node: Behaviour, have: Keys, lost: dict[Key[Any], Scope]) -> Keys:
         scope: Scope | None = getattr(node, "scope", None)

@@ -35,4 +35,3 @@ class Leaf(Observed, Declared, py_trees.behaviour.Behaviour):
     def __init__(self, name: str, params: BaseModel | None = None) -> None:
         super().__init__(name)
         self._declare(params)
-

@@ -66,8 +66,12 @@ Behaviour = py_trees.behaviour.Behaviour
 def site_variables(site: Site | None) -> dict[str, Any]:
     if site is None:
         return {"dock": "SHOP", "recruit_at": "POI0", "nav_attempts": 3, "dock_attempts": 3}
-    return {"dock": site.tour.dock, "recruit_at": site.tour.recruit_at,
-            "nav_attempts": site.navigation.attempts, "dock_attempts": site.docking.attempts}
+    return {
+        "dock": site.tour.dock,
+        "recruit_at": site.tour.recruit_at,
+        "nav_attempts": site.navigation.attempts,
+        "dock_attempts": site.docking.attempts,
+    }
 
 
 class _Builder:
@@ -101,8 +105,11 @@ class _Builder:
             raise TreeError(str(path), (), "expected a mapping with a 'root' node")
         unknown = set(data) - {"root", "description"}
         if unknown:
-            raise TreeError(str(path), (sorted(unknown)[0],),
-                            "unknown key (a tree file has 'root' and 'description')")
+            raise TreeError(
+                str(path),
+                (sorted(unknown)[0],),
+                "unknown key (a tree file has 'root' and 'description')",
+            )
         if "root" not in data:
             raise TreeError(str(path), ("root",), "missing required key")
         self.stack.append(path)
@@ -116,8 +123,9 @@ class _Builder:
 
     # ------------------------------------------------------------ nodes
 
-    def _collect(self, data: Any, file: str, path: Path_, variables: dict[str, Any]
-                 ) -> list[Behaviour]:
+    def _collect(
+        self, data: Any, file: str, path: Path_, variables: dict[str, Any]
+    ) -> list[Behaviour]:
         """:meth:`node`, with its errors noted and the build going on (all in one pass)."""
         try:
             return self.node(data, file, path, variables)
@@ -130,8 +138,7 @@ class _Builder:
             if str(error) not in (str(e) for e in self.errors):  # an include, once per stop
                 self.errors.append(error)
 
-    def node(self, data: Any, file: str, path: Path_, variables: dict[str, Any]
-             ) -> list[Behaviour]:
+    def node(self, data: Any, file: str, path: Path_, variables: dict[str, Any]) -> list[Behaviour]:
         """The behaviours for one node entry (none when ``when`` is false, several for foreach)."""
         if not isinstance(data, dict):
             raise TreeError(file, path, f"expected a node (a mapping), got {_short(data)}")
@@ -163,22 +170,34 @@ class _Builder:
             hint = f"; did you mean {close[0]!r}?" if close else f" (known: {', '.join(known)})"
             raise TreeError(file, (*path, "type"), f"unknown type {type_!r}{hint}")
         if behaviour is not None:
-            self.where[id(behaviour)] = Where(file, path,
-                                              line_of(file, path, self.marks.get(file, {})))
+            self.where[id(behaviour)] = Where(
+                file, path, line_of(file, path, self.marks.get(file, {}))
+            )
             return [behaviour]
         return []
 
-    def _composite(self, type_: str, data: dict[str, Any], file: str, path: Path_,
-                   variables: dict[str, Any], name: str) -> Behaviour:
+    def _composite(
+        self,
+        type_: str,
+        data: dict[str, Any],
+        file: str,
+        path: Path_,
+        variables: dict[str, Any],
+        name: str,
+    ) -> Behaviour:
         cls = self.factory.composites[type_]
         raw = {k: v for k, v in data.items() if k not in STRUCTURE | {"children"}}
         if "memory" in cls.Params.model_fields:
             if "memory" not in raw:
-                raise TreeError(file, (*path, "memory"), f"missing required key: a {type_} "
-                                "must say memory: true or false")
+                raise TreeError(
+                    file,
+                    (*path, "memory"),
+                    f"missing required key: a {type_} must say memory: true or false",
+                )
             if not isinstance(raw["memory"], bool):
-                raise TreeError(file, (*path, "memory"),
-                                f"expected true or false, got {_short(raw['memory'])}")
+                raise TreeError(
+                    file, (*path, "memory"), f"expected true or false, got {_short(raw['memory'])}"
+                )
         params = self._params(cls.Params, raw, file, path, variables)
         children_data = data.get("children")
         if not isinstance(children_data, list) or not children_data:
@@ -192,8 +211,15 @@ class _Builder:
             self.scopes[id(node)] = node.scope
         return node
 
-    def _decorator(self, type_: str, data: dict[str, Any], file: str, path: Path_,
-                   variables: dict[str, Any], name: str) -> Behaviour | None:
+    def _decorator(
+        self,
+        type_: str,
+        data: dict[str, Any],
+        file: str,
+        path: Path_,
+        variables: dict[str, Any],
+        name: str,
+    ) -> Behaviour | None:
         cls = self.factory.decorators[type_]
         raw = {k: v for k, v in data.items() if k not in STRUCTURE | {"child"}}
         params = self._params(cls.Params, raw, file, path, variables)
@@ -206,21 +232,34 @@ class _Builder:
             raise TreeError(file, (*path, "child"), "expected one node, got a foreach")
         return cls(name or f"{type_}{_summary(params)}", child[0], params)
 
-    def _leaf(self, type_: str, data: dict[str, Any], file: str, path: Path_,
-              variables: dict[str, Any], name: str) -> Behaviour:
+    def _leaf(
+        self,
+        type_: str,
+        data: dict[str, Any],
+        file: str,
+        path: Path_,
+        variables: dict[str, Any],
+        name: str,
+    ) -> Behaviour:
         cls = self.factory.leaves[type_]
         raw = {k: v for k, v in data.items() if k not in STRUCTURE}
         params = self._params(cls.Params, raw, file, path, variables)
         return cls(name or f"{type_}{_summary(params)}", params)
 
-    def _params(self, model: type[BaseModel], raw: dict[str, Any], file: str, path: Path_,
-                variables: dict[str, Any]) -> BaseModel:
+    def _params(
+        self,
+        model: type[BaseModel],
+        raw: dict[str, Any],
+        file: str,
+        path: Path_,
+        variables: dict[str, Any],
+    ) -> BaseModel:
         values = {k: self._subst(v, file, (*path, k), variables) for k, v in raw.items()}
-        return validate(model, values, file, TreeError, context={"site": self.site},
-                        base=path)
+        return validate(model, values, file, TreeError, context={"site": self.site}, base=path)
 
-    def _include(self, data: dict[str, Any], file: str, path: Path_,
-                 variables: dict[str, Any]) -> list[Behaviour]:
+    def _include(
+        self, data: dict[str, Any], file: str, path: Path_, variables: dict[str, Any]
+    ) -> list[Behaviour]:
         self._no_unknown(data, {"include", "with", "when", "foreach"}, file, path, "include")
         target = data["include"]
         if not isinstance(target, str):
@@ -234,18 +273,23 @@ class _Builder:
         node, _ = self.file(Path(file).parent / target, scope)
         return [node] if node is not None else []
 
-    def _foreach(self, data: dict[str, Any], file: str, path: Path_,
-                 variables: dict[str, Any]) -> list[Behaviour]:
+    def _foreach(
+        self, data: dict[str, Any], file: str, path: Path_, variables: dict[str, Any]
+    ) -> list[Behaviour]:
         if data["foreach"] != "stops":
             raise TreeError(file, (*path, "foreach"), "expected 'stops' (the site's tour stops)")
         if "include" not in data:
             raise TreeError(file, (*path, "include"), "missing required key: foreach needs include")
-        stops = [] if self.site is None else [
-            {**s.model_dump(), "index": i} for i, s in enumerate(self.site.tour.stops)]
+        stops = (
+            []
+            if self.site is None
+            else [{**s.model_dump(), "index": i} for i, s in enumerate(self.site.tour.stops)]
+        )
         out: list[Behaviour] = []
         for stop in stops:
-            nodes = self._include({k: v for k, v in data.items() if k != "foreach"}, file, path,
-                                  {**variables, **stop})
+            nodes = self._include(
+                {k: v for k, v in data.items() if k != "foreach"}, file, path, {**variables, **stop}
+            )
             for n in nodes:
                 n.scope = Scope.STOP  # type: ignore[attr-defined] - every built node is Observed
                 self.scopes[id(n)] = Scope.STOP
@@ -260,8 +304,9 @@ class _Builder:
         negate = expr.startswith("not ")
         name = expr[4:].strip() if negate else expr.strip()
         if name not in variables:
-            raise TreeError(file, path, f"unknown variable {name!r} (known: "
-                            f"{', '.join(sorted(variables))})")
+            raise TreeError(
+                file, path, f"unknown variable {name!r} (known: {', '.join(sorted(variables))})"
+            )
         return bool(variables[name]) != negate
 
     def _subst(self, value: Any, file: str, path: Path_, variables: dict[str, Any]) -> Any:
@@ -269,8 +314,12 @@ class _Builder:
             whole = _VAR.fullmatch(value)
             for match in _VAR.finditer(value):
                 if match.group(1) not in variables:
-                    raise TreeError(file, path, f"unknown variable {match.group(1)!r} (known: "
-                                    f"{', '.join(sorted(variables))})")
+                    raise TreeError(
+                        file,
+                        path,
+                        f"unknown variable {match.group(1)!r} (known: "
+                        f"{', '.join(sorted(variables))})",
+                    )
             if whole:
                 return variables[whole.group(1)]
             return _VAR.sub(lambda m: str(variables[m.group(1)]), value)
@@ -281,17 +330,24 @@ class _Builder:
         return value
 
     @staticmethod
-    def _no_unknown(data: dict[str, Any], allowed: set[str], file: str, path: Path_,
-                    what: str) -> None:
+    def _no_unknown(
+        data: dict[str, Any], allowed: set[str], file: str, path: Path_, what: str
+    ) -> None:
         for key in data:
             if key not in allowed:
-                raise TreeError(file, (*path, key),
-                                f"unknown key for {what} (expected: {', '.join(sorted(allowed))})")
+                raise TreeError(
+                    file,
+                    (*path, key),
+                    f"unknown key for {what} (expected: {', '.join(sorted(allowed))})",
+                )
 
 
 def _summary(params: BaseModel) -> str:
-    values = [str(v) for v in params.model_dump(exclude_none=True).values()
-              if isinstance(v, str | int | float) and not isinstance(v, bool) and v != ""]
+    values = [
+        str(v)
+        for v in params.model_dump(exclude_none=True).values()
+        if isinstance(v, str | int | float) and not isinstance(v, bool) and v != ""
+    ]
     return f" {' '.join(values)}" if values else ""
 
 
@@ -323,12 +379,18 @@ def _undeclared(tree: LoadedTree) -> Iterator[TreeError]:
     for node in tree.nodes():
         where = tree.where.get(id(node), Where(tree.file, ()))
         who = f"{type(node).__name__} {node.name!r}"
-        for key in (*getattr(node, "reads", ()), *getattr(node, "optional_reads", ()),
-                    *getattr(node, "writes", ())):
+        for key in (
+            *getattr(node, "reads", ()),
+            *getattr(node, "optional_reads", ()),
+            *getattr(node, "writes", ()),
+        ):
             if declared.get(key.name) is not key:
-                yield TreeError(where.file, where.path,
-                                f"{who} uses {key.name}, which no key declaration knows "
-                                "(frog_bt/model/keys.py, or an input of frog_bt/model/wire.py)")
+                yield TreeError(
+                    where.file,
+                    where.path,
+                    f"{who} uses {key.name}, which no key declaration knows "
+                    "(frog_bt/model/keys.py, or an input of frog_bt/model/wire.py)",
+                )
 
 
 def _gap_error(tree: LoadedTree, gap: Gap) -> TreeError:
@@ -336,13 +398,17 @@ def _gap_error(tree: LoadedTree, gap: Gap) -> TreeError:
     reader = f"{type(gap.node).__name__} {gap.node.name!r}"
     if gap.scope is not None:
         scope = gap.scope.name.lower()
-        why = (f"a {scope} starts without it: the value from before this {scope} "
-               f"is not this {scope}'s; write it in this {scope}, before the reader")
+        why = (
+            f"a {scope} starts without it: the value from before this {scope} "
+            f"is not this {scope}'s; write it in this {scope}, before the reader"
+        )
     elif gap.writers:
         at = [_at(tree, w) for w in gap.writers[:3]]
-        why = (f"{', '.join(at)} write{'s' if len(at) == 1 else ''} it, but not before it on "
-               "every path (a later node, another selector alternative, a sibling in "
-               "parallel, or a part that may fail or be skipped)")
+        why = (
+            f"{', '.join(at)} write{'s' if len(at) == 1 else ''} it, but not before it on "
+            "every path (a later node, another selector alternative, a sibling in "
+            "parallel, or a part that may fail or be skipped)"
+        )
     else:
         why = "nothing writes it"
     return TreeError(where.file, where.path, f"{reader} reads {gap.key.name}: {why}")
@@ -353,8 +419,11 @@ def _at(tree: LoadedTree, node: Behaviour) -> str:
     if where is None:
         return f"{type(node).__name__} {node.name!r}"
     line = where.line
-    place = f"{Path(where.file).name}:{line[0]}" if line else (
-        f"{Path(where.file).name}: {format_path(where.path)}")
+    place = (
+        f"{Path(where.file).name}:{line[0]}"
+        if line
+        else (f"{Path(where.file).name}: {format_path(where.path)}")
+    )
     return f"{type(node).__name__} {node.name!r} ({place})"
 
 

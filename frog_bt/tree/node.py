@@ -117,8 +117,11 @@ class Declared:
                 trace.decided.append(self)  # type: ignore[arg-type]
         except MissingValue as missing:
             self.feedback_message = f"no value for {missing.key.name}"  # type: ignore[attr-defined]
-            self.ctx.note(f"{self.name}: no value for {missing.key.name}; failing",
-                          incident=IncidentKind.MISSING_VALUE, subject=missing.key.name)
+            self.ctx.note(
+                f"{self.name}: no value for {missing.key.name}; failing",
+                incident=IncidentKind.MISSING_VALUE,
+                subject=missing.key.name,
+            )
             self.stop(FAILURE)  # type: ignore[attr-defined]
             yield self  # type: ignore[misc]
         finally:

@@ -36,10 +36,24 @@ from frog_bt.errors import FrogError
 
 Behaviour = py_trees.behaviour.Behaviour
 
-ASCII = {"sequence": "[-]", "sequence*": "{-}", "selector": "[o]", "selector*": "{o}",
-         "parallel": "/_/", "decorator": "-^-", "leaf": "-->", "composite": "[+]"}
-GLYPH = {"sequence": "→", "selector": "?", "parallel": "⇉", "decorator": "◇", "leaf": "•",
-         "composite": "+"}
+ASCII = {
+    "sequence": "[-]",
+    "sequence*": "{-}",
+    "selector": "[o]",
+    "selector*": "{o}",
+    "parallel": "/_/",
+    "decorator": "-^-",
+    "leaf": "-->",
+    "composite": "[+]",
+}
+GLYPH = {
+    "sequence": "→",
+    "selector": "?",
+    "parallel": "⇉",
+    "decorator": "◇",
+    "leaf": "•",
+    "composite": "+",
+}
 # kind -> (DOT shape, DOT style, Mermaid opening and closing brackets, fill colour)
 LOOK = {
     "sequence": ("box", "filled", '["', '"]', "#fde0c5"),
@@ -114,9 +128,18 @@ def _outline(behaviour: Behaviour, ids: Iterator[int]) -> Node:
     node_id = f"n{next(ids)}"
     kind, memory, params = _kind(behaviour)
     children = tuple(_outline(child, ids) for child in behaviour.children)
-    return Node(node_id, kind, type(behaviour).__name__, " ".join(behaviour.name.split()),
-                params, _key_names(behaviour, "reads"), _key_names(behaviour, "optional_reads"),
-                _key_names(behaviour, "writes"), memory, children)
+    return Node(
+        node_id,
+        kind,
+        type(behaviour).__name__,
+        " ".join(behaviour.name.split()),
+        params,
+        _key_names(behaviour, "reads"),
+        _key_names(behaviour, "optional_reads"),
+        _key_names(behaviour, "writes"),
+        memory,
+        children,
+    )
 
 
 def _key_names(behaviour: Behaviour, group: str) -> tuple[str, ...]:
@@ -127,18 +150,32 @@ def _kind(b: Behaviour) -> tuple[str, bool, tuple[tuple[str, str], ...]]:
     if isinstance(b, py_trees.composites.Parallel):
         policy = b.policy
         if isinstance(policy, py_trees.common.ParallelPolicy.SuccessOnAll):
-            return "parallel", False, (("policy", "all"),
-                                       ("synchronise", _value(policy.synchronise)))
+            return (
+                "parallel",
+                False,
+                (("policy", "all"), ("synchronise", _value(policy.synchronise))),
+            )
         if isinstance(policy, py_trees.common.ParallelPolicy.SuccessOnOne):
             return "parallel", False, (("policy", "one"),)
         return "parallel", False, (("policy", type(policy).__name__),)
     if isinstance(b, py_trees.composites.Sequence | py_trees.composites.Selector):
         kind = "sequence" if isinstance(b, py_trees.composites.Sequence) else "selector"
         scope = getattr(b, "scope", None)
-        return kind, b.memory, (("memory", _value(b.memory)),
-                                *((("scope", scope.name.lower()),) if scope is not None else ()))
-    kind = ("decorator" if isinstance(b, py_trees.decorators.Decorator) else
-            "composite" if isinstance(b, py_trees.composites.Composite) else "leaf")
+        return (
+            kind,
+            b.memory,
+            (
+                ("memory", _value(b.memory)),
+                *((("scope", scope.name.lower()),) if scope is not None else ()),
+            ),
+        )
+    kind = (
+        "decorator"
+        if isinstance(b, py_trees.decorators.Decorator)
+        else "composite"
+        if isinstance(b, py_trees.composites.Composite)
+        else "leaf"
+    )
     describe = getattr(b, "describe", None)
     described: dict[str, Any] = describe() if callable(describe) else {}
     params = tuple((str(k), _value(v)) for k, v in described.items() if v is not None and v != "")
@@ -192,8 +229,10 @@ def text(root: Node, *, unicode: bool = False, keys: bool = False) -> str:
     return "\n".join(lines) + "\n"
 
 
-ASCII_LEGEND = ("legend: {-} sequence with memory, [-] without; {o} selector with memory, "
-                "[o] without; /_/ parallel; -^- decorator; --> leaf")
+ASCII_LEGEND = (
+    "legend: {-} sequence with memory, [-] without; {o} selector with memory, "
+    "[o] without; /_/ parallel; -^- decorator; --> leaf"
+)
 UNICODE_LEGEND = "legend: → sequence, ? selector, ⇉ parallel, ◇ decorator, • leaf"
 
 
@@ -202,8 +241,7 @@ UNICODE_LEGEND = "legend: → sequence, ? selector, ⇉ parallel, ◇ decorator,
 
 def _graph_lines(node: Node, keys: bool) -> list[str]:
     glyph = "" if node.kind in ("leaf", "decorator") else GLYPH[node.kind] + " "
-    return [glyph + node.name, *filter(None, [node.detail()]),
-            *(node.key_groups() if keys else [])]
+    return [glyph + node.name, *filter(None, [node.detail()]), *(node.key_groups() if keys else [])]
 
 
 def _dot_quote(text: str) -> str:
@@ -223,8 +261,9 @@ def dot(root: Node, *, keys: bool = False, rankdir: str = "LR") -> str:
     for node in root.walk():
         shape, style, _, _, fill = LOOK[node.kind]
         label = "\\n".join(_dot_quote(line)[1:-1] for line in _graph_lines(node, keys))
-        out.append(f'    {node.id} [label="{label}", shape={shape}, style="{style}", '
-                   f'fillcolor="{fill}"];')
+        out.append(
+            f'    {node.id} [label="{label}", shape={shape}, style="{style}", fillcolor="{fill}"];'
+        )
     out += [f"    {node.id} -> {child.id};" for node in root.walk() for child in node.children]
     out.append("}")
     return "\n".join(out) + "\n"
@@ -232,8 +271,14 @@ def dot(root: Node, *, keys: bool = False, rankdir: str = "LR") -> str:
 
 def _mermaid_escape(text: str) -> str:
     # Mermaid decodes #name; and #number; entities inside quoted labels.
-    for char, entity in (("#", "#35;"), ("&", "#amp;"), ('"', "#quot;"), ("<", "#lt;"),
-                         (">", "#gt;"), ("`", "#96;")):
+    for char, entity in (
+        ("#", "#35;"),
+        ("&", "#amp;"),
+        ('"', "#quot;"),
+        ("<", "#lt;"),
+        (">", "#gt;"),
+        ("`", "#96;"),
+    ):
         text = text.replace(char, entity)
     return text
 
@@ -247,8 +292,9 @@ def mermaid(root: Node, *, keys: bool = False, rankdir: str = "LR") -> str:
         out.append(f"    {node.id}{opening}{label}{closing}:::{node.kind}")
     out += [f"    {node.id} --> {child.id}" for node in root.walk() for child in node.children]
     used = sorted({node.kind for node in root.walk()})
-    out += [f"    classDef {kind} fill:{LOOK[kind][4]},stroke:#555555,color:#000000"
-            for kind in used]
+    out += [
+        f"    classDef {kind} fill:{LOOK[kind][4]},stroke:#555555,color:#000000" for kind in used
+    ]
     return "\n".join(out) + "\n"
 
 
@@ -259,11 +305,18 @@ def graphviz(dot_text: str, fmt: str, timeout: float = 60.0) -> bytes:
     """``dot_text`` rendered by Graphviz's ``dot -T<fmt>``; :class:`GraphvizError` if it can't."""
     program = shutil.which("dot")
     if program is None:
-        raise GraphvizError(f"{fmt} needs Graphviz's `dot` program, which is not installed "
-                            "(apt-get install graphviz)")
+        raise GraphvizError(
+            f"{fmt} needs Graphviz's `dot` program, which is not installed "
+            "(apt-get install graphviz)"
+        )
     try:
-        result = subprocess.run([program, f"-T{fmt}"], input=dot_text.encode("utf-8"),
-                                capture_output=True, timeout=timeout, check=False)
+        result = subprocess.run(
+            [program, f"-T{fmt}"],
+            input=dot_text.encode("utf-8"),
+            capture_output=True,
+            timeout=timeout,
+            check=False,
+        )
     except (OSError, subprocess.TimeoutExpired) as exc:
         raise GraphvizError(f"dot -T{fmt}: {exc}") from exc
     if result.returncode != 0:

@@ -20,22 +20,32 @@ from frog_bt.tree.factory import NodeFactory
 
 TREE_SCHEMA_FILE = "tree.schema.json"
 SITE_SCHEMA_FILE = "site.schema.json"
-VARIABLE = {"type": "string", "pattern": r"^\{\w+\}$",
-            "description": "a tree variable, e.g. {poi}, taking its value and type"}
+VARIABLE = {
+    "type": "string",
+    "pattern": r"^\{\w+\}$",
+    "description": "a tree variable, e.g. {poi}, taking its value and type",
+}
 NODE = {"$ref": "#/$defs/node"}
 COMMON = {
     "name": {"type": "string", "description": "shown in render, telemetry and logs"},
-    "when": {"type": "string", "pattern": r"^(not )?\w+$",
-             "description": "keep this node only where the variable is true (or false)"},
+    "when": {
+        "type": "string",
+        "pattern": r"^(not )?\w+$",
+        "description": "keep this node only where the variable is true (or false)",
+    },
 }
 
 
 def _params(cls: Any, defs: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
     schema = cls.Params.model_json_schema(ref_template="#/$defs/{model}")
     defs.update(schema.pop("$defs", {}))
-    props = {name: {"anyOf": [prop, VARIABLE], **({"description": prop["description"]}
-                                                   if "description" in prop else {})}
-             for name, prop in schema.get("properties", {}).items()}
+    props = {
+        name: {
+            "anyOf": [prop, VARIABLE],
+            **({"description": prop["description"]} if "description" in prop else {}),
+        }
+        for name, prop in schema.get("properties", {}).items()
+    }
     return props, list(schema.get("required", []))
 
 
@@ -51,34 +61,64 @@ def tree_schema(factory: NodeFactory) -> dict[str, Any]:
         elif node.kind == "decorator":
             props["child"] = NODE
             required = [*required, "child"]
-        kinds.append({
-            "title": node.name, "description": node.doc.split("\n\n")[0],
-            "type": "object", "additionalProperties": False,
-            "properties": {"type": {"const": node.name}, **COMMON, **props},
-            "required": ["type", *required]})
-    kinds.append({
-        "title": "include", "description": "another tree file's root, with variables",
-        "type": "object", "additionalProperties": False, "required": ["include"],
-        "properties": {"include": {"type": "string"}, "with": {"type": "object"},
-                       "when": COMMON["when"]}})
-    kinds.append({
-        "title": "foreach", "description": "a tree file once per tour stop (in children)",
-        "type": "object", "additionalProperties": False, "required": ["foreach", "include"],
-        "properties": {"foreach": {"const": "stops"}, "include": {"type": "string"},
-                       "with": {"type": "object"}, "when": COMMON["when"]}})
+        kinds.append(
+            {
+                "title": node.name,
+                "description": node.doc.split("\n\n")[0],
+                "type": "object",
+                "additionalProperties": False,
+                "properties": {"type": {"const": node.name}, **COMMON, **props},
+                "required": ["type", *required],
+            }
+        )
+    kinds.append(
+        {
+            "title": "include",
+            "description": "another tree file's root, with variables",
+            "type": "object",
+            "additionalProperties": False,
+            "required": ["include"],
+            "properties": {
+                "include": {"type": "string"},
+                "with": {"type": "object"},
+                "when": COMMON["when"],
+            },
+        }
+    )
+    kinds.append(
+        {
+            "title": "foreach",
+            "description": "a tree file once per tour stop (in children)",
+            "type": "object",
+            "additionalProperties": False,
+            "required": ["foreach", "include"],
+            "properties": {
+                "foreach": {"const": "stops"},
+                "include": {"type": "string"},
+                "with": {"type": "object"},
+                "when": COMMON["when"],
+            },
+        }
+    )
     defs["node"] = {"anyOf": kinds}
     return {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
-        "title": "frog-bt tree file", "type": "object", "additionalProperties": False,
+        "title": "frog-bt tree file",
+        "type": "object",
+        "additionalProperties": False,
         "required": ["root"],
         "properties": {"description": {"type": "string"}, "root": NODE},
-        "$defs": defs}
+        "$defs": defs,
+    }
 
 
 def site_schema() -> dict[str, Any]:
     schema = Site.model_json_schema()
-    return {"$schema": "https://json-schema.org/draft/2020-12/schema",
-            "title": "frog-bt site configuration", **schema}
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "frog-bt site configuration",
+        **schema,
+    }
 
 
 def dumps(schema: dict[str, Any]) -> str:

@@ -30,8 +30,16 @@ root:
 
 
 def faces(bench, *levels_distance_facing):
-    bench.ros("faces", FaceData(bench.clock.now(), tuple(
-        Face(7, level, distance, facing) for level, distance, facing in levels_distance_facing)))
+    bench.ros(
+        "faces",
+        FaceData(
+            bench.clock.now(),
+            tuple(
+                Face(7, level, distance, facing)
+                for level, distance, facing in levels_distance_facing
+            ),
+        ),
+    )
 
 
 def run_part_a(bench, series):
@@ -47,10 +55,15 @@ def run_part_a(bench, series):
 
 def test_icl_on_for_the_scope_and_meter_every_two_seconds(tmp_path):
     bench = Bench(write_tree(tmp_path, TREE))
-    series = [(0.5, 0.4, 1.0, True), (0.5, -0.6, 1.0, True), (0.5, 0.8, 1.0, True),
-              (0.5, 0.9, 3.0, True),  # too far: not stored
-              (0.5, -0.5, 1.0, True), (0.5, -0.7, 1.0, False),  # not facing: not stored
-              (1.0, -0.9, 1.0, True)]
+    series = [
+        (0.5, 0.4, 1.0, True),
+        (0.5, -0.6, 1.0, True),
+        (0.5, 0.8, 1.0, True),
+        (0.5, 0.9, 3.0, True),  # too far: not stored
+        (0.5, -0.5, 1.0, True),
+        (0.5, -0.7, 1.0, False),  # not facing: not stored
+        (1.0, -0.9, 1.0, True),
+    ]
     run_part_a(bench, series)
     sent = bench.take_sent()
     meters = [m.level for m in sent if isinstance(m, Engagement)]
@@ -63,8 +76,10 @@ def test_icl_on_for_the_scope_and_meter_every_two_seconds(tmp_path):
     assert decision.tie and decision.engaged is False
     assert StartPoi("POI1", "POI1", "b") not in sent
     assert sent[-1] == FinishPoi("POI1")
-    assert bench.take_published() == [("/ICL_command", {"data": "start"}),
-                                       ("/ICL_command", {"data": "stop"})]
+    assert bench.take_published() == [
+        ("/ICL_command", {"data": "start"}),
+        ("/ICL_command", {"data": "stop"}),
+    ]
 
 
 def test_engaged_visitor_gets_part_b(tmp_path):

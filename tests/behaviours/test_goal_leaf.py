@@ -62,7 +62,7 @@ def bench(tmp_path, request):
 
 
 def leaf(bench) -> GoalLeaf:
-    node, = (n for n in bench.core.root.iterate() if isinstance(n, GoalLeaf))
+    (node,) = (n for n in bench.core.root.iterate() if isinstance(n, GoalLeaf))
     return node
 
 

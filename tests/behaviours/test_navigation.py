@@ -12,7 +12,7 @@ NAVIGATE = "root: {type: Navigate, poi: POI1, timeout: 30}"
 
 
 def goal(bench):
-    (topic, msg), = bench.take_published()
+    ((topic, msg),) = bench.take_published()
     assert topic == "/GotoWayPoint"
     return msg
 
@@ -27,10 +27,16 @@ def test_goal_carries_the_poi_pose_in_the_map_frame(tmp_path):
     assert msg["pose"]["orientation"] == {"x": 0.0, "y": 0.0, "z": 0.898316, "w": 0.43934}
 
 
-@pytest.mark.parametrize(("poi", "clock_time", "waypoint"), [
-    ("POI1", "13:00:00", "POI1a"), ("POI1", "13:00:01", "POI1b"),
-    ("POI2", "12:00:00", "POI2a"), ("POI2", "12:00:01", "POI2b"), ("POI3", "23:59:00", "POI3"),
-])
+@pytest.mark.parametrize(
+    ("poi", "clock_time", "waypoint"),
+    [
+        ("POI1", "13:00:00", "POI1a"),
+        ("POI1", "13:00:01", "POI1b"),
+        ("POI2", "12:00:00", "POI2a"),
+        ("POI2", "12:00:01", "POI2b"),
+        ("POI3", "23:59:00", "POI3"),
+    ],
+)
 def test_time_of_day_variant_in_madrid(tmp_path, poi, clock_time, waypoint):
     h, m, s = map(int, clock_time.split(":"))
     start = MORNING - 10.5 * 3600 + h * 3600 + m * 60 + s  # MORNING is 10:30 local
@@ -39,7 +45,9 @@ def test_time_of_day_variant_in_madrid(tmp_path, poi, clock_time, waypoint):
     msg = goal(bench)
     expected = bench.site.pois[waypoint]
     assert (msg["pose"]["position"]["x"], msg["pose"]["orientation"]["z"]) == (
-        expected.x, expected.z)
+        expected.x,
+        expected.z,
+    )
     assert bench.core.board.get(keys.WAYPOINT) == waypoint
 
 
@@ -70,14 +78,19 @@ def test_times_out_on_the_project_clock(tmp_path):
 
 
 def test_response_with_nothing_pending_is_ignored(tmp_path):
-    bench = Bench(write_tree(tmp_path, """
+    bench = Bench(
+        write_tree(
+            tmp_path,
+            """
         root:
           type: Sequence
           memory: true
           children:
             - {type: FinishPoi, poi: POI1}
             - {type: Navigate, poi: POI1}
-        """))
+        """,
+        )
+    )
     bench.ros("response", 2)  # before any goal: stale
     bench.tick()  # snapshot drops it, then the goal is sent
     assert bench.core.actions.stale_responses == 1
@@ -85,7 +98,10 @@ def test_response_with_nothing_pending_is_ignored(tmp_path):
 
 
 def test_retry_resends_then_skip_stop(tmp_path):
-    bench = Bench(write_tree(tmp_path, """
+    bench = Bench(
+        write_tree(
+            tmp_path,
+            """
         root:
           type: Sequence
           memory: true
@@ -100,7 +116,10 @@ def test_retry_resends_then_skip_stop(tmp_path):
               children:
                 - {type: Skipped, poi: POI3}
                 - {type: FinishPoi, poi: POI3}
-        """), start=AFTERNOON)
+        """,
+        ),
+        start=AFTERNOON,
+    )
     bench.tick()
     goal(bench)
     bench.ros("response", 3)

@@ -52,7 +52,9 @@ def test_stale_detections_are_not_acted_on(tmp_path):
 
 
 def recruit_tree(tmp_path):
-    return write_tree(tmp_path, """
+    return write_tree(
+        tmp_path,
+        """
         root:
           type: Retry
           attempts: null
@@ -73,7 +75,8 @@ def recruit_tree(tmp_path):
                        on_timeout: success}
                     - {type: AskTour}
                     - {type: WaitAnswer}
-        """)
+        """,
+    )
 
 
 def test_rejected_approach_seeks_someone_else_and_declined_visitor_is_skipped(tmp_path):
@@ -159,7 +162,8 @@ def test_a_person_whose_approach_always_fails_is_approached_once_a_minute(tmp_pa
     assert all(60 < b - a <= 60.3 for a, b in itertools.pairwise(times))
     assert {(topic, data) for _, topic, data in sent} == {("/ApproachPeopleFar", 7)}
     assert "approach of visitor 7 aborted: seek again (not them for 60 s)" in [
-        note.text for note in bench.core.journal.notes]
+        note.text for note in bench.core.journal.notes
+    ]
 
 
 def test_lost_finish_introduction_asks_the_visitor_after_the_timeout(tmp_path):
@@ -176,7 +180,8 @@ def test_lost_finish_introduction_asks_the_visitor_after_the_timeout(tmp_path):
     bench.advance(0.1)
     bench.tick()
     assert [m for m in bench.take_sent() if not isinstance(m, Engagement)] == [
-        AskTour(engaged=None)]
+        AskTour(engaged=None)
+    ]
     kinds = [i.kind for i in bench.core.journal.incidents]
     assert kinds == ["event missing"]
 
@@ -187,8 +192,9 @@ def test_a_wait_without_a_bound_is_a_load_error(tmp_path):
 
 
 def test_finish_introduction_that_came_before_the_wait_does_not_count(tmp_path):
-    bench = Bench(write_tree(tmp_path, "root: {type: WaitEvent, event: finish_introduction, "
-                             "timeout: 5}"))
+    bench = Bench(
+        write_tree(tmp_path, "root: {type: WaitEvent, event: finish_introduction, timeout: 5}")
+    )
     bench.event(FinishIntroduction())
     bench.tick()  # the event arrived before the leaf started: not this one
     bench.advance(5)
@@ -196,8 +202,13 @@ def test_finish_introduction_that_came_before_the_wait_does_not_count(tmp_path):
 
 
 def test_no_answer_within_the_site_timeout_declines_and_seeks_again(tmp_path):
-    bench = Bench(write_tree(tmp_path, "root: {type: Sequence, memory: true, children: ["
-                             "{type: SeekVisitor}, {type: WaitAnswer}]}"))
+    bench = Bench(
+        write_tree(
+            tmp_path,
+            "root: {type: Sequence, memory: true, children: ["
+            "{type: SeekVisitor}, {type: WaitAnswer}]}",
+        )
+    )
     bench.pose(0.0, 0.0)
     bench.persons((7, 2.0, 0.0, 180.0))
     assert bench.tick() == RUNNING
@@ -207,12 +218,18 @@ def test_no_answer_within_the_site_timeout_declines_and_seeks_again(tmp_path):
     assert bench.tick() == FAILURE
     assert bench.core.board.get(keys.DECLINED) == frozenset({7})
     assert bench.core.journal.incidents[-1].text == (
-        "visitor 7 gave no answer within 120 s: seek again")
+        "visitor 7 gave no answer within 120 s: seek again"
+    )
 
 
 def test_an_unanswered_approach_fails_after_the_site_timeout(tmp_path):
-    bench = Bench(write_tree(tmp_path, "root: {type: Sequence, memory: true, children: ["
-                             "{type: SeekVisitor}, {type: ApproachVisitor}]}"))
+    bench = Bench(
+        write_tree(
+            tmp_path,
+            "root: {type: Sequence, memory: true, children: ["
+            "{type: SeekVisitor}, {type: ApproachVisitor}]}",
+        )
+    )
     bench.pose(0.0, 0.0)
     bench.persons((7, 2.0, 0.0, 180.0))
     bench.tick()
@@ -225,14 +242,19 @@ def test_an_unanswered_approach_fails_after_the_site_timeout(tmp_path):
 
 
 def test_a_command_is_blamed_on_its_node_with_what_it_read(tmp_path):
-    bench = Bench(write_tree(tmp_path, """
+    bench = Bench(
+        write_tree(
+            tmp_path,
+            """
         root:
           type: Sequence
           memory: true
           children:
             - {type: SeekVisitor}
             - {type: ApproachVisitor}
-    """))
+    """,
+        )
+    )
     bench.pose(100.0, 30.0)
     bench.persons((2, 103.0, 30.0, 200.0))
     bench.tick()

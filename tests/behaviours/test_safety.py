@@ -74,8 +74,13 @@ def test_missing_diagnostics_do_not_hold_a_tour_back(tmp_path):
 
 
 def test_location_features_pause_on_a_stale_pose(tmp_path):
-    bench = Bench(write_tree(tmp_path, "root: {type: LocationAware, child: "
-                             "{type: WaitEvent, event: content_done, timeout: 600}}"))
+    bench = Bench(
+        write_tree(
+            tmp_path,
+            "root: {type: LocationAware, child: "
+            "{type: WaitEvent, event: content_done, timeout: 600}}",
+        )
+    )
     bench.pose(95.9, 17.2)  # in the shop zone
     bench.tick()
     assert bench.take_sent() == [Volume(50)]
@@ -89,7 +94,10 @@ def test_location_features_pause_on_a_stale_pose(tmp_path):
 
 
 def test_silent_face_stream_is_reported_and_gives_no_data(tmp_path):
-    bench = Bench(write_tree(tmp_path, """
+    bench = Bench(
+        write_tree(
+            tmp_path,
+            """
         root:
           type: FaceStream
           child:
@@ -98,7 +106,9 @@ def test_silent_face_stream_is_reported_and_gives_no_data(tmp_path):
             children:
               - {type: WaitEvent, event: content_done, timeout: 600}
               - {type: DecideEngagement, about: POI1}
-        """))
+        """,
+        )
+    )
     bench.tick()
     bench.advance(4.0)
     bench.tick()

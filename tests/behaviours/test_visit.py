@@ -47,7 +47,10 @@ def test_stale_tracking_is_not_taken_for_a_lost_visitor(tmp_path):
 
 
 def test_content_plays_the_chosen_waypoint_and_waits_for_its_own_done(tmp_path):
-    bench = Bench(write_tree(tmp_path, """
+    bench = Bench(
+        write_tree(
+            tmp_path,
+            """
         root:
           type: Sequence
           memory: true
@@ -55,7 +58,9 @@ def test_content_plays_the_chosen_waypoint_and_waits_for_its_own_done(tmp_path):
             - {type: Navigate, poi: POI2}
             - {type: PlayContent, poi: POI2, part: a}
             - {type: FinishPoi, poi: POI2}
-        """))
+        """,
+        )
+    )
     bench.tick()
     bench.ros("response", 2)
     assert bench.tick() == RUNNING

@@ -26,9 +26,14 @@ def test_lost_finish_introduction_asks_anyway_and_the_tour_completes():
 
 
 def test_a_visitor_whose_approach_always_fails_gives_way_to_another():
-    t = tour({"visitors": [
-        {"id": 7, "position": [103.0, 36.0], "facing": True, "approach": "failed"},
-        {"id": 8, "position": [106.0, 37.5], "facing": True}]})
+    t = tour(
+        {
+            "visitors": [
+                {"id": 7, "position": [103.0, 36.0], "facing": True, "approach": "failed"},
+                {"id": 8, "position": [106.0, 37.5], "facing": True},
+            ]
+        }
+    )
     assert t.outcome.code == 0, t.outcome.reason
     approaches = [c for c in t.ros_commands() if c.startswith("/Approach")]
     assert approaches == ["/ApproachPeopleFar 7", "/ApproachPeopleFar 8"]
@@ -39,9 +44,13 @@ def test_a_visitor_whose_approach_always_fails_gives_way_to_another():
 
 def test_a_lone_visitor_whose_approach_always_fails_is_tried_once_a_minute():
     async def main() -> list[float]:
-        async with Running({"visitors": [
-                {"id": 7, "position": [103.0, 36.0], "facing": True, "approach": "failed"}]}
-                ) as run:
+        async with Running(
+            {
+                "visitors": [
+                    {"id": 7, "position": [103.0, 36.0], "facing": True, "approach": "failed"}
+                ]
+            }
+        ) as run:
             await run.sim.wait_for(lambda r: r.channel == "/ApproachPeopleFar", 30)
             start = run.sim.clock.now()
             await run.sim.wait_for(lambda r: r.t > start + 300, 30)
@@ -65,15 +74,22 @@ def test_twenty_percent_loss_each_way_every_part_once_and_tour_ended_acked():
     t = run.tour()
     assert t.outcome.code == 0, t.outcome.reason
     assert run.sim.datagrams_lost > 20  # the loss really happened, both ways
-    starts = Counter(tuple(r.payload[k] for k in ("poi", "part"))
-                     for r in run.sim.received("start_poi"))
+    starts = Counter(
+        tuple(r.payload[k] for k in ("poi", "part")) for r in run.sim.received("start_poi")
+    )
     assert set(starts.values()) == {1}  # resent until acked, acted on once
     assert {poi for poi, _ in starts} == {"POI1", "POI2", "POI3", "POI4", "POI5", "END"}
     assert [r.payload["state"] for r in run.sim.received("tour")] == ["started", "ended"]
-    out = {json.loads(d)["seq"]: json.loads(d) for direction, d in datagrams
-           if direction == "out" and json.loads(d)["type"] != "ack"}
-    acked = {json.loads(d)["seq"] for direction, d in datagrams
-             if direction == "in" and json.loads(d)["type"] == "ack"}
+    out = {
+        json.loads(d)["seq"]: json.loads(d)
+        for direction, d in datagrams
+        if direction == "out" and json.loads(d)["type"] != "ack"
+    }
+    acked = {
+        json.loads(d)["seq"]
+        for direction, d in datagrams
+        if direction == "in" and json.loads(d)["type"] == "ack"
+    }
     ended = [seq for seq, m in out.items() if m["type"] == "tour" and m["state"] == "ended"]
     assert len(ended) == 1 and ended[0] in acked  # acked before the executive exited
     assert run.executive.link.pending == 0

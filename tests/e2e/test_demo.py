@@ -11,9 +11,24 @@ from mcap.reader import make_reader
 def test_demo_runs_a_tour_to_a_docked_finish_and_summarises_it(tmp_path):
     mcap = tmp_path / "demo.mcap"
     result = subprocess.run(
-        [sys.executable, "-m", "frog_bt", "demo", "--quiet", "--speed", "300", "--record",
-         str(mcap), "--rerun", "off"], capture_output=True, text=True, timeout=120,
-        cwd=tmp_path)
+        [
+            sys.executable,
+            "-m",
+            "frog_bt",
+            "demo",
+            "--quiet",
+            "--speed",
+            "300",
+            "--record",
+            str(mcap),
+            "--rerun",
+            "off",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
+    )
     assert result.returncode == 0, result.stderr
     out = result.stdout
     assert "route:     POI0 -> POI1a -> POI2a -> POI3 -> POI4 -> POI5 -> TEMP -> END -> SHOP" in out
@@ -30,12 +45,31 @@ def test_demo_runs_a_tour_to_a_docked_finish_and_summarises_it(tmp_path):
 
 def test_demo_with_a_skipped_stop_says_why_and_exits_1(tmp_path):
     scenario = tmp_path / "skip.yaml"
-    scenario.write_text("extends: default\nnavigation:\n  failures:\n"
-                        "    - {poi: POI3, times: 3, result: failed, after: 5}\n")
+    scenario.write_text(
+        "extends: default\nnavigation:\n  failures:\n"
+        "    - {poi: POI3, times: 3, result: failed, after: 5}\n"
+    )
     result = subprocess.run(
-        [sys.executable, "-m", "frog_bt", "demo", "--quiet", "--speed", "300", "--scenario",
-         str(scenario), "--record", str(tmp_path / "d.mcap"), "--rerun", "off"],
-        capture_output=True, text=True, timeout=120, cwd=tmp_path)
+        [
+            sys.executable,
+            "-m",
+            "frog_bt",
+            "demo",
+            "--quiet",
+            "--speed",
+            "300",
+            "--scenario",
+            str(scenario),
+            "--record",
+            str(tmp_path / "d.mcap"),
+            "--rerun",
+            "off",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
+    )
     assert result.returncode == 1, result.stdout + result.stderr
     out = result.stdout
     assert "problems:  navigation failed (3); stop skipped" in out
@@ -43,5 +77,6 @@ def test_demo_with_a_skipped_stop_says_why_and_exits_1(tmp_path):
     assert "skipped POI3: navigation kept failing" in out
     assert "outcome:   tour ended docked, but POI3 skipped" in out
     assert result.stderr.strip().splitlines()[-1] == (
-        "frog-bt: tour ended docked, but POI3 skipped")
+        "frog-bt: tour ended docked, but POI3 skipped"
+    )
     assert "[" not in out.split("visitors:")[1].splitlines()[0]  # plain words, no reprs

@@ -23,8 +23,11 @@ def morning():
 
 
 def test_engaged_visitor_gets_both_parts_with_counted_decisions(morning):
-    assert story(morning, "POI1") == ["start_poi POI1 POI1a a", "start_poi POI1 POI1a b",
-                                      "finish_poi POI1"]
+    assert story(morning, "POI1") == [
+        "start_poi POI1 POI1a a",
+        "start_poi POI1 POI1a b",
+        "finish_poi POI1",
+    ]
     assert story(morning, "POI2")[:2] == ["start_poi POI2 POI2a a", "start_poi POI2 POI2a b"]
     decisions = {about: d for about, d in morning.summary.decisions}
     assert set(decisions) == {"introduction", "POI1", "POI2"}
@@ -69,10 +72,13 @@ def first(records, predicate, after=-math.inf):
 
 def test_projector_is_warm_on_arrival_at_poi3_and_off_after_it(morning):
     log = list(morning.sim.log)
-    goal = first(log, lambda r: r.channel == "/GotoWayPoint"
-                 and morning.summary.waypoint_of(r.payload) == "POI3")
-    arrived = first(log, lambda r: r.channel == "/FROG_response" and r.payload["data"] == 2,
-                    after=goal.t)
+    goal = first(
+        log,
+        lambda r: r.channel == "/GotoWayPoint" and morning.summary.waypoint_of(r.payload) == "POI3",
+    )
+    arrived = first(
+        log, lambda r: r.channel == "/FROG_response" and r.payload["data"] == 2, after=goal.t
+    )
     on = [r for r in log if r.channel == "projector"]
     assert [r.payload["on"] for r in on] == [True, False]
     assert on[0].t >= goal.t and arrived.t - on[0].t >= 20.0

@@ -15,13 +15,19 @@ from frog_bt.runtime.checkpoint import load as load_checkpoint
 
 
 def commands_after(run: Running, t: float) -> list[str]:
-    return [describe(r, run.summary) for r in run.sim.received()
-            if r.t >= t and r.channel not in ("ack", "engagement", "volume")]
+    return [
+        describe(r, run.summary)
+        for r in run.sim.received()
+        if r.t >= t and r.channel not in ("ack", "engagement", "volume")
+    ]
 
 
 def is_(channel: str, **fields: object):
-    return lambda r: r.direction == "in" and r.channel == channel and all(
-        r.payload.get(k) == v for k, v in fields.items())
+    return lambda r: (
+        r.direction == "in"
+        and r.channel == channel
+        and all(r.payload.get(k) == v for k, v in fields.items())
+    )
 
 
 async def _battery_low_during_content() -> tuple[list[str], int, str, str]:
@@ -30,8 +36,7 @@ async def _battery_low_during_content() -> tuple[list[str], int, str, str]:
         run.sim.world.battery.percentage = 12.0  # the battery sags mid-content
         t = run.sim.clock.now()
         outcome = await run.finish()
-        return commands_after(run, t), outcome.code, outcome.reason, \
-            run.sim.world.docking_state
+        return commands_after(run, t), outcome.code, outcome.reason, run.sim.world.docking_state
 
 
 def test_battery_low_mid_content_aborts_politely_and_docks():
@@ -64,11 +69,15 @@ def test_abort_switches_the_projector_off():
 
 
 async def _fault() -> tuple[list[str], int, str]:
-    async with Running({"faults": [{"at": 120, "name": "motors", "level": 2,
-                                    "message": "overheated"}]}, once=True) as run:
+    async with Running(
+        {"faults": [{"at": 120, "name": "motors", "level": 2, "message": "overheated"}]}, once=True
+    ) as run:
         outcome = await run.finish()
-        return [describe(r, run.summary) for r in run.sim.received("tour")], outcome.code, \
-            outcome.reason
+        return (
+            [describe(r, run.summary) for r in run.sim.received("tour")],
+            outcome.code,
+            outcome.reason,
+        )
 
 
 def test_electronics_fault_aborts_with_its_reason():
@@ -80,28 +89,40 @@ def test_electronics_fault_aborts_with_its_reason():
 async def _undock_fails() -> tuple[list[str], int, str]:
     async with Running({"docking": {"undock_failures": 5}}, once=True) as run:
         outcome = await run.finish()
-        return [c for c in commands_after(run, 0) if not c.startswith("follow")], \
-            outcome.code, outcome.reason
+        return (
+            [c for c in commands_after(run, 0) if not c.startswith("follow")],
+            outcome.code,
+            outcome.reason,
+        )
 
 
 def test_undocking_failure_is_retried_then_stops_with_a_reason():
     commands, code, reason = asyncio.run(_undock_fails())
-    assert commands == ["tour started", "/docking/dock undock", "/docking/dock undock",
-                        "/docking/dock undock", "tour aborted undock failed"]
+    assert commands == [
+        "tour started",
+        "/docking/dock undock",
+        "/docking/dock undock",
+        "/docking/dock undock",
+        "tour aborted undock failed",
+    ]
     assert (code, reason) == (1, "undock failed")
 
 
 async def _dock_fails() -> tuple[list[str], int, str]:
     async with Running({"docking": {"dock_failures": 5}}, once=True) as run:
         outcome = await run.finish(90)
-        return [c for c in commands_after(run, 0) if c.startswith(("/docking", "tour"))], \
-            outcome.code, outcome.reason
+        return (
+            [c for c in commands_after(run, 0) if c.startswith(("/docking", "tour"))],
+            outcome.code,
+            outcome.reason,
+        )
 
 
 def test_docking_failure_is_retried_then_stops_with_a_reason():
     commands, code, reason = asyncio.run(_dock_fails())
-    assert commands[-5:] == ["/docking/dock dock"] * 3 + ["tour aborted dock failed"] \
-        or commands[-4:] == ["/docking/dock dock"] * 3 + ["tour aborted dock failed"]
+    assert commands[-5:] == ["/docking/dock dock"] * 3 + ["tour aborted dock failed"] or commands[
+        -4:
+    ] == ["/docking/dock dock"] * 3 + ["tour aborted dock failed"]
     assert (code, reason) == (1, "dock failed")
 
 
@@ -121,20 +142,24 @@ async def _crash_and_resume(tmp_path) -> tuple[list[str], list[str], int, list[s
         resumed = commands_after(second, restart_t)
         announced = second.summary.lines()
     await sim.stop()
-    return resumed, [describe(r, second.summary) for r in sim.received("tour")], outcome.code, \
-        announced
+    return (
+        resumed,
+        [describe(r, second.summary) for r in sim.received("tour")],
+        outcome.code,
+        announced,
+    )
 
 
 def test_a_restarted_executive_resumes_the_tour_at_the_current_stop(tmp_path):
     resumed, tours, code, summary = asyncio.run(_crash_and_resume(tmp_path))
     assert code == 0
     resumed_line = next(line for line in summary if line.startswith("resumed:"))
-    assert re.fullmatch(r"resumed:   resuming the tour at POI2: checkpoint \d s old",
-                        resumed_line)
+    assert re.fullmatch(r"resumed:   resuming the tour at POI2: checkpoint \d s old", resumed_line)
     gotos = [c for c in resumed if c.startswith("/GotoWayPoint")]
     assert gotos[0] == "/GotoWayPoint POI2a"  # re-navigates to the current stop
     assert "/docking/dock undock" not in resumed and not any(
-        c.startswith("/Approach") for c in resumed)  # no new start, no new recruitment
+        c.startswith("/Approach") for c in resumed
+    )  # no new start, no new recruitment
     assert tours == ["tour started", "tour ended"]  # one tour, resumed, not a second one
     assert not (tmp_path / "checkpoint.json").exists()  # cleared when the tour ended
 
@@ -167,8 +192,16 @@ def test_a_resumed_tour_is_a_tour_a_low_battery_aborts(tmp_path):
 
 async def _fresh_ignores(tmp_path) -> list[str]:
     checkpoint = tmp_path / "checkpoint.json"
-    checkpoint.write_text(json.dumps({"version": 1, "done": ["start", "recruit", "stop 0"],
-                                      "visitor": 7, "written": time.time()}))
+    checkpoint.write_text(
+        json.dumps(
+            {
+                "version": 1,
+                "done": ["start", "recruit", "stop 0"],
+                "visitor": 7,
+                "written": time.time(),
+            }
+        )
+    )
     async with Running({}, checkpoint=checkpoint, fresh=True, once=True) as run:
         await run.finish()
         return commands_after(run, 0)
@@ -181,8 +214,16 @@ def test_fresh_ignores_the_checkpoint(tmp_path):
 
 async def _docked_robot_does_not_resume(tmp_path) -> list[str]:
     checkpoint = tmp_path / "checkpoint.json"
-    checkpoint.write_text(json.dumps({"version": 1, "done": ["start", "recruit", "stop 0"],
-                                      "visitor": 7, "written": time.time()}))
+    checkpoint.write_text(
+        json.dumps(
+            {
+                "version": 1,
+                "done": ["start", "recruit", "stop 0"],
+                "visitor": 7,
+                "written": time.time(),
+            }
+        )
+    )
     async with Running({}, checkpoint=checkpoint, once=True) as run:
         await run.finish()
         return commands_after(run, 0)
@@ -195,12 +236,15 @@ def test_a_checkpoint_is_dropped_when_the_robot_is_docked(tmp_path):
 
 
 async def _wrong_secret() -> tuple[int, str]:
-    async with Rehearsal(fast(), site=load_site(), sim_secret="the right one",
-                         secret="a wrong one") as run:
+    async with Rehearsal(
+        fast(), site=load_site(), sim_secret="the right one", secret="a wrong one"
+    ) as run:
         outcome = await run.finish(30)
         return outcome.code, outcome.reason
 
 
 def test_once_stops_when_rosbridge_keeps_refusing_the_secret():
     assert asyncio.run(_wrong_secret()) == (
-        1, "rosbridge refused authentication (check the secret)")
+        1,
+        "rosbridge refused authentication (check the secret)",
+    )

@@ -36,8 +36,7 @@ def drain(sock: socket.socket) -> list[str]:
 def test_pings_come_at_half_the_watchdog_interval_by_the_clock(tmp_path: Path) -> None:
     sock = fake_systemd(tmp_path / "notify")
     now = [100.0]
-    notifier = Notifier(str(tmp_path / "notify"), watchdog_usec=2_000_000,
-                        clock=lambda: now[0])
+    notifier = Notifier(str(tmp_path / "notify"), watchdog_usec=2_000_000, clock=lambda: now[0])
     notifier.ready("starting")
     for _ in range(40):  # the loop turns every 0.1 s for 4 s
         notifier.alive()
@@ -58,22 +57,39 @@ def test_without_notify_socket_nothing_is_sent() -> None:
     notifier.alive()  # no socket, no error
 
 
-def test_the_executive_is_ready_pings_and_a_stopped_loop_stops_the_pings(
-        tmp_path: Path) -> None:
+def test_the_executive_is_ready_pings_and_a_stopped_loop_stops_the_pings(tmp_path: Path) -> None:
     sock = fake_systemd(tmp_path / "notify")
 
     async def main() -> tuple[list[str], list[str], list[str]]:
         listen = free_udp_port()
-        sim = Simulator(fast({"speed": 5.0}), rosbridge_port=0, frontend_port=0,
-                        executive=("127.0.0.1", listen))
+        sim = Simulator(
+            fast({"speed": 5.0}), rosbridge_port=0, frontend_port=0, executive=("127.0.0.1", listen)
+        )
         await sim.start()
-        env = {**os.environ, "NOTIFY_SOCKET": str(tmp_path / "notify"),
-               "WATCHDOG_USEC": "200000"}  # a ping every 0.1 s
+        env = {
+            **os.environ,
+            "NOTIFY_SOCKET": str(tmp_path / "notify"),
+            "WATCHDOG_USEC": "200000",
+        }  # a ping every 0.1 s
         proc = await asyncio.create_subprocess_exec(
-            sys.executable, "-m", "frog_bt", "run", "--sim-time", "--quiet",
-            "--checkpoint", "none", "--rosbridge", f"ws://127.0.0.1:{sim.rosbridge_port}",
-            "--frontend", f"127.0.0.1:{sim.frontend_port}", "--listen", f"127.0.0.1:{listen}",
-            env=env, stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.DEVNULL)
+            sys.executable,
+            "-m",
+            "frog_bt",
+            "run",
+            "--sim-time",
+            "--quiet",
+            "--checkpoint",
+            "none",
+            "--rosbridge",
+            f"ws://127.0.0.1:{sim.rosbridge_port}",
+            "--frontend",
+            f"127.0.0.1:{sim.frontend_port}",
+            "--listen",
+            f"127.0.0.1:{listen}",
+            env=env,
+            stdout=asyncio.subprocess.DEVNULL,
+            stderr=asyncio.subprocess.DEVNULL,
+        )
         loop = asyncio.get_running_loop()
         heard: list[str] = []
 
@@ -129,17 +145,21 @@ def _stopped(pid: int) -> bool:
         return f.read().rsplit(")", 1)[1].split()[0] in ("T", "t")
 
 
-def test_init_service_writes_a_notify_unit_with_a_watchdog_for_that_folder(
-        tmp_path: Path) -> None:
+def test_init_service_writes_a_notify_unit_with_a_watchdog_for_that_folder(tmp_path: Path) -> None:
     from frog_bt.cli import main
 
     site = tmp_path / "alcazar"
     assert main(["init", str(site), "--service", "--user", "frog"]) == 0
     unit = (site / "frog-bt.service").read_text()
-    for line in ("Type=notify", "Restart=always", "WatchdogSec=10", "User=frog",
-                 f"--tree {site.resolve()}/trees/tour.yaml",
-                 f"--config {site.resolve()}/config/site.yaml",
-                 f"--checkpoint {site.resolve()}/state/checkpoint.json"):
+    for line in (
+        "Type=notify",
+        "Restart=always",
+        "WatchdogSec=10",
+        "User=frog",
+        f"--tree {site.resolve()}/trees/tour.yaml",
+        f"--config {site.resolve()}/config/site.yaml",
+        f"--checkpoint {site.resolve()}/state/checkpoint.json",
+    ):
         assert line in unit, line
     assert (site / "state").is_dir() and (site / "recordings").is_dir()
     assert main(["init", str(site), "--service"]) == 2  # exists: not overwritten

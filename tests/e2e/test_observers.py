@@ -26,10 +26,13 @@ def test_every_observer_attaches_to_a_live_executive_and_closes(tmp_path: Path) 
     site, tree = load_site(), load_tree()
     out = io.StringIO()
     observers: list[Observer] = [
-        Recorder(tmp_path / "one.mcap"), RecordingDir(tmp_path / "dir", 10**9),
-        TourSummary(site), StatusLine(out),
+        Recorder(tmp_path / "one.mcap"),
+        RecordingDir(tmp_path / "dir", 10**9),
+        TourSummary(site),
+        StatusLine(out),
         Telemetry.open(f"save:{tmp_path / 'in.rrd'}", site, tree),
-        TelemetryProcess(f"save:{tmp_path / 'child.rrd'}", site, tree)]
+        TelemetryProcess(f"save:{tmp_path / 'child.rrd'}", site, tree),
+    ]
     assert all(isinstance(o, Observer) for o in observers)
     attached: list[Observer] = []
 
@@ -48,6 +51,7 @@ def test_every_observer_attaches_to_a_live_executive_and_closes(tmp_path: Path) 
     assert isinstance(summary, TourSummary) and summary.complete
     assert (tmp_path / "one.mcap").stat().st_size > 0
     assert sorted(p.name.split("-")[-1] for p in (tmp_path / "dir").iterdir())[:1] == [
-        "idle0001.mcap"]
+        "idle0001.mcap"
+    ]
     assert (tmp_path / "in.rrd").stat().st_size > 0 and (tmp_path / "child.rrd").exists()
     assert "success" in out.getvalue()  # the status line's last line: the tour's end

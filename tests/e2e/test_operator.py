@@ -19,8 +19,11 @@ from frog_bt.model.outcomes import IncidentKind
 
 def sent_(channel: str, **fields: object):
     """A message the simulated front end sent (content_done, frontend_idle)."""
-    return lambda r: r.direction == "out" and r.channel == channel and all(
-        r.payload.get(k) == v for k, v in fields.items())
+    return lambda r: (
+        r.direction == "out"
+        and r.channel == channel
+        and all(r.payload.get(k) == v for k, v in fields.items())
+    )
 
 
 async def _home_mid_content() -> tuple[list[str], int, str, str, str]:
@@ -30,8 +33,13 @@ async def _home_mid_content() -> tuple[list[str], int, str, str, str]:
         answer = run.executive.core.command(Command.HOME)
         again = run.executive.core.command(Command.HOME)
         outcome = await run.finish()
-        return (commands_after(run, t), outcome.code, outcome.reason, answer.text,
-                again.text if not again.ok else "applied twice")
+        return (
+            commands_after(run, t),
+            outcome.code,
+            outcome.reason,
+            answer.text,
+            again.text if not again.ok else "applied twice",
+        )
 
 
 def test_home_ends_the_tour_politely_with_reason_operator_and_docks() -> None:
@@ -49,16 +57,24 @@ def test_home_ends_the_tour_politely_with_reason_operator_and_docks() -> None:
 async def _skip_at(poi: str, event: str) -> tuple[list[str], str, list[str]]:
     async with Running({}, once=True) as run:
         if event == "drive":
-            await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint"
-                                   and run.summary.waypoint_of(r.payload).startswith(poi), 60)
+            await run.sim.wait_for(
+                lambda r: (
+                    r.channel == "/GotoWayPoint"
+                    and run.summary.waypoint_of(r.payload).startswith(poi)
+                ),
+                60,
+            )
         else:
             await run.sim.wait_for(is_("start_poi", poi=poi, part="a"), 60)
         t = run.sim.clock.now()
         answer = run.executive.core.command(Command.SKIP)
         outcome = await run.finish()
         assert outcome.code == 0, outcome.reason
-        skipped = [i.subject for i in run.executive.core.journal.incidents
-                   if i.kind is IncidentKind.STOP_LEFT]
+        skipped = [
+            i.subject
+            for i in run.executive.core.journal.incidents
+            if i.kind is IncidentKind.STOP_LEFT
+        ]
         return commands_after(run, t), answer.text, skipped
 
 
@@ -84,8 +100,11 @@ async def _refusals() -> list[tuple[bool, str]]:
         core = run.executive.core
         await run.sim.wait_for(is_("tour", state="started"), 60)
         # docked, undocking: no stop yet
-        answers = [core.command(Command.SKIP), core.command(Command.RESUME),
-                   core.command(Command.SERVICE_ON)]
+        answers = [
+            core.command(Command.SKIP),
+            core.command(Command.RESUME),
+            core.command(Command.SERVICE_ON),
+        ]
         assert core.board.get(keys.SKIP) is None and core.board.get(keys.IN_SERVICE)
         await run.finish()
         answers += [core.command(Command.HOME), core.command(Command.PAUSE)]
@@ -151,7 +170,8 @@ async def _service_off() -> tuple[list[str], bool, list[str]]:
         core = run.executive.core
         await run.sim.wait_for(is_("start_poi", poi="POI4", part="a"), 60)
         assert core.command(Command.SERVICE_OFF).text == (
-            "out of service: this tour finishes, then no new tour starts")
+            "out of service: this tour finishes, then no new tour starts"
+        )
         ended = await run.sim.wait_for(is_("tour", state="ended"), 60)
         idle = await run.sim.wait_for(sent_("frontend_idle"), 60)
         await run.sim.clock.sleep_until(idle.t + 120.0)  # a front end ready, two minutes

@@ -23,16 +23,30 @@ async def _signal_mid_content(sig: int) -> tuple[int, list[str]]:
     await sim.start()
     try:
         proc = await asyncio.create_subprocess_exec(
-            sys.executable, "-m", "frog_bt", "run", "--sim-time", "--quiet",
-            "--checkpoint", "none", "--rosbridge", f"ws://127.0.0.1:{sim.rosbridge_port}",
-            "--frontend", f"127.0.0.1:{sim.frontend_port}", "--listen", f"127.0.0.1:{listen}")
-        await sim.wait_for(lambda r: r.channel == "start_poi" and r.payload["poi"] == "POI1",
-                           60)
+            sys.executable,
+            "-m",
+            "frog_bt",
+            "run",
+            "--sim-time",
+            "--quiet",
+            "--checkpoint",
+            "none",
+            "--rosbridge",
+            f"ws://127.0.0.1:{sim.rosbridge_port}",
+            "--frontend",
+            f"127.0.0.1:{sim.frontend_port}",
+            "--listen",
+            f"127.0.0.1:{listen}",
+        )
+        await sim.wait_for(lambda r: r.channel == "start_poi" and r.payload["poi"] == "POI1", 60)
         t = sim.clock.now()
         proc.send_signal(sig)
         code = await asyncio.wait_for(proc.wait(), 60)  # a hang fails here, loudly
-        after = [f"{r.channel} {r.payload.get('data', r.payload.get('poi', ''))}"
-                 for r in sim.received() if r.t >= t and r.channel not in ("ack", "engagement")]
+        after = [
+            f"{r.channel} {r.payload.get('data', r.payload.get('poi', ''))}"
+            for r in sim.received()
+            if r.t >= t and r.channel not in ("ack", "engagement")
+        ]
         return code, after
     finally:
         await sim.stop()

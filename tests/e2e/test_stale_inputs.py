@@ -27,8 +27,13 @@ def test_laser_drop_out_is_not_taken_for_a_lost_visitor():
     assert "laser tracking or pose stale: assuming the visitor follows" in notes
     assert not any(c.startswith("/Approach") for c in after)  # never went back to recruit
     assert [c for c in after if c.startswith("start_poi") and c.endswith(" a")] == [
-        "start_poi POI1 POI1a a", "start_poi POI2 POI2a a", "start_poi POI3 POI3 a",
-        "start_poi POI4 POI4 a", "start_poi POI5 POI5 a", "start_poi END END a"]
+        "start_poi POI1 POI1a a",
+        "start_poi POI2 POI2a a",
+        "start_poi POI3 POI3 a",
+        "start_poi POI4 POI4 a",
+        "start_poi POI5 POI5 a",
+        "start_poi END END a",
+    ]
 
 
 async def _pose_drops_out_near_the_shop() -> tuple[list[int], list[str]]:

@@ -16,9 +16,22 @@ from frog_bt.model.outcomes import TourState
 
 async def _both() -> tuple[Running, Running]:
     morning = Running({"start_time": "2026-06-01T10:30:00+02:00"}, once=True)
-    afternoon = Running({"start_time": "2026-06-01T15:10:00+02:00", "visitors": [
-        {"id": 42, "position": [103.0, 36.0], "facing": True, "answer": "positive",
-         "faces": "engaged", "follow": True}]}, once=True)
+    afternoon = Running(
+        {
+            "start_time": "2026-06-01T15:10:00+02:00",
+            "visitors": [
+                {
+                    "id": 42,
+                    "position": [103.0, 36.0],
+                    "facing": True,
+                    "answer": "positive",
+                    "faces": "engaged",
+                    "follow": True,
+                }
+            ],
+        },
+        once=True,
+    )
     async with morning as a, afternoon as b:
         await asyncio.gather(a.finish(120.0), b.finish(120.0))
         return a, b

@@ -28,17 +28,22 @@ async def _through_relay(restart: bool) -> dict[str, Any]:
     try:
         async with Running({}, sim=sim, listen=listen, once=True) as run:
             if restart:
-                await sim.wait_for(lambda r: r.channel == "start_poi"
-                                   and r.payload.get("poi") == "POI1", 60)
+                await sim.wait_for(
+                    lambda r: r.channel == "start_poi" and r.payload.get("poi") == "POI1", 60
+                )
                 await relay.stop()  # every client dropped: the executive and the robot
                 await run.executive_ticks_until(lambda: not run.executive.client.link.connected)
                 await relay.start()  # the same port
             outcome = await run.finish()
-            return {"outcome": outcome, "commands": [c for c in run.tour().ros_commands()],
-                    "ended": [r.payload["state"] for r in sim.received("tour")],
-                    "starts": _start_pois(run), "via": sim._rosbridge,
-                    "relayed": relay.protocol.stats.publishes_in,
-                    "reconnects": run.executive.client.link.reconnects}
+            return {
+                "outcome": outcome,
+                "commands": [c for c in run.tour().ros_commands()],
+                "ended": [r.payload["state"] for r in sim.received("tour")],
+                "starts": _start_pois(run),
+                "via": sim._rosbridge,
+                "relayed": relay.protocol.stats.publishes_in,
+                "reconnects": run.executive.client.link.reconnects,
+            }
     finally:
         await sim.stop()
         await relay.stop()

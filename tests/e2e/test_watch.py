@@ -81,8 +81,9 @@ def test_no_swap_while_a_tour_runs(tmp_path: Path) -> None:
     async def main() -> None:
         async with Running({}, site=site, tree=tree) as run:
             exe = run.executive
-            await run.sim.wait_for(lambda r: r.channel == "tour"
-                                   and r.payload.get("state") == "started", 30)
+            await run.sim.wait_for(
+                lambda r: r.channel == "tour" and r.payload.get("state") == "started", 30
+            )
             exe.offer(site, load_tree(tour_file, site))
             await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 30)
             assert exe.core.board.get(keys.TOUR_STATE) is TourState.STARTED and not exe.idle()
@@ -158,8 +159,14 @@ def test_a_reload_keeps_a_pause_and_its_timer() -> None:
     first.board.set(keys.TOUR_STATE, TourState.STARTED)
     assert first.command(Command.PAUSE).ok
     paused_at = bench.clock.now()
-    second = Core(bench.site, load_tree(None, bench.site), bench.clock, first._publish_topic,
-                  first._send, standing=first.standing)
+    second = Core(
+        bench.site,
+        load_tree(None, bench.site),
+        bench.clock,
+        first._publish_topic,
+        first._send,
+        standing=first.standing,
+    )
     assert second.board.get(keys.PAUSED) is True
     assert second.operator.paused_since == paused_at
     assert not second.command(Command.PAUSE).ok  # already paused, in the new tree too

@@ -26,8 +26,7 @@ from frog_bt.tree.loader import LoadedTree
 # High speed and short content: a whole tour takes a few seconds of wall time.
 FAST: dict[str, Any] = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
 
-__all__ = ["FAST", "Running", "Tour", "after_ticks", "describe", "fast", "free_udp_port",
-           "tour"]
+__all__ = ["FAST", "Running", "Tour", "after_ticks", "describe", "fast", "free_udp_port", "tour"]
 
 
 def fast(overrides: dict[str, Any] | None = None) -> Scenario:
@@ -47,20 +46,21 @@ class Tour:
 
     def commands(self) -> list[str]:
         """What the executive sent, as the simulator received it, compactly."""
-        return [describe(r, self.summary) for r in self.sim.received()
-                if r.channel != "ack"]
+        return [describe(r, self.summary) for r in self.sim.received() if r.channel != "ack"]
 
     def ros_commands(self) -> list[str]:
         return [c for c in self.commands() if c.startswith("/")]
 
     def frontend_commands(self, *types: str) -> list[str]:
         """Front-end commands, only of ``types`` when given."""
-        return [c for c in self.commands() if not c.startswith("/")
-                and (not types or c.split()[0] in types)]
+        return [
+            c
+            for c in self.commands()
+            if not c.startswith("/") and (not types or c.split()[0] in types)
+        ]
 
 
-async def after_ticks(exe: Executive, condition: Callable[[], bool], wall: float = 60.0
-                      ) -> None:
+async def after_ticks(exe: Executive, condition: Callable[[], bool], wall: float = 60.0) -> None:
     """Wait, tick by tick (a tap on the executive's ticks, no polling), until
     ``condition()`` holds; ``wall`` seconds only catch a hang."""
     if condition():
@@ -92,17 +92,30 @@ class Running(Rehearsal):
     """A rehearsal of the default scenario (fast, with ``scenario_data`` on top) that
     keeps a tour summary and the front-end commands sent; ``once`` is off unless asked."""
 
-    def __init__(self, scenario_data: dict[str, Any], *, site: Site | None = None,
-                 tree: LoadedTree | None = None, sim: Simulator | None = None,
-                 listen: tuple[str, int] | None = None, **executive_kwargs: Any) -> None:
+    def __init__(
+        self,
+        scenario_data: dict[str, Any],
+        *,
+        site: Site | None = None,
+        tree: LoadedTree | None = None,
+        sim: Simulator | None = None,
+        listen: tuple[str, int] | None = None,
+        **executive_kwargs: Any,
+    ) -> None:
         site = site or load_site()
         self.summary = TourSummary(site)
         self.sent: list[tuple[float, Any]] = []
         self.published: list[tuple[float, str]] = []
         executive_kwargs.setdefault("once", False)
-        super().__init__(None if sim is not None else fast(scenario_data), site=site,
-                         tree=tree, sim=sim, listen=listen, prepare=self._prepare,
-                         **executive_kwargs)
+        super().__init__(
+            None if sim is not None else fast(scenario_data),
+            site=site,
+            tree=tree,
+            sim=sim,
+            listen=listen,
+            prepare=self._prepare,
+            **executive_kwargs,
+        )
 
     def _prepare(self, executive: Executive) -> None:
         attach_all(executive, [self.summary])
@@ -110,11 +123,19 @@ class Running(Rehearsal):
         listen(executive, lambda e: self.published.append((e.t, e.topic)), RobotCommand)
 
     def tour(self) -> Tour:
-        return Tour(self.sim, self.executive, self.executive.outcome, self.summary, self.site,
-                    self.sent, self.published)
+        return Tour(
+            self.sim,
+            self.executive,
+            self.executive.outcome,
+            self.summary,
+            self.site,
+            self.sent,
+            self.published,
+        )
 
-    async def executive_ticks_until(self, condition: Callable[[], bool], wall: float = 60.0
-                                    ) -> None:
+    async def executive_ticks_until(
+        self, condition: Callable[[], bool], wall: float = 60.0
+    ) -> None:
         await after_ticks(self.executive, condition, wall)
 
     def published_at(self, topic: str) -> list[float]:
@@ -122,8 +143,13 @@ class Running(Rehearsal):
         return [t for t, name in self.published if name == topic]
 
 
-async def run_tour(scenario_data: dict[str, Any], *, site: Site | None = None,
-                   tree: LoadedTree | None = None, wall_timeout: float = 60.0) -> Tour:
+async def run_tour(
+    scenario_data: dict[str, Any],
+    *,
+    site: Site | None = None,
+    tree: LoadedTree | None = None,
+    wall_timeout: float = 60.0,
+) -> Tour:
     async with Running(scenario_data, site=site, tree=tree, once=True) as run:
         await run.finish(wall_timeout)
         return run.tour()

@@ -49,6 +49,7 @@ async def within(awaitable: Awaitable[T]) -> T:
 
 async def until(condition: Callable[[], bool]) -> None:
     """Let the event loop run until ``condition()`` holds (datagrams in flight land)."""
+
     async def poll() -> None:
         while not condition():
             await asyncio.sleep(0.001)
@@ -106,7 +107,8 @@ class FakePeer(asyncio.DatagramProtocol):
 async def fake_peer(host: str = HOST, **kwargs: Any) -> AsyncIterator[FakePeer]:
     loop = asyncio.get_running_loop()
     transport, peer = await loop.create_datagram_endpoint(
-        lambda: FakePeer(**kwargs), local_addr=(host, 0))
+        lambda: FakePeer(**kwargs), local_addr=(host, 0)
+    )
     try:
         yield peer
     finally:
@@ -138,11 +140,18 @@ def test_commands_delivered_and_acked_between_two_links() -> None:
         clock = ManualClock(T0)
         got: asyncio.Queue[FrontendMessage] = asyncio.Queue()
         front_tap, exec_tap = Tap(), Tap()
-        front = FrontendLink((HOST, 0), (HOST, 9), clock, inbound=COMMANDS,
-                             on_message=got.put_nowait, on_datagram=front_tap)
+        front = FrontendLink(
+            (HOST, 0),
+            (HOST, 9),
+            clock,
+            inbound=COMMANDS,
+            on_message=got.put_nowait,
+            on_datagram=front_tap,
+        )
         async with started(front):
-            executive = FrontendLink((HOST, 0), (HOST, front.listen_port), clock,
-                                     on_datagram=exec_tap)
+            executive = FrontendLink(
+                (HOST, 0), (HOST, front.listen_port), clock, on_datagram=exec_tap
+            )
             async with started(executive):
                 assert executive.listen_port != front.listen_port
                 executive.send(Volume(percent=80))
@@ -171,10 +180,16 @@ def test_events_both_ways_between_executive_and_simulated_front_end() -> None:
         exec_port, front_port = free_port(), free_port()
         events: asyncio.Queue[FrontendMessage] = asyncio.Queue()
         commands: asyncio.Queue[FrontendMessage] = asyncio.Queue()
-        executive = FrontendLink((HOST, exec_port), (HOST, front_port), clock,
-                                 on_message=events.put_nowait)
-        front = FrontendLink((HOST, front_port), (HOST, exec_port), clock, inbound=COMMANDS,
-                             on_message=commands.put_nowait)
+        executive = FrontendLink(
+            (HOST, exec_port), (HOST, front_port), clock, on_message=events.put_nowait
+        )
+        front = FrontendLink(
+            (HOST, front_port),
+            (HOST, exec_port),
+            clock,
+            inbound=COMMANDS,
+            on_message=commands.put_nowait,
+        )
         async with started(executive), started(front):
             front.send(UserPositive())
             executive.send(FollowMe(on=False))
@@ -194,8 +209,9 @@ def test_ack_goes_to_the_datagram_source_not_the_configured_peer() -> None:
         clock = ManualClock(T0)
         events: asyncio.Queue[FrontendMessage] = asyncio.Queue()
         async with fake_peer() as configured, fake_peer() as sender:
-            link = FrontendLink((HOST, 0), (HOST, configured.port), clock,
-                                on_message=events.put_nowait)
+            link = FrontendLink(
+                (HOST, 0), (HOST, configured.port), clock, on_message=events.put_nowait
+            )
             async with started(link):
                 sender.sendto({"type": "user_positive", "seq": 1}, (HOST, link.listen_port))
                 assert await within(events.get()) == UserPositive()
@@ -241,8 +257,7 @@ def test_resends_driven_by_the_clock(drop: int) -> None:
     run(main)
 
 
-def test_never_acking_peer_is_given_up_after_eight_sends(
-        caplog: pytest.LogCaptureFixture) -> None:
+def test_never_acking_peer_is_given_up_after_eight_sends(caplog: pytest.LogCaptureFixture) -> None:
     async def main() -> None:
         clock = ManualClock(T0)
         async with fake_peer(ack=False) as peer:
@@ -325,12 +340,14 @@ def test_datagram_from_a_non_peer_host_is_dropped(caplog: pytest.LogCaptureFixtu
             pytest.skip(f"cannot bind 127.0.0.2: {exc}")
         try:
             async with fake_peer() as friend:
-                link = FrontendLink((HOST, 0), (HOST, friend.port), clock,
-                                    on_message=events.append, on_datagram=tap)
+                link = FrontendLink(
+                    (HOST, 0), (HOST, friend.port), clock, on_message=events.append, on_datagram=tap
+                )
                 async with started(link):
                     for seq in (1, 2):
-                        stranger.sendto({"type": "user_positive", "seq": seq},
-                                        (HOST, link.listen_port))
+                        stranger.sendto(
+                            {"type": "user_positive", "seq": seq}, (HOST, link.listen_port)
+                        )
                         await until(lambda seq=seq: link.stats.foreign == seq)
                     assert events == [] and tap.outbound == []  # no ack, no message
                     assert tap.inbound.empty()  # not shown to on_datagram: never recorded
@@ -355,11 +372,13 @@ def test_oversized_and_malformed_datagrams_are_counted(caplog: pytest.LogCapture
         events: list[FrontendMessage] = []
         tap = Tap()
         async with fake_peer() as peer:
-            link = FrontendLink((HOST, 0), (HOST, peer.port), clock,
-                                on_message=events.append, on_datagram=tap)
+            link = FrontendLink(
+                (HOST, 0), (HOST, peer.port), clock, on_message=events.append, on_datagram=tap
+            )
             async with started(link):
-                big = json.dumps({"type": "user_positive", "seq": 1,
-                                  "pad": "x" * MAX_DATAGRAM}).encode()
+                big = json.dumps(
+                    {"type": "user_positive", "seq": 1, "pad": "x" * MAX_DATAGRAM}
+                ).encode()
                 assert MAX_DATAGRAM < len(big) < 16384
                 peer.sendto(big, (HOST, link.listen_port))
                 assert len(await within(tap.inbound.get())) == len(big)  # read whole
@@ -431,8 +450,9 @@ def test_peer_given_by_name_is_resolved() -> None:
         clock = ManualClock(T0)
         events: asyncio.Queue[FrontendMessage] = asyncio.Queue()
         async with fake_peer() as peer:
-            link = FrontendLink((HOST, 0), ("localhost", peer.port), clock,
-                                on_message=events.put_nowait)
+            link = FrontendLink(
+                (HOST, 0), ("localhost", peer.port), clock, on_message=events.put_nowait
+            )
             async with started(link):
                 peer.sendto({"type": "frontend_idle", "seq": 1}, (HOST, link.listen_port))
                 await within(events.get())
@@ -464,4 +484,8 @@ def test_warning_limiter(caplog: pytest.LogCaptureFixture) -> None:
         wall[0] += 5
         assert limiter.warn("malformed", "bad 5")
     assert [r.getMessage() for r in caplog.records] == [
-        "bad 1", "stranger", "bad 4 (2 more malformed suppressed)", "bad 5"]
+        "bad 1",
+        "stranger",
+        "bad 4 (2 more malformed suppressed)",
+        "bad 5",
+    ]

@@ -35,8 +35,10 @@ VALID: list[tuple[FrontendMessage, dict[str, Any]]] = [
     (StartIntroduction(icl=True), {"icl": True}),
     (AskTour(engaged=False), {"engaged": False}),
     (AskTour(engaged=None), {"engaged": None}),
-    (StartPoi(poi="POI1", waypoint="POI1b", part="a"),
-     {"poi": "POI1", "waypoint": "POI1b", "part": "a"}),
+    (
+        StartPoi(poi="POI1", waypoint="POI1b", part="a"),
+        {"poi": "POI1", "waypoint": "POI1b", "part": "a"},
+    ),
     (FinishPoi(poi="POI2"), {"poi": "POI2"}),
     (Engagement(level=-0.5), {"level": -0.5}),
     (Engagement(level=None), {"level": None}),
@@ -63,11 +65,24 @@ def wire(message: FrontendMessage, fields: dict[str, Any], seq: int = 1) -> dict
 
 def test_tables_cover_the_contract() -> None:
     assert set(COMMANDS) == {
-        "start_introduction", "ask_tour", "start_poi", "finish_poi", "engagement",
-        "follow_me", "volume", "special_content", "projector", "tour"}
+        "start_introduction",
+        "ask_tour",
+        "start_poi",
+        "finish_poi",
+        "engagement",
+        "follow_me",
+        "volume",
+        "special_content",
+        "projector",
+        "tour",
+    }
     assert set(EVENTS) == {
-        "frontend_idle", "finish_introduction", "user_positive", "user_negative",
-        "content_done"}
+        "frontend_idle",
+        "finish_introduction",
+        "user_positive",
+        "user_negative",
+        "content_done",
+    }
     assert {type(m).type for m, _ in VALID} == set(COMMANDS) | set(EVENTS)
 
 
@@ -93,8 +108,11 @@ def test_extra_fields_are_ignored() -> None:
 
 @pytest.mark.parametrize(
     ("cls", "name"),
-    [(cls, name) for cls in [*COMMANDS.values(), *EVENTS.values()]
-     for name in cls.__struct_fields__],
+    [
+        (cls, name)
+        for cls in [*COMMANDS.values(), *EVENTS.values()]
+        for name in cls.__struct_fields__
+    ],
     ids=lambda v: getattr(v, "type", v),
 )
 def test_missing_field(cls: type[FrontendMessage], name: str) -> None:

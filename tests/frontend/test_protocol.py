@@ -216,8 +216,9 @@ def test_frontend_idle_below_the_highest_seq_is_a_restart() -> None:
         assert ep.receive(event(type_, seq), PEER, T0 + seq).message is not None
     # Restarted 2 s later: seq 1 again (still within the dedup window), then seqs 2, 3.
     assert ep.receive(event("frontend_idle", 1), PEER, T0 + 5).message is not None
-    assert ep.receive(event("content_done", 2, poi="POI1", part="a"), PEER, T0 + 6).message \
-        == ContentDone("POI1", "a")
+    assert ep.receive(
+        event("content_done", 2, poi="POI1", part="a"), PEER, T0 + 6
+    ).message == ContentDone("POI1", "a")
     assert ep.receive(event("user_positive", 3), PEER, T0 + 7).message == UserPositive()
     assert ep.stats.peer_restarts == 1 and ep.stats.duplicates == 0
 
@@ -351,24 +352,47 @@ def test_huge_level_is_malformed_not_a_crash() -> None:
 
 # ------------------------------------------------------------------ properties
 
-json_scalars = (st.none() | st.booleans() | st.integers() | st.text()
-                | st.floats(allow_nan=False, allow_infinity=False))
+json_scalars = (
+    st.none()
+    | st.booleans()
+    | st.integers()
+    | st.text()
+    | st.floats(allow_nan=False, allow_infinity=False)
+)
 json_values = st.recursive(
     json_scalars,
-    lambda children: st.lists(children, max_size=4)
-    | st.dictionaries(st.text(max_size=8), children, max_size=4),
+    lambda children: (
+        st.lists(children, max_size=4) | st.dictionaries(st.text(max_size=8), children, max_size=4)
+    ),
     max_leaves=12,
 )
 type_names = st.sampled_from([*COMMANDS, *EVENTS, "ack", "", "dance"]) | st.text(max_size=12)
 field_names = st.sampled_from(
-    ["icl", "engaged", "poi", "waypoint", "part", "level", "on", "percent", "spot", "state",
-     "reason"]) | st.text(max_size=8)
+    [
+        "icl",
+        "engaged",
+        "poi",
+        "waypoint",
+        "part",
+        "level",
+        "on",
+        "percent",
+        "spot",
+        "state",
+        "reason",
+    ]
+) | st.text(max_size=8)
 json_objects = st.fixed_dictionaries(
     {},
-    optional={"type": type_names | json_values,
-              "seq": st.integers(min_value=-3, max_value=2**40) | json_values},
-).flatmap(lambda head: st.dictionaries(field_names, json_values, max_size=5).map(
-    lambda rest: {**rest, **head}))
+    optional={
+        "type": type_names | json_values,
+        "seq": st.integers(min_value=-3, max_value=2**40) | json_values,
+    },
+).flatmap(
+    lambda head: st.dictionaries(field_names, json_values, max_size=5).map(
+        lambda rest: {**rest, **head}
+    )
+)
 
 
 @given(st.binary(max_size=300))
@@ -393,14 +417,21 @@ def test_decode_datagram_on_any_json_object(obj: dict[str, Any]) -> None:
             decode_message(data, table)
 
 
-@given(st.binary(max_size=300) | json_objects.map(lambda o: json.dumps(o).encode()),
-       st.sampled_from([PEER, "127.0.0.2"]))
+@given(
+    st.binary(max_size=300) | json_objects.map(lambda o: json.dumps(o).encode()),
+    st.sampled_from([PEER, "127.0.0.2"]),
+)
 def test_receive_never_raises(data: bytes, host: str) -> None:
     for ep in (executive(), front_end()):
         received = ep.receive(data, host, T0)
         assert received.reply is None or loads(received.reply)["type"] == "ack"
-        counted = (ep.stats.received + ep.stats.malformed + ep.stats.foreign
-                   + ep.stats.duplicates + ep.stats.acked)
+        counted = (
+            ep.stats.received
+            + ep.stats.malformed
+            + ep.stats.foreign
+            + ep.stats.duplicates
+            + ep.stats.acked
+        )
         assert counted <= 1
 
 
@@ -417,8 +448,9 @@ messages = st.one_of(
     st.builds(COMMANDS["volume"], percent=st.integers(0, 100)),
     st.builds(COMMANDS["special_content"], spot=texts),
     st.builds(COMMANDS["projector"], on=st.booleans()),
-    st.builds(COMMANDS["tour"], state=st.sampled_from(["started", "ended", "aborted"]),
-              reason=texts),
+    st.builds(
+        COMMANDS["tour"], state=st.sampled_from(["started", "ended", "aborted"]), reason=texts
+    ),
     *(st.just(cls()) for cls in EVENTS.values() if not cls.__struct_fields__),
     st.builds(EVENTS["content_done"], poi=texts, part=parts),
 )
@@ -441,8 +473,10 @@ def test_round_trip_every_message_type(message: FrontendMessage, skip: int) -> N
 
 
 @settings(max_examples=50)
-@given(st.lists(st.sampled_from(["send", "ack", "poll"]), max_size=40),
-       st.lists(st.floats(min_value=0.0, max_value=0.6), min_size=40, max_size=40))
+@given(
+    st.lists(st.sampled_from(["send", "ack", "poll"]), max_size=40),
+    st.lists(st.floats(min_value=0.0, max_value=0.6), min_size=40, max_size=40),
+)
 def test_every_command_is_acked_or_given_up(ops: list[str], steps: list[float]) -> None:
     """Whatever the interleaving, each sent command ends acked or unacked, never lost."""
     ep = executive()

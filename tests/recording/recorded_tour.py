@@ -40,33 +40,55 @@ class RecordedTour:
     received: list[Record]  # what the simulator got from the executive
 
 
-async def _record(path: Path, data: dict[str, Any] | None, site: Site | None,
-                  tree: LoadedTree | None, wall_timeout: float) -> RecordedTour:
+async def _record(
+    path: Path,
+    data: dict[str, Any] | None,
+    site: Site | None,
+    tree: LoadedTree | None,
+    wall_timeout: float,
+) -> RecordedTour:
     site = site or load_site()
     recorder = Recorder(path)
-    rehearsal = Rehearsal(scenario(data), site=site, tree=tree, prepare=lambda exe: attach_all(exe, [recorder]))
+    rehearsal = Rehearsal(
+        scenario(data), site=site, tree=tree, prepare=lambda exe: attach_all(exe, [recorder])
+    )
     start = rehearsal.sim.clock.now()
     try:
         async with rehearsal:
             outcome = await rehearsal.finish(wall_timeout)
     finally:
         recorder.close()
-    return RecordedTour(path, outcome, start, rehearsal.sim.clock.now(), site,
-                        rehearsal.executive, rehearsal.sim.received())
+    return RecordedTour(
+        path,
+        outcome,
+        start,
+        rehearsal.sim.clock.now(),
+        site,
+        rehearsal.executive,
+        rehearsal.sim.received(),
+    )
 
 
-def record_tour(path: Path, data: dict[str, Any] | None = None, *, site: Site | None = None,
-                tree: LoadedTree | None = None, wall_timeout: float = 60.0) -> RecordedTour:
+def record_tour(
+    path: Path,
+    data: dict[str, Any] | None = None,
+    *,
+    site: Site | None = None,
+    tree: LoadedTree | None = None,
+    wall_timeout: float = 60.0,
+) -> RecordedTour:
     """Run one tour of the default scenario (with ``data`` on top) and record it to ``path``."""
     return asyncio.run(_record(path, data, site, tree, wall_timeout))
 
 
 # Tours back to back: a fast robot, short content, a visitor who comes back.
 FAST_TOURS: dict[str, Any] = {
-    "speed": 400.0, "navigation": {"speed": 3.0, "approach_time": 1.0},
+    "speed": 400.0,
+    "navigation": {"speed": 3.0, "approach_time": 1.0},
     "docking": {"undock_time": 2.0, "dock_time": 3.0},
     "content": {"default": 4, "introduction": 3},
-    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0}}
+    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0},
+}
 
 
 def record_day(directory: Path, tours: int, max_bytes: int) -> RecordingDir:
@@ -79,11 +101,11 @@ def record_day(directory: Path, tours: int, max_bytes: int) -> RecordingDir:
 
         def prepare(executive: Any) -> None:
             attach_all(executive, [recordings])
-            listen(executive, lambda _e: executive.outcome.tours >= tours and enough.set(),
-                   Ticked)
+            listen(executive, lambda _e: executive.outcome.tours >= tours and enough.set(), Ticked)
 
-        rehearsal = Rehearsal(scenario_from("default", FAST_TOURS), site=load_site(),
-                              prepare=prepare, once=False)
+        rehearsal = Rehearsal(
+            scenario_from("default", FAST_TOURS), site=load_site(), prepare=prepare, once=False
+        )
         async with rehearsal:
             await asyncio.wait_for(enough.wait(), 60)
             rehearsal.executive.stop("enough")

@@ -26,8 +26,11 @@ from frog_bt.runtime.observer import attach_all
 
 
 def is_(channel: str, **fields: object):  # type: ignore[no-untyped-def]
-    return lambda r: r.direction == "in" and r.channel == channel and all(
-        r.payload.get(k) == v for k, v in fields.items())
+    return lambda r: (
+        r.direction == "in"
+        and r.channel == channel
+        and all(r.payload.get(k) == v for k, v in fields.items())
+    )
 
 
 async def _record_with_commands(path: Path) -> list[tuple[bool, str]]:
@@ -60,9 +63,9 @@ def commanded(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
-def test_a_tour_with_operator_commands_replays_identically(commanded: Path,
-                                                           capsys: pytest.CaptureFixture[str]
-                                                           ) -> None:
+def test_a_tour_with_operator_commands_replays_identically(
+    commanded: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     result = Replay(commanded, load_site(), load_tree(site=load_site())).run()
     assert result.identical, result.divergence
     assert result.operator_commands == 4
@@ -70,23 +73,27 @@ def test_a_tour_with_operator_commands_replays_identically(commanded: Path,
     assert ", 4 operator commands" in capsys.readouterr().out
 
 
-def test_without_the_skip_handler_the_replayed_answer_differs(commanded: Path,
-                                                              tmp_path: Path) -> None:
+def test_without_the_skip_handler_the_replayed_answer_differs(
+    commanded: Path, tmp_path: Path
+) -> None:
     trees = tmp_path / "trees"
     shutil.copytree(resources.tree_dir(), trees)
     visit = trees / "visit_poi.yaml"
     lines = visit.read_text().splitlines()
     start = next(i for i, line in enumerate(lines) if "type: OperatorSkip" in line)
     # the OperatorSkip decorator and its three lines go; its child moves up one level
-    body = [line[2:] if line.startswith("      ") else line for line in lines[start + 4:]]
+    body = [line[2:] if line.startswith("      ") else line for line in lines[start + 4 :]]
     visit.write_text("\n".join([*lines[:start], *body]) + "\n")
     tree = load_tree(trees / "tour.yaml", load_site())
     result = Replay(commanded, load_site(), tree).run()
     div = result.divergence
     assert div is not None and div.expected is not None and div.got is not None
     assert div.expected.channel == channels.OPERATOR
-    assert div.expected.payload == {"command": "skip", "ok": True,
-                                    "did": "skipping POI2: on to the next stop"}
+    assert div.expected.payload == {
+        "command": "skip",
+        "ok": True,
+        "did": "skipping POI2: on to the next stop",
+    }
     assert div.got.payload["ok"] is False
 
 
@@ -102,25 +109,28 @@ def copy_corrupting(src: Path, dst: Path, channel: str, data: bytes, nth: int = 
         for schema, chan, message in reader.iter_messages(log_time_order=False):
             if chan.id not in chans:
                 if schema is not None and schema.id not in schemas:
-                    schemas[schema.id] = writer.register_schema(schema.name, schema.encoding,
-                                                                schema.data)
+                    schemas[schema.id] = writer.register_schema(
+                        schema.name, schema.encoding, schema.data
+                    )
                 chans[chan.id] = writer.register_channel(
-                    chan.topic, chan.message_encoding,
-                    schemas[schema.id] if schema is not None else 0)
+                    chan.topic,
+                    chan.message_encoding,
+                    schemas[schema.id] if schema is not None else 0,
+                )
             payload = message.data
             if chan.topic == channel:
                 seen += 1
                 if seen == nth:
                     payload = data
-            writer.add_message(chans[chan.id], message.log_time, payload, message.publish_time,
-                               message.sequence)
+            writer.add_message(
+                chans[chan.id], message.log_time, payload, message.publish_time, message.sequence
+            )
         writer.finish()
 
 
-def test_a_bad_message_of_our_channels_is_counted_and_reported(commanded: Path,
-                                                               tmp_path: Path,
-                                                               capsys: pytest.CaptureFixture[str]
-                                                               ) -> None:
+def test_a_bad_message_of_our_channels_is_counted_and_reported(
+    commanded: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     bad = tmp_path / "bad.mcap"
     copy_corrupting(commanded, bad, channels.BLAME, b'{"channel": 5, "node": "x"}', nth=3)
     result = Replay(bad, load_site(), load_tree(site=load_site())).run()

@@ -70,8 +70,7 @@ def _json(obj: object) -> bytes:
 
 def _types(site: Site) -> dict[str, str]:
     """Every channel a frog-bt recording has, with its schema name."""
-    types = {site.topic(role): topic.type for role, topic in (*INPUTS.items(),
-                                                              *OUTPUTS.items())}
+    types = {site.topic(role): topic.type for role, topic in (*INPUTS.items(), *OUTPUTS.items())}
     return {**types, CLOCK.name: CLOCK.type, **OWN_TYPES}
 
 
@@ -94,11 +93,18 @@ def good_messages(site: Site) -> list[Message]:
     """One good message on every channel (and an ack each way), a second apart."""
     topic = site.topic
     faces = FaceData(T0, (Face(7, 0.4, 1.2, True),))
-    diagnostics = Diagnostics(T0, 73.5, (), (DiagnosticStatus(0, "battery", values=(
-        KeyValue("percentage", "73.5"),)),))
-    primer = channels.Primer(inputs=[channels.PrimerInput(
-        topic("docking_state"), T0 - 30.0, msgspec.Raw(b'{"data":"docked"}'))],
-        frontend_ready=True, frontend_out_seqs=[1, 2])
+    diagnostics = Diagnostics(
+        T0, 73.5, (), (DiagnosticStatus(0, "battery", values=(KeyValue("percentage", "73.5"),)),)
+    )
+    primer = channels.Primer(
+        inputs=[
+            channels.PrimerInput(
+                topic("docking_state"), T0 - 30.0, msgspec.Raw(b'{"data":"docked"}')
+            )
+        ],
+        frontend_ready=True,
+        frontend_out_seqs=[1, 2],
+    )
     made = [
         (channels.PRIMER, channels.encode(primer)),
         (CLOCK.name, _json({"clock": {"secs": int(T0), "nsecs": 0}})),
@@ -106,19 +112,27 @@ def good_messages(site: Site) -> list[Message]:
         (topic("response"), b'{"data": 2}'),
         (topic("docking_state"), b'{"data": "undocked"}'),
         (topic("diagnostic"), _json(DIAGNOSTICS.encode(diagnostics))),
-        (topic("persons"), _json(PERSONS.encode(PersonDetections(T0, (
-            PersonDetection(3, Point(1.0, 2.0), 181.0),))))),
+        (
+            topic("persons"),
+            _json(
+                PERSONS.encode(PersonDetections(T0, (PersonDetection(3, Point(1.0, 2.0), 181.0),)))
+            ),
+        ),
         (topic("faces"), _json(FACES.encode(faces))),
-        (topic("people"), _json(PEOPLE.encode(TrackedPeople(T0, (
-            TrackedPerson(3, Point(1.0, 2.0)),))))),
+        (
+            topic("people"),
+            _json(PEOPLE.encode(TrackedPeople(T0, (TrackedPerson(3, Point(1.0, 2.0)),)))),
+        ),
         (topic("goto"), _json(POSE.encode(POSE_VALUE))),
         (topic("approach"), b'{"data": 3}'),
         (topic("icl"), b'{"data": "start"}'),
         (topic("dock"), b'{"data": "undock"}'),
         (FRONTEND_IN, b'{"type": "frontend_idle", "seq": 1}'),
         (FRONTEND_OUT, b'{"type": "ack", "seq": 1}'),
-        (FRONTEND_OUT, b'{"type": "start_poi", "seq": 3, "poi": "POI1", "waypoint": '
-                       b'"POI1b", "part": "a"}'),
+        (
+            FRONTEND_OUT,
+            b'{"type": "start_poi", "seq": 3, "poi": "POI1", "waypoint": "POI1b", "part": "a"}',
+        ),
         (FRONTEND_IN, b'{"type": "ack", "seq": 3}'),
         (FRONTEND_IN, b'{"type": "content_done", "seq": 2, "poi": "POI1", "part": "a"}'),
         (channels.TICK, channels.encode(channels.Tick(1, "RUNNING"))),
@@ -133,9 +147,11 @@ def good_messages(site: Site) -> list[Message]:
 BAD: dict[str, tuple[bytes, str]] = {  # a damaged message of each kind: data, its reason
     "pose": (b'{"pose": {"position": {"x": 1, "y": 2}}}', "pose.orientation: missing field"),
     "response": (b"not json", "not JSON"),
-    "diagnostic": (b'{"status": [{"level": 2, "name": "battery", "values": [{"key": '
-                   b'"percentage", "value": "lots"}]}]}',
-                   "status[0].values[0].value: expected a number, got 'lots'"),
+    "diagnostic": (
+        b'{"status": [{"level": 2, "name": "battery", "values": [{"key": '
+        b'"percentage", "value": "lots"}]}]}',
+        "status[0].values[0].value: expected a number, got 'lots'",
+    ),
     "goto": (b"[1, 2]", "expected `object`, got `array`"),
     "approach": (b'{"data": "seven"}', "data: expected `int`, got `str`"),
     FRONTEND_IN: (b'{"type": "user_maybe", "seq": 4}', "type"),
@@ -167,8 +183,11 @@ def test_every_channel_decodes_to_its_type(tmp_path: Path) -> None:
     assert inputs[CLOCK_ROLE].value == T0
     diagnostics = inputs["diagnostic"].value
     assert isinstance(diagnostics, Diagnostics) and diagnostics.battery == 73.5
-    for role, kind in (("faces", FaceData), ("persons", PersonDetections),
-                       ("people", TrackedPeople)):
+    for role, kind in (
+        ("faces", FaceData),
+        ("persons", PersonDetections),
+        ("people", TrackedPeople),
+    ):
         assert isinstance(inputs[role].value, kind)
 
     commands = {r.role: r for r in records if isinstance(r, RobotCommand)}
@@ -177,42 +196,57 @@ def test_every_channel_decodes_to_its_type(tmp_path: Path) -> None:
     assert commands["goto"].msg == POSE.encode(POSE_VALUE)
     assert [commands[r].value for r in ("approach", "icl", "dock")] == [3, "start", "undock"]
 
-    assert [(type(r), r.seq) for r in records
-            if isinstance(r, FrontendIn | FrontendOut | FrontendAck)] == [
-        (FrontendIn, 1), (FrontendAck, 1), (FrontendOut, 3), (FrontendAck, 3), (FrontendIn, 2)]
+    assert [
+        (type(r), r.seq) for r in records if isinstance(r, FrontendIn | FrontendOut | FrontendAck)
+    ] == [(FrontendIn, 1), (FrontendAck, 1), (FrontendOut, 3), (FrontendAck, 3), (FrontendIn, 2)]
     acks = [r.direction for r in records if isinstance(r, FrontendAck)]
     assert acks == ["out", "in"]
     assert [r.message for r in records if isinstance(r, FrontendIn | FrontendOut)] == [
-        FrontendIdle(), StartPoi("POI1", "POI1b", "a"), ContentDone("POI1", "a")]
+        FrontendIdle(),
+        StartPoi("POI1", "POI1b", "a"),
+        ContentDone("POI1", "a"),
+    ]
 
     own = {r.channel: type(r.message) for r in records if isinstance(r, Own)}
-    assert own == {channels.TICK: channels.Tick, channels.BLAME: channels.Blame,
-                   channels.TREE: channels.Tree, channels.OPERATOR: channels.Operator,
-                   channels.ALERT: channels.Alert}
+    assert own == {
+        channels.TICK: channels.Tick,
+        channels.BLAME: channels.Blame,
+        channels.TREE: channels.Tree,
+        channels.OPERATOR: channels.Operator,
+        channels.ALERT: channels.Alert,
+    }
     (primed,) = [r for r in records if isinstance(r, Primed)]
     assert primed.primer.frontend_out_seqs == [1, 2] and primed.primer.frontend_ready
     assert [(i.role, i.value, i.t) for i in primed.inputs] == [
-        ("docking_state", "docked", T0 - 30.0)]  # at the time it was received
+        ("docking_state", "docked", T0 - 30.0)
+    ]  # at the time it was received
 
 
-def test_a_damaged_message_of_each_kind_is_counted_and_the_rest_still_read(
-        tmp_path: Path) -> None:
+def test_a_damaged_message_of_each_kind_is_counted_and_the_rest_still_read(tmp_path: Path) -> None:
     good = good_messages(SITE)
-    bad_primer = channels.encode(channels.Primer(inputs=[
-        channels.PrimerInput(SITE.topic("response"), T0 - 5, msgspec.Raw(b'{"data": 1.5}')),
-        channels.PrimerInput(SITE.topic("docking_state"), T0 - 4,
-                             msgspec.Raw(b'{"data": "docked"}'))]))
-    damaged = [(_topic(key), T0 + 100 + i, data) for i, (key, (data, _)) in enumerate(
-        BAD.items())]
+    bad_primer = channels.encode(
+        channels.Primer(
+            inputs=[
+                channels.PrimerInput(SITE.topic("response"), T0 - 5, msgspec.Raw(b'{"data": 1.5}')),
+                channels.PrimerInput(
+                    SITE.topic("docking_state"), T0 - 4, msgspec.Raw(b'{"data": "docked"}')
+                ),
+            ]
+        )
+    )
+    damaged = [(_topic(key), T0 + 100 + i, data) for i, (key, (data, _)) in enumerate(BAD.items())]
     damaged.append((channels.PRIMER, T0 + 200, bad_primer))
     later = [(topic, t + 300, data) for topic, t, data in good]
     reader = Reader(SITE, keep=5)
-    records = list(reader.read(write(tmp_path / "bad.mcap", [*good, *damaged, *later],
-                                     _types(SITE))))
+    records = list(
+        reader.read(write(tmp_path / "bad.mcap", [*good, *damaged, *later], _types(SITE)))
+    )
 
     bad = [r for r in records if isinstance(r, Bad)]
     assert [(b.channel, b.t) for b in bad] == [
-        *((topic, t) for topic, t, _ in damaged[:-1]), (channels.PRIMER, T0 + 200)]
+        *((topic, t) for topic, t, _ in damaged[:-1]),
+        (channels.PRIMER, T0 + 200),
+    ]
     for record, (_, reason) in zip(bad, BAD.values(), strict=False):
         assert reason in record.reason, (record.channel, record.reason)
     assert bad[-1].reason == "inputs[0] (/FROG_response): data: expected `int`, got `float`"
@@ -244,17 +278,31 @@ TOPICS = sorted(_types(SITE))
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.lists(st.tuples(st.sampled_from(TOPICS), st.binary(max_size=80)
-                          | st.sampled_from([b'{"data": 1}', b'{"type": "ack", "seq": 1}',
-                                             b'{"tick": 1, "status": "RUNNING"}', b"{}",
-                                             b'{"inputs": [{"topic": "/FROG_response", '
-                                             b'"t": 1, "msg": {"data": "x"}}]}'])),
-                max_size=8))
+@given(
+    st.lists(
+        st.tuples(
+            st.sampled_from(TOPICS),
+            st.binary(max_size=80)
+            | st.sampled_from(
+                [
+                    b'{"data": 1}',
+                    b'{"type": "ack", "seq": 1}',
+                    b'{"tick": 1, "status": "RUNNING"}',
+                    b"{}",
+                    b'{"inputs": [{"topic": "/FROG_response", "t": 1, "msg": {"data": "x"}}]}',
+                ]
+            ),
+        ),
+        max_size=8,
+    )
+)
 def test_any_bytes_on_any_channel_are_a_record_never_an_exception(
-        messages: list[tuple[str, bytes]]) -> None:
+    messages: list[tuple[str, bytes]],
+) -> None:
     reader = Reader(SITE)
-    recording = _Messages(_types(SITE), [(topic, T0 + i, data)
-                                         for i, (topic, data) in enumerate(messages)])
+    recording = _Messages(
+        _types(SITE), [(topic, T0 + i, data) for i, (topic, data) in enumerate(messages)]
+    )
     records: list[Record] = list(reader.read(recording))
     bad = sum(isinstance(r, Bad) for r in records)
     assert bad == reader.tally.count
@@ -263,7 +311,8 @@ def test_any_bytes_on_any_channel_are_a_record_never_an_exception(
 
 
 def test_replay_reports_a_damaged_robot_input_and_command(
-        tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     site = load_site()
     once = tmp_path / "input.mcap"
     copy_corrupting(tour.path, once, site.topic("docking_state"), b'{"data": 7}', nth=2)
@@ -286,8 +335,7 @@ def test_replay_reports_a_damaged_robot_input_and_command(
 
 def test_the_report_counts_damaged_messages_and_reads_past_them(tmp_path: Path) -> None:
     good = good_messages(SITE)
-    damaged = [(_topic(key), T0 + 100 + i, data) for i, (key, (data, _)) in enumerate(
-        BAD.items())]
+    damaged = [(_topic(key), T0 + 100 + i, data) for i, (key, (data, _)) in enumerate(BAD.items())]
     path = tmp_path / "bad.mcap"
     write(path, [*good, *damaged], _types(SITE))
     facts = read_file(str(path), SITE)

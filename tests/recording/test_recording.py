@@ -38,8 +38,15 @@ from frog_bt.runtime.observer import Observers, attach_all
 from frog_bt.sim import Simulator
 
 ROOT = Path(__file__).resolve().parents[2]
-JSON_TYPES: dict[str, Any] = {"object": dict, "array": list, "string": str, "boolean": bool,
-                              "null": type(None), "number": (int, float), "integer": int}
+JSON_TYPES: dict[str, Any] = {
+    "object": dict,
+    "array": list,
+    "string": str,
+    "boolean": bool,
+    "null": type(None),
+    "number": (int, float),
+    "integer": int,
+}
 
 
 def conforms(value: Any, schema: dict[str, Any]) -> bool:
@@ -57,17 +64,21 @@ def conforms(value: Any, schema: dict[str, Any]) -> bool:
     types = schema.get("type")
     if types is not None:
         types = [types] if isinstance(types, str) else types
-        ok = [t for t in types if isinstance(value, JSON_TYPES[t])
-              and not (t in ("number", "integer") and isinstance(value, bool))]
+        ok = [
+            t
+            for t in types
+            if isinstance(value, JSON_TYPES[t])
+            and not (t in ("number", "integer") and isinstance(value, bool))
+        ]
         if not ok:
             return False
     if isinstance(value, dict):
         props = schema.get("properties", {})
         extra = schema.get("additionalProperties")
-        return (all(k in value for k in schema.get("required", ()))
-                and all(conforms(v, props[k]) if k in props
-                        else isinstance(extra, dict) and conforms(v, extra)
-                        for k, v in value.items()))
+        return all(k in value for k in schema.get("required", ())) and all(
+            conforms(v, props[k]) if k in props else isinstance(extra, dict) and conforms(v, extra)
+            for k, v in value.items()
+        )
     if isinstance(value, list) and "items" in schema:
         return all(conforms(v, schema["items"]) for v in value)
     return True
@@ -107,8 +118,11 @@ def test_a_recorded_tour_has_every_channel_typed_and_stamped(tour: RecordedTour)
     assert counts[TICK] == tour.executive.core.ticks
 
     # The ROS commands recorded are the ones the robot got, in order.
-    recorded = [(c.topic, json.loads(m.data)) for _, c, m in messages if c.topic in
-                {t.name for t in OUTPUTS.values()}]
+    recorded = [
+        (c.topic, json.loads(m.data))
+        for _, c, m in messages
+        if c.topic in {t.name for t in OUTPUTS.values()}
+    ]
     assert recorded == [(r.channel, r.payload) for r in tour.received if r.side == "ros"]
     # Front-end commands too (resends share a seq; acks are the executive's answers).
     commands: dict[int, tuple[str, dict[str, Any]]] = {}
@@ -117,22 +131,31 @@ def test_a_recorded_tour_has_every_channel_typed_and_stamped(tour: RecordedTour)
             data = json.loads(m.data)
             if data["type"] != "ack":
                 commands.setdefault(data.pop("seq"), (data.pop("type"), data))
-    got = [(r.channel, r.payload) for r in tour.received
-           if r.side == "frontend" and r.channel != "ack"]
-    assert len(got) > 10 and got == list(commands.values())[:len(got)]
+    got = [
+        (r.channel, r.payload) for r in tour.received if r.side == "frontend" and r.channel != "ack"
+    ]
+    assert len(got) > 10 and got == list(commands.values())[: len(got)]
 
 
 def fake_executive() -> Any:
     site = load_site()
     links = Links(LinkStatus.CONNECTED, LinkStatus.ACKING, LinkStatus.SIM)
-    return SimpleNamespace(site=site, sim_time=True, clock=SimClock(), observers=Observers(),
-                           core=SimpleNamespace(tree=None), links=links)
+    return SimpleNamespace(
+        site=site,
+        sim_time=True,
+        clock=SimClock(),
+        observers=Observers(),
+        core=SimpleNamespace(tree=None),
+        links=links,
+    )
 
 
-def wire_of(executive: Any) -> tuple[Callable[[str, bytes, float], None],
-                                     Callable[[float, str, Any], None]]:
+def wire_of(
+    executive: Any,
+) -> tuple[Callable[[str, bytes, float], None], Callable[[float, str, Any], None]]:
     """(datagram(direction, data, t), ros_in(t, topic, msg)): raw traffic as the live
     executive tells its observers."""
+
     def datagram(direction: str, data: bytes, t: float) -> None:
         executive.observers.emit(Datagram(t, "in" if direction == "in" else "out", data))
 
@@ -157,8 +180,11 @@ def test_what_arrives_before_the_first_clock_is_stamped_with_it(tmp_path: Path) 
     datagram("in", b"{}", 1.0)  # after close: ignored
     _, messages = read_all(path)
     assert [(c.topic, from_ns(m.log_time)) for _, c, m in messages] == [
-        (FRONTEND_IN, 1_780_000_000.5), ("/docking/state", 1_780_000_000.5),
-        ("/clock", 1_780_000_000.5), ("/clock", 1_780_000_000.6)]
+        (FRONTEND_IN, 1_780_000_000.5),
+        ("/docking/state", 1_780_000_000.5),
+        ("/clock", 1_780_000_000.5),
+        ("/clock", 1_780_000_000.6),
+    ]
 
 
 @given(st.floats(min_value=1e7, max_value=4e9))  # ns stamps hold any epoch time exactly
@@ -168,14 +194,21 @@ def test_nanosecond_stamps_give_the_clock_time_back(t: float) -> None:
 
 def test_a_crash_still_leaves_valid_mcap(tmp_path: Path) -> None:
     path = tmp_path / "crash.mcap"
-    code = ("import sys; from pathlib import Path\n"
-            "from frog_bt.live.recording import Recorder\n"
-            "from frog_bt.model.events import Datagram\n"
-            "r = Recorder(Path(sys.argv[1]))\n"
-            "r.on_event(Datagram(1.0, 'out', b'{\"type\":\"tour\",\"seq\":1}'))\n"
-            "raise RuntimeError('boom')\n")
-    proc = subprocess.run([sys.executable, "-c", code, str(path)], cwd=ROOT,
-                          capture_output=True, text=True, timeout=30)
+    code = (
+        "import sys; from pathlib import Path\n"
+        "from frog_bt.live.recording import Recorder\n"
+        "from frog_bt.model.events import Datagram\n"
+        "r = Recorder(Path(sys.argv[1]))\n"
+        'r.on_event(Datagram(1.0, \'out\', b\'{"type":"tour","seq":1}\'))\n'
+        "raise RuntimeError('boom')\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code, str(path)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
     assert proc.returncode == 1 and "boom" in proc.stderr
     summary, messages = read_all(path)
     assert summary is not None and len(messages) == 1
@@ -186,15 +219,34 @@ def test_sigterm_stops_the_run_and_leaves_valid_mcap(tmp_path: Path) -> None:
 
     async def main() -> tuple[int | None, float, str]:
         listen = free_udp_port()
-        sim = Simulator(scenario({"speed": 100.0}), rosbridge_port=0, frontend_port=0,
-                        executive=("127.0.0.1", listen))
+        sim = Simulator(
+            scenario({"speed": 100.0}),
+            rosbridge_port=0,
+            frontend_port=0,
+            executive=("127.0.0.1", listen),
+        )
         await sim.start()
         proc = await asyncio.create_subprocess_exec(
-            sys.executable, "-m", "frog_bt", "run", "--sim-time", "--checkpoint", "none",
-            "--record", str(path),
-            "--quiet", "--rosbridge", f"ws://127.0.0.1:{sim.rosbridge_port}",
-            "--frontend", f"127.0.0.1:{sim.frontend_port}", "--listen", f"127.0.0.1:{listen}",
-            cwd=ROOT, stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE)
+            sys.executable,
+            "-m",
+            "frog_bt",
+            "run",
+            "--sim-time",
+            "--checkpoint",
+            "none",
+            "--record",
+            str(path),
+            "--quiet",
+            "--rosbridge",
+            f"ws://127.0.0.1:{sim.rosbridge_port}",
+            "--frontend",
+            f"127.0.0.1:{sim.frontend_port}",
+            "--listen",
+            f"127.0.0.1:{listen}",
+            cwd=ROOT,
+            stdout=asyncio.subprocess.PIPE,
+            stderr=asyncio.subprocess.PIPE,
+        )
         try:
             await sim.wait_for(lambda r: r.channel == "/GotoWayPoint", timeout=30)
             proc.send_signal(signal.SIGTERM)

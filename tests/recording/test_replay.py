@@ -24,7 +24,8 @@ from frog_bt.recordings.commands import differences, local_time
 
 
 def test_b_replaying_the_recorded_tour_is_identical(
-        tour: RecordedTour, capsys: pytest.CaptureFixture[str]) -> None:
+    tour: RecordedTour, capsys: pytest.CaptureFixture[str]
+) -> None:
     assert main(["replay", str(tour.path), "--quiet"]) == 0
     out = capsys.readouterr().out
     first, summary = out.splitlines()
@@ -44,7 +45,8 @@ def swapped_stops(tmp_path: Path, a: str, b: str) -> Path:
 
 
 def test_c_a_changed_stop_order_diverges_at_the_first_different_goal(
-        tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     config = swapped_stops(tmp_path, "POI4", "POI5")
     site = load_site(config)
     result = Replay(tour.path, site, load_tree(site=site)).run()
@@ -57,8 +59,10 @@ def test_c_a_changed_stop_order_diverges_at_the_first_different_goal(
 
     assert main(["replay", str(tour.path), "--config", str(config), "--quiet"]) == 1
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0] == (f"divergence at {local_time(div.t)} (+{div.t - result.start:.1f} s into "
-                        f"the recording), command {div.number}:")
+    assert lines[0] == (
+        f"divergence at {local_time(div.t)} (+{div.t - result.start:.1f} s into "
+        f"the recording), command {div.number}:"
+    )
     assert lines[1].startswith("  expected: /GotoWayPoint {") and "51.7105" in lines[1]
     assert lines[2].startswith("  got:      /GotoWayPoint {") and "52.08933" in lines[2]
     assert lines[3] == "  differs:  waypoint POI4 → POI5"  # in domain terms
@@ -66,12 +70,14 @@ def test_c_a_changed_stop_order_diverges_at_the_first_different_goal(
     assert sent[0].startswith("  recorded: sent by Navigate POI4 (goto.yaml:")
     assert sent[1].startswith("  replayed: sent by Navigate POI5 (goto.yaml:")
     assert div.expected.node.startswith("Navigate POI4") and div.got.node.startswith(
-        "Navigate POI5")  # blame: the node that sent each command, on both sides
+        "Navigate POI5"
+    )  # blame: the node that sent each command, on both sides
     assert lines[-1].startswith("replayed ")
 
 
 def test_not_a_file_not_mcap_and_missing_channels_exit_2(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     text = tmp_path / "notes.mcap"
     text.write_text("hello\n", encoding="utf-8")
     other = tmp_path / "other.mcap"
@@ -80,13 +86,17 @@ def test_not_a_file_not_mcap_and_missing_channels_exit_2(
         writer.start()
         schema = writer.register_schema("std_msgs/String", "jsonschema", b"{}")
         channel = writer.register_channel("/chatter", "json", schema)
-        writer.add_message(channel, log_time=1, data=json.dumps({"data": "hi"}).encode(),
-                           publish_time=1)
+        writer.add_message(
+            channel, log_time=1, data=json.dumps({"data": "hi"}).encode(), publish_time=1
+        )
         writer.finish()
     empty = tmp_path / "empty"
     empty.mkdir()
-    for path, reason in ((empty, "no recordings (*.mcap) found"), (text, "not an MCAP file"),
-                         (other, "no channel /ApproachPeopleFar")):
+    for path, reason in (
+        (empty, "no recordings (*.mcap) found"),
+        (text, "not an MCAP file"),
+        (other, "no channel /ApproachPeopleFar"),
+    ):
         assert main(["replay", str(path)]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and reason in err, err
@@ -113,11 +123,11 @@ def changed_config(tmp_path: Path, change: Any) -> Path:
 
 
 def test_a_moved_variant_cut_off_is_blamed_on_the_variant_choice(
-        tour: RecordedTour, tmp_path: Path) -> None:
+    tour: RecordedTour, tmp_path: Path
+) -> None:
     """The tour was recorded at 10:30; with POI1's variant a only until 10:00 the replay
     drives to POI1b: the report says so in waypoint names, and which node sent each."""
-    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(
-        until="10:00"))
+    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(until="10:00"))
     site = load_site(config)
     div = Replay(tour.path, site, load_tree(site=site)).run().divergence
     assert div is not None
@@ -127,7 +137,8 @@ def test_a_moved_variant_cut_off_is_blamed_on_the_variant_choice(
 
 
 def test_a_removed_extension_is_blamed_on_the_content_node(
-        tour: RecordedTour, tmp_path: Path) -> None:
+    tour: RecordedTour, tmp_path: Path
+) -> None:
     """Without the engagement-gated part b, the replay finishes the POI where the
     recording played part b: `start_poi … part b → finish_poi`, both nodes named."""
     trees = tmp_path / "trees"
@@ -148,7 +159,8 @@ def test_a_removed_extension_is_blamed_on_the_content_node(
 
 
 def test_a_changed_engagement_gate_names_the_content_nodes_and_the_vote(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Recorded with a visitor whose engagement swings (the ``mixed`` faces): at POI2 the
     vote over the first and last 15 % of the samples said engaged, and part b played.
     Voting over 5 % only ties, and a tie means no extension: the report names
@@ -161,7 +173,8 @@ def test_a_changed_engagement_gate_names_the_content_nodes_and_the_vote(
     div = Replay(recorded.path, site, load_tree(site=site)).run().divergence
     assert div is not None and div.expected is not None and div.got is not None
     assert differences(div.expected, div.got, site) == (
-        "start_poi poi POI2 waypoint POI2a part b → finish_poi poi POI2")
+        "start_poi poi POI2 waypoint POI2a part b → finish_poi poi POI2"
+    )
     assert div.expected.node.startswith("PlayContent POI2 b (visit_poi.yaml:")
     assert div.got.node.startswith("FinishPoi POI2 (visit_poi.yaml:")
     assert div.expected.reads["/engaged"] == "True"
@@ -181,21 +194,24 @@ def test_a_skipped_stop_is_reported_with_the_nodes_on_both_sides(tmp_path: Path)
     """Recorded: navigation to POI2 failed once and the retry got there. With one
     navigation attempt only, the replay gives up on POI2: where the recording sent the
     goal again, the replay's guided drive ends (follow-me off) on its way to skip it."""
-    recorded = record_tour(tmp_path / "retry.mcap",
-                           {"navigation": {"failures": [{"poi": "POI2", "times": 1}]}})
+    recorded = record_tour(
+        tmp_path / "retry.mcap", {"navigation": {"failures": [{"poi": "POI2", "times": 1}]}}
+    )
     assert recorded.outcome.code == 0
     config = changed_config(tmp_path, lambda d: d["navigation"].update(attempts=1))
     site = load_site(config)
     div = Replay(recorded.path, site, load_tree(site=site)).run().divergence
     assert div is not None and div.expected is not None and div.got is not None
     assert differences(div.expected, div.got, site) == (
-        "/GotoWayPoint waypoint POI2a → follow_me on false")
+        "/GotoWayPoint waypoint POI2a → follow_me on false"
+    )
     assert div.expected.node.startswith("Navigate POI2 (goto.yaml:")  # the retry
     assert div.got.node.startswith("Guide to POI2 (visit_poi.yaml:")  # giving up on it
 
 
 def test_a_corpus_is_replayed_in_parallel_and_summarised(
-        tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Two morning tours (the same recording twice), an afternoon tour, a truncated copy
     and a corrupt file, with POI1's variant a moved to end at 10:00: the morning tours
     diverge at the variant choice, the afternoon one does not, the truncated one is
@@ -209,11 +225,21 @@ def test_a_corpus_is_replayed_in_parallel_and_summarised(
     data = tour.path.read_bytes()
     (corpus / "d-truncated.mcap").write_bytes(data[: len(data) * 3 // 4])
     (corpus / "e-corrupt.mcap").write_bytes(data[:8] + bytes(range(256)) * 4)
-    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(
-        until="10:00"))
+    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(until="10:00"))
     report = tmp_path / "report.json"
-    code = main(["replay", str(corpus), "--config", str(config), "--jobs", "2",
-                 "--report", str(report), "--quiet"])
+    code = main(
+        [
+            "replay",
+            str(corpus),
+            "--config",
+            str(config),
+            "--jobs",
+            "2",
+            "--report",
+            str(report),
+            "--quiet",
+        ]
+    )
     assert code == 1
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith(f"{corpus / 'a-morning.mcap'}: diverged at +")
@@ -223,22 +249,30 @@ def test_a_corpus_is_replayed_in_parallel_and_summarised(
     assert lines[3].endswith(" s]") and "[d-truncated.mcap: cut short" in lines[3]
     assert lines[4].startswith(f"{corpus / 'e-corrupt.mcap'}: unreadable: ")
     assert "waypoint POI1a → POI1b" in lines[0] and "replayed: Navigate POI1" in lines[0]
-    assert lines[5] == ("3 of 5 tours diverge: 3 at Navigate POI1: waypoint; 1 unreadable; "
-                        "1 recovered from a cut")
+    assert lines[5] == (
+        "3 of 5 tours diverge: 3 at Navigate POI1: waypoint; 1 unreadable; 1 recovered from a cut"
+    )
     rows = json.loads(report.read_text())
     assert [r["status"] for r in rows["tours"]] == [
-        "diverged", "diverged", "identical", "diverged", "unreadable"]
+        "diverged",
+        "diverged",
+        "identical",
+        "diverged",
+        "unreadable",
+    ]
     assert rows["summary"]["by_signature"] == {"Navigate POI1: waypoint": 3}
     assert rows["tours"][4]["reason"]  # why it could not be read
     assert rows["tours"][3]["recovered"].startswith("d-truncated.mcap: cut short")
 
 
 def test_json_report_names_nodes_reads_and_the_domain_diff(
-        tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(
-        until="10:00"))
-    assert main(["replay", str(tour.path), "--config", str(config), "--format", "json",
-                 "--quiet"]) == 1
+    tour: RecordedTour, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(until="10:00"))
+    assert (
+        main(["replay", str(tour.path), "--config", str(config), "--format", "json", "--quiet"])
+        == 1
+    )
     out = json.loads(capsys.readouterr().out)
     div = out["divergence"]
     assert out["identical"] is False and div["differs"] == "waypoint POI1a → POI1b"
@@ -257,31 +291,40 @@ def test_a_recording_carries_the_tree_that_ran(tour: RecordedTour) -> None:
     from frog_bt.tree.loader import DEFAULT_TREE
 
     with open(tour.path, "rb") as f:
-        trees = [json.loads(m.data) for _, c, m in make_reader(f).iter_messages()
-                 if c.topic == "/frog_bt/tree"]
+        trees = [
+            json.loads(m.data)
+            for _, c, m in make_reader(f).iter_messages()
+            if c.topic == "/frog_bt/tree"
+        ]
     assert len(trees) == 1 and trees[0]["format"] == "BehaviorTree.CPP v4"
     assert trees[0]["xml"] == tree_xml(DEFAULT_TREE, tour.site, FACTORY)
 
 
 def test_the_viewer_shows_recorded_and_replayed_commands_and_the_divergence(
-        tour: RecordedTour, tmp_path: Path) -> None:
+    tour: RecordedTour, tmp_path: Path
+) -> None:
     from rerun.chunk import RrdReader
 
-    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(
-        until="10:00"))
+    config = changed_config(tmp_path, lambda d: d["variants"]["POI1"][0].update(until="10:00"))
     rrd = tmp_path / "what-if.rrd"
-    assert main(["replay", str(tour.path), "--config", str(config), "--quiet",
-                 "--rerun", f"save:{rrd}"]) == 1
+    assert (
+        main(
+            ["replay", str(tour.path), "--config", str(config), "--quiet", "--rerun", f"save:{rrd}"]
+        )
+        == 1
+    )
     texts: dict[str, list[str]] = {}
     for chunk in RrdReader(rrd).stream():
         if chunk.entity_path.startswith("/log/replay/") and not chunk.is_static:
             batch = chunk.to_record_batch()
             if "TextLog:text" in batch.schema.names:
                 texts.setdefault(chunk.entity_path, []).extend(
-                    t for row in batch.column("TextLog:text").to_pylist() for t in row)
+                    t for row in batch.column("TextLog:text").to_pylist() for t in row
+                )
     recorded, replayed = texts["/log/replay/recorded"], texts["/log/replay/replayed"]
     assert len(recorded) == len(replayed) > 1  # two lanes, command for command
     assert recorded[-1].startswith("recorded: /GotoWayPoint waypoint POI1a  [Navigate POI1")
     assert replayed[-1].startswith("replayed: /GotoWayPoint waypoint POI1b  [Navigate POI1")
     assert texts["/log/replay/divergence"] == [
-        f"divergence, command {len(recorded)}: waypoint POI1a → POI1b"]
+        f"divergence, command {len(recorded)}: waypoint POI1a → POI1b"
+    ]

@@ -31,19 +31,29 @@ def metadata(path: Path) -> dict[str, str]:
     with open(path, "rb") as f:
         reader = make_reader(f)
         assert reader.get_summary() is not None  # closed: summary and footer written
-        return {k: v for m in reader.iter_metadata() if m.name == "frog_bt"
-                for k, v in m.metadata.items()}
+        return {
+            k: v
+            for m in reader.iter_metadata()
+            if m.name == "frog_bt"
+            for k, v in m.metadata.items()
+        }
 
 
 def test_a_day_is_recorded_one_file_per_tour_and_idle_period_each_replaying_alone(
-        tmp_path: Path) -> None:
+    tmp_path: Path,
+) -> None:
     """Two tours: idle 1, tour 1, idle 2, tour 2, idle 3 (stopped there), named by the
     clock's local time and number, each closed with a footer; every file replays
     identically on its own (a tour file after its lead-in, an idle file from its primer)."""
     recordings = record_day(tmp_path / "day", 2, 10**12)
     names = [p.name for p in recordings.files]
-    assert [n[16:] for n in names] == ["idle0001.mcap", "tour0001.mcap", "idle0002.mcap",
-                                       "tour0002.mcap", "idle0003.mcap"]
+    assert [n[16:] for n in names] == [
+        "idle0001.mcap",
+        "tour0001.mcap",
+        "idle0002.mcap",
+        "tour0002.mcap",
+        "idle0003.mcap",
+    ]
     assert all(n.startswith("20260601-10") for n in names)  # the scenario's day, not today
     assert [p for _, p in numbered(tmp_path / "day")] == recordings.files
     assert metadata(recordings.files[1]) == {"kind": "tour", "tour": "1", "lead_in": names[0]}
@@ -58,12 +68,17 @@ def test_a_day_is_recorded_one_file_per_tour_and_idle_period_each_replaying_alon
 
 
 def test_the_budget_deletes_the_oldest_tours_first_and_logs_each(
-        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
     day = tmp_path / "day"
     day.mkdir()
-    for name, size in (("20260601-090000-idle0001", 100), ("20260601-090100-tour0001", 400),
-                       ("20260601-100000-idle0002", 100), ("20260601-100100-tour0002", 400),
-                       ("20260601-110000-idle0003", 100)):
+    for name, size in (
+        ("20260601-090000-idle0001", 100),
+        ("20260601-090100-tour0001", 400),
+        ("20260601-100000-idle0002", 100),
+        ("20260601-100100-tour0002", 400),
+        ("20260601-110000-idle0003", 100),
+    ):
         (day / f"{name}.mcap").write_bytes(b"x" * size)
     (day / "notes.mcap").write_bytes(b"x" * 5000)  # not ours: never counted nor deleted
     recordings = RecordingDir(day, 700)
@@ -71,11 +86,15 @@ def test_the_budget_deletes_the_oldest_tours_first_and_logs_each(
     with caplog.at_level(logging.WARNING, logger="frog_bt.live.rotation"):
         recordings.enforce_budget()
     assert sorted(p.name for p in day.iterdir()) == [
-        "20260601-100000-idle0002.mcap", "20260601-100100-tour0002.mcap",
-        "20260601-110000-idle0003.mcap", "notes.mcap"]
+        "20260601-100000-idle0002.mcap",
+        "20260601-100100-tour0002.mcap",
+        "20260601-110000-idle0003.mcap",
+        "notes.mcap",
+    ]
     assert [r.getMessage() for r in caplog.records] == [
         "recording budget 700 bytes: deleted 20260601-090000-idle0001.mcap (100 bytes)",
-        "recording budget 700 bytes: deleted 20260601-090100-tour0001.mcap (400 bytes)"]
+        "recording budget 700 bytes: deleted 20260601-090100-tour0001.mcap (400 bytes)",
+    ]
 
 
 def test_a_small_budget_keeps_the_latest_tours_while_recording(tmp_path: Path) -> None:
@@ -95,7 +114,8 @@ def test_a_tour_without_its_lead_in_says_why_it_cannot_be_replayed(tmp_path: Pat
 
 
 def test_a_killed_writers_file_is_recovered_by_replay_and_numbering_goes_on(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """`frog-bt run --record DIR` killed with SIGKILL in the middle of a tour: the tour
     file has no footer; replay says it recovered it, and what is there replays
     identically. A restarted executive goes on with the next number."""
@@ -103,15 +123,34 @@ def test_a_killed_writers_file_is_recovered_by_replay_and_numbering_goes_on(
 
     async def run_and_kill() -> None:
         listen = free_udp_port()
-        sim = Simulator(scenario_from("default", {**FAST_TOURS, "speed": 50.0}),
-                        rosbridge_port=0, frontend_port=0, executive=("127.0.0.1", listen))
+        sim = Simulator(
+            scenario_from("default", {**FAST_TOURS, "speed": 50.0}),
+            rosbridge_port=0,
+            frontend_port=0,
+            executive=("127.0.0.1", listen),
+        )
         await sim.start()
         proc = await asyncio.create_subprocess_exec(
-            sys.executable, "-m", "frog_bt", "run", "--sim-time", "--checkpoint", "none",
-            "--record", str(day), "--quiet",
-            "--rosbridge", f"ws://127.0.0.1:{sim.rosbridge_port}",
-            "--frontend", f"127.0.0.1:{sim.frontend_port}", "--listen", f"127.0.0.1:{listen}",
-            cwd=ROOT, stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.DEVNULL)
+            sys.executable,
+            "-m",
+            "frog_bt",
+            "run",
+            "--sim-time",
+            "--checkpoint",
+            "none",
+            "--record",
+            str(day),
+            "--quiet",
+            "--rosbridge",
+            f"ws://127.0.0.1:{sim.rosbridge_port}",
+            "--frontend",
+            f"127.0.0.1:{sim.frontend_port}",
+            "--listen",
+            f"127.0.0.1:{listen}",
+            cwd=ROOT,
+            stdout=asyncio.subprocess.DEVNULL,
+            stderr=asyncio.subprocess.DEVNULL,
+        )
         try:
             # In the tour (its file is open) and past a chunk flush (a second of wall time
             # at most after the fourth goal): then kill, without warning.
@@ -130,7 +169,8 @@ def test_a_killed_writers_file_is_recovered_by_replay_and_numbering_goes_on(
                 if tours and tours[-1].stat().st_size > 50_000:
                     break
                 assert asyncio.get_running_loop().time() < deadline, (
-                    f"no tour file past 50 kB within 60 s: {[p.name for p in tours]}")
+                    f"no tour file past 50 kB within 60 s: {[p.name for p in tours]}"
+                )
                 await asyncio.sleep(0.05)
             os.kill(proc.pid, signal.SIGKILL)
             await proc.wait()
@@ -145,11 +185,11 @@ def test_a_killed_writers_file_is_recovered_by_replay_and_numbering_goes_on(
     assert [p.name[16:] for p in files] == ["idle0001.mcap", "tour0001.mcap"]
     assert main(["replay", str(files[1]), "--quiet"]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[0].startswith(f"note: {files[1].name}: cut short (no summary or footer): "
-                             "recovered ") and out[0].endswith("; replayed up to the cut")
+    assert out[0].startswith(
+        f"note: {files[1].name}: cut short (no summary or footer): recovered "
+    ) and out[0].endswith("; replayed up to the cut")
     assert out[1].startswith("identical: ")
-    assert main(["replay", str(day), "--quiet", "--report",
-                 str(tmp_path / "r.json")]) == 0
+    assert main(["replay", str(day), "--quiet", "--report", str(tmp_path / "r.json")]) == 0
     rows = json.loads((tmp_path / "r.json").read_text())["tours"]
     assert [r["status"] for r in rows] == ["identical", "identical"]
     assert rows[1]["recovered"].startswith(f"{files[1].name}: cut short")

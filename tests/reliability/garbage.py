@@ -32,37 +32,108 @@ VALID_MSGS: dict[str, dict[str, Any]] = {
     "geometry_msgs/PoseStamped": msgs.pose_stamped(97.19, 63.02, 0.898316, 0.43934, T),
     "std_msgs/Int32": {"data": 2},
     "std_msgs/String": {"data": "docked"},
-    "diagnostic_msgs/DiagnosticArray": msgs.diagnostic_array(T, [
-        {"level": 0, "name": "battery", "message": "ok", "hardware_id": "bms",
-         "values": [("percentage", "73.5")]},
-        {"level": 2, "name": "motors", "message": "hot", "hardware_id": "", "values": []}]),
-    "frog_msgs/PersonDetections": msgs.person_detections(T, [
-        {"id": 7, "position": (103.0, 36.0), "orientation": 181.0},
-        {"id": 8, "position": (105.5, 35.0), "orientation": 90.0}]),
-    "frog_msgs/FaceData": msgs.face_data(T, [
-        {"id": 7, "engagement": 0.4, "distance": 1.2, "facing": True},
-        {"id": 9, "engagement": -1.0, "distance": 3.5, "facing": False}]),
-    "frog_msgs/TrackedPeople": msgs.tracked_people(T, [
-        {"id": 3, "position": (103.0, 36.0)}, {"id": 4, "position": (1.0, 2.0)}]),
+    "diagnostic_msgs/DiagnosticArray": msgs.diagnostic_array(
+        T,
+        [
+            {
+                "level": 0,
+                "name": "battery",
+                "message": "ok",
+                "hardware_id": "bms",
+                "values": [("percentage", "73.5")],
+            },
+            {"level": 2, "name": "motors", "message": "hot", "hardware_id": "", "values": []},
+        ],
+    ),
+    "frog_msgs/PersonDetections": msgs.person_detections(
+        T,
+        [
+            {"id": 7, "position": (103.0, 36.0), "orientation": 181.0},
+            {"id": 8, "position": (105.5, 35.0), "orientation": 90.0},
+        ],
+    ),
+    "frog_msgs/FaceData": msgs.face_data(
+        T,
+        [
+            {"id": 7, "engagement": 0.4, "distance": 1.2, "facing": True},
+            {"id": 9, "engagement": -1.0, "distance": 3.5, "facing": False},
+        ],
+    ),
+    "frog_msgs/TrackedPeople": msgs.tracked_people(
+        T, [{"id": 3, "position": (103.0, 36.0)}, {"id": 4, "position": (1.0, 2.0)}]
+    ),
     "rosgraph_msgs/Clock": msgs.clock(T),
 }
 VALID_FIELDS: dict[str, dict[str, Any]] = {
-    "frontend_idle": {}, "finish_introduction": {}, "user_positive": {}, "user_negative": {},
+    "frontend_idle": {},
+    "finish_introduction": {},
+    "user_positive": {},
+    "user_negative": {},
     "content_done": {"poi": "POI1", "part": "a"},
-    "start_introduction": {"icl": True}, "ask_tour": {"engaged": None},
-    "start_poi": {"poi": "POI1", "waypoint": "POI1a", "part": "b"}, "finish_poi": {"poi": "POI1"},
-    "engagement": {"level": -0.25}, "follow_me": {"on": False}, "volume": {"percent": 80},
-    "special_content": {"spot": "toilets"}, "projector": {"on": True},
+    "start_introduction": {"icl": True},
+    "ask_tour": {"engaged": None},
+    "start_poi": {"poi": "POI1", "waypoint": "POI1a", "part": "b"},
+    "finish_poi": {"poi": "POI1"},
+    "engagement": {"level": -0.25},
+    "follow_me": {"on": False},
+    "volume": {"percent": 80},
+    "special_content": {"spot": "toilets"},
+    "projector": {"on": True},
     "tour": {"state": "started", "reason": ""},
 }
 BAD_VALUES: list[Any] = [
-    None, True, False, 0, -1, 1, 2**31, -(2**31) - 1, 2**64, 10**400, 1e308, 1.5, -1.0000001,
-    1.0000001, 361.0, -0.5, float("nan"), float("inf"), float("-inf"), "", "x", "NaN", "1e400",
-    "\u0000", "\udcff", "é" * 50, [], {}, [1, 2], {"secs": 1}, {"sec": 1, "nanosec": -1},
-    {"secs": 1, "nsecs": 10**9}, {"a": {"b": []}}, [[[]]],
+    None,
+    True,
+    False,
+    0,
+    -1,
+    1,
+    2**31,
+    -(2**31) - 1,
+    2**64,
+    10**400,
+    1e308,
+    1.5,
+    -1.0000001,
+    1.0000001,
+    361.0,
+    -0.5,
+    float("nan"),
+    float("inf"),
+    float("-inf"),
+    "",
+    "x",
+    "NaN",
+    "1e400",
+    "\u0000",
+    "\udcff",
+    "é" * 50,
+    [],
+    {},
+    [1, 2],
+    {"secs": 1},
+    {"sec": 1, "nanosec": -1},
+    {"secs": 1, "nsecs": 10**9},
+    {"a": {"b": []}},
+    [[[]]],
 ]
-OPS = [None, 5, "", "PUBLISH", "publish ", "fragment", "png", "auth", "set_level",
-       "call_service", "service_response", "advertise", "subscribe", "status", "raw_bytes"]
+OPS = [
+    None,
+    5,
+    "",
+    "PUBLISH",
+    "publish ",
+    "fragment",
+    "png",
+    "auth",
+    "set_level",
+    "call_service",
+    "service_response",
+    "advertise",
+    "subscribe",
+    "status",
+    "raw_bytes",
+]
 DEEP = "[" * 50_000
 HUGE = '{"op":"publish","topic":"/FROG_pose","msg":"' + "x" * (MAX_FRAME_BYTES + 10) + '"}'
 HUGE_DATAGRAM = b'{"type":"user_positive","seq":1,"pad":"' + b"x" * MAX_DATAGRAM + b'"}'
@@ -71,10 +142,13 @@ HUGE_DATAGRAM = b'{"type":"user_positive","seq":1,"pad":"' + b"x" * MAX_DATAGRAM
 class Garbage:
     def __init__(self, seed: int) -> None:
         self.rng = random.Random(seed)
-        self._frames = [json.dumps({"op": "publish", "topic": topic, "msg": VALID_MSGS[type_]})
-                        for topic, type_ in TOPIC_TYPES.items()]
-        self._datagrams = [encode_datagram(type_, 1, fields)
-                           for type_, fields in VALID_FIELDS.items()]
+        self._frames = [
+            json.dumps({"op": "publish", "topic": topic, "msg": VALID_MSGS[type_]})
+            for topic, type_ in TOPIC_TYPES.items()
+        ]
+        self._datagrams = [
+            encode_datagram(type_, 1, fields) for type_, fields in VALID_FIELDS.items()
+        ]
 
     # ------------------------------------------------------------ values
 
@@ -85,8 +159,9 @@ class Garbage:
             return rng.choice(BAD_VALUES)
         parent: Any = obj
         while True:
-            key = rng.choice(list(parent)) if isinstance(parent, dict) \
-                else rng.randrange(len(parent))
+            key = (
+                rng.choice(list(parent)) if isinstance(parent, dict) else rng.randrange(len(parent))
+            )
             child = parent[key]
             if isinstance(child, dict | list) and child and rng.random() < 0.75:
                 parent = child
@@ -146,14 +221,29 @@ class Garbage:
             elif what == 2:
                 del frame[rng.choice(["op", "topic", "msg"])]
             elif what == 3:
-                frame = {"op": "status", "level": rng.choice(BAD_VALUES[:8]),
-                         "msg": rng.choice(["", "x", None]), "id": rng.choice([None, 1, "a"])}
+                frame = {
+                    "op": "status",
+                    "level": rng.choice(BAD_VALUES[:8]),
+                    "msg": rng.choice(["", "x", None]),
+                    "id": rng.choice([None, 1, "a"]),
+                }
             else:
                 frame = rng.choice([[], [frame], 1, "publish", None, True])
             return json.dumps(frame)
         if roll < 0.999:
-            return rng.choice(["", " ", "{", "}", "null", "[]", '{"op":}', "{'op': 'publish'}",
-                               DEEP[: rng.randrange(900, 3000)]])
+            return rng.choice(
+                [
+                    "",
+                    " ",
+                    "{",
+                    "}",
+                    "null",
+                    "[]",
+                    '{"op":}',
+                    "{'op': 'publish'}",
+                    DEEP[: rng.randrange(900, 3000)],
+                ]
+            )
         return rng.choice([HUGE, DEEP])
 
     def frames(self, n: int) -> Iterator[str | bytes]:
@@ -178,8 +268,9 @@ class Garbage:
             obj = json.loads(valid)
             what = rng.randrange(4)
             if what == 0:
-                obj["type"] = rng.choice([None, 1, "", "ACK", "hello", "frontend idle",
-                                          "start_tour", "x" * 100])
+                obj["type"] = rng.choice(
+                    [None, 1, "", "ACK", "hello", "frontend idle", "start_tour", "x" * 100]
+                )
             elif what == 1:
                 obj["seq"] = rng.choice([None, -1, 1.5, "1", True, [1], 2**70, float("nan")])
             elif what == 2:

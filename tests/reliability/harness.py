@@ -47,19 +47,33 @@ Event = Published | LinkState
 
 
 class TourRun(Rehearsal):
-    def __init__(self, scenario: dict[str, Any] | None = None, *, site: Site | None = None,
-                 secret: str | None = None, sim_secret: str | None = None) -> None:
+    def __init__(
+        self,
+        scenario: dict[str, Any] | None = None,
+        *,
+        site: Site | None = None,
+        secret: str | None = None,
+        sim_secret: str | None = None,
+    ) -> None:
         site = site or load_site()
         self.events: list[Event] = []
         self._waiters: list[tuple[Callable[[Event], bool], asyncio.Future[Event]]] = []
         self.summary = TourSummary(site)
-        super().__init__(scenario_from("default", {**FAST, **(scenario or {})}), site=site,
-                         sim_secret=sim_secret, secret=secret, prepare=self._prepare)
+        super().__init__(
+            scenario_from("default", {**FAST, **(scenario or {})}),
+            site=site,
+            sim_secret=sim_secret,
+            secret=secret,
+            prepare=self._prepare,
+        )
 
     def _prepare(self, exe: Executive) -> None:
         attach_all(exe, [self.summary])
-        listen(exe, lambda out: self._add(Published(out.t, out.topic, out.msg,
-                                                    exe.client.link.connected)), RobotCommand)
+        listen(
+            exe,
+            lambda out: self._add(Published(out.t, out.topic, out.msg, exe.client.link.connected)),
+            RobotCommand,
+        )
         on_link = exe.client.on_link
 
         def link_changed(state: LinkState) -> None:
@@ -83,8 +97,9 @@ class TourRun(Rehearsal):
                 keep.append((predicate, fut))
         self._waiters = keep
 
-    async def wait_event(self, predicate: Callable[[Event], bool], *,
-                         since: int = 0, timeout: float = WAIT) -> Event:
+    async def wait_event(
+        self, predicate: Callable[[Event], bool], *, since: int = 0, timeout: float = WAIT
+    ) -> Event:
         """The first event from index ``since`` on (logged or to come) satisfying ``predicate``."""
         for event in self.events[since:]:
             if predicate(event):
@@ -97,8 +112,9 @@ class TourRun(Rehearsal):
         """Wait until the executive's rosbridge link is up (or down)."""
         if self.executive.client.link.connected == up:
             return self.executive.client.link
-        event = await self.wait_event(lambda e: isinstance(e, LinkState) and e.connected == up,
-                                      since=len(self.events))
+        event = await self.wait_event(
+            lambda e: isinstance(e, LinkState) and e.connected == up, since=len(self.events)
+        )
         assert isinstance(event, LinkState)
         return event
 
@@ -162,12 +178,18 @@ class Outage:
 
 def arrived(sim: Simulator, since: float) -> Callable[[Record], bool]:
     """A simulator log predicate: /FROG_response 2 (arrival) published at or after ``since``."""
-    return lambda r: (r.direction == "out" and r.channel == "/FROG_response"
-                      and r.payload.get("data") == 2 and r.t >= since)
+    return lambda r: (
+        r.direction == "out"
+        and r.channel == "/FROG_response"
+        and r.payload.get("data") == 2
+        and r.t >= since
+    )
 
 
-def received(channel: str, *, where: Callable[[Any], bool] = lambda p: True,
-             since: float = 0.0) -> Callable[[Record], bool]:
+def received(
+    channel: str, *, where: Callable[[Any], bool] = lambda p: True, since: float = 0.0
+) -> Callable[[Record], bool]:
     """A simulator log predicate: the executive's ``channel`` message, received from ``since``."""
-    return lambda r: (r.direction == "in" and r.channel == channel and r.t >= since
-                      and where(r.payload))
+    return lambda r: (
+        r.direction == "in" and r.channel == channel and r.t >= since and where(r.payload)
+    )

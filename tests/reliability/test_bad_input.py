@@ -128,9 +128,13 @@ def test_frontend_decoders_accept_or_raise_decode_error() -> None:
         assert s.malformed > DATAGRAMS // 2
 
 
-JSON = st.recursive(st.none() | st.booleans() | st.integers() | st.floats() | st.text(),
-                    lambda inner: st.lists(inner, max_size=3)
-                    | st.dictionaries(st.text(max_size=8), inner, max_size=3), max_leaves=8)
+JSON = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats() | st.text(),
+    lambda inner: (
+        st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=8), inner, max_size=3)
+    ),
+    max_leaves=8,
+)
 
 
 def _replace_somewhere(obj: Any, path: list[int], value: Any) -> Any:
@@ -153,8 +157,7 @@ def test_a_valid_message_with_any_value_anywhere(type_: str, path: list[int], va
 
 @settings(max_examples=300, deadline=None)
 @given(st.sampled_from(sorted(VALID_FIELDS)), st.lists(st.integers(0, 9), max_size=3), JSON)
-def test_a_valid_datagram_with_any_value_anywhere(type_: str, path: list[int],
-                                                  value: Any) -> None:
+def test_a_valid_datagram_with_any_value_anywhere(type_: str, path: list[int], value: Any) -> None:
     obj = _replace_somewhere({"type": type_, "seq": 3, **VALID_FIELDS[type_]}, path, value)
     data = json.dumps(obj).encode("utf-8", "surrogatepass")
     for table in (fm.EVENTS, fm.COMMANDS):
@@ -175,8 +178,7 @@ async def until(condition: Any, what: str, timeout: float = 60.0) -> None:
         await asyncio.sleep(0.001)
 
 
-def test_running_executive_survives_a_flood_of_bad_input(
-        caplog: pytest.LogCaptureFixture) -> None:
+def test_running_executive_survives_a_flood_of_bad_input(caplog: pytest.LogCaptureFixture) -> None:
     caplog.set_level(logging.WARNING)
     site = load_site()
     g = Garbage(seed=3)
@@ -202,9 +204,15 @@ def test_running_executive_survives_a_flood_of_bad_input(
         async with serve(handler, "127.0.0.1", 0) as server:
             port = server.sockets[0].getsockname()[1]
             listen = ("127.0.0.1", free_udp_port())
-            exe = Executive(site, load_tree(site=site), SimClock(),
-                            rosbridge_url=f"ws://127.0.0.1:{port}",
-                            frontend=front_end.getsockname(), listen=listen, sim_time=True)
+            exe = Executive(
+                site,
+                load_tree(site=site),
+                SimClock(),
+                rosbridge_url=f"ws://127.0.0.1:{port}",
+                frontend=front_end.getsockname(),
+                listen=listen,
+                sim_time=True,
+            )
             task = asyncio.create_task(exe.run())
             await asyncio.wait_for(subscribed.wait(), 10)
             (ws,) = connections
@@ -226,8 +234,9 @@ def test_running_executive_survives_a_flood_of_bad_input(
                     await ws.send(frame)
                     sent += 1
                 t += 0.1  # a good /clock now and then: the tree keeps ticking
-                await ws.send(json.dumps({"op": "publish", "topic": "/clock",
-                                          "msg": encode_clock(t)}))
+                await ws.send(
+                    json.dumps({"op": "publish", "topic": "/clock", "msg": encode_clock(t)})
+                )
                 pushed += 201
                 for data in g.datagrams(LIVE_DATAGRAMS // batches):
                     if classify_datagram(data, fm.EVENTS) == "malformed":
@@ -239,8 +248,10 @@ def test_running_executive_survives_a_flood_of_bad_input(
                     stranger.sendto(data[:65000], listen)
                     foreign += 1
                 s, want = exe.link.stats, local + foreign
-                await until(lambda s=s, want=want: s.malformed + s.duplicates + s.foreign
-                            >= want, "the datagrams to be counted")
+                await until(
+                    lambda s=s, want=want: s.malformed + s.duplicates + s.foreign >= want,
+                    "the datagrams to be counted",
+                )
             await until(lambda: exe.client.stats.received >= pushed, "the frames to be read")
 
             # Still ticking, every bad frame and datagram counted, nothing acted on.
@@ -260,8 +271,12 @@ def test_running_executive_survives_a_flood_of_bad_input(
         # It advertised and subscribed, and sent nothing else but its goodbyes at the
         # shutdown (unsubscribe, unadvertise): no tour began.
         ops = Counter(f["op"] for f in from_executive)
-        assert ops == {"advertise": 4, "subscribe": len(TOPIC_TYPES),
-                       "unadvertise": 4, "unsubscribe": len(TOPIC_TYPES)}, ops
+        assert ops == {
+            "advertise": 4,
+            "subscribe": len(TOPIC_TYPES),
+            "unadvertise": 4,
+            "unsubscribe": len(TOPIC_TYPES),
+        }, ops
         with pytest.raises(BlockingIOError):
             front_end.recv(65536)  # no command to the front end either
         for sock in (front_end, peer, stranger):
@@ -270,8 +285,9 @@ def test_running_executive_survives_a_flood_of_bad_input(
         records = [r for r in caplog.records if r.levelno >= logging.WARNING]
         assert not [r for r in records if r.levelno >= logging.ERROR]
         # at most one warning per kind (topic, foreign, malformed) per 5 s
-        assert len(records) < 40 and len(records) * 500 < total, \
-            [r.getMessage()[:100] for r in records]
+        assert len(records) < 40 and len(records) * 500 < total, [
+            r.getMessage()[:100] for r in records
+        ]
 
     asyncio.run(main())  # how fast is measured in scripts/bench, not here
 

@@ -63,7 +63,8 @@ def tour_states(run: TourRun) -> list[str]:
 
 
 def test_front_end_that_never_acks_gets_eight_sends_then_a_warning(
-        caplog: pytest.LogCaptureFixture) -> None:
+    caplog: pytest.LogCaptureFixture,
+) -> None:
     caplog.set_level(logging.WARNING, logger="frog_bt.frontend")
 
     async def main() -> None:
@@ -116,15 +117,19 @@ def test_front_end_silent_mid_tour_content_ends_by_timeout(tmp_path: Path) -> No
             # POI2 waited its own content_timeout (15 s) for each part it played, then
             # went on; no other stop timed out.
             timeouts = content_timeouts(run)
-            assert timeouts and all(t.startswith("POI2 part") and "within 15 s" in t
-                                    for t in timeouts), timeouts
+            assert timeouts and all(
+                t.startswith("POI2 part") and "within 15 s" in t for t in timeouts
+            ), timeouts
             starts = [c.split()[1] for c in run.commands("start_poi") if c.endswith(" a")]
             assert starts == STOPS
 
             # The content_done of POI2 a went out late, when the front end woke, and
             # changed nothing: POI3's content waited for its own.
-            late = [x for x in sim.log.sent("content_done", side="frontend")
-                    if x.payload["poi"] == "POI2"]
+            late = [
+                x
+                for x in sim.log.sent("content_done", side="frontend")
+                if x.payload["poi"] == "POI2"
+            ]
             assert late and late[0].t >= woke - 0.2
             # Commands sent while it was silent were resent, then given up.
             assert run.executive.link.stats.unacked >= 2
@@ -141,9 +146,14 @@ def test_front_end_restart_mid_tour_starts_no_second_tour() -> None:
             sim, exe = run.sim, run.executive
             heard: list[str] = []
             listen(exe, lambda e: heard.append(e.message.type), FrontendIn)
-            await sim.wait_for(received("/GotoWayPoint", since=0.0,
-                                        where=lambda p: run.summary.waypoint_of(p) == "POI1a"),
-                               30)
+            await sim.wait_for(
+                received(
+                    "/GotoWayPoint",
+                    since=0.0,
+                    where=lambda p: run.summary.waypoint_of(p) == "POI1a",
+                ),
+                30,
+            )
             sim.restart_frontend()
             outcome = await run.finish()
             assert outcome.code == 0, outcome.reason
@@ -215,7 +225,11 @@ def test_events_of_a_restarted_front_end_are_not_taken_for_duplicates() -> None:
         w.command(fm.StartPoi(poi, poi, "a"))
         w.run(1.2)
     assert [type(m).__name__ for m in w.since(6.0)] == [
-        "FrontendIdle", "ContentDone", "ContentDone", "ContentDone"]
+        "FrontendIdle",
+        "ContentDone",
+        "ContentDone",
+        "ContentDone",
+    ]
     assert w.exe.stats.peer_restarts == 1 and w.exe.stats.duplicates == 0
 
 

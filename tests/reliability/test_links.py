@@ -55,7 +55,7 @@ def test_an_outage_and_a_silent_front_end_show_as_link_states(tmp_path: Path) ->
     frontend = [links.frontend for _, links in seen]
     lost = rosbridge.index("reconnecting")
     assert rosbridge[lost + 1] == "connected" and rosbridge[-1] == "closed"  # at the exit
-    assert "silent" in frontend and "acking" in frontend[frontend.index("silent"):]
+    assert "silent" in frontend and "acking" in frontend[frontend.index("silent") :]
     silent_at = frontend.index("silent")
     assert "front end silent" in lines[silent_at]
     assert seen[-1][1].clock == "/clock"
@@ -69,6 +69,7 @@ def test_an_outage_and_a_silent_front_end_show_as_link_states(tmp_path: Path) ->
             for name in batch.schema.names:
                 if name.endswith(":state"):
                     lanes.setdefault(chunk.entity_path, []).extend(
-                        s for row in batch.column(name).to_pylist() for s in row)
+                        s for row in batch.column(name).to_pylist() for s in row
+                    )
     assert "silent" in lanes["/links/frontend"] and "acking" in lanes["/links/frontend"]
     assert "reconnecting" in lanes["/links/rosbridge"]

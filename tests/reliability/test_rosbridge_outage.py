@@ -52,11 +52,18 @@ def test_tour_survives_three_rosbridge_outages() -> None:
             # 2. Content at POI2: the content ends while the link is down, so the goal to
             #    POI3 is published while down; it waits in the queue and goes out on
             #    reconnect.
-            await sim.wait_for(lambda r: r.direction == "in" and r.channel == "start_poi"
-                               and r.payload["poi"] == "POI2", 30)
+            await sim.wait_for(
+                lambda r: (
+                    r.direction == "in" and r.channel == "start_poi" and r.payload["poi"] == "POI2"
+                ),
+                30,
+            )
             n = len(run.events)
-            second = await run.outage(until=run.wait_event(
-                lambda e: getattr(e, "topic", None) == GOTO and not e.link_up, since=n))
+            second = await run.outage(
+                until=run.wait_event(
+                    lambda e: getattr(e, "topic", None) == GOTO and not e.link_up, since=n
+                )
+            )
             assert waypoint(second.result.msg) == "POI3"
             await sim.wait_for(received(GOTO, since=second.sim_up), 30)
             restored(run)
@@ -64,9 +71,17 @@ def test_tour_survives_three_rosbridge_outages() -> None:
             # 3. Docking: "docked" is published while the link is down; the 1 Hz docking
             #    state after the reconnect tells the executive.
             r = await sim.wait_for(received(DOCK, where=lambda p: p["data"] == "dock"), 30)
-            third = await run.outage(until=sim.wait_for(
-                lambda x: x.direction == "out" and x.channel == "/docking/state"
-                and x.payload["data"] == "docked" and x.t >= r.t, 30))
+            third = await run.outage(
+                until=sim.wait_for(
+                    lambda x: (
+                        x.direction == "out"
+                        and x.channel == "/docking/state"
+                        and x.payload["data"] == "docked"
+                        and x.t >= r.t
+                    ),
+                    30,
+                )
+            )
 
             outcome = await run.finish()
             assert outcome.code == 0, outcome.reason
@@ -90,11 +105,21 @@ def test_tour_survives_three_rosbridge_outages() -> None:
             # robot, already there, answered 1 then 2.
             gotos = [waypoint(p.msg) for p in run.published if p.topic == GOTO]
             assert gotos[:3] == ["POI0", "POI1a", "POI1a"], gotos
-            answers = [x.payload["data"] for x in sim.log.sent("/FROG_response")
-                       if first.sim_down <= x.t]
+            answers = [
+                x.payload["data"] for x in sim.log.sent("/FROG_response") if first.sim_down <= x.t
+            ]
             assert answers[:3] == [2, 1, 2]  # lost while down, then the re-sent goal's
-            assert run.summary.visited == ["POI0", "POI1a", "POI2a", "POI3", "POI4", "POI5",
-                                           "TEMP", "END", "SHOP"]
+            assert run.summary.visited == [
+                "POI0",
+                "POI1a",
+                "POI2a",
+                "POI3",
+                "POI4",
+                "POI5",
+                "TEMP",
+                "END",
+                "SHOP",
+            ]
 
             # Nothing timed out, failed or was skipped because the link was down.
             # (typed incidents: a timeout, a failure, a skip, an abort, a lost visitor
@@ -106,7 +131,8 @@ def test_tour_survives_three_rosbridge_outages() -> None:
 
 
 def test_publishes_beyond_the_queue_while_down_are_dropped_counted_and_logged(
-        caplog: pytest.LogCaptureFixture) -> None:
+    caplog: pytest.LogCaptureFixture,
+) -> None:
     caplog.set_level(logging.WARNING, logger="frog_bt.rosbridge")
     client = RosbridgeClient("ws://127.0.0.1:9", queue_limit=10)  # never connected
     client.advertise(DOCK, "std_msgs/String")

@@ -95,8 +95,9 @@ def test_sim_command_defaults_are_loopback() -> None:
 # ------------------------------------------------------------------ rosbridge auth
 
 
-def test_secret_from_the_environment_or_a_file(tmp_path: Path,
-                                               monkeypatch: pytest.MonkeyPatch) -> None:
+def test_secret_from_the_environment_or_a_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     secret_file = tmp_path / "secret"
     secret_file.write_text(SECRET + "\n", encoding="utf-8")
     site = load_site().model_copy(update={"links": Links(secret_file=str(secret_file))})
@@ -131,15 +132,17 @@ def test_tour_with_a_shared_secret_never_logs_it(caplog: pytest.LogCaptureFixtur
 
 @pytest.mark.parametrize("secret", [WRONG, None], ids=["wrong secret", "no secret"])
 def test_wrong_secret_is_refused_and_the_executive_keeps_trying(
-        secret: str | None, caplog: pytest.LogCaptureFixture) -> None:
+    secret: str | None, caplog: pytest.LogCaptureFixture
+) -> None:
     caplog.set_level(logging.DEBUG)
 
     async def main() -> None:
         async with TourRun(secret=secret, sim_secret=SECRET) as run:
             exe = run.executive
             for _ in range(2):  # refused, and refused again after the backoff
-                await run.wait_event(lambda e: isinstance(e, LinkState) and not e.connected,
-                                     since=len(run.events))
+                await run.wait_event(
+                    lambda e: isinstance(e, LinkState) and not e.connected, since=len(run.events)
+                )
             assert not run.task.done()
             assert run.sim.bridge.stats.auth_failures >= 2
             assert run.sim.received(side="ros") == []  # not one op acted on
@@ -151,8 +154,13 @@ def test_wrong_secret_is_refused_and_the_executive_keeps_trying(
     asyncio.run(main())
     assert leaks(caplog, SECRET, WRONG) == []
     # the executive says why, as a warning (rate-limited like every link warning)
-    assert [r for r in caplog.records if r.name == "frog_bt.rosbridge.client"
-            and r.levelno == logging.WARNING and "authentication failed" in r.getMessage()]
+    assert [
+        r
+        for r in caplog.records
+        if r.name == "frog_bt.rosbridge.client"
+        and r.levelno == logging.WARNING
+        and "authentication failed" in r.getMessage()
+    ]
 
 
 # ------------------------------------------------------------------ safe YAML
@@ -178,8 +186,15 @@ def test_python_tags_in_definition_files_are_refused(tmp_path: Path) -> None:
     assert not marker.exists()
 
 
-@pytest.mark.parametrize("type_", ["os.system", "py_trees.behaviours.Success",
-                                   "frog_bt.behaviours.navigation.Navigate", "__import__"])
+@pytest.mark.parametrize(
+    "type_",
+    [
+        "os.system",
+        "py_trees.behaviours.Success",
+        "frog_bt.behaviours.navigation.Navigate",
+        "__import__",
+    ],
+)
 def test_tree_files_name_only_registered_leaf_types(tmp_path: Path, type_: str) -> None:
     tree = tmp_path / "tree.yaml"
     tree.write_text(f"root: {{type: {type_}}}\n", encoding="utf-8")

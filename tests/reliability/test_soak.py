@@ -26,15 +26,24 @@ def test_five_tours_with_two_faults_of_each_kind_are_all_accounted_for(tmp_path:
     """Server restarts, front-end restarts, stale perception, kill -9 (twice each) and a
     low battery, over 15 % datagram loss: every tour that started ended or aborted, no
     visitor is left without being told, and each executive's recordings are readable."""
-    plan = [Fault(1, "rosbridge", 10.0), Fault(1, "stale", 20.0), Fault(2, "kill", 15.0),
-            Fault(2, "frontend", 40.0), Fault(3, "battery", 10.0), Fault(4, "rosbridge", 30.0),
-            Fault(4, "kill", 20.0), Fault(5, "frontend", 10.0), Fault(5, "stale", 30.0)]
+    plan = [
+        Fault(1, "rosbridge", 10.0),
+        Fault(1, "stale", 20.0),
+        Fault(2, "kill", 15.0),
+        Fault(2, "frontend", 40.0),
+        Fault(3, "battery", 10.0),
+        Fault(4, "rosbridge", 30.0),
+        Fault(4, "kill", 20.0),
+        Fault(5, "frontend", 10.0),
+        Fault(5, "stale", 30.0),
+    ]
     report = asyncio.run(soak(5, 7, tmp_path, speed=300.0, faults=plan, wall_timeout=150.0))
     assert not report.timed_out, report.lines()
     # Each kind happened (the harness injects a fault when it sees its tour under way: at
     # 300x a loaded machine can let a tour pass before its second fault's time).
-    assert set(report.faults) == {"rosbridge", "stale", "kill", "frontend", "battery"}, \
+    assert set(report.faults) == {"rosbridge", "stale", "kill", "frontend", "battery"}, (
         report.lines()
+    )
     assert report.restarts == report.faults["kill"] >= 1
     assert report.completed + report.aborted >= 5, report.lines()
     assert report.started == report.completed + report.aborted  # all told

@@ -46,19 +46,23 @@ def check_golden(name: str, actual: str) -> None:
         return
     assert path.exists(), f"{path.name} missing: run with FROG_UPDATE_GOLDEN=1"
     assert actual == path.read_text(encoding="utf-8"), (
-        f"{path.name} differs; if intended, regenerate with FROG_UPDATE_GOLDEN=1")
+        f"{path.name} differs; if intended, regenerate with FROG_UPDATE_GOLDEN=1"
+    )
 
 
-@pytest.mark.parametrize(("golden", "argv"), [
-    ("tour.ascii.txt", []),
-    ("tour.unicode.txt", ["--format", "unicode"]),
-    ("tour.dot", ["--format", "dot"]),
-    ("tour.mmd", ["--format", "mermaid"]),
-    ("small_keys.ascii.txt", [str(SMALL), "--keys"]),
-    ("small_keys.unicode.txt", [str(SMALL), "--keys", "-f", "unicode"]),
-    ("small_keys.dot", [str(SMALL), "--keys", "-f", "dot"]),
-    ("small_keys.mmd", [str(SMALL), "--keys", "-f", "mermaid"]),
-])
+@pytest.mark.parametrize(
+    ("golden", "argv"),
+    [
+        ("tour.ascii.txt", []),
+        ("tour.unicode.txt", ["--format", "unicode"]),
+        ("tour.dot", ["--format", "dot"]),
+        ("tour.mmd", ["--format", "mermaid"]),
+        ("small_keys.ascii.txt", [str(SMALL), "--keys"]),
+        ("small_keys.unicode.txt", [str(SMALL), "--keys", "-f", "unicode"]),
+        ("small_keys.dot", [str(SMALL), "--keys", "-f", "dot"]),
+        ("small_keys.mmd", [str(SMALL), "--keys", "-f", "mermaid"]),
+    ],
+)
 def test_text_formats_match_their_golden_files(capsys, golden, argv):
     code, out, err = cli(capsys, *argv)
     assert (code, err) == (0, "")
@@ -82,10 +86,14 @@ def test_labels_are_escaped_for_dot_and_mermaid():
     small = render.outline(load_tree(SMALL).root)
     dot_text, mermaid_text = render.dot(small), render.mermaid(small)
     assert r'label="Wait\\for \"done\"\nWaitEvent' in dot_text
-    assert '"→ Greet #quot;visitor#quot; [#35;1] #lt;now#gt; #amp; #96;then#96;<br/>' \
-        in mermaid_text
-    labels = [line.split('"', 1)[1].rsplit('"', 1)[0].replace("<br/>", "\n")
-              for line in mermaid_text.splitlines() if line.startswith("    n") and '"' in line]
+    assert (
+        '"→ Greet #quot;visitor#quot; [#35;1] #lt;now#gt; #amp; #96;then#96;<br/>' in mermaid_text
+    )
+    labels = [
+        line.split('"', 1)[1].rsplit('"', 1)[0].replace("<br/>", "\n")
+        for line in mermaid_text.splitlines()
+        if line.startswith("    n") and '"' in line
+    ]
     assert labels and not any(c in label for label in labels for c in '"<>`')
 
 
@@ -109,8 +117,10 @@ def test_images_without_dot_exit_1_with_one_line(capsys, monkeypatch, tmp_path, 
     monkeypatch.setenv("PATH", str(tmp_path))  # an empty folder: no `dot` anywhere
     code, out, err = cli(capsys, "-f", fmt, "-o", str(tmp_path / f"tree.{fmt}"))
     assert (code, out) == (1, "")
-    assert err == (f"frog-bt: {fmt} needs Graphviz's `dot` program, which is not installed "
-                   "(apt-get install graphviz)\n")
+    assert err == (
+        f"frog-bt: {fmt} needs Graphviz's `dot` program, which is not installed "
+        "(apt-get install graphviz)\n"
+    )
     assert not (tmp_path / f"tree.{fmt}").exists()
 
 
@@ -119,8 +129,10 @@ def test_an_invalid_tree_exits_2_naming_file_and_path(capsys, tmp_path):
     bad.write_text("root: {type: Sequence, children: [{type: FinishPoi, poi: POI1}]}\n")
     code, out, err = cli(capsys, str(bad), "-f", "dot")
     assert (code, out) == (2, "")
-    assert err == (f"frog-bt: {bad}:1:7: root.memory: missing required key: "
-                   "a Sequence must say memory: true or false\n")
+    assert err == (
+        f"frog-bt: {bad}:1:7: root.memory: missing required key: "
+        "a Sequence must say memory: true or false\n"
+    )
 
 
 def test_an_invalid_config_exits_2(capsys, tmp_path):
@@ -145,6 +157,12 @@ def test_render_loads_neither_websockets_nor_rerun(tmp_path):
         loaded = sorted(m for m in sys.modules if m.split(".")[0] in ("websockets", "rerun"))
         assert not loaded, loaded
     """)
-    result = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
-                            text=True, timeout=60, check=False)
+    result = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
     assert result.returncode == 0, result.stderr

@@ -28,10 +28,12 @@ from frog_bt.sim.traffic import Record
 
 # Tours in about 0.6 s of wall time: a fast robot, short content, quick answers.
 FAST: dict[str, Any] = {
-    "speed": 400.0, "navigation": {"speed": 3.0, "approach_time": 1.0},
+    "speed": 400.0,
+    "navigation": {"speed": 3.0, "approach_time": 1.0},
     "docking": {"undock_time": 2.0, "dock_time": 3.0},
     "content": {"default": 4, "introduction": 3},
-    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0}}
+    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0},
+}
 
 # kind -> (scenario, overrides, local start); one day each, so that no two overlap
 KINDS: dict[str, tuple[str, dict[str, Any], str]] = {
@@ -39,12 +41,24 @@ KINDS: dict[str, tuple[str, dict[str, Any], str]] = {
     "bored": ("bored", {}, "2026-06-03T10:00:00"),
     "declines": ("declines", {}, "2026-06-04T10:00:00"),
     "declined_then_home": ("declines", {}, "2026-06-05T10:00:00"),
-    "nav_failure": ("nav_failure", {"navigation": {"failures": [
-        {"poi": "POI1", "times": 3, "result": "aborted", "after": 1.0}]}},
-        "2026-06-06T11:00:00"),
-    "fault": ("fault", {"faults": [{"at": 60, "name": "motors", "level": 2,
-                                    "message": "motor driver overheated"}]},
-              "2026-06-07T10:00:00"),
+    "nav_failure": (
+        "nav_failure",
+        {
+            "navigation": {
+                "failures": [{"poi": "POI1", "times": 3, "result": "aborted", "after": 1.0}]
+            }
+        },
+        "2026-06-06T11:00:00",
+    ),
+    "fault": (
+        "fault",
+        {
+            "faults": [
+                {"at": 60, "name": "motors", "level": 2, "message": "motor driver overheated"}
+            ]
+        },
+        "2026-06-07T10:00:00",
+    ),
     "operator_skips": ("default", {}, "2026-06-08T10:00:00"),
     "undock_failure": ("undock_failure", {}, "2026-06-09T10:00:00"),
     "wander_off": ("wander_off", {}, "2026-06-10T10:00:00"),
@@ -90,14 +104,18 @@ def _merge(a: dict[str, Any], b: dict[str, Any]) -> dict[str, Any]:
 
 
 def _is(channel: str, **fields: Any) -> Callable[[Record], bool]:
-    return lambda r: r.direction == "in" and r.channel == channel and all(
-        r.payload.get(k) == v for k, v in fields.items())
+    return lambda r: (
+        r.direction == "in"
+        and r.channel == channel
+        and all(r.payload.get(k) == v for k, v in fields.items())
+    )
 
 
 async def _home_after_a_no(r: Rehearsal) -> None:
     no = asyncio.Event()
-    listen(r.executive, lambda e: no.set() if e.message.type == "user_negative" else None,
-           FrontendIn)
+    listen(
+        r.executive, lambda e: no.set() if e.message.type == "user_negative" else None, FrontendIn
+    )
     await asyncio.wait_for(no.wait(), 60)  # the executive has the visitor's no
     assert r.executive.core.command(Command.HOME).ok
 
@@ -105,13 +123,19 @@ async def _home_after_a_no(r: Rehearsal) -> None:
 async def _skip_content_then_drive(r: Rehearsal) -> None:
     await r.sim.wait_for(_is("start_poi", poi="POI3", part="a"), 60)
     assert r.executive.core.command(Command.SKIP).ok  # during POI3's content
-    await r.sim.wait_for(lambda rec: rec.channel == "/GotoWayPoint"
-                         and rec.payload["pose"]["position"]["x"] == 51.7105, 60)
+    await r.sim.wait_for(
+        lambda rec: (
+            rec.channel == "/GotoWayPoint" and rec.payload["pose"]["position"]["x"] == 51.7105
+        ),
+        60,
+    )
     assert r.executive.core.command(Command.SKIP).ok  # during the drive to POI4
 
 
 ACTIONS: dict[str, Callable[[Rehearsal], Awaitable[None]]] = {
-    "declined_then_home": _home_after_a_no, "operator_skips": _skip_content_then_drive}
+    "declined_then_home": _home_after_a_no,
+    "operator_skips": _skip_content_then_drive,
+}
 
 
 def _seen(kind: str, code: int, reason: str, records: list[Record]) -> Seen:
@@ -128,8 +152,11 @@ def _seen(kind: str, code: int, reason: str, records: list[Record]) -> Seen:
             seen.ros.append((rec.channel, rec.payload))
         elif rec.direction == "out" and rec.channel in ("user_positive", "user_negative"):
             seen.answers.append(rec.channel)
-        elif rec.direction == "out" and rec.channel == "/docking/state" \
-                and rec.payload["data"] == "docked":
+        elif (
+            rec.direction == "out"
+            and rec.channel == "/docking/state"
+            and rec.payload["data"] == "docked"
+        ):
             seen.docked.append(rec.t)
         elif rec.direction == "out" and rec.channel == "/FROG_pose":
             p = rec.payload["pose"]["position"]
@@ -144,7 +171,9 @@ async def _tour(directory: Path, kind: str) -> Seen:
     data = _merge(_merge(FAST, overrides), {"start_time": start + "+02:00"})
     site = load_site()
     recordings = RecordingDir(directory, 10**12)
-    run = Rehearsal(scenario_from(name, data), site=site, prepare=lambda exe: attach_all(exe, [recordings]))
+    run = Rehearsal(
+        scenario_from(name, data), site=site, prepare=lambda exe: attach_all(exe, [recordings])
+    )
     try:
         async with run:
             action = ACTIONS.get(kind)
@@ -162,8 +191,13 @@ async def _resumed(directory: Path, checkpoint: Path) -> Seen:
     name, _, start = KINDS["resumed"]
     site = load_site()
     first = RecordingDir(directory, 10**12)
-    run = Rehearsal(scenario_from(name, _merge(FAST, {"start_time": start + "+02:00"})),
-                    site=site, prepare=lambda exe: attach_all(exe, [first]), checkpoint=checkpoint, once=False)
+    run = Rehearsal(
+        scenario_from(name, _merge(FAST, {"start_time": start + "+02:00"})),
+        site=site,
+        prepare=lambda exe: attach_all(exe, [first]),
+        checkpoint=checkpoint,
+        once=False,
+    )
     try:
         async with run:
             sim, listen = run.sim, run.listen
@@ -172,8 +206,14 @@ async def _resumed(directory: Path, checkpoint: Path) -> Seen:
     finally:
         first.close()
     second = RecordingDir(directory, 10**12)
-    again = Rehearsal(None, sim=sim, listen=listen, site=site, prepare=lambda exe: attach_all(exe, [second]),
-                      checkpoint=checkpoint)
+    again = Rehearsal(
+        None,
+        sim=sim,
+        listen=listen,
+        site=site,
+        prepare=lambda exe: attach_all(exe, [second]),
+        checkpoint=checkpoint,
+    )
     try:
         async with again:
             outcome = await again.finish(60)

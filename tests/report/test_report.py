@@ -58,11 +58,11 @@ def test_the_figures_are_those_the_corpus_was_seeded_with(corpus, tmp_path) -> N
     assert t["tours_per_hour"] == hours
     # the fault aborts its tour; every other kind completes
     assert t["completed"] == len(seeded) - kinds.count("fault")
-    assert [r["ended"] for r in tours] == ["aborted" if k == "fault" else "ended"
-                                           for k in kinds]
+    assert [r["ended"] for r in tours] == ["aborted" if k == "fault" else "ended" for k in kinds]
     assert t["failure_causes"] == {
         "aborted: electronics fault: motors: motor driver overheated": 1,
-        "fault: motors: motor driver overheated": 1}
+        "fault: motors: motor driver overheated": 1,
+    }
     # one invitation each; a second after a decline or a visitor who wandered off
     assert t["invitations"] == 6 + kinds.count("declines") + kinds.count("wander_off")
     assert t["invitations_declined"] == kinds.count("declines")
@@ -75,7 +75,8 @@ def test_the_figures_are_those_the_corpus_was_seeded_with(corpus, tmp_path) -> N
     for r, kind in zip(tours, kinds, strict=True):
         engagement = json.loads(r["engagement"])
         assert [e["poi"] for e in engagement] == (
-            ["POI1", "POI1", "POI2"] if kind == "wander_off" else ["POI1", "POI2"])
+            ["POI1", "POI1", "POI2"] if kind == "wander_off" else ["POI1", "POI2"]
+        )
         assert {e["decision"] for e in engagement} == {"a only" if kind == "bored" else "b"}
         assert all(e["samples"] > 0 for e in engagement)
     # the time-of-day variant the site picks for the tour's start
@@ -91,8 +92,22 @@ def test_csv_parquet_and_a_self_contained_html(corpus, tmp_path) -> None:
     pq = pytest.importorskip("pyarrow.parquet")
     directory, _ = corpus
     out = tmp_path / "r.html"
-    assert main(["report", str(directory), "-o", str(out), "--csv", str(tmp_path / "r.csv"),
-                 "--parquet", str(tmp_path / "r.parquet"), "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "report",
+                str(directory),
+                "-o",
+                str(out),
+                "--csv",
+                str(tmp_path / "r.csv"),
+                "--parquet",
+                str(tmp_path / "r.parquet"),
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     with open(tmp_path / "r.csv", newline="") as f:
         table = list(csv.DictReader(f))
     assert len(table) == 6 and table[0]["day"] == "2026-06-01"
@@ -135,18 +150,25 @@ def test_two_jobs_and_a_dask_cluster_give_the_same_rows(corpus, tmp_path) -> Non
     one = report(tmp_path, str(directory))
     two = report(tmp_path, str(directory), "--jobs", "2")
     assert two == one
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                                  protocol="tcp://", host="127.0.0.1",
-                                  dashboard_address=None) as cluster:
+    with distributed.LocalCluster(
+        n_workers=1,
+        threads_per_worker=2,
+        processes=False,
+        protocol="tcp://",
+        host="127.0.0.1",
+        dashboard_address=None,
+    ) as cluster:
         fleet = report(tmp_path, str(directory), "--scheduler", cluster.scheduler_address)
         first = sorted(directory.glob("*.mcap"))[0]
-        assert main(["replay", str(first), "--scheduler", cluster.scheduler_address,
-                     "--quiet"]) == 0  # batch replay through the same seam: identical
+        assert (
+            main(["replay", str(first), "--scheduler", cluster.scheduler_address, "--quiet"]) == 0
+        )  # batch replay through the same seam: identical
     assert fleet == one
 
 
-def test_a_cut_file_is_read_to_the_cut_and_a_foreign_one_is_skipped(corpus, tmp_path,
-                                                                     capsys) -> None:
+def test_a_cut_file_is_read_to_the_cut_and_a_foreign_one_is_skipped(
+    corpus, tmp_path, capsys
+) -> None:
     directory, _ = corpus
     files = sorted(directory.glob("*.mcap"))
     work = tmp_path / "mixed"
@@ -167,36 +189,77 @@ def test_the_pieces_of_a_tour_are_joined_into_one() -> None:
     site = load_site()
     # robot a: killed during POI2 (the halt said finish_poi), restarted at 410 (a file
     # of its own), the tour resumed at POI2
-    before = Piece("a/1.mcap", started=100.0, started_seq=1, t0=100.0, t1=400.0,
-                   stops=[StopFacts("POI1", "POI1a", "ab", 200.0, 220.0),
-                          StopFacts("POI2", "POI2a", "a", 380.0, 400.0)], distance=50.0)
-    after = Piece("a/2.mcap", t0=405.0, t1=900.0, ended="ended", end_seq=30,
-                  stops=[StopFacts("POI2", "POI2a", "ab", 450.0, 480.0)], distance=70.0)
+    before = Piece(
+        "a/1.mcap",
+        started=100.0,
+        started_seq=1,
+        t0=100.0,
+        t1=400.0,
+        stops=[
+            StopFacts("POI1", "POI1a", "ab", 200.0, 220.0),
+            StopFacts("POI2", "POI2a", "a", 380.0, 400.0),
+        ],
+        distance=50.0,
+    )
+    after = Piece(
+        "a/2.mcap",
+        t0=405.0,
+        t1=900.0,
+        ended="ended",
+        end_seq=30,
+        stops=[StopFacts("POI2", "POI2a", "ab", 450.0, 480.0)],
+        distance=70.0,
+    )
     # robot b, the same hours: a rotation (the tour file opens just after `tour started`,
     # the end of the tour before resent into it), then a new executive whose first
     # `tour started` has seq 1 again: a new tour
     opened = Piece("b/1.mcap", started=390.0, started_seq=7, t0=390.0, t1=390.0)
     resent = Piece("b/2.mcap", t0=391.0, t1=391.0, ended="ended", end_seq=5)
-    rotated = Piece("b/2.mcap", started=391.0, started_seq=7, t0=391.0, t1=600.0,
-                    ended="ended", end_seq=60,
-                    stops=[StopFacts("POI1", "POI1a", "a", 410.0, 420.0)])
-    fresh = Piece("b/3.mcap", started=700.0, started_seq=7, t0=700.0, t1=800.0,
-                  ended="aborted", reason="operator")
-    files = [FileFacts("a/2.mcap", [after], restarts=[405.0]),
-             FileFacts("b/3.mcap", [fresh], restarts=[650.0]),
-             FileFacts("a/1.mcap", [before], restarts=[90.0]),
-             FileFacts("b/2.mcap", [resent, rotated]),
-             FileFacts("b/1.mcap", [opened], restarts=[1.0])]
+    rotated = Piece(
+        "b/2.mcap",
+        started=391.0,
+        started_seq=7,
+        t0=391.0,
+        t1=600.0,
+        ended="ended",
+        end_seq=60,
+        stops=[StopFacts("POI1", "POI1a", "a", 410.0, 420.0)],
+    )
+    fresh = Piece(
+        "b/3.mcap",
+        started=700.0,
+        started_seq=7,
+        t0=700.0,
+        t1=800.0,
+        ended="aborted",
+        reason="operator",
+    )
+    files = [
+        FileFacts("a/2.mcap", [after], restarts=[405.0]),
+        FileFacts("b/3.mcap", [fresh], restarts=[650.0]),
+        FileFacts("a/1.mcap", [before], restarts=[90.0]),
+        FileFacts("b/2.mcap", [resent, rotated]),
+        FileFacts("b/1.mcap", [opened], restarts=[1.0]),
+    ]
     tours = join(files)
-    assert [(t.robot, [Path(p.file).name for p in t.pieces], t.resumed, t.last.ended)
-            for t in tours] == [
+    assert [
+        (t.robot, [Path(p.file).name for p in t.pieces], t.resumed, t.last.ended) for t in tours
+    ] == [
         ("a", ["1.mcap", "2.mcap"], True, "ended"),
         ("b", ["1.mcap", "2.mcap", "2.mcap"], False, "ended"),
-        ("b", ["3.mcap"], False, "aborted")]
+        ("b", ["3.mcap"], False, "aborted"),
+    ]
     first = rows(files, site)[0]
-    assert (first.robot, first.files, first.stops_visited, first.parts, first.distance_m,
-            first.ended, first.duration_s, first.resumed) == (
-        "a", "1.mcap;2.mcap", "POI1;POI2", "POI1 ab; POI2 ab", 120.0, "ended", 800.0, True)
+    assert (
+        first.robot,
+        first.files,
+        first.stops_visited,
+        first.parts,
+        first.distance_m,
+        first.ended,
+        first.duration_s,
+        first.resumed,
+    ) == ("a", "1.mcap;2.mcap", "POI1;POI2", "POI1 ab; POI2 ab", 120.0, "ended", 800.0, True)
     assert json.loads(first.time_at_stops) == {"POI1": 20.0, "POI2": 50.0}  # 20 + 30
 
 
@@ -211,18 +274,28 @@ def test_a_tour_file_opening_with_the_tour_befores_end_resent_is_read_whole() ->
     idle.take(FrontendOut(101.0, 7, Tour("started", ""), b""))
     tour = _Pieces("r/2-tour.mcap", site)
     tour.first(101.1)
-    for record in (FrontendOut(101.2, 5, Tour("ended", ""), b""),
-                   FrontendOut(130.0, 9, AskTour(True), b""),
-                   FrontendIn(131.0, 3, UserPositive(), b""),
-                   FrontendOut(150.0, 10, StartPoi("POI1", "POI1a", "a"), b""),
-                   FrontendOut(170.0, 11, FinishPoi("POI1"), b""),
-                   FrontendOut(300.0, 20, Tour("ended", ""), b"")):
+    for record in (
+        FrontendOut(101.2, 5, Tour("ended", ""), b""),
+        FrontendOut(130.0, 9, AskTour(True), b""),
+        FrontendIn(131.0, 3, UserPositive(), b""),
+        FrontendOut(150.0, 10, StartPoi("POI1", "POI1a", "a"), b""),
+        FrontendOut(170.0, 11, FinishPoi("POI1"), b""),
+        FrontendOut(300.0, 20, Tour("ended", ""), b""),
+    ):
         tour.take(record)
-    files = [FileFacts("r/1-idle.mcap", idle.finish(), restarts=[]),
-             FileFacts("r/2-tour.mcap", tour.finish())]
+    files = [
+        FileFacts("r/1-idle.mcap", idle.finish(), restarts=[]),
+        FileFacts("r/2-tour.mcap", tour.finish()),
+    ]
     (row,) = rows(files, site)
-    assert (row.invitations, row.invitations_accepted, row.stops_visited, row.ended,
-            row.duration_s, row.resumed) == (1, 1, "POI1", "ended", 199.0, False)
+    assert (
+        row.invitations,
+        row.invitations_accepted,
+        row.stops_visited,
+        row.ended,
+        row.duration_s,
+        row.resumed,
+    ) == (1, 1, "POI1", "ended", 199.0, False)
 
 
 def test_mistakes_are_one_line_and_exit_2(tmp_path, capsys) -> None:
@@ -235,14 +308,18 @@ def test_mistakes_are_one_line_and_exit_2(tmp_path, capsys) -> None:
     assert "--jobs 0: expected 1 or more" in capsys.readouterr().err
 
 
-def test_without_the_report_extra_it_says_which_before_reading(corpus, tmp_path, capsys,
-                                                               monkeypatch) -> None:
+def test_without_the_report_extra_it_says_which_before_reading(
+    corpus, tmp_path, capsys, monkeypatch
+) -> None:
     import importlib.util
 
     directory, _ = corpus
     real = importlib.util.find_spec
-    monkeypatch.setattr(importlib.util, "find_spec",
-                        lambda name, *a: None if name == "matplotlib" else real(name, *a))
+    monkeypatch.setattr(
+        importlib.util,
+        "find_spec",
+        lambda name, *a: None if name == "matplotlib" else real(name, *a),
+    )
     out, table = tmp_path / "r.html", tmp_path / "r.csv"
     assert main(["report", str(directory), "-o", str(out), "--csv", str(table)]) == 2
     assert "needs matplotlib: pip install 'frog-bt[report]'" in capsys.readouterr().err
@@ -257,22 +334,35 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
     from frog_bt.sim import scenario_from
 
     day, checkpoint = tmp_path / "day", tmp_path / "checkpoint.json"
-    scenario = scenario_from("default", {"speed": 400.0, "content": {"default": 10,
-                                                                     "introduction": 8}})
+    scenario = scenario_from(
+        "default", {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
+    )
 
     async def run() -> None:
         first_files = RecordingDir(day, 10**9)
-        first = Rehearsal(scenario, site=load_site(), prepare=lambda exe: attach_all(exe, [first_files]),
-                          checkpoint=checkpoint, once=False)
+        first = Rehearsal(
+            scenario,
+            site=load_site(),
+            prepare=lambda exe: attach_all(exe, [first_files]),
+            checkpoint=checkpoint,
+            once=False,
+        )
         async with first:
-            await first.sim.wait_for(lambda r: r.channel == "start_poi"
-                                     and r.payload.get("poi") == "POI2", 60)
+            await first.sim.wait_for(
+                lambda r: r.channel == "start_poi" and r.payload.get("poi") == "POI2", 60
+            )
             first.own_sim = False  # the robot goes on; this executive stops (as if killed)
         first_files.close()
         second_files = RecordingDir(day, 10**9)
         try:
-            async with Rehearsal(None, site=load_site(), sim=first.sim, listen=first.listen,
-                                 prepare=lambda exe: attach_all(exe, [second_files]), checkpoint=checkpoint) as second:
+            async with Rehearsal(
+                None,
+                site=load_site(),
+                sim=first.sim,
+                listen=first.listen,
+                prepare=lambda exe: attach_all(exe, [second_files]),
+                checkpoint=checkpoint,
+            ) as second:
                 outcome = await second.finish()
                 assert outcome.code == 0, outcome.reason
         finally:
@@ -287,13 +377,14 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
     assert row["stops_visited"] == "POI1;POI2;POI3;POI4;POI5;END"  # POI2 once: resumed there
 
 
-def test_without_the_fleet_extra_scheduler_says_which(corpus, tmp_path, capsys,
-                                                      monkeypatch) -> None:
+def test_without_the_fleet_extra_scheduler_says_which(
+    corpus, tmp_path, capsys, monkeypatch
+) -> None:
     directory, _ = corpus
     monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed fails
     for command in ("report", "replay"):
-        assert main([command, str(directory), "--scheduler", "tcp://127.0.0.1:1",
-                     "--quiet"]) == 2
+        assert main([command, str(directory), "--scheduler", "tcp://127.0.0.1:1", "--quiet"]) == 2
         err = capsys.readouterr().err.strip().splitlines()
-        assert err == [f"frog-bt {command}: --scheduler needs dask.distributed: "
-                       "pip install 'frog-bt[fleet]'"]
+        assert err == [
+            f"frog-bt {command}: --scheduler needs dask.distributed: pip install 'frog-bt[fleet]'"
+        ]

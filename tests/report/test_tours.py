@@ -99,15 +99,26 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
     assert by_kind["bored"]["parts"] == "; ".join(f"{s} a" for s in STOPS)
     # a visitor says no, another says yes: one tour, two invitations, one visitor
     declines = by_kind["declines"]
-    assert (declines["approaches"], declines["approaches_accepted"], declines["visitors"],
-            declines["invitations"], declines["invitations_accepted"],
-            declines["invitations_declined"], declines["introduction"]) == (
-        2, 2, 1, 2, 1, 1, "accepted")
+    assert (
+        declines["approaches"],
+        declines["approaches_accepted"],
+        declines["visitors"],
+        declines["invitations"],
+        declines["invitations_accepted"],
+        declines["invitations_declined"],
+        declines["introduction"],
+    ) == (2, 2, 1, 2, 1, 1, "accepted")
     # a no, and the operator sends the robot home: declined, aborted, nothing visited
     home = by_kind["declined_then_home"]
-    assert (home["introduction"], home["ended"], home["reason"], home["operator"],
-            home["stops_visited"], home["stops_skipped"], home["visitors"]) == (
-        "declined", "aborted", "operator", "home (ok)", "", "", 0)
+    assert (
+        home["introduction"],
+        home["ended"],
+        home["reason"],
+        home["operator"],
+        home["stops_visited"],
+        home["stops_skipped"],
+        home["visitors"],
+    ) == ("declined", "aborted", "operator", "home (ok)", "", "", 0)
     # POI1 cannot be reached: three goals (two retries), skipped with its reason
     nav = by_kind["nav_failure"]
     assert nav["stops_skipped"] == "POI1: navigation failed"
@@ -117,8 +128,10 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
     # a motor fault on the way: the tour aborted with its reason, the fault listed
     fault = by_kind["fault"]
     assert (fault["ended"], fault["reason"], fault["faults"]) == (
-        "aborted", "electronics fault: motors: motor driver overheated",
-        "motors: motor driver overheated")
+        "aborted",
+        "electronics fault: motors: motor driver overheated",
+        "motors: motor driver overheated",
+    )
     assert fault["stops_skipped"] == ""  # it never reached the stops after the abort
     # the operator skips POI3 during its content and POI4 on the way there
     skips = by_kind["operator_skips"]
@@ -126,14 +139,18 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
     assert skips["stops_visited"] == "POI1;POI2;POI3;POI5;END"
     assert skips["operator"] == "skip (ok); skip (ok)"
     # the first undock fails and is tried again
-    assert (by_kind["undock_failure"]["dock_retries"],
-            by_kind["undock_failure"]["nav_retries"]) == (1, 0)
+    assert (
+        by_kind["undock_failure"]["dock_retries"],
+        by_kind["undock_failure"]["nav_retries"],
+    ) == (1, 0)
     # a visitor lost on the way: back to POI0, a second visitor, POI1 again for them
     wander = by_kind["wander_off"]
     assert (wander["visitors"], wander["approaches"], wander["invitations"]) == (2, 2, 2)
     assert wander["stops_visited"] == "POI1;POI1;POI2;POI3;POI4;POI5;END"
-    assert json.loads(wander["time_at_stops"])["POI1"] > json.loads(
-        by_kind["afternoon"]["time_at_stops"])["POI1"] * 1.5  # both visits added
+    assert (
+        json.loads(wander["time_at_stops"])["POI1"]
+        > json.loads(by_kind["afternoon"]["time_at_stops"])["POI1"] * 1.5
+    )  # both visits added
     for kind in KINDS:
         if kind != "undock_failure":
             assert by_kind[kind]["dock_retries"] == 0, kind
@@ -147,12 +164,13 @@ def test_a_tour_resumed_after_a_restart_is_one_row(by_kind) -> None:
     assert len(row["files"].split(";")) == 4
     assert row["resumed"] is True and row["ended"] == "ended"
     assert row["stops_visited"] == ";".join(STOPS)  # POI2, cut by the restart, once
-    assert row["parts"] == "; ".join(f"{s} {'ab' if s in ('POI1', 'POI2') else 'a'}"
-                                     for s in STOPS)
+    assert row["parts"] == "; ".join(f"{s} {'ab' if s in ('POI1', 'POI2') else 'a'}" for s in STOPS)
     assert (row["approaches"], row["invitations"], row["visitors"]) == (1, 1, 1)
     # POI2's time: its part a before the restart and the whole visit after it
-    others = [json.loads(by_kind[k]["time_at_stops"])["POI2"]
-              for k in ("afternoon", "declines", "undock_failure")]
+    others = [
+        json.loads(by_kind[k]["time_at_stops"])["POI2"]
+        for k in ("afternoon", "declines", "undock_failure")
+    ]
     assert json.loads(row["time_at_stops"])["POI2"] > max(others)
     assert by_kind["totals"]["resumed"] == 1
 
@@ -160,8 +178,11 @@ def test_a_tour_resumed_after_a_restart_is_one_row(by_kind) -> None:
 def test_resends_across_a_rotation_are_not_new_tours(robot_day, by_kind) -> None:
     directory, _ = robot_day
     tour_file = next(directory.glob(f"{day_of('unacked').replace('-', '')}-*-tour*.mcap"))
-    started = [json.loads(data) for topic, _, data in open_recording(tour_file).messages()
-               if topic == "/frontend/out" and b'"started"' in data]
+    started = [
+        json.loads(data)
+        for topic, _, data in open_recording(tour_file).messages()
+        if topic == "/frontend/out" and b'"started"' in data
+    ]
     assert started  # `tour started`, unacked, sent again after the rotation
     row = by_kind["unacked"]
     assert len(row["files"].split(";")) == 2 and row["ended"] == "ended"
@@ -179,35 +200,47 @@ def test_the_totals_and_rates(robot_day, by_kind) -> None:
     answers = [a for s in seen.values() for a in s.answers]
     assert t["invitations"] == len(answers)
     assert t["invitation_acceptance"] == pytest.approx(
-        answers.count("user_positive") / len(answers))
-    assert t["approaches"] == sum(topic == "/ApproachPeopleFar" for s in seen.values()
-                                  for topic, _ in s.ros)
+        answers.count("user_positive") / len(answers)
+    )
+    assert t["approaches"] == sum(
+        topic == "/ApproachPeopleFar" for s in seen.values() for topic, _ in s.ros
+    )
     assert t["approach_success"] == 1.0  # every simulated approach reaches its person
     # one each; none for the decliner sent home, two for the tour that lost its first
     assert t["visitors"] == sum(by_kind[k]["visitors"] for k in KINDS) == len(KINDS)
     for poi in ("POI1", "POI2"):
-        decided = [parts for k in KINDS for p, parts, _ in visits(seen[k], k == "resumed")
-                   if p == poi]
+        decided = [
+            parts for k in KINDS for p, parts, _ in visits(seen[k], k == "resumed") if p == poi
+        ]
         assert t["gate_decisions"][poi] == len(decided)
         assert t["part_b_rate"][poi] == pytest.approx(
-            sum("b" in parts for parts in decided) / len(decided))
+            sum("b" in parts for parts in decided) / len(decided)
+        )
     assert t["failure_causes"] == {
         "stop skipped: operator": 2,
         "aborted: operator": 1,
         "stop skipped: navigation failed": 1,
         "aborted: electronics fault: motors: motor driver overheated": 1,
-        "fault: motors: motor driver overheated": 1}
+        "fault: motors: motor driver overheated": 1,
+    }
     assert t["distance_m"] == pytest.approx(sum(s.path_m for s in seen.values()), rel=0.01)
-    played = Counter(wp for k in KINDS for wp in {wp for poi, _, wp in visits(seen[k])
-                                                  if wp != poi})
+    played = Counter(
+        wp for k in KINDS for wp in {wp for poi, _, wp in visits(seen[k]) if wp != poi}
+    )
     assert t["variants"] == dict(played) and played["POI1b"] == played["POI2b"] == 1
 
 
 def test_csv_and_parquet_read_back_as_the_rows(robot_day, tmp_path) -> None:
     pq = pytest.importorskip("pyarrow.parquet")
     directory, _ = robot_day
-    got = report(tmp_path, str(directory), "--csv", str(tmp_path / "r.csv"),
-                 "--parquet", str(tmp_path / "r.parquet"))
+    got = report(
+        tmp_path,
+        str(directory),
+        "--csv",
+        str(tmp_path / "r.csv"),
+        "--parquet",
+        str(tmp_path / "r.parquet"),
+    )
     with open(tmp_path / "r.csv", newline="", encoding="utf-8") as f:
         table = list(csv.DictReader(f))
     assert table == [{k: str(v) for k, v in r.items()} for r in got["tours"]]
@@ -253,8 +286,7 @@ def test_the_html_is_one_self_contained_page(robot_day, tmp_path) -> None:
     assert "stop skipped: navigation failed" in text
 
 
-def test_cut_and_foreign_files_are_said_and_the_rest_is_read(robot_day, tmp_path,
-                                                             capsys) -> None:
+def test_cut_and_foreign_files_are_said_and_the_rest_is_read(robot_day, tmp_path, capsys) -> None:
     directory, _ = robot_day
     work = tmp_path / "frog1"
     shutil.copytree(directory, work)
@@ -285,8 +317,7 @@ def test_cut_and_foreign_files_are_said_and_the_rest_is_read(robot_day, tmp_path
     assert resumed["resumed"] is True and resumed["ended"] == "ended"
     assert resumed["stops_visited"].endswith("POI3;POI4;POI5;END")
     home = rows[day_of("declined_then_home")]  # from its tour file alone
-    assert (home["ended"], home["introduction"], home["resumed"]) == (
-        "aborted", "declined", False)
+    assert (home["ended"], home["introduction"], home["resumed"]) == ("aborted", "declined", False)
 
 
 def test_two_robots_tours_at_the_same_time_stay_apart(robot_day, tmp_path) -> None:
@@ -298,7 +329,9 @@ def test_two_robots_tours_at_the_same_time_stay_apart(robot_day, tmp_path) -> No
             shutil.copy(path, tmp_path / robot / path.name)
     got = report(tmp_path, str(tmp_path / "frog1"), str(tmp_path / "frog2"))
     assert [(r["robot"], r["resumed"], r["stops_visited"]) for r in got["tours"]] == [
-        ("frog1", True, ";".join(STOPS)), ("frog2", True, ";".join(STOPS))]
+        ("frog1", True, ";".join(STOPS)),
+        ("frog2", True, ";".join(STOPS)),
+    ]
 
 
 def test_one_job_two_jobs_alike(robot_day, tmp_path) -> None:

@@ -56,8 +56,9 @@ class Recorder:
 
 @asynccontextmanager
 async def client_for(url: str, rec: Recorder, **kwargs: Any) -> AsyncIterator[RosbridgeClient]:
-    client = RosbridgeClient(url, on_message=rec.on_message, on_link=rec.on_link,
-                             **{**FAST, **kwargs})
+    client = RosbridgeClient(
+        url, on_message=rec.on_message, on_link=rec.on_link, **{**FAST, **kwargs}
+    )
     try:
         yield client
     finally:
@@ -79,20 +80,29 @@ def test_subscribe_then_receive_typed_values() -> None:
             client.subscribe("/FROG_pose", "geometry_msgs/PoseStamped", throttle_rate=100)
             client.start()
             sub1, sub2 = await server.take(2)
-            assert sub1 == {"op": "subscribe", "id": sub1["id"], "topic": "/FROG_response",
-                            "type": "std_msgs/Int32"}
+            assert sub1 == {
+                "op": "subscribe",
+                "id": sub1["id"],
+                "topic": "/FROG_response",
+                "type": "std_msgs/Int32",
+            }
             assert sub2["type"] == "geometry_msgs/PoseStamped" and sub2["throttle_rate"] == 100
             assert sub1["id"] != sub2["id"]
 
             await server.publish("/not_subscribed", {"data": 1})  # ignored, not malformed
             await server.publish("/FROG_response", {"data": 2})
-            await server.publish("/FROG_pose", {
-                "header": {"stamp": {"sec": 10, "nanosec": 0}, "frame_id": "map"},
-                "pose": {"position": {"x": 1.5, "y": 2.5, "z": 0},
-                         "orientation": {"x": 0, "y": 0, "z": 0, "w": 1}}})
+            await server.publish(
+                "/FROG_pose",
+                {
+                    "header": {"stamp": {"sec": 10, "nanosec": 0}, "frame_id": "map"},
+                    "pose": {
+                        "position": {"x": 1.5, "y": 2.5, "z": 0},
+                        "orientation": {"x": 0, "y": 0, "z": 0, "w": 1},
+                    },
+                },
+            )
             assert await rec.messages.get() == ("/FROG_response", 2)
-            assert await rec.messages.get() == ("/FROG_pose",
-                                                Pose(10.0, "map", 1.5, 2.5, 0.0, 1.0))
+            assert await rec.messages.get() == ("/FROG_pose", Pose(10.0, "map", 1.5, 2.5, 0.0, 1.0))
             assert client.stats.received == 3 and client.stats.malformed == 0
 
             client.unsubscribe("/FROG_pose")
@@ -110,15 +120,20 @@ def test_publish_reaches_server_with_ids_in_order() -> None:
             client.advertise("/docking/dock", "std_msgs/String")
             client.start()
             assert await client.wait_connected(5)
-            assert ops(await server.take(2)) == [("advertise", "/GotoWayPoint"),
-                                                 ("advertise", "/docking/dock")]
+            assert ops(await server.take(2)) == [
+                ("advertise", "/GotoWayPoint"),
+                ("advertise", "/docking/dock"),
+            ]
             goal = encode_pose(97.19, 63.02, 0.898316, 0.43934, stamp=100.0)
             client.publish("/docking/dock", encode_string("undock"))
             client.publish("/GotoWayPoint", goal)
             client.publish("/docking/dock", encode_string("dock"))
             frames = await server.take(3)
-            assert ops(frames) == [("publish", "/docking/dock"), ("publish", "/GotoWayPoint"),
-                                   ("publish", "/docking/dock")]
+            assert ops(frames) == [
+                ("publish", "/docking/dock"),
+                ("publish", "/GotoWayPoint"),
+                ("publish", "/docking/dock"),
+            ]
             assert [f["msg"] for f in frames] == [{"data": "undock"}, goal, {"data": "dock"}]
             assert len({f["id"] for f in frames}) == 3
 
@@ -150,7 +165,8 @@ def test_bad_url_is_refused_at_construction(url: str) -> None:
 
 
 def test_malformed_inbound_frames_are_counted_and_the_client_keeps_working(
-        caplog: pytest.LogCaptureFixture) -> None:
+    caplog: pytest.LogCaptureFixture,
+) -> None:
     async def main() -> None:
         rec = Recorder()
         async with FakeRosbridge() as server, client_for(server.url, rec) as client:
@@ -174,8 +190,11 @@ def test_malformed_inbound_frames_are_counted_and_the_client_keeps_working(
             assert await rec.messages.get() == ("/FROG_response", 4)
             stats = client.stats
             assert stats.received == 9 and stats.malformed == 6
-            assert stats.malformed_by_topic == {FRAME_TOPIC: 4, "/FROG_response": 1,
-                                                "/ICL_FaceDataStream": 1}
+            assert stats.malformed_by_topic == {
+                FRAME_TOPIC: 4,
+                "/FROG_response": 1,
+                "/ICL_FaceDataStream": 1,
+            }
             assert client.link.connected
 
     with caplog.at_level(logging.WARNING, logger="frog_bt.rosbridge.client"):
@@ -253,9 +272,11 @@ def test_reconnect_restores_advertise_subscribe_and_flushes_queue_in_order() -> 
             await second.start()
             try:
                 frames = await second.take(5)
-                assert ops(frames) == [("advertise", "/GotoWayPoint"),
-                                       ("subscribe", "/FROG_response")] + \
-                    [("publish", "/GotoWayPoint")] * 3
+                assert (
+                    ops(frames)
+                    == [("advertise", "/GotoWayPoint"), ("subscribe", "/FROG_response")]
+                    + [("publish", "/GotoWayPoint")] * 3
+                )
                 assert [f["msg"]["pose"]["position"]["x"] for f in frames[2:]] == [0, 1, 2]
                 assert frames[1]["type"] == "std_msgs/Int32"
                 assert not {f["id"] for f in frames} & {f["id"] for f in first}
@@ -331,8 +352,10 @@ def test_frames_not_yet_written_when_the_link_drops_are_requeued() -> None:
     client._on_down("test")
     assert client.queued == 3
     frames = [json.loads(f) for f in client.session.on_connected(1.0)]
-    assert ops(frames) == [("advertise", "/a"), ("subscribe", "/b"), ("subscribe", "/c")] + \
-        [("publish", "/a")] * 3
+    assert (
+        ops(frames)
+        == [("advertise", "/a"), ("subscribe", "/b"), ("subscribe", "/c")] + [("publish", "/a")] * 3
+    )
     assert [f["msg"]["data"] for f in frames[3:]] == [0, 1, 2]
 
 
@@ -342,18 +365,24 @@ def test_frames_not_yet_written_when_the_link_drops_are_requeued() -> None:
 def test_auth_frame_is_sent_first_when_a_secret_is_configured() -> None:
     async def main() -> None:
         rec = Recorder()
-        async with FakeRosbridge() as server, \
-                client_for(server.url, rec, secret="s3cret") as client:
+        async with (
+            FakeRosbridge() as server,
+            client_for(server.url, rec, secret="s3cret") as client,
+        ):
             client.advertise("/docking/dock", "std_msgs/String")
             client.subscribe("/docking/state", "std_msgs/String")
             client.start()
             auth, adv, sub = await server.take(3)
-            assert ops([adv, sub]) == [("advertise", "/docking/dock"),
-                                       ("subscribe", "/docking/state")]
+            assert ops([adv, sub]) == [
+                ("advertise", "/docking/dock"),
+                ("subscribe", "/docking/state"),
+            ]
             assert auth["op"] == "auth"
             assert auth["client"] == "127.0.0.1" and auth["dest"] == "127.0.0.1"
-            text = (f"s3cret{auth['client']}{auth['dest']}{auth['rand']}{int(auth['t'])}"
-                    f"{auth['level']}{int(auth['end'])}")
+            text = (
+                f"s3cret{auth['client']}{auth['dest']}{auth['rand']}{int(auth['t'])}"
+                f"{auth['level']}{int(auth['end'])}"
+            )
             assert auth["mac"] == hashlib.sha512(text.encode()).hexdigest()
 
     run(main())
@@ -380,7 +409,11 @@ def test_link_state_callback_sequence() -> None:
 
         states = rec.link_log
         assert [(s.connected, s.reconnects) for s in states] == [
-            (True, 0), (False, 0), (True, 1), (False, 1)]
+            (True, 0),
+            (False, 0),
+            (True, 1),
+            (False, 1),
+        ]
         assert states[0].last_error is None and states[2].last_error is None
         assert states[1].last_error is not None
         assert states[3].last_error is None  # a deliberate close is no error
@@ -399,8 +432,7 @@ def test_nothing_listening_reports_the_error_and_close_stops_the_retries() -> No
         handler.addFilter(lambda record: "cannot connect" in record.getMessage())
         logging.getLogger("frog_bt.rosbridge.client").addHandler(handler)
         try:
-            client = RosbridgeClient(f"ws://127.0.0.1:{free_port()}", on_link=rec.on_link,
-                                     **FAST)
+            client = RosbridgeClient(f"ws://127.0.0.1:{free_port()}", on_link=rec.on_link, **FAST)
             task = client.start()
             await failed.wait()
         finally:
@@ -455,16 +487,18 @@ def test_a_server_that_closes_at_once_is_backed_off_and_reported_as_refused() ->
 
         async with serve(slam, "127.0.0.1", 0) as server:
             port = server.sockets[0].getsockname()[1]
-            client = RosbridgeClient(f"ws://127.0.0.1:{port}", secret="s3cret",
-                                     backoff_initial=0.05, backoff_max=0.4)
+            client = RosbridgeClient(
+                f"ws://127.0.0.1:{port}", secret="s3cret", backoff_initial=0.05, backoff_max=0.4
+            )
             client.start()
             await asyncio.wait_for(enough.wait(), 5)
             link = client.link
             await client.close()
         gaps = [b - a for a, b in itertools.pairwise(opened)]
         # 0.05, 0.1, 0.2, 0.4 s: doubling, never a tight loop
-        assert [round(g, 2) >= d * 0.9 for g, d in zip(gaps, (0.05, 0.1, 0.2, 0.4),
-                                                        strict=False)] == [True] * 4
+        assert [
+            round(g, 2) >= d * 0.9 for g, d in zip(gaps, (0.05, 0.1, 0.2, 0.4), strict=False)
+        ] == [True] * 4
         assert link.refused and not link.connected
         assert link.attempt >= 5 and "authentication refused?" in (link.last_error or "")
 

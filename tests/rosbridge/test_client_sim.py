@@ -12,8 +12,11 @@ from frog_bt.sim import Simulator, parse_scenario
 
 
 async def _drive_and_reconnect() -> tuple[list[int], int, int, int]:
-    sim = Simulator(parse_scenario({"speed": 100.0, "robot": {"docked": False}}),
-                    rosbridge_port=0, frontend_port=0)
+    sim = Simulator(
+        parse_scenario({"speed": 100.0, "robot": {"docked": False}}),
+        rosbridge_port=0,
+        frontend_port=0,
+    )
     await sim.start()
     poses: asyncio.Queue[Pose] = asyncio.Queue()
     responses: asyncio.Queue[int] = asyncio.Queue()
@@ -25,9 +28,13 @@ async def _drive_and_reconnect() -> tuple[list[int], int, int, int]:
             responses.put_nowait(value)  # type: ignore[arg-type]
 
     down = asyncio.Event()
-    client = RosbridgeClient(f"ws://127.0.0.1:{sim.rosbridge_port}", on_message=on_message,
-                             on_link=lambda state: None if state.connected else down.set(),
-                             backoff_initial=0.05, backoff_max=0.2)
+    client = RosbridgeClient(
+        f"ws://127.0.0.1:{sim.rosbridge_port}",
+        on_message=on_message,
+        on_link=lambda state: None if state.connected else down.set(),
+        backoff_initial=0.05,
+        backoff_max=0.2,
+    )
     client.subscribe("/FROG_pose", "geometry_msgs/PoseStamped")
     client.subscribe("/FROG_response", "std_msgs/Int32")
     client.advertise("/GotoWayPoint", "geometry_msgs/PoseStamped")
@@ -35,8 +42,9 @@ async def _drive_and_reconnect() -> tuple[list[int], int, int, int]:
     try:
         assert await client.wait_connected(5)
         start = await asyncio.wait_for(poses.get(), 5)
-        client.publish("/GotoWayPoint", encode_pose(start.x + 1.0, start.y, 0.0, 1.0,
-                                                    sim.clock.now()))
+        client.publish(
+            "/GotoWayPoint", encode_pose(start.x + 1.0, start.y, 0.0, 1.0, sim.clock.now())
+        )
         codes = [await asyncio.wait_for(responses.get(), 5) for _ in range(2)]
 
         await sim.stop_rosbridge()  # the robot's rosbridge goes away...

@@ -18,9 +18,14 @@ from .conftest import FakeRosbridge
 async def _ops() -> list[dict[str, Any]]:
     site = load_site()
     async with FakeRosbridge() as server:
-        executive = Executive(site, load_tree(site=site), WallClock(), rosbridge_url=server.url,
-                              frontend=("127.0.0.1", free_udp_port()),
-                              listen=("127.0.0.1", free_udp_port()))
+        executive = Executive(
+            site,
+            load_tree(site=site),
+            WallClock(),
+            rosbridge_url=server.url,
+            frontend=("127.0.0.1", free_udp_port()),
+            listen=("127.0.0.1", free_udp_port()),
+        )
         run = asyncio.create_task(executive.run())
         await asyncio.wait_for(executive.client.wait_connected(), 5)
         while len([f for f in server.frames if f["op"] == "subscribe"]) < len(INPUTS):
@@ -34,10 +39,16 @@ def test_ops_in_order_each_with_an_id():
     frames = asyncio.run(_ops())
     ops = [f["op"] for f in frames]
     n_in, n_out = len(INPUTS), len(OUTPUTS)
-    assert ops == (["advertise"] * n_out + ["subscribe"] * n_in
-                   + ["unsubscribe"] * n_in + ["unadvertise"] * n_out)
+    assert ops == (
+        ["advertise"] * n_out
+        + ["subscribe"] * n_in
+        + ["unsubscribe"] * n_in
+        + ["unadvertise"] * n_out
+    )
     assert all(isinstance(f.get("id"), str) and f["id"] for f in frames)
     assert {f["topic"] for f in frames if f["op"] == "subscribe"} == {
-        t.name for t in INPUTS.values()}
+        t.name for t in INPUTS.values()
+    }
     assert {(f["topic"], f["type"]) for f in frames if f["op"] == "advertise"} == {
-        (t.name, t.type) for t in OUTPUTS.values()}
+        (t.name, t.type) for t in OUTPUTS.values()
+    }

@@ -50,32 +50,57 @@ STAMP = 1_700_000_000.5
 
 
 def pose_msg(header: dict[str, Any] = ROS1_HEADER) -> dict[str, Any]:
-    return {"header": header,
-            "pose": {"position": {"x": 97.19, "y": 63.02, "z": 0.0},
-                     "orientation": {"x": 0.0, "y": 0.0, "z": 0.898316, "w": 0.43934}}}
+    return {
+        "header": header,
+        "pose": {
+            "position": {"x": 97.19, "y": 63.02, "z": 0.0},
+            "orientation": {"x": 0.0, "y": 0.0, "z": 0.898316, "w": 0.43934},
+        },
+    }
 
 
 def diagnostics_msg(header: dict[str, Any] = ROS1_HEADER) -> dict[str, Any]:
-    return {"header": header, "status": [
-        {"level": 0, "name": "battery", "message": "", "hardware_id": "",
-         "values": [{"key": "voltage", "value": "24.1"}, {"key": "percentage", "value": "73.5"}]},
-        {"level": 2, "name": "motors", "message": "overcurrent", "hardware_id": "m1",
-         "values": []},
-        {"level": 3, "name": "lidar", "message": "", "hardware_id": "", "values": []},
-        {"level": 1, "name": "fan", "message": "slow", "hardware_id": "", "values": []},
-    ]}
+    return {
+        "header": header,
+        "status": [
+            {
+                "level": 0,
+                "name": "battery",
+                "message": "",
+                "hardware_id": "",
+                "values": [
+                    {"key": "voltage", "value": "24.1"},
+                    {"key": "percentage", "value": "73.5"},
+                ],
+            },
+            {
+                "level": 2,
+                "name": "motors",
+                "message": "overcurrent",
+                "hardware_id": "m1",
+                "values": [],
+            },
+            {"level": 3, "name": "lidar", "message": "", "hardware_id": "", "values": []},
+            {"level": 1, "name": "fan", "message": "slow", "hardware_id": "", "values": []},
+        ],
+    }
 
 
 def persons_msg(header: dict[str, Any] = ROS1_HEADER) -> dict[str, Any]:
-    return {"header": header,
-            "persons": [{"id": 7, "position": {"x": 1.0, "y": 2.0, "z": 0.0},
-                         "orientation": 181.0}]}
+    return {
+        "header": header,
+        "persons": [{"id": 7, "position": {"x": 1.0, "y": 2.0, "z": 0.0}, "orientation": 181.0}],
+    }
 
 
 def faces_msg(header: dict[str, Any] = ROS1_HEADER) -> dict[str, Any]:
-    return {"header": header,
-            "faces": [{"id": 7, "engagement": 0.4, "distance": 1.2, "facing": True},
-                      {"id": 8, "engagement": -1, "distance": 0, "facing": False}]}
+    return {
+        "header": header,
+        "faces": [
+            {"id": 7, "engagement": 0.4, "distance": 1.2, "facing": True},
+            {"id": 8, "engagement": -1, "distance": 0, "facing": False},
+        ],
+    }
 
 
 def people_msg(header: dict[str, Any] = ROS1_HEADER) -> dict[str, Any]:
@@ -130,7 +155,8 @@ def test_int32_and_string() -> None:
 @pytest.mark.parametrize("header", [ROS1_HEADER, ROS2_HEADER], ids=["ros1", "ros2"])
 def test_diagnostics(header: dict[str, Any]) -> None:
     assert decode_diagnostics(diagnostics_msg(header)) == Diagnostics(
-        STAMP, 73.5, ("motors: overcurrent", "lidar"))
+        STAMP, 73.5, ("motors: overcurrent", "lidar")
+    )
 
 
 def test_diagnostics_without_battery_or_values() -> None:
@@ -142,19 +168,22 @@ def test_diagnostics_without_battery_or_values() -> None:
 @pytest.mark.parametrize("header", [ROS1_HEADER, ROS2_HEADER], ids=["ros1", "ros2"])
 def test_person_detections(header: dict[str, Any]) -> None:
     assert decode_person_detections(persons_msg(header)) == PersonDetections(
-        STAMP, (PersonDetection(7, Point(1.0, 2.0, 0.0), 181.0),))
+        STAMP, (PersonDetection(7, Point(1.0, 2.0, 0.0), 181.0),)
+    )
 
 
 @pytest.mark.parametrize("header", [ROS1_HEADER, ROS2_HEADER], ids=["ros1", "ros2"])
 def test_face_data(header: dict[str, Any]) -> None:
     assert decode_face_data(faces_msg(header)) == FaceData(
-        STAMP, (Face(7, 0.4, 1.2, True), Face(8, -1.0, 0.0, False)))
+        STAMP, (Face(7, 0.4, 1.2, True), Face(8, -1.0, 0.0, False))
+    )
 
 
 @pytest.mark.parametrize("header", [ROS1_HEADER, ROS2_HEADER], ids=["ros1", "ros2"])
 def test_tracked_people(header: dict[str, Any]) -> None:
     assert decode_tracked_people(people_msg(header)) == TrackedPeople(
-        STAMP, (TrackedPerson(3, Point(5.0, 6.5, 0.0)),))
+        STAMP, (TrackedPerson(3, Point(5.0, 6.5, 0.0)),)
+    )
 
 
 def test_clock_both_time_shapes() -> None:
@@ -164,9 +193,12 @@ def test_clock_both_time_shapes() -> None:
 
 def test_encoders_decode_back() -> None:
     assert decode_pose(encode_pose(97.19, 63.02, -0.56311, 0.82638, STAMP)) == Pose(
-        STAMP, "map", 97.19, 63.02, -0.56311, 0.82638)
+        STAMP, "map", 97.19, 63.02, -0.56311, 0.82638
+    )
     assert encode_pose(1, 2, 0, 1, STAMP)["header"]["stamp"] == {
-        "secs": 1_700_000_000, "nsecs": 500_000_000}  # ROS 1 shape on the way out
+        "secs": 1_700_000_000,
+        "nsecs": 500_000_000,
+    }  # ROS 1 shape on the way out
     assert decode_int32(encode_int32(17)) == 17
     assert decode_string(encode_string("dock")) == "dock"
     assert decode_clock(encode_clock(STAMP)) == STAMP
@@ -175,94 +207,181 @@ def test_encoders_decode_back() -> None:
 # ---------------------------------------------------------------- error paths
 
 
-@pytest.mark.parametrize(("decoder", "msg", "path"), [
-    # not an object at all
-    (decode_pose, [], ()),
-    (decode_int32, None, ()),
-    (decode_string, "docked", ()),
-    # missing fields
-    (decode_int32, {}, ("data",)),
-    (decode_pose, {"header": ROS1_HEADER}, ("pose",)),
-    (decode_pose, {"pose": {"position": {"x": 1}, "orientation": {"w": 1}}},
-     ("pose", "position", "y")),
-    (decode_pose, {"pose": {"position": {"x": 1, "y": 2}, "orientation": {"z": 1}}},
-     ("pose", "orientation", "w")),
-    (decode_diagnostics, {"status": [{"level": 0}]}, ("status", 0, "name")),
-    (decode_diagnostics, {"header": {}}, ("status",)),
-    (decode_face_data, {"faces": [{"id": 1, "engagement": 0, "distance": 1}]},
-     ("faces", 0, "facing")),
-    (decode_person_detections, {"persons": [{"id": 1, "orientation": 180}]},
-     ("persons", 0, "position")),
-    (decode_tracked_people, {"people": [{"position": {"x": 0, "y": 0}}]}, ("people", 0, "id")),
-    (decode_clock, {}, ("clock",)),
-    (decode_clock, {"clock": {"secs": 1}}, ("clock",)),
-    (decode_clock, {"clock": {"sec": 1}}, ("clock",)),
-    (decode_clock, {"clock": {"seconds": 1}}, ("clock",)),
-    # wrong types
-    (decode_int32, {"data": "2"}, ("data",)),
-    (decode_int32, {"data": 2.0}, ("data",)),
-    (decode_string, {"data": 3}, ("data",)),
-    (decode_pose, {"pose": {"position": {"x": "1", "y": 2}, "orientation": {"w": 1}}},
-     ("pose", "position", "x")),
-    (decode_pose, {"header": [], "pose": {}}, ("header",)),
-    (decode_pose, dict(pose_msg(), header={"frame_id": 5}), ("header", "frame_id")),
-    (decode_pose, dict(pose_msg(), header={"stamp": 5}), ("header", "stamp")),
-    (decode_diagnostics, {"status": {}}, ("status",)),
-    (decode_diagnostics, {"status": ["ok"]}, ("status", 0)),
-    (decode_diagnostics, {"status": [{"level": "2", "name": "x"}]}, ("status", 0, "level")),
-    (decode_diagnostics, {"status": [{"level": 0, "name": "x", "values": [{"key": "k"}]}]},
-     ("status", 0, "values", 0, "value")),
-    (decode_diagnostics, {"status": [{"level": 0, "name": "battery",
-                                      "values": [{"key": "percentage", "value": 73.5}]}]},
-     ("status", 0, "values", 0, "value")),
-    (decode_face_data, {"faces": [{"id": 1, "engagement": 0, "distance": 1, "facing": "yes"}]},
-     ("faces", 0, "facing")),
-    (decode_person_detections, {"persons": None}, ("persons",)),
-    # bool is not a number, and a number is not a bool
-    (decode_int32, {"data": True}, ("data",)),
-    (decode_pose, {"pose": {"position": {"x": False, "y": 2}, "orientation": {"w": 1}}},
-     ("pose", "position", "x")),
-    (decode_diagnostics, {"status": [{"level": True, "name": "x"}]}, ("status", 0, "level")),
-    (decode_face_data, {"faces": [{"id": 1, "engagement": 0, "distance": 1, "facing": 1}]},
-     ("faces", 0, "facing")),
-    (decode_tracked_people, {"people": [{"id": True, "position": {"x": 0, "y": 0}}]},
-     ("people", 0, "id")),
-    (decode_clock, {"clock": {"secs": True, "nsecs": 0}}, ("clock", "secs")),
-    # NaN, infinity and numbers too big for a float or an int32
-    (decode_pose, {"pose": {"position": {"x": math.nan, "y": 2}, "orientation": {"w": 1}}},
-     ("pose", "position", "x")),
-    (decode_pose, {"pose": {"position": {"x": 1, "y": 2}, "orientation": {"w": -math.inf}}},
-     ("pose", "orientation", "w")),
-    (decode_pose, {"pose": {"position": {"x": 10**400, "y": 2}, "orientation": {"w": 1}}},
-     ("pose", "position", "x")),
-    (decode_face_data, {"faces": [{"id": 1, "engagement": math.inf, "distance": 1,
-                                   "facing": True}]}, ("faces", 0, "engagement")),
-    (decode_diagnostics, {"status": [{"level": 0, "name": "battery",
-                                      "values": [{"key": "percentage", "value": "nan"}]}]},
-     ("status", 0, "values", 0, "value")),
-    (decode_diagnostics, {"status": [{"level": 0, "name": "battery",
-                                      "values": [{"key": "percentage", "value": "full"}]}]},
-     ("status", 0, "values", 0, "value")),
-    (decode_int32, {"data": 2**31}, ("data",)),
-    (decode_int32, {"data": -(2**31) - 1}, ("data",)),
-    (decode_clock, {"clock": {"secs": 10**400, "nsecs": 0}}, ("clock",)),
-    (decode_clock, {"clock": {"sec": -(2**40), "nanosec": 0}}, ("clock",)),
-    # values outside their range
-    (decode_face_data, {"faces": [{"id": 1, "engagement": 1.01, "distance": 1,
-                                   "facing": True}]}, ("faces", 0, "engagement")),
-    (decode_face_data, {"faces": [{"id": 1, "engagement": -1.5, "distance": 1,
-                                   "facing": True}]}, ("faces", 0, "engagement")),
-    (decode_face_data, {"faces": [{"id": 1, "engagement": 0, "distance": -0.1,
-                                   "facing": True}]}, ("faces", 0, "distance")),
-    (decode_person_detections, {"persons": [{"id": 1, "position": {"x": 0, "y": 0},
-                                             "orientation": 360.5}]},
-     ("persons", 0, "orientation")),
-    (decode_diagnostics, {"status": [{"level": 4, "name": "x"}]}, ("status", 0, "level")),
-    (decode_clock, {"clock": {"secs": 1, "nsecs": 1_000_000_000}}, ("clock",)),
-    (decode_clock, {"clock": {"sec": 1, "nanosec": -1}}, ("clock",)),
-])
-def test_decode_errors_name_the_field(decoder: Callable[[Any], Any], msg: Any,
-                                      path: tuple[str | int, ...]) -> None:
+@pytest.mark.parametrize(
+    ("decoder", "msg", "path"),
+    [
+        # not an object at all
+        (decode_pose, [], ()),
+        (decode_int32, None, ()),
+        (decode_string, "docked", ()),
+        # missing fields
+        (decode_int32, {}, ("data",)),
+        (decode_pose, {"header": ROS1_HEADER}, ("pose",)),
+        (
+            decode_pose,
+            {"pose": {"position": {"x": 1}, "orientation": {"w": 1}}},
+            ("pose", "position", "y"),
+        ),
+        (
+            decode_pose,
+            {"pose": {"position": {"x": 1, "y": 2}, "orientation": {"z": 1}}},
+            ("pose", "orientation", "w"),
+        ),
+        (decode_diagnostics, {"status": [{"level": 0}]}, ("status", 0, "name")),
+        (decode_diagnostics, {"header": {}}, ("status",)),
+        (
+            decode_face_data,
+            {"faces": [{"id": 1, "engagement": 0, "distance": 1}]},
+            ("faces", 0, "facing"),
+        ),
+        (
+            decode_person_detections,
+            {"persons": [{"id": 1, "orientation": 180}]},
+            ("persons", 0, "position"),
+        ),
+        (decode_tracked_people, {"people": [{"position": {"x": 0, "y": 0}}]}, ("people", 0, "id")),
+        (decode_clock, {}, ("clock",)),
+        (decode_clock, {"clock": {"secs": 1}}, ("clock",)),
+        (decode_clock, {"clock": {"sec": 1}}, ("clock",)),
+        (decode_clock, {"clock": {"seconds": 1}}, ("clock",)),
+        # wrong types
+        (decode_int32, {"data": "2"}, ("data",)),
+        (decode_int32, {"data": 2.0}, ("data",)),
+        (decode_string, {"data": 3}, ("data",)),
+        (
+            decode_pose,
+            {"pose": {"position": {"x": "1", "y": 2}, "orientation": {"w": 1}}},
+            ("pose", "position", "x"),
+        ),
+        (decode_pose, {"header": [], "pose": {}}, ("header",)),
+        (decode_pose, dict(pose_msg(), header={"frame_id": 5}), ("header", "frame_id")),
+        (decode_pose, dict(pose_msg(), header={"stamp": 5}), ("header", "stamp")),
+        (decode_diagnostics, {"status": {}}, ("status",)),
+        (decode_diagnostics, {"status": ["ok"]}, ("status", 0)),
+        (decode_diagnostics, {"status": [{"level": "2", "name": "x"}]}, ("status", 0, "level")),
+        (
+            decode_diagnostics,
+            {"status": [{"level": 0, "name": "x", "values": [{"key": "k"}]}]},
+            ("status", 0, "values", 0, "value"),
+        ),
+        (
+            decode_diagnostics,
+            {
+                "status": [
+                    {
+                        "level": 0,
+                        "name": "battery",
+                        "values": [{"key": "percentage", "value": 73.5}],
+                    }
+                ]
+            },
+            ("status", 0, "values", 0, "value"),
+        ),
+        (
+            decode_face_data,
+            {"faces": [{"id": 1, "engagement": 0, "distance": 1, "facing": "yes"}]},
+            ("faces", 0, "facing"),
+        ),
+        (decode_person_detections, {"persons": None}, ("persons",)),
+        # bool is not a number, and a number is not a bool
+        (decode_int32, {"data": True}, ("data",)),
+        (
+            decode_pose,
+            {"pose": {"position": {"x": False, "y": 2}, "orientation": {"w": 1}}},
+            ("pose", "position", "x"),
+        ),
+        (decode_diagnostics, {"status": [{"level": True, "name": "x"}]}, ("status", 0, "level")),
+        (
+            decode_face_data,
+            {"faces": [{"id": 1, "engagement": 0, "distance": 1, "facing": 1}]},
+            ("faces", 0, "facing"),
+        ),
+        (
+            decode_tracked_people,
+            {"people": [{"id": True, "position": {"x": 0, "y": 0}}]},
+            ("people", 0, "id"),
+        ),
+        (decode_clock, {"clock": {"secs": True, "nsecs": 0}}, ("clock", "secs")),
+        # NaN, infinity and numbers too big for a float or an int32
+        (
+            decode_pose,
+            {"pose": {"position": {"x": math.nan, "y": 2}, "orientation": {"w": 1}}},
+            ("pose", "position", "x"),
+        ),
+        (
+            decode_pose,
+            {"pose": {"position": {"x": 1, "y": 2}, "orientation": {"w": -math.inf}}},
+            ("pose", "orientation", "w"),
+        ),
+        (
+            decode_pose,
+            {"pose": {"position": {"x": 10**400, "y": 2}, "orientation": {"w": 1}}},
+            ("pose", "position", "x"),
+        ),
+        (
+            decode_face_data,
+            {"faces": [{"id": 1, "engagement": math.inf, "distance": 1, "facing": True}]},
+            ("faces", 0, "engagement"),
+        ),
+        (
+            decode_diagnostics,
+            {
+                "status": [
+                    {
+                        "level": 0,
+                        "name": "battery",
+                        "values": [{"key": "percentage", "value": "nan"}],
+                    }
+                ]
+            },
+            ("status", 0, "values", 0, "value"),
+        ),
+        (
+            decode_diagnostics,
+            {
+                "status": [
+                    {
+                        "level": 0,
+                        "name": "battery",
+                        "values": [{"key": "percentage", "value": "full"}],
+                    }
+                ]
+            },
+            ("status", 0, "values", 0, "value"),
+        ),
+        (decode_int32, {"data": 2**31}, ("data",)),
+        (decode_int32, {"data": -(2**31) - 1}, ("data",)),
+        (decode_clock, {"clock": {"secs": 10**400, "nsecs": 0}}, ("clock",)),
+        (decode_clock, {"clock": {"sec": -(2**40), "nanosec": 0}}, ("clock",)),
+        # values outside their range
+        (
+            decode_face_data,
+            {"faces": [{"id": 1, "engagement": 1.01, "distance": 1, "facing": True}]},
+            ("faces", 0, "engagement"),
+        ),
+        (
+            decode_face_data,
+            {"faces": [{"id": 1, "engagement": -1.5, "distance": 1, "facing": True}]},
+            ("faces", 0, "engagement"),
+        ),
+        (
+            decode_face_data,
+            {"faces": [{"id": 1, "engagement": 0, "distance": -0.1, "facing": True}]},
+            ("faces", 0, "distance"),
+        ),
+        (
+            decode_person_detections,
+            {"persons": [{"id": 1, "position": {"x": 0, "y": 0}, "orientation": 360.5}]},
+            ("persons", 0, "orientation"),
+        ),
+        (decode_diagnostics, {"status": [{"level": 4, "name": "x"}]}, ("status", 0, "level")),
+        (decode_clock, {"clock": {"secs": 1, "nsecs": 1_000_000_000}}, ("clock",)),
+        (decode_clock, {"clock": {"sec": 1, "nanosec": -1}}, ("clock",)),
+    ],
+)
+def test_decode_errors_name_the_field(
+    decoder: Callable[[Any], Any], msg: Any, path: tuple[str | int, ...]
+) -> None:
     err = decode_error(decoder, msg)
     assert err.path == path
     if path:
@@ -271,13 +390,13 @@ def test_decode_errors_name_the_field(decoder: Callable[[Any], Any], msg: Any,
 
 def test_engagement_bounds_are_inclusive() -> None:
     for level in (-1, -1.0, 0, 1, 1.0):
-        decode_face_data({"faces": [{"id": 1, "engagement": level, "distance": 0,
-                                     "facing": True}]})
+        decode_face_data({"faces": [{"id": 1, "engagement": level, "distance": 0, "facing": True}]})
 
 
 def test_decode_error_message_names_path_and_problem() -> None:
-    err = decode_error(decode_pose, {"pose": {"position": {"x": "abc", "y": 0},
-                                              "orientation": {"w": 1}}})
+    err = decode_error(
+        decode_pose, {"pose": {"position": {"x": "abc", "y": 0}, "orientation": {"w": 1}}}
+    )
     assert str(err) == "pose.position.x: expected `float`, got `str`"
     err = decode_error(decode_diagnostics, {"status": [{"level": 0, "name": "x"}, 5]})
     assert str(err) == "status[1]: expected `object`, got `int`"
@@ -285,26 +404,83 @@ def test_decode_error_message_names_path_and_problem() -> None:
 
 # ---------------------------------------------------------------- properties
 
-KEYS = sorted({"header", "stamp", "secs", "nsecs", "sec", "nanosec", "frame_id", "pose",
-               "position", "orientation", "x", "y", "z", "w", "data", "status", "level",
-               "name", "message", "values", "key", "value", "persons", "faces", "people",
-               "id", "engagement", "distance", "facing", "clock"})
-scalars = (st.none() | st.booleans() | st.integers()
-           | st.sampled_from([2**31, -(2**31) - 1, 2**32, 10**400, -(10**400), 999_999_999,
-                              1_000_000_000, -1, 0, 3, 4])
-           | st.floats() | st.sampled_from(["percentage", "battery", "73.5", "nan", "inf",
-                                            "1e999", "-0", " 5 "])
-           | st.text(max_size=10))
+KEYS = sorted(
+    {
+        "header",
+        "stamp",
+        "secs",
+        "nsecs",
+        "sec",
+        "nanosec",
+        "frame_id",
+        "pose",
+        "position",
+        "orientation",
+        "x",
+        "y",
+        "z",
+        "w",
+        "data",
+        "status",
+        "level",
+        "name",
+        "message",
+        "values",
+        "key",
+        "value",
+        "persons",
+        "faces",
+        "people",
+        "id",
+        "engagement",
+        "distance",
+        "facing",
+        "clock",
+    }
+)
+scalars = (
+    st.none()
+    | st.booleans()
+    | st.integers()
+    | st.sampled_from(
+        [2**31, -(2**31) - 1, 2**32, 10**400, -(10**400), 999_999_999, 1_000_000_000, -1, 0, 3, 4]
+    )
+    | st.floats()
+    | st.sampled_from(["percentage", "battery", "73.5", "nan", "inf", "1e999", "-0", " 5 "])
+    | st.text(max_size=10)
+)
 json_like = st.recursive(
     scalars,
-    lambda inner: st.lists(inner, max_size=4)
-    | st.dictionaries(st.sampled_from(KEYS) | st.text(max_size=5), inner, max_size=6),
-    max_leaves=30)
+    lambda inner: (
+        st.lists(inner, max_size=4)
+        | st.dictionaries(st.sampled_from(KEYS) | st.text(max_size=5), inner, max_size=6)
+    ),
+    max_leaves=30,
+)
 
 
 # Values at the edges of what a decoder must refuse or accept, drawn often.
-NASTY: list[Any] = [None, True, False, 0, -1, 1.5, 2**31, 2**32, 10**400, -(10**400),
-                    math.nan, math.inf, -math.inf, "", "73.5", "nan", [], {}, [{}]]
+NASTY: list[Any] = [
+    None,
+    True,
+    False,
+    0,
+    -1,
+    1.5,
+    2**31,
+    2**32,
+    10**400,
+    -(10**400),
+    math.nan,
+    math.inf,
+    -math.inf,
+    "",
+    "73.5",
+    "nan",
+    [],
+    {},
+    [{}],
+]
 
 
 def _paths(value: Any, prefix: tuple[Any, ...] = ()) -> Iterator[tuple[Any, ...]]:
@@ -375,6 +551,7 @@ def test_decode_time_round_trip(secs: int, nsecs: int, ros2: bool) -> None:
 
 
 # ---------------------------------------------------------------- JSON text and objects
+
 
 def _outcome(decode: Callable[[Any], Any], msg: Any) -> tuple[str, Any]:
     try:

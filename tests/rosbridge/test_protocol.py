@@ -43,10 +43,18 @@ def test_advertise_and_subscribe_frames_carry_ids() -> None:
     s = connected()
     [adv] = parse(s.advertise("/GotoWayPoint", "geometry_msgs/PoseStamped"))
     [sub] = parse(s.subscribe("/FROG_response", "std_msgs/Int32"))
-    assert adv == {"op": "advertise", "id": adv["id"], "topic": "/GotoWayPoint",
-                   "type": "geometry_msgs/PoseStamped"}
-    assert sub == {"op": "subscribe", "id": sub["id"], "topic": "/FROG_response",
-                   "type": "std_msgs/Int32"}
+    assert adv == {
+        "op": "advertise",
+        "id": adv["id"],
+        "topic": "/GotoWayPoint",
+        "type": "geometry_msgs/PoseStamped",
+    }
+    assert sub == {
+        "op": "subscribe",
+        "id": sub["id"],
+        "topic": "/FROG_response",
+        "type": "std_msgs/Int32",
+    }
     assert isinstance(adv["id"], str) and isinstance(sub["id"], str)
     assert adv["id"] != sub["id"]
 
@@ -125,9 +133,12 @@ def test_on_connected_restores_everything_in_order() -> None:
     s.publish("/GotoWayPoint", {"pose": 1})
     frames = parse(s.on_connected(0.0))
     assert [(f["op"], f["topic"]) for f in frames] == [
-        ("advertise", "/GotoWayPoint"), ("advertise", "/docking/dock"),
+        ("advertise", "/GotoWayPoint"),
+        ("advertise", "/docking/dock"),
         ("subscribe", "/FROG_response"),
-        ("publish", "/docking/dock"), ("publish", "/GotoWayPoint")]
+        ("publish", "/docking/dock"),
+        ("publish", "/GotoWayPoint"),
+    ]
     assert frames[2]["throttle_rate"] == 50
     assert s.queued == 0 and s.connected
 
@@ -162,8 +173,7 @@ def test_unsubscribe_while_down_is_not_restored() -> None:
 
 def _mac(secret: str, f: dict[str, Any]) -> str:
     # rosauth: secret + client + dest + rand + t.sec + level + end.sec (whole seconds)
-    text = (f"{secret}{f['client']}{f['dest']}{f['rand']}{int(f['t'])}{f['level']}"
-            f"{int(f['end'])}")
+    text = f"{secret}{f['client']}{f['dest']}{f['rand']}{int(f['t'])}{f['level']}{int(f['end'])}"
     return hashlib.sha512(text.encode()).hexdigest()
 
 
@@ -205,8 +215,9 @@ def test_publish_frame() -> None:
 
 
 def test_status_frame() -> None:
-    assert decode_frame('{"op":"status","level":"error","msg":"no such topic","id":"x:1"}') \
-        == Status("error", "no such topic", "x:1")
+    assert decode_frame(
+        '{"op":"status","level":"error","msg":"no such topic","id":"x:1"}'
+    ) == Status("error", "no such topic", "x:1")
     assert decode_frame('{"op":"status"}') == Status("", "", None)
 
 
@@ -215,22 +226,25 @@ def test_unknown_ops_are_other(op: str) -> None:
     assert decode_frame(json.dumps({"op": op, "whatever": [1, 2]})) == OtherOp(op)
 
 
-@pytest.mark.parametrize(("text", "where"), [
-    ("", "not JSON"),
-    ("{", "not JSON"),
-    ("[1, 2]", "expected `object`"),
-    ('"publish"', "expected `object`"),
-    ("{}", "op"),
-    ('{"op": 3}', "op"),
-    ('{"op":"publish","msg":{}}', "topic"),
-    ('{"op":"publish","topic":"","msg":{}}', "topic"),
-    ('{"op":"publish","topic":7,"msg":{}}', "topic"),
-    ('{"op":"publish","topic":"/a"}', "msg"),
-    ('{"op":"publish","topic":"/a","msg":{"data":NaN}}', "not JSON"),
-    ('{"op":"publish","topic":"/a","msg":{"data":-Infinity}}', "not JSON"),
-    (b'\xff\xfe\xfa', "not JSON"),
-    ("[" * 100_000, "expected `object`"),
-])
+@pytest.mark.parametrize(
+    ("text", "where"),
+    [
+        ("", "not JSON"),
+        ("{", "not JSON"),
+        ("[1, 2]", "expected `object`"),
+        ('"publish"', "expected `object`"),
+        ("{}", "op"),
+        ('{"op": 3}', "op"),
+        ('{"op":"publish","msg":{}}', "topic"),
+        ('{"op":"publish","topic":"","msg":{}}', "topic"),
+        ('{"op":"publish","topic":7,"msg":{}}', "topic"),
+        ('{"op":"publish","topic":"/a"}', "msg"),
+        ('{"op":"publish","topic":"/a","msg":{"data":NaN}}', "not JSON"),
+        ('{"op":"publish","topic":"/a","msg":{"data":-Infinity}}', "not JSON"),
+        (b"\xff\xfe\xfa", "not JSON"),
+        ("[" * 100_000, "expected `object`"),
+    ],
+)
 def test_malformed_frames_raise_decode_error(text: str | bytes, where: str) -> None:
     with pytest.raises(DecodeError, match=where):
         decode_frame(text)
@@ -251,18 +265,26 @@ def test_oversized_frame_is_refused() -> None:
 
 # ---------------------------------------------------------------- properties
 
-json_scalars = (st.none() | st.booleans() | st.integers(-(2**70), 2**70)
-                | st.floats(allow_nan=False, allow_infinity=False) | st.text(max_size=20))
+json_scalars = (
+    st.none()
+    | st.booleans()
+    | st.integers(-(2**70), 2**70)
+    | st.floats(allow_nan=False, allow_infinity=False)
+    | st.text(max_size=20)
+)
 finite_json = st.recursive(
     json_scalars,
-    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner,
-                                                                 max_size=4),
-    max_leaves=20)
+    lambda inner: (
+        st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner, max_size=4)
+    ),
+    max_leaves=20,
+)
 frame_keys = st.sampled_from(["op", "topic", "msg", "level", "id", "type"])
 frame_like = st.dictionaries(
     frame_keys | st.text(max_size=5),
     st.sampled_from(["publish", "status", "advertise", "/a", ""]) | finite_json,
-    max_size=5)
+    max_size=5,
+)
 
 
 def _check_decode(value: str | bytes) -> None:

@@ -40,10 +40,17 @@ def main(port: int) -> int:
     if ok:
         goal = roslibpy.Topic(ros, "/GotoWayPoint", "geometry_msgs/PoseStamped")
         goal.advertise()
-        goal.publish(roslibpy.Message({
-            "header": {"seq": 0, "stamp": {"secs": 0, "nsecs": 0}, "frame_id": "map"},
-            "pose": {"position": {"x": start["x"] + 1.0, "y": start["y"], "z": 0.0},
-                     "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}}))
+        goal.publish(
+            roslibpy.Message(
+                {
+                    "header": {"seq": 0, "stamp": {"secs": 0, "nsecs": 0}, "frame_id": "map"},
+                    "pose": {
+                        "position": {"x": start["x"] + 1.0, "y": start["y"], "z": 0.0},
+                        "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
+                    },
+                }
+            )
+        )
         ok = finished.wait(20)
     print(json.dumps({"codes": codes, "start": start}), flush=True)
     try:

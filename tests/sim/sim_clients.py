@@ -41,12 +41,15 @@ class RosClient:
             if predicate(frame):
                 return frame
 
-    async def next_publish(self, topic: str,
-                           check: Callable[[dict[str, Any]], bool] = lambda msg: True,
-                           ) -> dict[str, Any]:
+    async def next_publish(
+        self,
+        topic: str,
+        check: Callable[[dict[str, Any]], bool] = lambda msg: True,
+    ) -> dict[str, Any]:
         """The ``msg`` of the next publish on ``topic`` that passes ``check``."""
-        frame = await self.next(lambda f: f.get("op") == "publish" and f.get("topic") == topic
-                                and check(f["msg"]))
+        frame = await self.next(
+            lambda f: f.get("op") == "publish" and f.get("topic") == topic and check(f["msg"])
+        )
         return frame["msg"]
 
     async def close(self) -> None:

@@ -34,8 +34,10 @@ from frog_bt.sim.play import DT, PASS_TAIL, SEQ_PER_PASS, Player, load, restampe
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "recording"))
 from recorded_tour import record_day, record_tour
 
-FAST_ROBOT = {"navigation": {"speed": 3.0, "approach_time": 1.0},
-              "docking": {"undock_time": 2.0, "dock_time": 3.0}}
+FAST_ROBOT = {
+    "navigation": {"speed": 3.0, "approach_time": 1.0},
+    "docking": {"undock_time": 2.0, "dock_time": 3.0},
+}
 HOST = "127.0.0.1"
 
 
@@ -72,7 +74,8 @@ def _free_udp_port() -> int:
 
 @pytest.mark.parametrize("which", ["one file", "tour file of a day"])
 def test_run_once_against_a_played_tour_reaches_its_end(
-        which: str, request: pytest.FixtureRequest) -> None:
+    which: str, request: pytest.FixtureRequest
+) -> None:
     if which == "one file":
         path, played = request.getfixturevalue("recorded"), ["tour.mcap"]
     else:
@@ -81,19 +84,57 @@ def test_run_once_against_a_played_tour_reaches_its_end(
     listen = _free_udp_port()
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
     player = subprocess.Popen(
-        [sys.executable, "-m", "frog_bt", "sim", "--play", str(path), "--speed", "60",
-         "--rosbridge", f"{HOST}:0", "--frontend", f"{HOST}:0",
-         "--executive", f"{HOST}:{listen}"],
-        stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
+        [
+            sys.executable,
+            "-m",
+            "frog_bt",
+            "sim",
+            "--play",
+            str(path),
+            "--speed",
+            "60",
+            "--rosbridge",
+            f"{HOST}:0",
+            "--frontend",
+            f"{HOST}:0",
+            "--executive",
+            f"{HOST}:{listen}",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        env=env,
+    )
     try:
-        start = _line(player, r"playing (.*) \(\d+ inputs.* rosbridge ws://127\.0\.0\.1:(\d+), "
-                              r"front end udp 127\.0\.0\.1:(\d+)")
+        start = _line(
+            player,
+            r"playing (.*) \(\d+ inputs.* rosbridge ws://127\.0\.0\.1:(\d+), "
+            r"front end udp 127\.0\.0\.1:(\d+)",
+        )
         assert [Path(f).name for f in start.group(1).split(", ")] == played
         run = subprocess.run(
-            [sys.executable, "-m", "frog_bt", "run", "--sim-time", "--once", "--quiet",
-             "--checkpoint", "none", "--rosbridge", f"ws://{HOST}:{start.group(2)}",
-             "--frontend", f"{HOST}:{start.group(3)}", "--listen", f"{HOST}:{listen}"],
-            capture_output=True, text=True, timeout=120, env=env)
+            [
+                sys.executable,
+                "-m",
+                "frog_bt",
+                "run",
+                "--sim-time",
+                "--once",
+                "--quiet",
+                "--checkpoint",
+                "none",
+                "--rosbridge",
+                f"ws://{HOST}:{start.group(2)}",
+                "--frontend",
+                f"{HOST}:{start.group(3)}",
+                "--listen",
+                f"{HOST}:{listen}",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env=env,
+        )
         assert run.returncode == 0, run.stderr[-2000:]
         assert "  outcome:   tour ended docked, every stop visited" in run.stdout.splitlines()
     finally:
@@ -101,8 +142,11 @@ def test_run_once_against_a_played_tour_reaches_its_end(
         out, _ = player.communicate(timeout=15)
     assert player.returncode == 0
     final = out.strip().splitlines()[-1]
-    match = re.search(r"stopped; played (\d+) inputs and (\d+) front-end events; "
-                      r"commands: (\d+) received, (\d+) differ from the recording", final)
+    match = re.search(
+        r"stopped; played (\d+) inputs and (\d+) front-end events; "
+        r"commands: (\d+) received, (\d+) differ from the recording",
+        final,
+    )
     assert match, final
     inputs, events, received, differ = map(int, match.groups())
     assert inputs > 500 and events >= 5, final
@@ -137,17 +181,19 @@ def test_a_day_file_is_played_after_its_lead_in_and_from_its_primer(day: list[Pa
     assert tour.files == [str(day[2]), str(day[3])]
     assert tour.commands and tour.events
     idle = load(day[2], site)
-    primer = next(channels.decode(topic, bytes(data)) for topic, _, data
-                  in open_recording(day[2]).messages() if topic == channels.PRIMER)
+    primer = next(
+        channels.decode(topic, bytes(data))
+        for topic, _, data in open_recording(day[2]).messages()
+        if topic == channels.PRIMER
+    )
     assert primer.inputs
     first = [(topic, msg) for t, topic, msg in idle.inputs if t == idle.start]
     assert first == [(p.topic, json.loads(bytes(p.msg))) for p in primer.inputs]
     assert ("/docking/state", {"data": "docked"}) in first
-    assert tour.inputs[:len(first)] == idle.inputs[:len(first)]
+    assert tour.inputs[: len(first)] == idle.inputs[: len(first)]
 
 
-def test_loop_plays_again_later_with_the_clock_and_stamps_going_forward(
-        recorded: Path) -> None:
+def test_loop_plays_again_later_with_the_clock_and_stamps_going_forward(recorded: Path) -> None:
     """With --loop the second pass runs on after the first (the clock never goes back),
     its stamps moved with it, its front-end events numbered after the first pass's."""
     site = load_site()
@@ -160,9 +206,17 @@ def test_loop_plays_again_later_with_the_clock_and_stamps_going_forward(
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as executive:
             executive.bind((HOST, 0))
             executive.setblocking(False)
-            player = Player(played, site, host=HOST, rosbridge_port=0, frontend_host=HOST,
-                            frontend_port=0, executive=executive.getsockname(),
-                            speed=2000.0, loop=True)
+            player = Player(
+                played,
+                site,
+                host=HOST,
+                rosbridge_port=0,
+                frontend_host=HOST,
+                frontend_port=0,
+                executive=executive.getsockname(),
+                speed=2000.0,
+                loop=True,
+            )
             await player.start()
             clocks: list[float] = []
             poses: list[tuple[float, float]] = []  # (the clock then, the pose's stamp)
@@ -197,7 +251,7 @@ def test_loop_plays_again_later_with_the_clock_and_stamps_going_forward(
     assert all(clock - 1.0 <= stamp <= clock + 1e-6 for clock, stamp in poses)
     n = len(played.events)
     seqs = [json.loads(data)["seq"] for _, data in played.events]
-    assert [d["seq"] for d in datagrams[:2 * n]] == seqs + [s + SEQ_PER_PASS for s in seqs]
+    assert [d["seq"] for d in datagrams[: 2 * n]] == seqs + [s + SEQ_PER_PASS for s in seqs]
     recorded_not_meter = sum(c.payload.get("type") != "engagement" for c in played.commands)
     assert player.comparison.missed >= recorded_not_meter  # no executive: none received
 
@@ -205,7 +259,8 @@ def test_loop_plays_again_later_with_the_clock_and_stamps_going_forward(
 def test_restamped_moves_a_header_stamp_in_its_own_shape() -> None:
     ros1 = {"header": {"stamp": {"secs": 10, "nsecs": 900_000_000}, "frame_id": "map"}}
     assert restamped(ros1, 0.25) == {
-        "header": {"stamp": {"secs": 11, "nsecs": 150_000_000}, "frame_id": "map"}}
+        "header": {"stamp": {"secs": 11, "nsecs": 150_000_000}, "frame_id": "map"}
+    }
     ros2 = {"header": {"stamp": {"sec": 10, "nanosec": 0}}, "data": 1}
     assert restamped(ros2, 2.0) == {"header": {"stamp": {"sec": 12, "nanosec": 0}}, "data": 1}
     assert restamped({"data": "docked"}, 5.0) == {"data": "docked"}
@@ -220,10 +275,17 @@ def test_with_no_client_it_plays_anyway_after_its_bound(recorded: Path) -> None:
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as front_end_peer:
             front_end_peer.bind((HOST, 0))
             front_end_peer.setblocking(False)
-            player = Player(played, site, host=HOST, rosbridge_port=0,
-                            frontend_host=HOST, frontend_port=0,
-                            executive=front_end_peer.getsockname(), speed=2000.0,
-                            wait_max=0.1)
+            player = Player(
+                played,
+                site,
+                host=HOST,
+                rosbridge_port=0,
+                frontend_host=HOST,
+                frontend_port=0,
+                executive=front_end_peer.getsockname(),
+                speed=2000.0,
+                wait_max=0.1,
+            )
             await player.start()
             try:
                 await asyncio.wait_for(player.over.wait(), 30)  # a bound, not a pace
@@ -255,15 +317,18 @@ def _foreign(path: Path) -> Path:
 
 
 def test_files_it_cannot_play_are_one_line_and_exit_2(
-        tmp_path: Path, day: list[Path], capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, day: list[Path], capsys: pytest.CaptureFixture[str]
+) -> None:
     text = tmp_path / "notes.mcap"
     text.write_text("hello")
     alone = tmp_path / day[3].name  # a tour file without the idle file it continues
     shutil.copy(day[3], alone)
-    for path, reason in ((text, f"{text}: not an MCAP file"),
-                         (_foreign(tmp_path / "chatter.mcap"), "no robot-side inputs in it"),
-                         (alone, f"continues {day[2].name}, which is gone"),
-                         (tmp_path / "nowhere.mcap", "nowhere.mcap")):
+    for path, reason in (
+        (text, f"{text}: not an MCAP file"),
+        (_foreign(tmp_path / "chatter.mcap"), "no robot-side inputs in it"),
+        (alone, f"continues {day[2].name}, which is gone"),
+        (tmp_path / "nowhere.mcap", "nowhere.mcap"),
+    ):
         assert main(["sim", "--play", str(path)]) == 2
         err = capsys.readouterr().err
         assert err.startswith("frog-bt sim: --play: ") and err.count("\n") == 1, err

@@ -23,8 +23,9 @@ class Link:
 
     def __init__(self, scenario: Scenario, answer: bool = True) -> None:
         self.traffic: list[tuple[str, str, dict[str, Any]]] = []
-        self.model = FrontendModel(scenario, HOST, lambda: answer,
-                                   lambda d, c, f: self.traffic.append((d, c, f)))
+        self.model = FrontendModel(
+            scenario, HOST, lambda: answer, lambda d, c, f: self.traffic.append((d, c, f))
+        )
         self.exe = Endpoint(HOST, fm.EVENTS)
         self.now = T0
         self.steps = 0
@@ -87,7 +88,8 @@ def test_events_are_resent_until_acked(link: Callable[..., Link]) -> None:
     k.run(1.0)
     assert k.model.endpoint.pending == 0
     assert [t for t in k.traffic if t[1] == "frontend_idle"] == [
-        ("out", "frontend_idle", {})]  # resends are not logged
+        ("out", "frontend_idle", {})
+    ]  # resends are not logged
 
 
 def test_commands_are_acked_and_logged(link: Callable[..., Link]) -> None:

@@ -28,8 +28,14 @@ def server() -> BridgeServer:
 
 def test_publish_frames_go_to_subscribers_without_id(server: BridgeServer) -> None:
     a, b = server.connect(), server.connect()
-    assert server.receive(a, frame(op="subscribe", id="s1", topic="/FROG_pose",
-                                   type="geometry_msgs/PoseStamped"), NOW) == []
+    assert (
+        server.receive(
+            a,
+            frame(op="subscribe", id="s1", topic="/FROG_pose", type="geometry_msgs/PoseStamped"),
+            NOW,
+        )
+        == []
+    )
     out = server.publish("/FROG_pose", {"x": 1}, NOW)
     assert sends(out) == [(a, {"op": "publish", "topic": "/FROG_pose", "msg": {"x": 1}})]
     assert server.publish("/other", {}, NOW) == []
@@ -38,9 +44,19 @@ def test_publish_frames_go_to_subscribers_without_id(server: BridgeServer) -> No
 
 def test_roslibpy_style_subscribe_with_compression(server: BridgeServer) -> None:
     c = server.connect()
-    server.receive(c, frame(op="subscribe", id="subscribe:/FROG_pose:1", type="x",
-                            topic="/FROG_pose", compression="none", throttle_rate=0,
-                            queue_length=0), NOW)
+    server.receive(
+        c,
+        frame(
+            op="subscribe",
+            id="subscribe:/FROG_pose:1",
+            type="x",
+            topic="/FROG_pose",
+            compression="none",
+            throttle_rate=0,
+            queue_length=0,
+        ),
+        NOW,
+    )
     assert len(server.publish("/FROG_pose", {}, NOW)) == 1
 
 
@@ -65,29 +81,44 @@ def test_throttle_rate(server: BridgeServer) -> None:
 def test_client_publishes_reach_the_robot_and_other_subscribers(server: BridgeServer) -> None:
     exe, tool = server.connect(), server.connect()
     server.receive(tool, frame(op="subscribe", topic="/GotoWayPoint"), NOW)
-    server.receive(exe, frame(op="advertise", id="a", topic="/GotoWayPoint",
-                              type="geometry_msgs/PoseStamped"), NOW)
-    out = server.receive(exe, frame(op="publish", id="p:1", topic="/GotoWayPoint",
-                                    msg={"pose": 1}), NOW)
+    server.receive(
+        exe,
+        frame(op="advertise", id="a", topic="/GotoWayPoint", type="geometry_msgs/PoseStamped"),
+        NOW,
+    )
+    out = server.receive(
+        exe, frame(op="publish", id="p:1", topic="/GotoWayPoint", msg={"pose": 1}), NOW
+    )
     assert out[-1] == Incoming(exe, "/GotoWayPoint", {"pose": 1})
-    assert sends(out) == [(tool, {"op": "publish", "topic": "/GotoWayPoint",
-                                  "msg": {"pose": 1}})]
+    assert sends(out) == [(tool, {"op": "publish", "topic": "/GotoWayPoint", "msg": {"pose": 1}})]
     # publish without advertise works too (rosbridge advertises implicitly)
     assert server.receive(tool, frame(op="publish", topic="/x", msg={}), NOW) == [
-        Incoming(tool, "/x", {})]
+        Incoming(tool, "/x", {})
+    ]
     server.receive(exe, frame(op="unadvertise", topic="/GotoWayPoint"), NOW)
     assert server.stats.publishes_in == 2 and server.stats.malformed == 0
 
 
-@pytest.mark.parametrize("text", [
-    "not json", "[1, 2]", '{"no": "op"}', '{"op": 5}', "NaN",
-    frame(op="publish", msg={}), frame(op="publish", topic="/t"),
-    frame(op="publish", topic="/t", msg=[1]), frame(op="subscribe", topic=""),
-    frame(op="subscribe", topic="/t", throttle_rate="fast"),
-    frame(op="advertise", topic="/t"), '{"op": "publish", "topic": "/t", "msg": {"x": NaN}}',
-])
-def test_malformed_frames_are_counted_and_answered_with_nothing(server: BridgeServer,
-                                                                text: str) -> None:
+@pytest.mark.parametrize(
+    "text",
+    [
+        "not json",
+        "[1, 2]",
+        '{"no": "op"}',
+        '{"op": 5}',
+        "NaN",
+        frame(op="publish", msg={}),
+        frame(op="publish", topic="/t"),
+        frame(op="publish", topic="/t", msg=[1]),
+        frame(op="subscribe", topic=""),
+        frame(op="subscribe", topic="/t", throttle_rate="fast"),
+        frame(op="advertise", topic="/t"),
+        '{"op": "publish", "topic": "/t", "msg": {"x": NaN}}',
+    ],
+)
+def test_malformed_frames_are_counted_and_answered_with_nothing(
+    server: BridgeServer, text: str
+) -> None:
     c = server.connect()
     assert server.receive(c, text, NOW) == []
     assert server.stats.malformed == 1
@@ -110,17 +141,28 @@ def test_unknown_ops_are_ignored(server: BridgeServer) -> None:
 
 def test_rosapi_services(server: BridgeServer) -> None:
     c = server.connect()
-    server.receive(c, frame(op="advertise", topic="/GotoWayPoint", type="geometry_msgs/Pose"),
-                   NOW)
-    ((_, reply),) = sends(server.receive(c, frame(op="call_service", id="c1",
-                                                  service="/rosapi/get_time"), NOW))
-    assert reply == {"op": "service_response", "id": "c1", "service": "/rosapi/get_time",
-                     "values": {"time": {"secs": 1_780_000_000, "nsecs": 0}}, "result": True}
-    ((_, reply),) = sends(server.receive(c, frame(op="call_service", service="/rosapi/topics"),
-                                         NOW))
+    server.receive(c, frame(op="advertise", topic="/GotoWayPoint", type="geometry_msgs/Pose"), NOW)
+    ((_, reply),) = sends(
+        server.receive(c, frame(op="call_service", id="c1", service="/rosapi/get_time"), NOW)
+    )
+    assert reply == {
+        "op": "service_response",
+        "id": "c1",
+        "service": "/rosapi/get_time",
+        "values": {"time": {"secs": 1_780_000_000, "nsecs": 0}},
+        "result": True,
+    }
+    ((_, reply),) = sends(
+        server.receive(c, frame(op="call_service", service="/rosapi/topics"), NOW)
+    )
     assert set(reply["values"]["topics"]) == {"/FROG_pose", "/GotoWayPoint"}
-    ((_, reply),) = sends(server.receive(c, frame(
-        op="call_service", service="/rosapi/topic_type", args={"topic": "/FROG_pose"}), NOW))
+    ((_, reply),) = sends(
+        server.receive(
+            c,
+            frame(op="call_service", service="/rosapi/topic_type", args={"topic": "/FROG_pose"}),
+            NOW,
+        )
+    )
     assert reply["values"] == {"type": "geometry_msgs/PoseStamped"}
     ((_, reply),) = sends(server.receive(c, frame(op="call_service", service="/x/y"), NOW))
     assert reply["result"] is False
@@ -129,8 +171,12 @@ def test_rosapi_services(server: BridgeServer) -> None:
 def test_auth_with_a_secret() -> None:
     server = BridgeServer(secret="s3cret", auth_time=lambda: NOW)
     good = server.connect()
-    assert server.receive(good, json.dumps(auth_frame("s3cret", "10.0.0.2", "10.0.0.1",
-                                                      NOW + 0.7)), NOW) == []
+    assert (
+        server.receive(
+            good, json.dumps(auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW + 0.7)), NOW
+        )
+        == []
+    )
     server.receive(good, frame(op="subscribe", topic="/t"), NOW)
     assert len(server.publish("/t", {}, NOW)) == 1
 
@@ -167,17 +213,21 @@ def test_auth_in_the_object_form_is_not_understood_and_the_next_frame_closes() -
     auth["t"], auth["end"] = {"secs": int(NOW), "nsecs": 0}, {"secs": int(NOW) + 60, "nsecs": 0}
     assert server.receive(c, json.dumps(auth), NOW) == []
     assert not server.clients[c].authenticated
-    assert server.receive(c, frame(op="subscribe", topic="/t", type="std_msgs/String"),
-                          NOW) == [Close(c, "authentication failed")]
+    assert server.receive(c, frame(op="subscribe", topic="/t", type="std_msgs/String"), NOW) == [
+        Close(c, "authentication failed")
+    ]
 
 
-@pytest.mark.parametrize(("what", "auth"), [
-    ("wrong secret", auth_frame("guess", "10.0.0.2", "10.0.0.1", NOW)),
-    ("t 5 s behind", auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW - 5.0)),
-    ("t 6 s ahead", auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW + 6.0)),
-    ("end already past", auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW - 2.0, ttl=1.0)),
-    ("a bool for t", {**auth_frame("s3cret", "a", "b", NOW), "t": True}),
-])
+@pytest.mark.parametrize(
+    ("what", "auth"),
+    [
+        ("wrong secret", auth_frame("guess", "10.0.0.2", "10.0.0.1", NOW)),
+        ("t 5 s behind", auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW - 5.0)),
+        ("t 6 s ahead", auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW + 6.0)),
+        ("end already past", auth_frame("s3cret", "10.0.0.2", "10.0.0.1", NOW - 2.0, ttl=1.0)),
+        ("a bool for t", {**auth_frame("s3cret", "a", "b", NOW), "t": True}),
+    ],
+)
 def test_a_bad_auth_closes_the_connection_without_a_status_frame(what: str, auth: Any) -> None:
     server = _authenticated_server()
     c = server.connect()

@@ -73,10 +73,15 @@ def test_an_empty_file_is_every_default(tmp_path: Path) -> None:
 
 
 def test_extends_merges_mappings_and_replaces_lists(tmp_path: Path) -> None:
-    write(tmp_path, "speed: 10\nnavigation: {speed: 1.0, approach_time: 4}\n"
-          "visitors: [{id: 1, position: [0, 0]}]\n", "base.yaml")
-    s = load_scenario(write(tmp_path, "extends: base.yaml\nnavigation: {speed: 2.0}\n"
-                                      "visitors: []\n"))
+    write(
+        tmp_path,
+        "speed: 10\nnavigation: {speed: 1.0, approach_time: 4}\n"
+        "visitors: [{id: 1, position: [0, 0]}]\n",
+        "base.yaml",
+    )
+    s = load_scenario(
+        write(tmp_path, "extends: base.yaml\nnavigation: {speed: 2.0}\nvisitors: []\n")
+    )
     assert s.speed == 10 and s.navigation.speed == 2.0 and s.navigation.approach_time == 4
     assert s.visitors == [] and s.name == "s"
 
@@ -87,10 +92,18 @@ def test_naive_start_time_is_local_time_at_the_site(tmp_path: Path) -> None:
     assert s.start_time.utcoffset() is not None
 
 
-def test_content_lookup_by_poi_then_waypoint_then_default(scenario: Callable[..., Scenario],
-                                                          ) -> None:
-    s = scenario(content={"default": 12, "introduction": 7, "POI1": {"a": 40, "b": 20},
-                          "POI2b": 9, "POI3": {"a": 5}})
+def test_content_lookup_by_poi_then_waypoint_then_default(
+    scenario: Callable[..., Scenario],
+) -> None:
+    s = scenario(
+        content={
+            "default": 12,
+            "introduction": 7,
+            "POI1": {"a": 40, "b": 20},
+            "POI2b": 9,
+            "POI3": {"a": 5},
+        }
+    )
     assert s.introduction_seconds == 7
     assert s.content_seconds("POI1", "POI1a", "a") == 40
     assert s.content_seconds("POI1", "POI1b", "b") == 20
@@ -100,39 +113,72 @@ def test_content_lookup_by_poi_then_waypoint_then_default(scenario: Callable[...
     assert isinstance(s.content["POI1"], ContentParts)
 
 
-@pytest.mark.parametrize(("text", "path", "expected"), [
-    ("colour: red\n", ("colour",), "unknown key"),
-    ("visitors: [{id: 1, position: [0, 0], hat: true}]\n", ("visitors", 0, "hat"),
-     "unknown key"),
-    ("visitors: [{position: [0, 0]}]\n", ("visitors", 0, "id"), "missing"),
-    ("visitors: [{id: 1, position: [0, 0], faces: happy}]\n", ("visitors", 0, "faces"),
-     "expected one of engaged, bored, mixed, far, not_facing, or a list"),
-    ("visitors: [{id: 1, position: [0, 0], faces: [0.5, 2]}]\n", ("visitors", 0, "faces"),
-     "a list of numbers in [-1, 1]"),
-    ("visitors: [{id: 1, position: [1, 2, 3]}]\n", ("visitors", 0, "position"),
-     "expected [x, y] or {x, y}"),
-    ("visitors: [{id: 1, position: [0, 0], approach: [maybe]}]\n",
-     ("visitors", 0, "approach", 0), "'succeeded', 'failed' or 'aborted'"),
-    ("visitors: [{id: 1, position: [0, 0], orientation: 90, facing: true}]\n",
-     ("visitors", 0), "not both"),
-    ("visitors: [{id: 1, position: [0, 0]}, {id: 1, position: [1, 1]}]\n",
-     ("visitors", 1, "id"), "duplicate visitor id 1"),
-    ("visitors: [{id: 1, position: [0, 0], wander_off: {}}]\n",
-     ("visitors", 0, "wander_off"), "exactly one of heading_to"),
-    ("navigation: {failures: [{goal: 1, poi: POI1}]}\n", ("navigation", "failures", 0),
-     "exactly one of goal: N or poi: NAME"),
-    ("navigation: {failures: [{goal: 1, result: lost}]}\n",
-     ("navigation", "failures", 0, "result"), "'failed' or 'aborted'"),
-    ("navigation: {speed: -1}\n", ("navigation", "speed"), "greater than 0"),
-    ("speed: fast\n", ("speed",), "got 'fast'"),
-    ("faults: [{at: 5, name: x, level: 1}]\n", ("faults", 0, "level"), "2 or 3"),
-    ("content: {POI1: {c: 3}}\n", ("content", "POI1", "c"), 'expected "a" or "b"'),
-    ("content: {default: {a: 3}}\n", ("content", "default"), "expected seconds > 0"),
-    ("content: {POI1: -4}\n", ("content", "POI1"), "seconds > 0 or {a: seconds"),
-])
-def test_errors_name_file_path_and_expectation(tmp_path: Path, text: str,
-                                               path: tuple[str | int, ...],
-                                               expected: str) -> None:
+@pytest.mark.parametrize(
+    ("text", "path", "expected"),
+    [
+        ("colour: red\n", ("colour",), "unknown key"),
+        (
+            "visitors: [{id: 1, position: [0, 0], hat: true}]\n",
+            ("visitors", 0, "hat"),
+            "unknown key",
+        ),
+        ("visitors: [{position: [0, 0]}]\n", ("visitors", 0, "id"), "missing"),
+        (
+            "visitors: [{id: 1, position: [0, 0], faces: happy}]\n",
+            ("visitors", 0, "faces"),
+            "expected one of engaged, bored, mixed, far, not_facing, or a list",
+        ),
+        (
+            "visitors: [{id: 1, position: [0, 0], faces: [0.5, 2]}]\n",
+            ("visitors", 0, "faces"),
+            "a list of numbers in [-1, 1]",
+        ),
+        (
+            "visitors: [{id: 1, position: [1, 2, 3]}]\n",
+            ("visitors", 0, "position"),
+            "expected [x, y] or {x, y}",
+        ),
+        (
+            "visitors: [{id: 1, position: [0, 0], approach: [maybe]}]\n",
+            ("visitors", 0, "approach", 0),
+            "'succeeded', 'failed' or 'aborted'",
+        ),
+        (
+            "visitors: [{id: 1, position: [0, 0], orientation: 90, facing: true}]\n",
+            ("visitors", 0),
+            "not both",
+        ),
+        (
+            "visitors: [{id: 1, position: [0, 0]}, {id: 1, position: [1, 1]}]\n",
+            ("visitors", 1, "id"),
+            "duplicate visitor id 1",
+        ),
+        (
+            "visitors: [{id: 1, position: [0, 0], wander_off: {}}]\n",
+            ("visitors", 0, "wander_off"),
+            "exactly one of heading_to",
+        ),
+        (
+            "navigation: {failures: [{goal: 1, poi: POI1}]}\n",
+            ("navigation", "failures", 0),
+            "exactly one of goal: N or poi: NAME",
+        ),
+        (
+            "navigation: {failures: [{goal: 1, result: lost}]}\n",
+            ("navigation", "failures", 0, "result"),
+            "'failed' or 'aborted'",
+        ),
+        ("navigation: {speed: -1}\n", ("navigation", "speed"), "greater than 0"),
+        ("speed: fast\n", ("speed",), "got 'fast'"),
+        ("faults: [{at: 5, name: x, level: 1}]\n", ("faults", 0, "level"), "2 or 3"),
+        ("content: {POI1: {c: 3}}\n", ("content", "POI1", "c"), 'expected "a" or "b"'),
+        ("content: {default: {a: 3}}\n", ("content", "default"), "expected seconds > 0"),
+        ("content: {POI1: -4}\n", ("content", "POI1"), "seconds > 0 or {a: seconds"),
+    ],
+)
+def test_errors_name_file_path_and_expectation(
+    tmp_path: Path, text: str, path: tuple[str | int, ...], expected: str
+) -> None:
     error = error_of(tmp_path, text)
     assert error.path == path, str(error)
     assert expected in error.detail, str(error)
@@ -163,8 +209,10 @@ def test_missing_file(tmp_path: Path) -> None:
 
 
 def test_world_refuses_unknown_pois(pois: dict[str, PoiPose]) -> None:
-    s = parse_scenario({"visitors": [{"id": 1, "position": [0, 0],
-                                      "wander_off": {"heading_to": "POI9"}}]}, "x.yaml")
+    s = parse_scenario(
+        {"visitors": [{"id": 1, "position": [0, 0], "wander_off": {"heading_to": "POI9"}}]},
+        "x.yaml",
+    )
     with pytest.raises(ConfigError) as info:
         World(s, pois)
     assert info.value.path == ("visitors", 0, "wander_off", "heading_to")

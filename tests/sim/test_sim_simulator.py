@@ -24,11 +24,13 @@ HOST = "127.0.0.1"
 Run = Callable[[Awaitable[Any]], Any]
 
 
-async def started(scenario: Scenario, run_clock: bool = True,
-                  **kwargs: Any) -> tuple[Simulator, Executive]:
+async def started(
+    scenario: Scenario, run_clock: bool = True, **kwargs: Any
+) -> tuple[Simulator, Executive]:
     exe = await Executive.open()
-    sim = Simulator(scenario, rosbridge_port=0, frontend_port=0,
-                    executive=(HOST, exe.port), **kwargs)
+    sim = Simulator(
+        scenario, rosbridge_port=0, frontend_port=0, executive=(HOST, exe.port), **kwargs
+    )
     await sim.start(run_clock=run_clock)
     exe.frontend = (HOST, sim.frontend_port)
     return sim, exe
@@ -54,8 +56,7 @@ def test_rosbridge_by_hand_stepping(arun: Run) -> None:
         await client.publish("/docking/dock", {"data": "undock"})
         await sim.wait_for(is_in("/docking/dock"), timeout=5)
         frame = await client.next(lambda f: f.get("topic") == "/docking/state")
-        assert frame == {"op": "publish", "topic": "/docking/state",
-                         "msg": {"data": "undocking"}}
+        assert frame == {"op": "publish", "topic": "/docking/state", "msg": {"data": "undocking"}}
         start = sim.clock.now()
         sim.advance(5.0)
         assert sim.clock.now() == pytest.approx(start + 5.0)
@@ -100,16 +101,22 @@ def test_the_clock_is_paced_and_never_runs_ahead(arun: Run) -> None:
 def test_two_clients_goal_response_and_forwarding(arun: Run) -> None:
     async def main() -> None:
         sim, exe = await started(fast(robot={"docked": False, "pose": {"x": 0, "y": 0}}))
-        executive, tool = (await RosClient.open(sim.rosbridge_port),
-                           await RosClient.open(sim.rosbridge_port))
+        executive, tool = (
+            await RosClient.open(sim.rosbridge_port),
+            await RosClient.open(sim.rosbridge_port),
+        )
         await executive.subscribe("/FROG_response")
         await tool.subscribe("/GotoWayPoint")
         await tool.subscribe("/FROG_response")
         await tool.subscribe("/FROG_pose")
         await tool.next_publish("/FROG_pose")  # the server has the tool's subscriptions
-        goal = {"header": {"seq": 0, "stamp": {"secs": 0, "nsecs": 0}, "frame_id": "map"},
-                "pose": {"position": {"x": 1.0, "y": 0.0, "z": 0.0},
-                         "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}}
+        goal = {
+            "header": {"seq": 0, "stamp": {"secs": 0, "nsecs": 0}, "frame_id": "map"},
+            "pose": {
+                "position": {"x": 1.0, "y": 0.0, "z": 0.0},
+                "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
+            },
+        }
         await executive.publish("/GotoWayPoint", goal)
         assert await tool.next_publish("/GotoWayPoint") == goal
         for client in (executive, tool):

@@ -60,8 +60,7 @@ def pose_of(w: World) -> tuple[float, float]:
 # ------------------------------------------------------------------ publishing
 
 
-def test_starts_docked_at_the_shop_and_publishes_at_its_rates(world: MakeWorld,
-                                                              pois: dict) -> None:
+def test_starts_docked_at_the_shop_and_publishes_at_its_rates(world: MakeWorld, pois: dict) -> None:
     w = world(visitors=[VISITOR])
     assert w.docking_state == "docked" and w.now == w.scenario.start_epoch
     outs = run(w, 1.0)
@@ -117,8 +116,11 @@ def test_a_new_goal_replaces_the_active_one(world: MakeWorld) -> None:
 
 
 def test_the_nth_goal_fails_after_some_driving(world: MakeWorld) -> None:
-    w = undocked(world, robot={"docked": False, "pose": {"x": 0, "y": 0}},
-                 navigation={"failures": [{"goal": 2, "result": "failed", "after": 2}]})
+    w = undocked(
+        world,
+        robot={"docked": False, "pose": {"x": 0, "y": 0}},
+        navigation={"failures": [{"goal": 2, "result": "failed", "after": 2}]},
+    )
     w.handle("/GotoWayPoint", goal(1, 0))
     assert codes(run(w, 2.0)) == [2]
     w.handle("/GotoWayPoint", goal(11, 0))
@@ -135,9 +137,11 @@ def test_the_nth_goal_fails_after_some_driving(world: MakeWorld) -> None:
 
 
 def test_the_first_k_goals_to_a_poi_abort(world: MakeWorld, pois: dict) -> None:
-    w = undocked(world, robot={"docked": False, "start": "SHOP"},
-                 navigation={"failures": [{"poi": "POI0", "times": 2, "result": "aborted",
-                                           "after": 1}]})
+    w = undocked(
+        world,
+        robot={"docked": False, "start": "SHOP"},
+        navigation={"failures": [{"poi": "POI0", "times": 2, "result": "aborted", "after": 1}]},
+    )
     x, y, z, qw = pois["POI0"]
     for _ in range(2):
         w.handle("/GotoWayPoint", goal(x + 0.3, y, z, qw))  # within 0.5 m: still POI0
@@ -159,7 +163,8 @@ def test_undock_then_dock(world: MakeWorld, pois: dict) -> None:
     w.handle("/GotoWayPoint", goal(pois["SHOP"][0] + 1.0, pois["SHOP"][1]))
     run(w, 3.0)
     assert w.handle("/docking/dock", encode_string("dock")) == [
-        ("/docking/state", {"data": "docking"})]
+        ("/docking/state", {"data": "docking"})
+    ]
     assert w.navigator.active is None
     states = [m["data"] for m in on(run(w, 10.0), "/docking/state")]
     assert states[-1] == "docked" and "failed" not in states
@@ -184,7 +189,8 @@ def test_scripted_undock_failures(world: MakeWorld) -> None:
 def test_asking_for_the_current_state_repeats_it(world: MakeWorld) -> None:
     w = world()
     assert w.handle("/docking/dock", encode_string("dock")) == [
-        ("/docking/state", {"data": "docked"})]
+        ("/docking/state", {"data": "docked"})
+    ]
     assert w.handle("/docking/dock", encode_string("fly")) == []
 
 
@@ -197,13 +203,17 @@ def near_visitor(make: MakeWorld, **visitor: Any) -> World:
 
 
 def test_detections_within_range_with_orientation(world: MakeWorld) -> None:
-    w = world(robot={"docked": False, "pose": {"x": 0, "y": 0}}, visitors=[
-        {"id": 1, "position": [3, 4], "facing": True},
-        {"id": 2, "position": [0, 5], "orientation": 40},
-        {"id": 3, "position": [0, -4], "facing": False},
-        {"id": 4, "position": [20, 0]},
-        {"id": 5, "position": [1, 1], "appear_at": "never"},
-        {"id": 6, "position": [1, 2], "appear_at": 3}])
+    w = world(
+        robot={"docked": False, "pose": {"x": 0, "y": 0}},
+        visitors=[
+            {"id": 1, "position": [3, 4], "facing": True},
+            {"id": 2, "position": [0, 5], "orientation": 40},
+            {"id": 3, "position": [0, -4], "facing": False},
+            {"id": 4, "position": [20, 0]},
+            {"id": 5, "position": [1, 1], "appear_at": "never"},
+            {"id": 6, "position": [1, 2], "appear_at": 3},
+        ],
+    )
     persons = decode_person_detections(on(run(w, 0.2), "/UvA_PersonDetectionAndPose")[-1])
     assert {p.id: p.orientation for p in persons.persons} == {1: 180.0, 2: 40.0, 3: 90.0}
     assert persons.persons[0].position.x == 3.0
@@ -254,12 +264,12 @@ def test_the_visitor_follows_once_the_tour_starts(world: MakeWorld, pois: dict) 
     assert math.hypot(w.pose.x - v.x, w.pose.y - v.y) == pytest.approx(1.2)
     assert codes(run(w, 60.0)) == [2]
     assert math.hypot(w.pose.x - v.x, w.pose.y - v.y) < 4.0
-    assert 7 in {p.id for p in decode_tracked_people(
-        on(run(w, 0.2), "/PeopleUPO")[-1]).people}
+    assert 7 in {p.id for p in decode_tracked_people(on(run(w, 0.2), "/PeopleUPO")[-1]).people}
 
 
-def test_the_visitor_wanders_off_when_the_robot_heads_to_a_poi(world: MakeWorld,
-                                                               pois: dict) -> None:
+def test_the_visitor_wanders_off_when_the_robot_heads_to_a_poi(
+    world: MakeWorld, pois: dict
+) -> None:
     w = near_visitor(world, wander_off={"heading_to": "POI2"})
     start_tour(w)
     v = w.visitors[7]
@@ -270,8 +280,9 @@ def test_the_visitor_wanders_off_when_the_robot_heads_to_a_poi(world: MakeWorld,
     assert v.state == "leaving"
     outs = run(w, 25.0)
     assert v.state == "gone"
-    assert 7 not in {p.id for p in decode_person_detections(
-        on(outs, "/UvA_PersonDetectionAndPose")[-1]).persons}
+    assert 7 not in {
+        p.id for p in decode_person_detections(on(outs, "/UvA_PersonDetectionAndPose")[-1]).persons
+    }
 
 
 def test_the_visitor_wanders_off_at_a_time(world: MakeWorld) -> None:
@@ -329,12 +340,15 @@ def test_no_faces_without_a_current_visitor(world: MakeWorld) -> None:
     assert len(on(outs, "/ICL_FaceDataStream")) == 5 and faces(outs) == []
 
 
-@pytest.mark.parametrize(("profile", "check"), [
-    ("engaged", lambda f: 0.2 <= f.engagement <= 0.9),
-    ("bored", lambda f: -0.9 <= f.engagement <= -0.2),
-    ("far", lambda f: f.distance > 2.0 and f.facing),
-    ("not_facing", lambda f: not f.facing and f.distance == 1.0),
-])
+@pytest.mark.parametrize(
+    ("profile", "check"),
+    [
+        ("engaged", lambda f: 0.2 <= f.engagement <= 0.9),
+        ("bored", lambda f: -0.9 <= f.engagement <= -0.2),
+        ("far", lambda f: f.distance > 2.0 and f.facing),
+        ("not_facing", lambda f: not f.facing and f.distance == 1.0),
+    ],
+)
 def test_engagement_profiles(profile: str, check: Callable[[Any], bool]) -> None:
     samples = [EngagementScript(profile, 7, seed=1).sample() for _ in range(3)]
     script = EngagementScript(profile, 7, seed=1)
@@ -368,11 +382,14 @@ def test_battery_drains_off_the_dock_and_charges_on_it(world: MakeWorld) -> None
 
 
 def test_scripted_faults(world: MakeWorld) -> None:
-    w = world(faults=[{"at": 3, "name": "motors", "level": 2, "message": "hot", "duration": 2},
-                      {"at": 4, "name": "laser", "level": 3}])
+    w = world(
+        faults=[
+            {"at": 3, "name": "motors", "level": 2, "message": "hot", "duration": 2},
+            {"at": 4, "name": "laser", "level": 3},
+        ]
+    )
     assert decode_diagnostics(on(run(w, 2.0), "/diagnostic")[-1]).faults == ()
-    assert decode_diagnostics(on(run(w, 2.0), "/diagnostic")[-1]).faults == ("motors: hot",
-                                                                            "laser")
+    assert decode_diagnostics(on(run(w, 2.0), "/diagnostic")[-1]).faults == ("motors: hot", "laser")
     assert decode_diagnostics(on(run(w, 2.0), "/diagnostic")[-1]).faults == ("laser",)
     status = on(run(w, 1.0), "/diagnostic")[-1]["status"][0]
     assert status["name"] == "battery" and status["level"] == 0

@@ -64,8 +64,9 @@ async def _run_tour(path: Path) -> Recorded:
     site = load_site()
     tree = load_tree(site=site)
     telemetry = Telemetry.open(f"save:{path}", site, tree)
-    rehearsal = Rehearsal(fast(), site=site, tree=tree,
-                          prepare=lambda executive: attach_all(executive, [telemetry]))
+    rehearsal = Rehearsal(
+        fast(), site=site, tree=tree, prepare=lambda executive: attach_all(executive, [telemetry])
+    )
     try:
         async with rehearsal:
             outcome = await rehearsal.finish(60.0)

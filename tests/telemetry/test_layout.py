@@ -40,7 +40,8 @@ def check_layout(index: TreeIndex, positions: list[tuple[float, float]]) -> None
             right_of_a = positions[a][0] + widths[a] / 2
             left_of_b = positions[b][0] - widths[b] / 2
             assert left_of_b - right_of_a >= GAP - 1e-6, (
-                f"{index.nodes[a].key} and {index.nodes[b].key} overlap")
+                f"{index.nodes[a].key} and {index.nodes[b].key} overlap"
+            )
 
 
 def test_tour_tree_layout_is_tidy():
@@ -93,12 +94,14 @@ def _tree(shape: list, counter: list[int]) -> Behaviour:
     name = f"node {counter[0]}" + "x" * (counter[0] * 7 % 13)
     if not shape:
         return py_trees.behaviours.Success(name=name)
-    return py_trees.composites.Sequence(name=name, memory=True,
-                                        children=[_tree(s, counter) for s in shape])
+    return py_trees.composites.Sequence(
+        name=name, memory=True, children=[_tree(s, counter) for s in shape]
+    )
 
 
-shapes = st.recursive(st.just([]), lambda inner: st.lists(inner, min_size=1, max_size=5),
-                      max_leaves=40)
+shapes = st.recursive(
+    st.just([]), lambda inner: st.lists(inner, min_size=1, max_size=5), max_leaves=40
+)
 
 
 @settings(max_examples=60, deadline=None)

@@ -22,13 +22,19 @@ def test_a_tour_is_written_by_writers_that_take_turns(tmp_path: Path) -> None:
     fresh interpreter: the child is forked before rerun is imported anywhere): several
     files, one recording id, each with the static scene and rows of its own, and the
     link lanes carried into each new file."""
-    code = ("import sys, frog_bt.live.telemetry.process as p; p.RECYCLE_ROWS = 3000\n"
-            "from frog_bt.cli import main\n"
-            "sys.exit(main(['demo', '--quiet', '--speed', '300', '--rerun', "
-            "'save:' + sys.argv[1], '--record', sys.argv[2]]))\n")
-    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "t.rrd"),
-                           str(tmp_path / "t.mcap")], cwd=tmp_path, capture_output=True,
-                          text=True, timeout=120)
+    code = (
+        "import sys, frog_bt.live.telemetry.process as p; p.RECYCLE_ROWS = 3000\n"
+        "from frog_bt.cli import main\n"
+        "sys.exit(main(['demo', '--quiet', '--speed', '300', '--rerun', "
+        "'save:' + sys.argv[1], '--record', sys.argv[2]]))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code, str(tmp_path / "t.rrd"), str(tmp_path / "t.mcap")],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert done.returncode == 0, done.stderr
     files = sorted(tmp_path.glob("t*.rrd"))
     assert len(files) >= 3 and tmp_path / "t.rrd" in files and tmp_path / "t.2.rrd" in files

@@ -28,8 +28,12 @@ def test_robot_pose_rows_cover_the_tour(recorded: Recorded):
 
 def test_every_node_has_a_status_lane_and_several_ran_and_succeeded(recorded: Recorded):
     index = recorded.telemetry.index
-    lanes = {n.key: [s for row in recorded.values(f"/bt/status/{n.key}", "StateChange:state")
-                     for s in row] for n in index.nodes}
+    lanes = {
+        n.key: [
+            s for row in recorded.values(f"/bt/status/{n.key}", "StateChange:state") for s in row
+        ]
+        for n in index.nodes
+    }
     assert all(f"/bt/status/{key}" in recorded.chunks for key in lanes)
     ran = [key for key, states in lanes.items() if "RUNNING" in states]
     succeeded = [key for key, states in lanes.items() if "SUCCESS" in states]
@@ -68,13 +72,17 @@ def test_text_log_has_commands_events_and_decisions(recorded: Recorded):
 
 
 def test_map_scene_and_series(recorded: Recorded):
-    labels = [label for row in recorded.values("/map/pois", "Points2D:labels", static=True)
-              for label in row]
+    labels = [
+        label
+        for row in recorded.values("/map/pois", "Points2D:labels", static=True)
+        for label in row
+    ]
     assert "POI0" in labels and "POI1a/POI1b" in labels and "SHOP" in labels
     assert recorded.values("/map/route", "LineStrips2D:strips", static=True)
     assert recorded.rows("/map/visitors") > 10
-    assert "7" in [label for row in recorded.values("/map/visitors", "Points2D:labels")
-                   for label in row]
+    assert "7" in [
+        label for row in recorded.values("/map/visitors", "Points2D:labels") for label in row
+    ]
     assert recorded.rows("/plots/battery") > 10
     assert recorded.rows("/plots/people/persons") > 10
     assert recorded.rows("/plots/engagement/faces/7") > 10  # the face stream at stops

@@ -88,8 +88,11 @@ def test_a_notes_level_comes_from_its_incident_kind_not_its_words(bench: Bench):
     journal.note("giving up: undock failed", IncidentKind.GAVE_UP)
     bench.tick()
     assert [(note[2][:9], note[3]) for note in rows.batch.notes] == [
-        ("the visit", Level.INFO), ("approach ", Level.WARN), ("resuming ", Level.INFO),
-        ("giving up", Level.ERROR)]
+        ("the visit", Level.INFO),
+        ("approach ", Level.WARN),
+        ("resuming ", Level.INFO),
+        ("giving up", Level.ERROR),
+    ]
 
 
 def test_rows_ask_to_be_written_every_batch_ticks_and_stop_after_detach(bench: Bench):

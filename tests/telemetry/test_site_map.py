@@ -18,8 +18,7 @@ def test_pois_sharing_a_spot_share_a_mark_with_both_headings():
     assert len(marks) == len(site.pois) - 1
     shop = marks["SHOP"]
     assert (shop.x, shop.y) == (site.pois["SHOP"].x, site.pois["SHOP"].y)
-    assert math.isclose(shop.headings[0], 2 * math.atan2(site.pois["SHOP"].z,
-                                                         site.pois["SHOP"].w))
+    assert math.isclose(shop.headings[0], 2 * math.atan2(site.pois["SHOP"].z, site.pois["SHOP"].w))
 
 
 def test_routes_follow_the_variants_of_each_period_and_merge_identical_ones():
@@ -39,14 +38,23 @@ def test_routes_follow_the_variants_of_each_period_and_merge_identical_ones():
 def test_routes_without_variants_and_with_three_periods():
     site = load_site()
     plain = site.model_copy(update={"variants": {}})
-    plain = plain.model_copy(update={"tour": site.tour.model_copy(update={"stops": [
-        s for s in site.tour.stops if s.poi not in site.variants]})})
+    plain = plain.model_copy(
+        update={
+            "tour": site.tour.model_copy(
+                update={"stops": [s for s in site.tour.stops if s.poi not in site.variants]}
+            )
+        }
+    )
     assert [r.label for r in tour_routes(plain)] == ["tour route"]
-    three = site.model_copy(update={"variants": {
-        "POI1": [Variant(waypoint="POI1a", until=time(11, 0)), Variant(waypoint="POI2b")],
-        "POI2": [Variant(waypoint="POI2a", until=time(12, 0)), Variant(waypoint="POI2b")]}})
-    assert [r.label for r in tour_routes(three)] == ["until 11:00", "11:00-12:00",
-                                                     "after 12:00"]
+    three = site.model_copy(
+        update={
+            "variants": {
+                "POI1": [Variant(waypoint="POI1a", until=time(11, 0)), Variant(waypoint="POI2b")],
+                "POI2": [Variant(waypoint="POI2a", until=time(12, 0)), Variant(waypoint="POI2b")],
+            }
+        }
+    )
+    assert [r.label for r in tour_routes(three)] == ["until 11:00", "11:00-12:00", "after 12:00"]
 
 
 def test_zones_become_closed_outlines():
@@ -63,14 +71,24 @@ def test_zones_become_closed_outlines():
 
 def test_zones_are_read_by_duck_typing():
     assert zone_outlines(SimpleNamespace()) == []  # type: ignore[arg-type]
-    site = SimpleNamespace(zones=SimpleNamespace(
-        volume=SimpleNamespace(zones=[
-            SimpleNamespace(name="hall", percent=60, circle=SimpleNamespace(x=0, y=0, r=2),
-                            polygon=None),
-            SimpleNamespace(name="room", percent=80, circle=None,
-                            polygon=[(0, 0), (1, 0), (1, 1)])]),
-        special=[SimpleNamespace(spot="bar", circle=None, polygon=None)]))
+    site = SimpleNamespace(
+        zones=SimpleNamespace(
+            volume=SimpleNamespace(
+                zones=[
+                    SimpleNamespace(
+                        name="hall", percent=60, circle=SimpleNamespace(x=0, y=0, r=2), polygon=None
+                    ),
+                    SimpleNamespace(
+                        name="room", percent=80, circle=None, polygon=[(0, 0), (1, 0), (1, 1)]
+                    ),
+                ]
+            ),
+            special=[SimpleNamespace(spot="bar", circle=None, polygon=None)],
+        )
+    )
     outlines = zone_outlines(site)  # type: ignore[arg-type]
     assert [(z.label, z.kind, len(z.points)) for z in outlines] == [
-        ("hall 60%", "volume", 49), ("room 80%", "volume", 4)]
+        ("hall 60%", "volume", 49),
+        ("room 80%", "volume", 4),
+    ]
     assert outlines[0].points == circle_points(0.0, 0.0, 2.0)

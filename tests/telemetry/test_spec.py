@@ -15,34 +15,42 @@ from frog_bt.live.telemetry import Telemetry
 from frog_bt.live.telemetry.spec import DEFAULT_URL, Sink, parse_spec
 
 
-@pytest.mark.parametrize(("spec", "sink"), [
-    ("spawn", Sink("spawn")),
-    ("save:tour.rrd", Sink("save", "tour.rrd")),
-    ("save:/tmp/a b/tour.rrd", Sink("save", "/tmp/a b/tour.rrd")),
-    ("connect", Sink("connect", DEFAULT_URL)),
-    ("connect:", Sink("connect", DEFAULT_URL)),
-    ("connect:rerun+http://127.0.0.1:9877/proxy",
-     Sink("connect", "rerun+http://127.0.0.1:9877/proxy")),
-    ("serve", Sink("serve")),
-    ("serve:9900", Sink("serve", port=9900)),
-])
+@pytest.mark.parametrize(
+    ("spec", "sink"),
+    [
+        ("spawn", Sink("spawn")),
+        ("save:tour.rrd", Sink("save", "tour.rrd")),
+        ("save:/tmp/a b/tour.rrd", Sink("save", "/tmp/a b/tour.rrd")),
+        ("connect", Sink("connect", DEFAULT_URL)),
+        ("connect:", Sink("connect", DEFAULT_URL)),
+        (
+            "connect:rerun+http://127.0.0.1:9877/proxy",
+            Sink("connect", "rerun+http://127.0.0.1:9877/proxy"),
+        ),
+        ("serve", Sink("serve")),
+        ("serve:9900", Sink("serve", port=9900)),
+    ],
+)
 def test_accepted_specs(spec: str, sink: Sink):
     assert parse_spec(spec) == sink
 
 
-@pytest.mark.parametrize(("spec", "message"), [
-    ("", "expected spawn, save:FILE.rrd, connect[:URL] or serve[:PORT]"),
-    ("view", "expected spawn, save:FILE.rrd"),
-    ("spawn:9876", "expected spawn"),
-    ("save", "save needs a file"),
-    ("save:", "save needs a file"),
-    ("save:tour.mcap", "should end in .rrd"),
-    ("connect:http://127.0.0.1:9876", "expected a URL like rerun+http://127.0.0.1:9876/proxy"),
-    ("connect:rerun+http://127.0.0.1:9876", "expected a URL like"),
-    ("serve:web", "expected serve or serve:PORT"),
-    ("serve:0", "expected serve or serve:PORT"),
-    ("serve:70000", "expected serve or serve:PORT"),
-])
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        ("", "expected spawn, save:FILE.rrd, connect[:URL] or serve[:PORT]"),
+        ("view", "expected spawn, save:FILE.rrd"),
+        ("spawn:9876", "expected spawn"),
+        ("save", "save needs a file"),
+        ("save:", "save needs a file"),
+        ("save:tour.mcap", "should end in .rrd"),
+        ("connect:http://127.0.0.1:9876", "expected a URL like rerun+http://127.0.0.1:9876/proxy"),
+        ("connect:rerun+http://127.0.0.1:9876", "expected a URL like"),
+        ("serve:web", "expected serve or serve:PORT"),
+        ("serve:0", "expected serve or serve:PORT"),
+        ("serve:70000", "expected serve or serve:PORT"),
+    ],
+)
 def test_bad_specs_say_what_was_expected(spec: str, message: str):
     with pytest.raises(ValueError, match="rerun telemetry spec") as info:
         parse_spec(spec)
@@ -57,12 +65,15 @@ def test_open_rejects_a_bad_spec_before_starting_anything():
 
 
 def test_importing_telemetry_does_not_import_rerun():
-    code = ("import sys, frog_bt.live.telemetry, frog_bt.live.telemetry.rows, "
-            "frog_bt.live.telemetry.layout, frog_bt.live.telemetry.site_map, "
-            "frog_bt.live.telemetry.spec; "
-            "sys.exit('rerun imported' if 'rerun' in sys.modules else 0)")
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                            timeout=60)
+    code = (
+        "import sys, frog_bt.live.telemetry, frog_bt.live.telemetry.rows, "
+        "frog_bt.live.telemetry.layout, frog_bt.live.telemetry.site_map, "
+        "frog_bt.live.telemetry.spec; "
+        "sys.exit('rerun imported' if 'rerun' in sys.modules else 0)"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=60
+    )
     assert result.returncode == 0, result.stdout + result.stderr
 
 

@@ -14,8 +14,16 @@ from frog_bt.config import load_site
 from frog_bt.tree import render
 from frog_bt.tree.catalogue import catalogue
 
-BUILTIN = {"Sequence", "ReactiveSequence", "Fallback", "ReactiveFallback", "Parallel",
-           "RetryUntilSuccessful", "ForceSuccess", "SubTree"}
+BUILTIN = {
+    "Sequence",
+    "ReactiveSequence",
+    "Fallback",
+    "ReactiveFallback",
+    "Parallel",
+    "RetryUntilSuccessful",
+    "ForceSuccess",
+    "SubTree",
+}
 
 
 @pytest.fixture(scope="module")
@@ -27,23 +35,41 @@ def test_one_behavior_tree_per_file_subtrees_and_a_model(xml_text: str) -> None:
     root = ET.fromstring(xml_text)
     assert root.get("BTCPP_format") == "4" and root.get("main_tree_to_execute") == "tour"
     assert [t.get("ID") for t in root.findall("BehaviorTree")] == [
-        "tour", "dock", "goto", "recruit", "visit_poi"]
+        "tour",
+        "dock",
+        "goto",
+        "recruit",
+        "visit_poi",
+    ]
     site = load_site()
     visits = [s for s in root.iter("SubTree") if s.get("ID") == "visit_poi"]
     assert [v.get("poi") for v in visits] == [s.poi for s in site.tour.stops]  # foreach
     assert {"poi": "{dock}"}.items() <= next(
-        s for s in root.iter("SubTree") if s.get("ID") == "goto").attrib.items()
+        s for s in root.iter("SubTree") if s.get("ID") == "goto"
+    ).attrib.items()
     # memory composites and py_trees' decorators map to BT.CPP's own nodes
     tags = {e.tag for e in root.iter()}
-    assert {"Sequence", "Fallback", "ReactiveFallback", "RetryUntilSuccessful",
-            "ForceSuccess"} <= tags
+    assert {
+        "Sequence",
+        "Fallback",
+        "ReactiveFallback",
+        "RetryUntilSuccessful",
+        "ForceSuccess",
+    } <= tags
     assert root.find(".//ReactiveFallback").get("name") == "FROG"
     # every frog-bt node type used is declared, with its parameters as ports
     model = {e.get("ID"): e for e in root.find("TreeNodesModel")}
     params = {n.name: [p.name for p in n.params] for n in catalogue(FACTORY)}
     used = {e.tag for e in root.iter() if e.tag not in BUILTIN} - {
-        "root", "BehaviorTree", "TreeNodesModel", "Action", "Decorator", "input_port",
-        "MetadataFields", "Metadata"}
+        "root",
+        "BehaviorTree",
+        "TreeNodesModel",
+        "Action",
+        "Decorator",
+        "input_port",
+        "MetadataFields",
+        "Metadata",
+    }
     assert used == set(model)
     for name, element in model.items():
         assert [p.get("name") for p in element.findall("input_port")] == params[name]
@@ -56,8 +82,9 @@ def test_import_gives_the_same_tree_and_the_same_xml(xml_text: str, tmp_path: Pa
     site = load_site()
     imported = load_tree(path, site)
     shipped = load_tree(site=site)
-    assert render.text(render.outline(imported.root), keys=True) == \
-        render.text(render.outline(shipped.root), keys=True)
+    assert render.text(render.outline(imported.root), keys=True) == render.text(
+        render.outline(shipped.root), keys=True
+    )
     assert btcpp_xml(path, site) == xml_text  # export, import, export: the same XML
 
 
@@ -66,8 +93,10 @@ def test_behaviortree_cpp_loads_it_and_creates_the_tree(xml_text: str) -> None:
     ports, so each frog-bt node's attributes are checked against the TreeNodesModel here
     and stripped; built-in nodes keep theirs (num_attempts, SubTree remapping)."""
     root = ET.fromstring(xml_text)
-    model = {e.get("ID"): (e.tag, {p.get("name") for p in e.findall("input_port")})
-             for e in root.find("TreeNodesModel")}
+    model = {
+        e.get("ID"): (e.tag, {p.get("name") for p in e.findall("input_port")})
+        for e in root.find("TreeNodesModel")
+    }
     for element in root.iter():
         if element.tag in model:
             extra = set(element.attrib) - model[element.tag][1] - {"name", "_skipIf"}
@@ -91,7 +120,8 @@ def test_behaviortree_cpp_loads_it_and_creates_the_tree(xml_text: str) -> None:
     broken = factory()  # and it does refuse what it does not know
     with pytest.raises(RuntimeError, match="RetryUntilSuccessfull"):
         broken.register_behavior_tree_from_text(
-            text.replace("RetryUntilSuccessful", "RetryUntilSuccessfull"))
+            text.replace("RetryUntilSuccessful", "RetryUntilSuccessfull")
+        )
         broken.create_tree("tour")
 
 
@@ -116,13 +146,15 @@ def test_what_has_no_bt_cpp_equivalent_round_trips(tmp_path: Path) -> None:
     assert sequence is not None
     assert sequence.find("ClockTimeout").get("seconds") == "30"  # not BT.CPP's Timeout
     parallel = sequence.find("Parallel")
-    assert parallel.attrib == {"success_count": "1", "failure_count": "1",
-                               "synchronise": "false"}
+    assert parallel.attrib == {"success_count": "1", "failure_count": "1", "synchronise": "false"}
     # `when` is kept, as a BT.CPP precondition (the loader leaves the node out)
     assert [(e.get("name"), e.get("_skipIf")) for e in parallel] == [
-        (None, "nav_attempts"), ("Give up twice", None)]
+        (None, "nav_attempts"),
+        ("Give up twice", None),
+    ]
     xml = tmp_path / "t.xml"
     xml.write_text(text)
     assert btcpp_xml(xml, site) == text
-    assert render.text(render.outline(load_tree(xml, site).root)) == \
-        render.text(render.outline(load_tree(tree, site).root))
+    assert render.text(render.outline(load_tree(xml, site).root)) == render.text(
+        render.outline(load_tree(tree, site).root)
+    )

@@ -31,7 +31,8 @@ def test_the_docs_node_reference_is_the_catalogue() -> None:
     start = text.index("<!-- leaves:begin -->\n") + len("<!-- leaves:begin -->\n")
     end = text.index("<!-- leaves:end -->")
     assert text[start:end] == as_markdown(catalogue(FACTORY)), (
-        "docs/TREES.md is out of date: paste `frog-bt leaves` between the leaves markers")
+        "docs/TREES.md is out of date: paste `frog-bt leaves` between the leaves markers"
+    )
 
 
 def test_json_format(capsys: pytest.CaptureFixture[str]) -> None:

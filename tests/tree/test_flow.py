@@ -52,17 +52,22 @@ def test_removing_seek_visitor_is_refused(trees: Path) -> None:
 
 
 def test_seek_visitor_after_approach_visitor_is_refused(trees: Path) -> None:
-    edit(trees / "recruit.yaml", "      - {type: SeekVisitor}\n      - {type: ApproachVisitor}\n",
-         "      - {type: ApproachVisitor}\n      - {type: SeekVisitor}\n")
+    edit(
+        trees / "recruit.yaml",
+        "      - {type: SeekVisitor}\n      - {type: ApproachVisitor}\n",
+        "      - {type: ApproachVisitor}\n      - {type: SeekVisitor}\n",
+    )
     message = refused(trees)
     assert "ApproachVisitor 'ApproachVisitor' reads /visitor" in message
     assert "SeekVisitor 'SeekVisitor' (recruit.yaml:18)" in message
 
 
 def test_removing_decide_engagement_at_the_stops_is_refused(trees: Path) -> None:
-    edit(trees / "visit_poi.yaml",
-         '                        - {type: DecideEngagement, about: "{poi}", when: face_stream}\n',
-         "")
+    edit(
+        trees / "visit_poi.yaml",
+        '                        - {type: DecideEngagement, about: "{poi}", when: face_stream}\n',
+        "",
+    )
     message = refused(trees)
     assert "visit_poi.yaml" in message and "Engaged 'Engaged' reads /engaged" in message
     assert message.count("\n") == 0  # one error per place, not one per stop
@@ -72,40 +77,49 @@ def test_a_value_from_an_earlier_stop_is_not_this_stops(tmp_path: Path) -> None:
     """A decision written before the stops does not reach a stop's reader: each stop of
     a foreach starts without the keys that belong to one stop."""
     (tmp_path / "stop.yaml").write_text("root: {type: Engaged}\n")
-    path = write_tree(tmp_path, """
+    path = write_tree(
+        tmp_path,
+        """
         root:
           type: Sequence
           memory: true
           children:
             - {type: DecideEngagement, about: introduction}
             - {foreach: stops, include: stop.yaml}
-    """)
+    """,
+    )
     with pytest.raises(TreeError, match="a stop starts without it"):
         load_tree(path, load_site())
 
 
 def test_a_writer_in_another_selector_alternative_does_not_count(tmp_path: Path) -> None:
-    path = write_tree(tmp_path, """
+    path = write_tree(
+        tmp_path,
+        """
         root:
           type: Selector
           memory: true
           children:
             - {type: SeekVisitor}
             - {type: ApproachVisitor}
-    """)
+    """,
+    )
     with pytest.raises(TreeError, match="ApproachVisitor 'ApproachVisitor' reads /visitor"):
         load_tree(path, load_site())
 
 
 def test_every_error_of_a_tree_in_one_pass(tmp_path: Path) -> None:
-    path = write_tree(tmp_path, """
+    path = write_tree(
+        tmp_path,
+        """
         root:
           type: Sequence
           memory: true
           children:
             - {type: ApproachVisitor}
             - {type: Engaged}
-    """)
+    """,
+    )
     with pytest.raises(TreeError) as info:
         load_tree(path, load_site())
     lines = str(info.value).splitlines()
@@ -114,7 +128,8 @@ def test_every_error_of_a_tree_in_one_pass(tmp_path: Path) -> None:
 
 
 def test_a_missing_value_at_run_time_fails_the_leaf_with_a_reason(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Past the check (here switched off), a required read of a value nothing wrote
     fails the reading leaf with the reason; it never raises out of the tick."""
     monkeypatch.setattr(loader, "check_keys", lambda tree: None)
@@ -143,20 +158,27 @@ class Mood(Leaf):
         return SUCCESS
 
 
-@pytest.mark.parametrize(("leaf", "message"), [
-    (VisitorName, "VisitorName 'VisitorName' uses /visitor, which no key declaration knows"),
-    (Mood, "Mood 'Mood' uses /mood, which no key declaration knows"),
-])
-def test_keys_are_declared_once(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                         leaf: type[Leaf], message: str) -> None:
+@pytest.mark.parametrize(
+    ("leaf", "message"),
+    [
+        (VisitorName, "VisitorName 'VisitorName' uses /visitor, which no key declaration knows"),
+        (Mood, "Mood 'Mood' uses /mood, which no key declaration knows"),
+    ],
+)
+def test_keys_are_declared_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, leaf: type[Leaf], message: str
+) -> None:
     monkeypatch.setitem(FACTORY.leaves, leaf.__name__, leaf)
-    path = write_tree(tmp_path, f"""
+    path = write_tree(
+        tmp_path,
+        f"""
         root:
           type: Sequence
           memory: true
           children:
             - {{type: SeekVisitor}}
             - {{type: {leaf.__name__}}}
-    """)
+    """,
+    )
     with pytest.raises(TreeError, match=re.escape(message)):
         load_tree(path, load_site())

@@ -31,9 +31,11 @@ def validator(schema: dict) -> jsonschema.Draft202012Validator:
 
 def test_the_shipped_schemas_are_the_generated_ones() -> None:
     assert (resources.tree_dir() / TREE_SCHEMA_FILE).read_text() == dumps(tree_schema(FACTORY)), (
-        "run: frog-bt schema tree > trees/tree.schema.json")
+        "run: frog-bt schema tree > trees/tree.schema.json"
+    )
     assert (resources.site_dir() / SITE_SCHEMA_FILE).read_text() == dumps(site_schema()), (
-        "run: frog-bt schema site > config/site.schema.json")
+        "run: frog-bt schema site > config/site.schema.json"
+    )
 
 
 @pytest.mark.parametrize("path", TREES, ids=lambda p: p.name)
@@ -49,21 +51,29 @@ def test_the_shipped_site_validates_and_points_at_the_schema() -> None:
     assert list(validator(site_schema()).iter_errors(yaml.safe_load(text))) == []
 
 
-@pytest.mark.parametrize("root", [
-    {"type": "Navigat", "poi": "POI1"},  # unknown type
-    {"type": "Navigate", "poi": "POI1", "speed": 3},  # unknown parameter
-    {"type": "Navigate"},  # missing parameter
-    {"type": "Sequence", "children": [{"type": "FinishPoi", "poi": "POI1"}]},  # no memory
-    {"type": "Retry", "attempts": 0, "child": {"type": "GiveUp"}},  # out of range
-    {"type": "PlayContent", "poi": "POI1", "part": "c"},
-])
+@pytest.mark.parametrize(
+    "root",
+    [
+        {"type": "Navigat", "poi": "POI1"},  # unknown type
+        {"type": "Navigate", "poi": "POI1", "speed": 3},  # unknown parameter
+        {"type": "Navigate"},  # missing parameter
+        {"type": "Sequence", "children": [{"type": "FinishPoi", "poi": "POI1"}]},  # no memory
+        {"type": "Retry", "attempts": 0, "child": {"type": "GiveUp"}},  # out of range
+        {"type": "PlayContent", "poi": "POI1", "part": "c"},
+    ],
+)
 def test_mistakes_are_flagged(root: dict) -> None:
     assert list(validator(tree_schema(FACTORY)).iter_errors({"root": root}))
 
 
 def test_variables_are_accepted_for_any_parameter() -> None:
-    tree = {"root": {"type": "Retry", "attempts": "{nav_attempts}",
-                     "child": {"type": "Navigate", "poi": "{poi}"}}}
+    tree = {
+        "root": {
+            "type": "Retry",
+            "attempts": "{nav_attempts}",
+            "child": {"type": "Navigate", "poi": "{poi}"},
+        }
+    }
     assert list(validator(tree_schema(FACTORY)).iter_errors(tree)) == []
 
 

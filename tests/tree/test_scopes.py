@@ -84,8 +84,7 @@ def test_without_a_scope_the_value_is_seen(tmp_path: Path) -> None:
     assert SeeEngaged.seen == [(True, "POI1", None)]
 
 
-def test_a_wider_scope_keeps_narrower_scopes_out_but_not_its_own_wider_keys(
-        tmp_path: Path) -> None:
+def test_a_wider_scope_keeps_narrower_scopes_out_but_not_its_own_wider_keys(tmp_path: Path) -> None:
     """A stop does not clear the tour's visitor; a tour clears everything of the tour."""
     bench = Bench(write_tree(tmp_path, two_parts("stop")))
     bench.core.board.set(keys.VISITOR, 7)
@@ -98,55 +97,77 @@ def test_a_wider_scope_keeps_narrower_scopes_out_but_not_its_own_wider_keys(
 
 
 def test_each_stop_of_a_foreach_starts_afresh(tmp_path: Path) -> None:
-    write_tree(tmp_path, """
+    write_tree(
+        tmp_path,
+        """
     root:
       type: Sequence
       memory: true
       children: [{type: SeeEngaged}, {type: WriteEngaged}]
-    """, "stop.yaml")
-    bench = Bench(write_tree(tmp_path, """
+    """,
+        "stop.yaml",
+    )
+    bench = Bench(
+        write_tree(
+            tmp_path,
+            """
     root:
       type: Sequence
       memory: true
       children:
         - {foreach: stops, include: stop.yaml}
-    """))
+    """,
+        )
+    )
     assert bench.tick() == SUCCESS
     stops = len(bench.site.tour.stops)
     assert SeeEngaged.seen == [(None, None, None)] * stops
 
 
 def test_a_required_read_of_an_earlier_scopes_value_is_refused(tmp_path: Path) -> None:
-    path = write_tree(tmp_path, """
+    path = write_tree(
+        tmp_path,
+        """
     root:
       type: Sequence
       memory: true
       children:
         - {type: WriteEngaged}
         - {type: Sequence, scope: visitor, memory: true, children: [{type: NeedEngaged}]}
-    """)
-    with pytest.raises(TreeError, match="NeedEngaged 'NeedEngaged' reads /engaged: a visitor "
-                                        "starts without it"):
+    """,
+    )
+    with pytest.raises(
+        TreeError, match="NeedEngaged 'NeedEngaged' reads /engaged: a visitor starts without it"
+    ):
         load_tree(path, load_site())
 
 
 def test_a_required_read_within_the_scope_is_accepted(tmp_path: Path) -> None:
-    path = write_tree(tmp_path, """
+    path = write_tree(
+        tmp_path,
+        """
     root:
       type: Sequence
       scope: visitor
       memory: true
       children: [{type: WriteEngaged}, {type: NeedEngaged}]
-    """)
+    """,
+    )
     load_tree(path, load_site())
 
 
 def test_an_unknown_scope_is_a_load_error_naming_the_choices(tmp_path: Path) -> None:
-    path = write_tree(tmp_path, """
+    path = write_tree(
+        tmp_path,
+        """
     root: {type: Sequence, scope: room, memory: true, children: [{type: SeeEngaged}]}
-    """)
-    with pytest.raises(TreeError, match=r"t.yaml:2:\d+: root.scope: .*'tour', 'visitor' or "
-                                        "'stop'"):
+    """,
+    )
+    with pytest.raises(
+        TreeError,
+        match=r"t.yaml:2:\d+: root.scope: .*'tour', 'visitor' or "
+        "'stop'",
+    ):
         load_tree(path, load_site())
 
 

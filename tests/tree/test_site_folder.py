@@ -11,7 +11,7 @@ from frog_bt.cli import main
 
 
 def test_check_in_a_folder_made_by_init_checks_that_folders_files(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     site = tmp_path / "alcazar"
     assert main(["init", str(site)]) == 0
@@ -25,12 +25,13 @@ def test_check_in_a_folder_made_by_init_checks_that_folders_files(
         err = capsys.readouterr().err
         assert err.splitlines()[0] == (
             f"frog-bt: site folder {site}: using {site / 'trees' / 'tour.yaml'}, "
-            f"{site / 'config' / 'site.yaml'}")
+            f"{site / 'config' / 'site.yaml'}"
+        )
         assert f"{recruit}:17:9: root.child.children[0]: ApproachVisitor" in err
 
 
 def test_an_option_given_wins_and_elsewhere_the_packaged_files_are_used(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     site = tmp_path / "alcazar"
     assert main(["init", str(site)]) == 0

@@ -76,6 +76,7 @@ class Day:
                 parts.append(f"skipped {', '.join(left)}")
             if message.reason:
                 parts.append(message.reason)
-            self.last.appendleft(f"{start}{self._local(t)} tour {message.state}: "
-                                 f"{'; '.join(parts)}")
+            self.last.appendleft(
+                f"{start}{self._local(t)} tour {message.state}: {'; '.join(parts)}"
+            )
             self._tour_start = None

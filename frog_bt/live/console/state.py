@@ -42,8 +42,9 @@ class LogLines(logging.Handler):
         super().__init__(logging.INFO)
         self.lines: deque[str] = deque(maxlen=size)
         self.addFilter(OwnedBy(owner))
-        self.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s",
-                                            "%H:%M:%S"))
+        self.setFormatter(
+            logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s", "%H:%M:%S")
+        )
 
     def emit(self, record: logging.LogRecord) -> None:
         try:
@@ -71,8 +72,12 @@ def running_names(root: Behaviour) -> list[str]:
 
 
 def tree(node: Behaviour) -> dict[str, Any]:
-    return {"name": node.name, "type": type(node).__name__, "status": node.status.value,
-            "children": [tree(c) for c in children(node)]}
+    return {
+        "name": node.name,
+        "type": type(node).__name__,
+        "status": node.status.value,
+        "children": [tree(c) for c in children(node)],
+    }
 
 
 def site_map(executive: Executive) -> dict[str, Any]:
@@ -81,13 +86,15 @@ def site_map(executive: Executive) -> dict[str, Any]:
     return {
         "pois": [{"label": m.label, "x": m.x, "y": m.y} for m in poi_marks(site)],
         "routes": [{"label": r.label, "points": r.points} for r in tour_routes(site)],
-        "zones": [{"label": z.label, "kind": z.kind, "points": z.points}
-                  for z in zone_outlines(site)],
-        "stops": [s.poi for s in site.tour.stops], "dock": site.tour.dock}
+        "zones": [
+            {"label": z.label, "kind": z.kind, "points": z.points} for z in zone_outlines(site)
+        ],
+        "stops": [s.poi for s in site.tour.stops],
+        "dock": site.tour.dock,
+    }
 
 
-def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock
-          ) -> dict[str, Any]:
+def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock) -> dict[str, Any]:
     """The state the console page and outside tools read (CONTRACT §7 and more)."""
     core = executive.core
     board = core.board
@@ -115,14 +122,22 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock
         "touring": touring,
         "links": links,
         "links_for_s": {name: now - since[name][1] for name in links if name in since},
-        "alerts": [{"id": a.id, "kind": a.kind, "text": a.text, "since": a.since,
-                    "state": a.state} for a in executive.staff.book.shown()],
+        "alerts": [
+            {"id": a.id, "kind": a.kind, "text": a.text, "since": a.since, "state": a.state}
+            for a in executive.staff.book.shown()
+        ],
         "tours": {"started": day.started, "completed": day.completed, "aborted": day.aborted},
         "day": {"visitors": day.visitors, "skipped": day.skipped, "last": list(day.last)},
-        "robot": ({"x": pose.value.x, "y": pose.value.y, "yaw": pose.value.yaw}
-                  if pose is not None else None),
-        "people": ([[p.position.x, p.position.y] for p in people.value.people]
-                   if people is not None else []),
+        "robot": (
+            {"x": pose.value.x, "y": pose.value.y, "yaw": pose.value.yaw}
+            if pose is not None
+            else None
+        ),
+        "people": (
+            [[p.position.x, p.position.y] for p in people.value.people]
+            if people is not None
+            else []
+        ),
         "path": running_names(core.root),
         "log": list(logs.lines),
         "time": now,

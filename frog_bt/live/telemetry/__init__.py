@@ -44,8 +44,9 @@ STEP_PAUSE = 0.0005  # seconds between two steps of writing a batch (see Telemet
 class Telemetry(TelemetryObserver):
     """One rerun recording of one executive run (or replay). Build it with :meth:`open`."""
 
-    def __init__(self, rec: RecordingStream, site: Site, tree: LoadedTree, *,
-                 batch_ticks: int = BATCH_TICKS) -> None:
+    def __init__(
+        self, rec: RecordingStream, site: Site, tree: LoadedTree, *, batch_ticks: int = BATCH_TICKS
+    ) -> None:
         """Log to ``rec`` (a ``rerun.RecordingStream`` with its sink already set)."""
         from frog_bt.live.telemetry.blueprint import default_blueprint
         from frog_bt.live.telemetry.writer import Writer
@@ -61,8 +62,15 @@ class Telemetry(TelemetryObserver):
         self.writer.write_static()
 
     @classmethod
-    def open(cls, spec: str, site: Site, tree: LoadedTree, *, app_id: str = "frog-bt",
-             recording_id: str | None = None) -> Telemetry:
+    def open(
+        cls,
+        spec: str,
+        site: Site,
+        tree: LoadedTree,
+        *,
+        app_id: str = "frog-bt",
+        recording_id: str | None = None,
+    ) -> Telemetry:
         """A recording streaming to ``spec`` (see :mod:`frog_bt.live.telemetry.spec`).
 
         Raises ValueError for a spec it does not know, before anything starts.
@@ -83,8 +91,7 @@ class Telemetry(TelemetryObserver):
             rec.spawn(port=sink.port)
         return cls(rec, site, tree)
 
-    def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]
-                     ) -> None:
+    def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]) -> None:
         try:
             self.writer.write_links(tick, t, changes)
         except Exception:  # telemetry must never stop the robot

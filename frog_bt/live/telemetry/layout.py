@@ -55,14 +55,16 @@ class TreeIndex:
         index = cls()
         index._add(root, 0, None)
         digits = len(str(len(index.nodes) - 1))
-        index.nodes = [dataclasses.replace(n, key=node_key(n.index, n.name, digits))
-                       for n in index.nodes]
+        index.nodes = [
+            dataclasses.replace(n, key=node_key(n.index, n.name, digits)) for n in index.nodes
+        ]
         return index
 
     def _add(self, behaviour: Behaviour, depth: int, parent: int | None) -> int:
         number = len(self.nodes)
-        self.nodes.append(TreeNode(number, behaviour.name, type(behaviour).__name__, depth,
-                                   parent, ()))
+        self.nodes.append(
+            TreeNode(number, behaviour.name, type(behaviour).__name__, depth, parent, ())
+        )
         self.behaviours.append(behaviour)
         children = tuple(self._add(child, depth + 1, number) for child in behaviour.children)
         node = self.nodes[number]
@@ -126,9 +128,12 @@ class _Shape:
     right: list[float]  # ... rightmost edge
 
 
-def tidy_layout(index: TreeIndex, widths: Sequence[float] | None = None,
-                gap: float = GAP, level_height: float = LEVEL_HEIGHT
-                ) -> list[tuple[float, float]]:
+def tidy_layout(
+    index: TreeIndex,
+    widths: Sequence[float] | None = None,
+    gap: float = GAP,
+    level_height: float = LEVEL_HEIGHT,
+) -> list[tuple[float, float]]:
     """(x, y) centre of every node, in index order; the root is at (0, 0), children below."""
     if not index.nodes:
         return []
@@ -140,8 +145,9 @@ def tidy_layout(index: TreeIndex, widths: Sequence[float] | None = None,
     return [(root.offsets[n.index], n.depth * level_height) for n in index.nodes]
 
 
-def _shape(node: TreeNode, shapes: dict[int, _Shape], widths: Sequence[float],
-           gap: float) -> _Shape:
+def _shape(
+    node: TreeNode, shapes: dict[int, _Shape], widths: Sequence[float], gap: float
+) -> _Shape:
     half = widths[node.index] / 2
     if not node.children:
         return _Shape({node.index: 0.0}, [-half], [half])

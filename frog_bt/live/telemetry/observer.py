@@ -70,8 +70,7 @@ class TelemetryObserver(ABC):
         loop.call_soon(self._flush_soon)
 
     @abstractmethod
-    def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]
-                     ) -> None: ...
+    def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]) -> None: ...
 
     @abstractmethod
     def _flush_soon(self) -> None:

@@ -55,8 +55,13 @@ def available() -> bool:
 Item = tuple[object, ...]  # ("batch", Batch) | ("links", tick, t, changes) | ("close",)
 
 
-def _serve(spec: str, site: Site, tree: LoadedTree, recording_id: str,
-           inbox: multiprocessing.queues.Queue[Item]) -> None:
+def _serve(
+    spec: str,
+    site: Site,
+    tree: LoadedTree,
+    recording_id: str,
+    inbox: multiprocessing.queues.Queue[Item],
+) -> None:
     """The child: write what comes until ``close`` (or the parent is gone)."""
     from frog_bt.live.telemetry import Telemetry
 
@@ -99,8 +104,15 @@ class TelemetryProcess(TelemetryObserver):
     """The executive's side: rows buffered here, written by a child; see the module
     docstring. Attached and closed like :class:`~frog_bt.live.telemetry.Telemetry`."""
 
-    def __init__(self, spec: str, site: Site, tree: LoadedTree, *, batch_ticks: int = 50,
-                 recycle_rows: int | None = None) -> None:
+    def __init__(
+        self,
+        spec: str,
+        site: Site,
+        tree: LoadedTree,
+        *,
+        batch_ticks: int = 50,
+        recycle_rows: int | None = None,
+    ) -> None:
         parse_spec(spec)  # ValueError for a spec it does not know, before anything starts
         super().__init__(site, tree, batch_ticks=batch_ticks)
         self.spec = spec
@@ -117,9 +129,17 @@ class TelemetryProcess(TelemetryObserver):
         self.children += 1
         self._inbox = self._context.Queue(maxsize=QUEUE_BATCHES)
         self._child = self._context.Process(
-            target=_serve, name=f"frog-bt telemetry {self.children}", daemon=True,
-            args=(_numbered(self.spec, self.children), self.site, self.tree,
-                  self.recording_id, self._inbox))
+            target=_serve,
+            name=f"frog-bt telemetry {self.children}",
+            daemon=True,
+            args=(
+                _numbered(self.spec, self.children),
+                self.site,
+                self.tree,
+                self.recording_id,
+                self._inbox,
+            ),
+        )
         self._child.start()
         self._written = 0
 
@@ -137,8 +157,7 @@ class TelemetryProcess(TelemetryObserver):
 
     # ------------------------------------------------------------ the executive's side
 
-    def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]
-                     ) -> None:
+    def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]) -> None:
         self._send(("links", tick, t, changes))
 
     def _flush_soon(self) -> None:
@@ -170,8 +189,10 @@ class TelemetryProcess(TelemetryObserver):
             return True
         except queue.Full:
             self.dropped += 1
-            self._warnings.warn("full", f"rerun telemetry: the writer is behind; "
-                                        f"{self.dropped} batches dropped so far")
+            self._warnings.warn(
+                "full",
+                f"rerun telemetry: the writer is behind; {self.dropped} batches dropped so far",
+            )
             return False
 
     def close(self) -> None:

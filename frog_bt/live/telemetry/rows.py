@@ -63,16 +63,29 @@ class Batch:
             rows[:] = [r for r in rows if not math.isnan(r[1])]
 
     def __len__(self) -> int:
-        return (len(self.poses) + len(self.inputs) + len(self.outputs) + len(self.events)
-                + len(self.statuses) + len(self.notes) + len(self.blackboard))
+        return (
+            len(self.poses)
+            + len(self.inputs)
+            + len(self.outputs)
+            + len(self.events)
+            + len(self.statuses)
+            + len(self.notes)
+            + len(self.blackboard)
+        )
 
 
 class Rows:
     """Buffers rows from a core's taps until :meth:`drain`; calls ``on_full`` every
     ``batch_ticks`` ticks so the owner can write them out."""
 
-    def __init__(self, site: Site, index: TreeIndex, *, batch_ticks: int = 50,
-                 on_full: Callable[[], None] | None = None) -> None:
+    def __init__(
+        self,
+        site: Site,
+        index: TreeIndex,
+        *,
+        batch_ticks: int = 50,
+        on_full: Callable[[], None] | None = None,
+    ) -> None:
         self.index = index
         self.roles = {site.topic(role): role for role in INPUTS}
         self.batch = Batch()
@@ -191,7 +204,7 @@ class Rows:
             i = len(notes) - 1
             while i >= 0 and notes[i] is not self._last_note:
                 i -= 1
-            batch.notes.extend((tick, n.at, n.text, n.level) for n in notes[i + 1:])
+            batch.notes.extend((tick, n.at, n.text, n.level) for n in notes[i + 1 :])
             self._last_note = notes[-1]
         for key in ENGAGEMENT_KEYS:
             value = core.board.get(key)

@@ -78,16 +78,26 @@ def _period_label(start: dtime | None, end: dtime | None) -> str:
 def _periods(site: Site) -> list[tuple[dtime | None, dtime | None, dtime]]:
     """(start, end, a time of day inside) of each period with its own variants."""
     stops = {s.poi for s in site.tour.stops}
-    cuts = sorted({v.until for name, vs in site.variants.items() if name in stops
-                   for v in vs if v.until is not None})
+    cuts = sorted(
+        {
+            v.until
+            for name, vs in site.variants.items()
+            if name in stops
+            for v in vs
+            if v.until is not None
+        }
+    )
     bounds: list[dtime | None] = [None, *cuts, None]
     periods = []
     for start, end in itertools.pairwise(bounds):
         if end is not None:
             inside = end  # a variant holds while the time is at or before its `until`
         elif start is not None:
-            inside = dtime(23, 59, 59) if start >= dtime(23, 59) else dtime(
-                start.hour + (start.minute + 1) // 60, (start.minute + 1) % 60)
+            inside = (
+                dtime(23, 59, 59)
+                if start >= dtime(23, 59)
+                else dtime(start.hour + (start.minute + 1) // 60, (start.minute + 1) % 60)
+            )
         else:
             inside = dtime(12, 0)
         periods.append((start, end, inside))
@@ -98,26 +108,30 @@ def tour_routes(site: Site) -> list[Route]:
     """The tour's route per period of the day (see the module docstring)."""
     merged: list[tuple[dtime | None, dtime | None, tuple[str, ...], tuple[XY, ...]]] = []
     for start, end, at in _periods(site):
-        names = (site.tour.dock, site.tour.recruit_at,
-                 *(site.waypoint_for(s.poi, at) for s in site.tour.stops), site.tour.dock)
+        names = (
+            site.tour.dock,
+            site.tour.recruit_at,
+            *(site.waypoint_for(s.poi, at) for s in site.tour.stops),
+            site.tour.dock,
+        )
         points = tuple((site.pois[n].x, site.pois[n].y) for n in names)
         if merged and _same(merged[-1][3], points):
             first = merged.pop()
             start, names = first[0], first[2]
         merged.append((start, end, names, points))
-    return [Route(_period_label(start, end), names, points)
-            for start, end, names, points in merged]
+    return [Route(_period_label(start, end), names, points) for start, end, names, points in merged]
 
 
 def _same(a: Sequence[XY], b: Sequence[XY]) -> bool:
     return len(a) == len(b) and all(math.dist(p, q) < 0.01 for p, q in zip(a, b, strict=True))
 
 
-def circle_points(x: float, y: float, r: float, segments: int = CIRCLE_SEGMENTS
-                  ) -> tuple[XY, ...]:
+def circle_points(x: float, y: float, r: float, segments: int = CIRCLE_SEGMENTS) -> tuple[XY, ...]:
     """A closed polygon around the circle (the last point is the first)."""
-    points = tuple((x + r * math.cos(2 * math.pi * k / segments),
-                    y + r * math.sin(2 * math.pi * k / segments)) for k in range(segments))
+    points = tuple(
+        (x + r * math.cos(2 * math.pi * k / segments), y + r * math.sin(2 * math.pi * k / segments))
+        for k in range(segments)
+    )
     return (*points, points[0])
 
 
@@ -147,8 +161,14 @@ def zone_outlines(site: Site) -> list[Outline]:
     if zones is None:
         return []
     volume = getattr(zones, "volume", None)
-    out = _outlines(getattr(volume, "zones", ()), "volume",
-                    lambda z: f"{getattr(z, 'name', '')} {getattr(z, 'percent', '')}%".strip())
-    out += _outlines(getattr(zones, "special", ()), "special",
-                     lambda z: str(getattr(z, "spot", getattr(z, "name", ""))))
+    out = _outlines(
+        getattr(volume, "zones", ()),
+        "volume",
+        lambda z: f"{getattr(z, 'name', '')} {getattr(z, 'percent', '')}%".strip(),
+    )
+    out += _outlines(
+        getattr(zones, "special", ()),
+        "special",
+        lambda z: str(getattr(z, "spot", getattr(z, "name", ""))),
+    )
     return out

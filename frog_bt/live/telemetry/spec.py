@@ -49,7 +49,8 @@ def parse_spec(spec: str) -> Sink:
         if not sep:
             return Sink("serve")
         if not arg.isdigit() or not 0 < int(arg) < 65536:
-            raise ValueError(f"rerun telemetry spec {spec!r}: expected serve or serve:PORT "
-                             "(1-65535)")
+            raise ValueError(
+                f"rerun telemetry spec {spec!r}: expected serve or serve:PORT (1-65535)"
+            )
         return Sink("serve", port=int(arg))
     raise ValueError(f"rerun telemetry spec {spec!r}: {EXPECTED}")

@@ -35,8 +35,12 @@ Status = py_trees.common.Status
 TICK, TIME = "tick", "time"  # the timelines: tick number, project-clock time
 
 STATES = ("RUNNING", "SUCCESS", "FAILURE", "INVALID")
-STATUS_COLORS = {Status.RUNNING: 0xF5B400FF, Status.SUCCESS: 0x2EA043FF,
-                 Status.FAILURE: 0xE5484DFF, Status.INVALID: 0x8B949EFF}
+STATUS_COLORS = {
+    Status.RUNNING: 0xF5B400FF,
+    Status.SUCCESS: 0x2EA043FF,
+    Status.FAILURE: 0xE5484DFF,
+    Status.INVALID: 0x8B949EFF,
+}
 ROUTE_COLORS = (0xA371F7AA, 0x39C5CFAA, 0xDB61A2AA, 0x8B949EAA)  # one per period of the day
 ZONE_COLORS = {"volume": 0x3FB95099, "special": 0xDB61A299}
 FACING, NOT_FACING, TRACKED = 0x3FB950FF, 0xFF8C42FF, 0x8B949E66
@@ -59,8 +63,12 @@ def status_path(key: str) -> str:
     return f"bt/status/{key}"
 
 
-HEALTH_COLORS = {Health.OK: 0x3CB371FF, Health.WAIT: 0xE0A030FF, Health.BAD: 0xD04040FF,
-                 Health.OFF: 0x808080FF}  # the colour of a link lane, by its state's health
+HEALTH_COLORS = {
+    Health.OK: 0x3CB371FF,
+    Health.WAIT: 0xE0A030FF,
+    Health.BAD: 0xD04040FF,
+    Health.OFF: 0x808080FF,
+}  # the colour of a link lane, by its state's health
 
 
 def link_path(name: str) -> str:
@@ -71,8 +79,10 @@ def _times(rows: Sequence[tuple[Any, ...]]) -> list[rr.TimeColumn]:
     # Nanoseconds as rerun rounds them one by one (round(1e9 * t)), but in one numpy pass:
     # a list of floats costs rerun a Python conversion per row.
     ns = np.round(np.array([r[1] for r in rows], dtype=np.float64) * 1e9).astype(np.int64)
-    return [rr.TimeColumn(TICK, sequence=[r[0] for r in rows]),
-            rr.TimeColumn(TIME, timestamp=ns.astype("datetime64[ns]"))]
+    return [
+        rr.TimeColumn(TICK, sequence=[r[0] for r in rows]),
+        rr.TimeColumn(TIME, timestamp=ns.astype("datetime64[ns]")),
+    ]
 
 
 class Writer:
@@ -98,63 +108,136 @@ class Writer:
         rec, site = self.rec, self.site
         rec.log("map", rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)  # map y points up
         marks = poi_marks(site)
-        rec.log("map/pois", rr.Points2D([(m.x, m.y) for m in marks], radii=R_POI, colors=POI,
-                                        labels=[m.label for m in marks], show_labels=True,
-                                        draw_order=30), static=True)
+        rec.log(
+            "map/pois",
+            rr.Points2D(
+                [(m.x, m.y) for m in marks],
+                radii=R_POI,
+                colors=POI,
+                labels=[m.label for m in marks],
+                show_labels=True,
+                draw_order=30,
+            ),
+            static=True,
+        )
         heads = [(m.x, m.y, h) for m in marks for h in m.headings]
-        rec.log("map/pois/headings", rr.Arrows2D(
-            origins=[(x, y) for x, y, _ in heads],
-            vectors=[(3 * math.cos(h), 3 * math.sin(h)) for _, _, h in heads],
-            radii=R_ARROW, colors=POI, draw_order=29), static=True)
+        rec.log(
+            "map/pois/headings",
+            rr.Arrows2D(
+                origins=[(x, y) for x, y, _ in heads],
+                vectors=[(3 * math.cos(h), 3 * math.sin(h)) for _, _, h in heads],
+                radii=R_ARROW,
+                colors=POI,
+                draw_order=29,
+            ),
+            static=True,
+        )
         routes = tour_routes(site)
-        rec.log("map/route", rr.LineStrips2D(
-            [r.points for r in routes], radii=R_ROUTE, labels=[r.label for r in routes],
-            colors=np.array([ROUTE_COLORS[i % len(ROUTE_COLORS)] for i in range(len(routes))],
-                            dtype=np.uint32),
-            show_labels=False, draw_order=10), static=True)
+        rec.log(
+            "map/route",
+            rr.LineStrips2D(
+                [r.points for r in routes],
+                radii=R_ROUTE,
+                labels=[r.label for r in routes],
+                colors=np.array(
+                    [ROUTE_COLORS[i % len(ROUTE_COLORS)] for i in range(len(routes))],
+                    dtype=np.uint32,
+                ),
+                show_labels=False,
+                draw_order=10,
+            ),
+            static=True,
+        )
         zones = zone_outlines(site)
         if zones:
-            rec.log("map/zones", rr.LineStrips2D(
-                [z.points for z in zones], radii=R_ZONE, labels=[z.label for z in zones],
-                colors=np.array([ZONE_COLORS.get(z.kind, 0x8B949E99) for z in zones],
-                                dtype=np.uint32), show_labels=False,
-                draw_order=5), static=True)
-        rec.log("map/robot", rr.Points2D.from_fields(radii=R_ROBOT, colors=ROBOT, labels="FROG",
-                                                     show_labels=False, draw_order=50),
-                static=True)
-        rec.log("map/robot/heading", rr.Arrows2D.from_fields(radii=R_ARROW * 1.5, colors=ROBOT,
-                                                             draw_order=51), static=True)
-        rec.log("map/robot/trail", rr.LineStrips2D.from_fields(radii=R_TRAIL, colors=TRAIL,
-                                                               draw_order=20), static=True)
-        rec.log("map/people", rr.Points2D.from_fields(radii=R_TRACKED, colors=TRACKED,
-                                                      draw_order=39), static=True)
-        rec.log("map/visitors", rr.Points2D.from_fields(radii=R_VISITOR, show_labels=True,
-                                                        draw_order=40), static=True)
+            rec.log(
+                "map/zones",
+                rr.LineStrips2D(
+                    [z.points for z in zones],
+                    radii=R_ZONE,
+                    labels=[z.label for z in zones],
+                    colors=np.array(
+                        [ZONE_COLORS.get(z.kind, 0x8B949E99) for z in zones], dtype=np.uint32
+                    ),
+                    show_labels=False,
+                    draw_order=5,
+                ),
+                static=True,
+            )
+        rec.log(
+            "map/robot",
+            rr.Points2D.from_fields(
+                radii=R_ROBOT, colors=ROBOT, labels="FROG", show_labels=False, draw_order=50
+            ),
+            static=True,
+        )
+        rec.log(
+            "map/robot/heading",
+            rr.Arrows2D.from_fields(radii=R_ARROW * 1.5, colors=ROBOT, draw_order=51),
+            static=True,
+        )
+        rec.log(
+            "map/robot/trail",
+            rr.LineStrips2D.from_fields(radii=R_TRAIL, colors=TRAIL, draw_order=20),
+            static=True,
+        )
+        rec.log(
+            "map/people",
+            rr.Points2D.from_fields(radii=R_TRACKED, colors=TRACKED, draw_order=39),
+            static=True,
+        )
+        rec.log(
+            "map/visitors",
+            rr.Points2D.from_fields(radii=R_VISITOR, show_labels=True, draw_order=40),
+            static=True,
+        )
         self._write_tree()
-        for name, color in (("battery", 0x3FB950FF), ("persons", 0xFF8C42FF),
-                            ("people", 0x6E7681FF)):
+        for name, color in (
+            ("battery", 0x3FB950FF),
+            ("persons", 0xFF8C42FF),
+            ("people", 0x6E7681FF),
+        ):
             path = "plots/battery" if name == "battery" else f"plots/people/{name}"
             rec.log(path, rr.SeriesLines(names=name, colors=color), static=True)
-        rec.log("plots/engagement/meter", rr.SeriesLines(names="meter", colors=0xFF8C42FF,
-                                                         widths=3.0), static=True)
-        rec.log("plots/engagement/decision", rr.SeriesPoints(names="decision",
-                                                             colors=0xF778BAFF,
-                                                             marker_sizes=6.0), static=True)
+        rec.log(
+            "plots/engagement/meter",
+            rr.SeriesLines(names="meter", colors=0xFF8C42FF, widths=3.0),
+            static=True,
+        )
+        rec.log(
+            "plots/engagement/decision",
+            rr.SeriesPoints(names="decision", colors=0xF778BAFF, marker_sizes=6.0),
+            static=True,
+        )
 
     def _write_tree(self) -> None:
         rec, nodes = self.rec, self.index.nodes
         ids = [n.key for n in nodes]
-        rec.log("bt/graph", rr.GraphNodes(
-            ids, positions=tidy_layout(self.index), labels=[n.name for n in nodes],
-            show_labels=True), static=True)  # colours are temporal: static ones would win
-        rec.log("bt/graph", rr.GraphEdges([(ids[a], ids[b]) for a, b in self.index.edges()],
-                                          graph_type="directed"), static=True)
-        config = rr.StateConfiguration(values=list(STATES), colors=np.array(
-            [STATUS_COLORS[Status[s]] for s in STATES], dtype=np.uint32))
+        rec.log(
+            "bt/graph",
+            rr.GraphNodes(
+                ids,
+                positions=tidy_layout(self.index),
+                labels=[n.name for n in nodes],
+                show_labels=True,
+            ),
+            static=True,
+        )  # colours are temporal: static ones would win
+        rec.log(
+            "bt/graph",
+            rr.GraphEdges([(ids[a], ids[b]) for a, b in self.index.edges()], graph_type="directed"),
+            static=True,
+        )
+        config = rr.StateConfiguration(
+            values=list(STATES),
+            colors=np.array([STATUS_COLORS[Status[s]] for s in STATES], dtype=np.uint32),
+        )
         for node in nodes:
             rec.log(status_path(node.key), config, static=True)
-        links = rr.StateConfiguration(values=[s.value for s in LinkStatus], colors=np.array(
-            [HEALTH_COLORS[s.health] for s in LinkStatus], dtype=np.uint32))
+        links = rr.StateConfiguration(
+            values=[s.value for s in LinkStatus],
+            colors=np.array([HEALTH_COLORS[s.health] for s in LinkStatus], dtype=np.uint32),
+        )
         for name in ("rosbridge", "frontend", "clock"):
             rec.log(link_path(name), links, static=True)
 
@@ -165,8 +248,7 @@ class Writer:
         rec.set_time(TIME, timestamp=np.datetime64(round(t * 1e9), "ns"))
         for name, state in changes:
             rec.log(link_path(name), rr.StateChange(state=state.value))
-        level = "WARN" if any(s.health in (Health.WAIT, Health.BAD) for _, s in changes) \
-            else "INFO"
+        level = "WARN" if any(s.health in (Health.WAIT, Health.BAD) for _, s in changes) else "INFO"
         rec.log("log/links", rr.TextLog(", ".join(f"{n} {s}" for n, s in changes), level=level))
 
     # ------------------------------------------------------------ batches
@@ -194,7 +276,8 @@ class Writer:
                 yield
         for tick, t, _, message in batch.events:
             logs.setdefault("log/frontend/in", []).append(
-                (tick, t, "INFO", "← front end " + _describe(message)))
+                (tick, t, "INFO", "← front end " + _describe(message))
+            )
         for tick, t, text, level in batch.notes:  # the level is the note's incident kind's
             logs.setdefault("log/notes", []).append((tick, t, level.value, text))
         self._read_blackboard(batch)
@@ -203,20 +286,26 @@ class Writer:
                 continue
             yield
             rows.sort(key=lambda r: (r[0], r[1]))
-            self.rec.send_columns(path, indexes=_times(rows), columns=rr.TextLog.columns(
-                text=[r[3] for r in rows], level=[r[2] for r in rows]))
+            self.rec.send_columns(
+                path,
+                indexes=_times(rows),
+                columns=rr.TextLog.columns(text=[r[3] for r in rows], level=[r[2] for r in rows]),
+            )
 
-    def _write_statuses(self, rows: list[tuple[int, float, tuple[Status, ...]]]
-                        ) -> Iterator[None]:
+    def _write_statuses(self, rows: list[tuple[int, float, tuple[Status, ...]]]) -> Iterator[None]:
         # A step reads about STATUSES_PER_STEP node statuses: a few rows of a big tree.
         per_step = max(1, STATUSES_PER_STEP // max(1, len(self.index)))
         changes: dict[int, list[tuple[int, float, str]]] = {}
         colors: list[np.ndarray] = []
         previous = self._statuses
         for start in range(0, len(rows), per_step):
-            part = rows[start:start + per_step]
-            colors.append(np.array([[STATUS_COLORS[s] for s in statuses]
-                                    for _, _, statuses in part], dtype=np.uint32))
+            part = rows[start : start + per_step]
+            colors.append(
+                np.array(
+                    [[STATUS_COLORS[s] for s in statuses] for _, _, statuses in part],
+                    dtype=np.uint32,
+                )
+            )
             for tick, t, statuses in part:
                 for i, status in enumerate(statuses):
                     if not previous or previous[i] is not status:
@@ -224,26 +313,37 @@ class Writer:
                 previous = statuses
             yield
         self._statuses = previous
-        self.rec.send_columns("bt/graph", indexes=_times(rows), columns=rr.GraphNodes.columns(
-            colors=np.concatenate(colors).reshape(-1)).partition([len(self.index)] * len(rows)))
+        self.rec.send_columns(
+            "bt/graph",
+            indexes=_times(rows),
+            columns=rr.GraphNodes.columns(colors=np.concatenate(colors).reshape(-1)).partition(
+                [len(self.index)] * len(rows)
+            ),
+        )
         yield
         for n, (i, lane) in enumerate(changes.items(), 1):
-            self.rec.send_columns(status_path(self.index.nodes[i].key), indexes=_times(lane),
-                                  columns=rr.StateChange.columns(state=[r[2] for r in lane]))
+            self.rec.send_columns(
+                status_path(self.index.nodes[i].key),
+                indexes=_times(lane),
+                columns=rr.StateChange.columns(state=[r[2] for r in lane]),
+            )
             if n % LANES_PER_STEP == 0:
                 yield
         yield
 
-    def _write_poses(self, rows: list[tuple[int, float, float, float, float]]
-                     ) -> Iterator[None]:
+    def _write_poses(self, rows: list[tuple[int, float, float, float, float]]) -> Iterator[None]:
         xy = np.array([(r[2], r[3]) for r in rows], dtype=np.float64)
         yaw = np.array([r[4] for r in rows], dtype=np.float64)
         times = _times(rows)
-        self.rec.send_columns("map/robot", indexes=times,
-                              columns=rr.Points2D.columns(positions=xy))
+        self.rec.send_columns("map/robot", indexes=times, columns=rr.Points2D.columns(positions=xy))
         yield
-        self.rec.send_columns("map/robot/heading", indexes=times, columns=rr.Arrows2D.columns(
-            origins=xy, vectors=np.stack([6 * np.cos(yaw), 6 * np.sin(yaw)], axis=1)))
+        self.rec.send_columns(
+            "map/robot/heading",
+            indexes=times,
+            columns=rr.Arrows2D.columns(
+                origins=xy, vectors=np.stack([6 * np.cos(yaw), 6 * np.sin(yaw)], axis=1)
+            ),
+        )
         trail_rows, strips = [], []
         for row in rows:
             point = (row[2], row[3])
@@ -256,12 +356,16 @@ class Writer:
                 strips.append(np.array(self._trail, dtype=np.float32))
         yield
         if trail_rows:
-            self.rec.send_columns("map/robot/trail", indexes=_times(trail_rows),
-                                  columns=rr.LineStrips2D.columns(strips=strips))
+            self.rec.send_columns(
+                "map/robot/trail",
+                indexes=_times(trail_rows),
+                columns=rr.LineStrips2D.columns(strips=strips),
+            )
             yield
 
-    def _read_inputs(self, batch: Batch, logs: dict[str, list[tuple[int, float, str, str]]],
-                     goals: list[GoalRow]) -> Iterator[None]:
+    def _read_inputs(
+        self, batch: Batch, logs: dict[str, list[tuple[int, float, str, str]]], goals: list[GoalRow]
+    ) -> Iterator[None]:
         scalars: dict[str, list[tuple[int, float, float]]] = {}
         visitors: list[tuple[int, float, Any]] = []
         people: list[tuple[int, float, Any]] = []
@@ -270,8 +374,7 @@ class Writer:
         for tick, t, role, value in batch.inputs:
             if role == "persons":
                 visitors.append((tick, t, value.persons))
-                scalars.setdefault("plots/people/persons", []).append(
-                    (tick, t, len(value.persons)))
+                scalars.setdefault("plots/people/persons", []).append((tick, t, len(value.persons)))
             elif role == "people":
                 people.append((tick, t, value.people))
                 scalars.setdefault("plots/people/people", []).append((tick, t, len(value.people)))
@@ -283,8 +386,14 @@ class Writer:
                     scalars.setdefault("plots/battery", []).append((tick, t, value.battery))
                 if value.faults != self._faults:
                     self._faults = value.faults
-                    ros_log.append((tick, t, "WARN" if value.faults else "INFO",
-                                    "faults: " + ("; ".join(value.faults) or "none")))
+                    ros_log.append(
+                        (
+                            tick,
+                            t,
+                            "WARN" if value.faults else "INFO",
+                            "faults: " + ("; ".join(value.faults) or "none"),
+                        )
+                    )
             elif role == "response":
                 code = Response.of(value)
                 name = code.word if code is not None else "unknown"
@@ -296,20 +405,26 @@ class Writer:
                 self._docking = value
                 level = "WARN" if value == DockingState.FAILED else "INFO"
                 ros_log.append((tick, t, level, f"docking state: {value}"))
-        logs["log/ros/in"] = [(tick, t, level, "← robot " + text)
-                              for tick, t, level, text in ros_log]
+        logs["log/ros/in"] = [
+            (tick, t, level, "← robot " + text) for tick, t, level, text in ros_log
+        ]
         for path, rows in scalars.items():
-            self.rec.send_columns(path, indexes=_times(rows),
-                                  columns=rr.Scalars.columns(scalars=[r[2] for r in rows]))
+            self.rec.send_columns(
+                path, indexes=_times(rows), columns=rr.Scalars.columns(scalars=[r[2] for r in rows])
+            )
             yield
         for face_id, rows in faces.items():
             path = f"plots/engagement/faces/{face_id}"
             if face_id not in self._faces:
                 self._faces.add(face_id)
-                self.rec.log(path, rr.SeriesLines(names=f"face {face_id}", colors=FACE,
-                                                  widths=1.0), static=True)
-            self.rec.send_columns(path, indexes=_times(rows),
-                                  columns=rr.Scalars.columns(scalars=[r[2] for r in rows]))
+                self.rec.log(
+                    path,
+                    rr.SeriesLines(names=f"face {face_id}", colors=FACE, widths=1.0),
+                    static=True,
+                )
+            self.rec.send_columns(
+                path, indexes=_times(rows), columns=rr.Scalars.columns(scalars=[r[2] for r in rows])
+            )
             yield
         if visitors:
             self._write_people("map/visitors", visitors, labelled=True)
@@ -318,8 +433,9 @@ class Writer:
             self._write_people("map/people", people, labelled=False)
             yield
 
-    def _write_people(self, path: str, rows: list[tuple[int, float, Any]], *, labelled: bool
-                      ) -> None:
+    def _write_people(
+        self, path: str, rows: list[tuple[int, float, Any]], *, labelled: bool
+    ) -> None:
         positions = [(p.position.x, p.position.y) for _, _, ps in rows for p in ps]
         lengths = [len(ps) for _, _, ps in rows]
         xy = np.array(positions, dtype=np.float64).reshape(-1, 2)
@@ -330,19 +446,27 @@ class Writer:
             persons = [p for _, _, ps in rows for p in ps]
             facing = [lo < p.orientation < hi for p in persons]
             columns = rr.Points2D.columns(
-                positions=xy, colors=np.array([FACING if f else NOT_FACING for f in facing],
-                                              dtype=np.uint32),
-                labels=[str(p.id) for p in persons])
+                positions=xy,
+                colors=np.array([FACING if f else NOT_FACING for f in facing], dtype=np.uint32),
+                labels=[str(p.id) for p in persons],
+            )
         self.rec.send_columns(path, indexes=_times(rows), columns=columns.partition(lengths))
 
-    def _read_outputs(self, batch: Batch, logs: dict[str, list[tuple[int, float, str, str]]],
-                      goals: list[GoalRow]) -> None:
+    def _read_outputs(
+        self, batch: Batch, logs: dict[str, list[tuple[int, float, str, str]]], goals: list[GoalRow]
+    ) -> None:
         for tick, t, side, channel, payload in batch.outputs:
             if side == "frontend":
-                level = ("WARN" if getattr(payload, "state", "") == "aborted" else
-                         "DEBUG" if channel in PERIODIC else "INFO")
+                level = (
+                    "WARN"
+                    if getattr(payload, "state", "") == "aborted"
+                    else "DEBUG"
+                    if channel in PERIODIC
+                    else "INFO"
+                )
                 logs.setdefault("log/frontend/out", []).append(
-                    (tick, t, level, "→ front end " + _describe(payload)))
+                    (tick, t, level, "→ front end " + _describe(payload))
+                )
                 continue
             out: RobotCommand = payload
             role = out.role
@@ -363,22 +487,28 @@ class Writer:
             if key == "/engagement_meter" and isinstance(value, int | float):
                 meter.append((tick, t, float(value)))
             elif key == "/engagement_decision" and value is not None:
-                engaged = getattr(value[-1] if isinstance(value, tuple) else value, "engaged",
-                                  None)
+                engaged = getattr(value[-1] if isinstance(value, tuple) else value, "engaged", None)
                 if engaged is not None:
                     decision.append((tick, t, 1.0 if engaged else -1.0))
-        for path, rows in (("plots/engagement/meter", meter),
-                           ("plots/engagement/decision", decision)):
+        for path, rows in (
+            ("plots/engagement/meter", meter),
+            ("plots/engagement/decision", decision),
+        ):
             if rows:
-                self.rec.send_columns(path, indexes=_times(rows),
-                                      columns=rr.Scalars.columns(scalars=[r[2] for r in rows]))
+                self.rec.send_columns(
+                    path,
+                    indexes=_times(rows),
+                    columns=rr.Scalars.columns(scalars=[r[2] for r in rows]),
+                )
 
     def _end_face_session(self, tick: int, t: float) -> None:
         """Break the engagement lines between face-stream sessions (a clear is a gap in a
         time series), at the stop and again at the next start."""
         self._set_time(tick, t)
-        for path in ("plots/engagement/meter",
-                     *(f"plots/engagement/faces/{face_id}" for face_id in self._faces)):
+        for path in (
+            "plots/engagement/meter",
+            *(f"plots/engagement/faces/{face_id}" for face_id in self._faces),
+        ):
             self.rec.log(path, rr.Clear(recursive=False))
 
     def _set_time(self, tick: int, t: float) -> None:
@@ -393,16 +523,35 @@ class Writer:
             self._goal = None
             return
         name, x, y, yaw = goal
-        rec.log("map/goal", rr.Points2D([(x, y)], radii=R_GOAL, colors=GOAL, labels=f"goal {name}",
-                                        show_labels=False, draw_order=45))
-        rec.log("map/goal/heading", rr.Arrows2D(origins=[(x, y)], vectors=[
-            (4 * math.cos(yaw), 4 * math.sin(yaw))], radii=R_ARROW * 1.5, colors=GOAL,
-            draw_order=46))
+        rec.log(
+            "map/goal",
+            rr.Points2D(
+                [(x, y)],
+                radii=R_GOAL,
+                colors=GOAL,
+                labels=f"goal {name}",
+                show_labels=False,
+                draw_order=45,
+            ),
+        )
+        rec.log(
+            "map/goal/heading",
+            rr.Arrows2D(
+                origins=[(x, y)],
+                vectors=[(4 * math.cos(yaw), 4 * math.sin(yaw))],
+                radii=R_ARROW * 1.5,
+                colors=GOAL,
+                draw_order=46,
+            ),
+        )
         self._goal = goal
 
 
 def _describe(message: Any) -> str:
     """``start_poi poi=POI1 waypoint=POI1a part=a`` (empty fields left out)."""
-    fields = " ".join(f"{k}={v:.2f}" if isinstance(v, float) else f"{k}={v}"
-                      for k, v in message_fields(message).items() if v != "")
+    fields = " ".join(
+        f"{k}={v:.2f}" if isinstance(v, float) else f"{k}={v}"
+        for k, v in message_fields(message).items()
+        if v != ""
+    )
     return f"{message.type} {fields}".rstrip()

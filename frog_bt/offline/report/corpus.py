@@ -11,8 +11,12 @@ from frog_bt.config import Site
 from frog_bt.offline.report.facts import FileFacts, read_file
 
 
-def read_corpus(files: list[Path], site: Site, executor: Executor,
-                progress: Callable[[int, int], None] | None = None) -> list[FileFacts]:
+def read_corpus(
+    files: list[Path],
+    site: Site,
+    executor: Executor,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[FileFacts]:
     """Facts of every file, in the order given."""
     futures = [executor.submit(read_file, str(f), site) for f in files]
     out = []

@@ -71,8 +71,17 @@ from frog_bt.recordings.reader import (
 
 JUMP = 10.0  # metres: a pose step this long is a relocalisation, not a drive
 OWN = (FRONTEND_IN, FRONTEND_OUT, OPERATOR, ALERT, PRIMER)
-ROS_ROLES = ("pose", "goto", "approach", "response", "dock", "docking_state", "icl", "faces",
-             "diagnostic")
+ROS_ROLES = (
+    "pose",
+    "goto",
+    "approach",
+    "response",
+    "dock",
+    "docking_state",
+    "icl",
+    "faces",
+    "diagnostic",
+)
 BAD_NOTED = 3  # reasons of bad messages a file's facts keep (all are counted)
 
 
@@ -140,8 +149,7 @@ class Piece:
 
     def of_a_tour(self) -> bool:
         """Something only a tour does happened in it."""
-        return bool(self.stops or self.invitations or self.approaches or self.goals
-                    or self.ended)
+        return bool(self.stops or self.invitations or self.approaches or self.goals or self.ended)
 
 
 @dataclass
@@ -247,8 +255,7 @@ class _Pieces:
             poi, part = message.poi, message.part
             stop = self._stop(poi)
             if part == "a" or stop is None:
-                stop = StopFacts(poi, message.waypoint or poi,
-                                 face_stream=poi in self.face_stops)
+                stop = StopFacts(poi, message.waypoint or poi, face_stream=poi in self.face_stops)
                 piece.stops.append(stop)
                 stop.start = t
             if part not in stop.parts:
@@ -312,8 +319,11 @@ class _Pieces:
             stop = self._stop(message.poi)
             if stop is not None and stop.a_end is None:
                 stop.a_end = t  # the decision counts the samples up to here
-        if isinstance(message, UserPositive | UserNegative) and self.piece is not None \
-                and self.asked:
+        if (
+            isinstance(message, UserPositive | UserNegative)
+            and self.piece is not None
+            and self.asked
+        ):
             self.asked = False
             piece = self.piece
             if isinstance(message, UserPositive):
@@ -366,15 +376,19 @@ class _Pieces:
             state = DockingState.of(value)
             if state in (DockingState.DOCKING, DockingState.UNDOCKING):
                 # what is under way (a file may open here)
-                self.dock = DockCommand.DOCK if state is DockingState.DOCKING \
-                    else DockCommand.UNDOCK
+                self.dock = (
+                    DockCommand.DOCK if state is DockingState.DOCKING else DockCommand.UNDOCK
+                )
             elif state is DockingState.FAILED and self.dock is not None:
                 self.dock_failed = self.dock
             elif state is DockingState.DOCKED and self.back is not None:
                 self.back.t1, self.back = t, None  # home after the abort: the tour is over
         elif role == "faces" and self.stream_on and isinstance(value, FaceData):
-            self.samples.extend((t, face.engagement) for face in value.faces
-                                if face.distance <= self.near and face.facing)
+            self.samples.extend(
+                (t, face.engagement)
+                for face in value.faces
+                if face.distance <= self.near and face.facing
+            )
         elif role == "diagnostic" and piece is not None and isinstance(value, Diagnostics):
             for status in value.statuses:
                 if status.level == DiagnosticLevel.ERROR:
@@ -437,12 +451,17 @@ def read_file(path: str, site: Site) -> FileFacts:
         # An executive's first file: neither a tour file nor an idle file it rotated into
         # (those open with a primer); a file without our metadata is one whole run.
         kind = recording.metadata.get("frog_bt", {}).get("kind")
-        restarts = [start] if start is not None and kind != "tour" and not pieces.primed \
-            else []
+        restarts = [start] if start is not None and kind != "tour" and not pieces.primed else []
         tally = reader.tally
-        return FileFacts(path, pieces.finish(), restarts, recovered=recording.recovered,
-                         start=start or 0.0, bad=tally.count,
-                         bad_first=tally.lines(start or 0.0)[:BAD_NOTED])
+        return FileFacts(
+            path,
+            pieces.finish(),
+            restarts,
+            recovered=recording.recovered,
+            start=start or 0.0,
+            bad=tally.count,
+            bad_first=tally.lines(start or 0.0)[:BAD_NOTED],
+        )
     except RecordingError as exc:
         return FileFacts(path, error=str(exc).replace(f"{path}: ", ""))
     except Exception as exc:  # a damaged file must not stop the corpus

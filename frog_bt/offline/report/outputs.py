@@ -59,8 +59,9 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
         raise MissingExtra(f"the HTML report needs matplotlib: {EXTRA}") from exc
     out = []
 
-    def bar(title: str, data: dict[Any, float], xlabel: str, ylabel: str,
-            rotate: bool = False) -> None:
+    def bar(
+        title: str, data: dict[Any, float], xlabel: str, ylabel: str, rotate: bool = False
+    ) -> None:
         fig, ax = plt.subplots(figsize=(5.2, 2.7))
         ax.bar([str(k) for k in data], list(data.values()), color="#3a6ea5")
         ax.set_xlabel(xlabel)
@@ -81,8 +82,12 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
         plt.close(fig)
 
     bar("Tours per day", t["tours_per_day"], "day", "tours", rotate=True)
-    bar("Tours per hour of the day", {f"{h}:00": n for h, n in t["tours_per_hour"].items()},
-        "hour (local time)", "tours")
+    bar(
+        "Tours per hour of the day",
+        {f"{h}:00": n for h, n in t["tours_per_hour"].items()},
+        "hour (local time)",
+        "tours",
+    )
     rates = {poi: 100 * r for poi, r in t["part_b_rate"].items() if r is not None}
     if rates:
         bar("Part b played (the engagement gate)", rates, "stop", "% of visits")
@@ -99,8 +104,13 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
         ax.grid(axis="y", alpha=0.3)
         out.append(("Time at each stop", _png(fig)))
         plt.close(fig)
-    bar("Distance driven per day", {d: m / 1000 for d, m in t["distance_per_day_m"].items()},
-        "day", "km", rotate=True)
+    bar(
+        "Distance driven per day",
+        {d: m / 1000 for d, m in t["distance_per_day_m"].items()},
+        "day",
+        "km",
+        rotate=True,
+    )
     return out
 
 
@@ -108,35 +118,66 @@ def _pct(x: float | None) -> str:
     return "-" if x is None else f"{100 * x:.1f} %"
 
 
-def write_html(rows: list[Row], t: dict[str, Any], path: Path, title: str,
-               skipped: list[str]) -> None:
+def write_html(
+    rows: list[Row], t: dict[str, Any], path: Path, title: str, skipped: list[str]
+) -> None:
     e = html.escape
     figures = plots(rows, t)
     tour_min = t["tour_minutes"] or {}
     summary = [
-        ("Tours", f"{t['tours']} ({t['completed']} completed, {t['resumed']} resumed "
-                  "after a restart)"),
+        (
+            "Tours",
+            f"{t['tours']} ({t['completed']} completed, {t['resumed']} resumed after a restart)",
+        ),
         ("Completion rate", _pct(t["completion_rate"])),
         ("Approach success", f"{_pct(t['approach_success'])} of {t['approaches']} approaches"),
-        ("Invitation acceptance", f"{_pct(t['invitation_acceptance'])} of "
-                                  f"{t['invitations']} invitations "
-                                  f"({t['invitations_declined']} declined)"),
+        (
+            "Invitation acceptance",
+            f"{_pct(t['invitation_acceptance'])} of "
+            f"{t['invitations']} invitations "
+            f"({t['invitations_declined']} declined)",
+        ),
         ("Visitors reached", f"{t['visitors']} (said yes to a tour)"),
-        *((f"Part b at {poi}", f"{_pct(r)} of {t['gate_decisions'][poi]} visits")
-          for poi, r in t["part_b_rate"].items()),
-        ("Tour length", f"median {tour_min.get('median', '-')} min "
-                        f"(from {tour_min.get('min', '-')} to {tour_min.get('max', '-')})"),
+        *(
+            (f"Part b at {poi}", f"{_pct(r)} of {t['gate_decisions'][poi]} visits")
+            for poi, r in t["part_b_rate"].items()
+        ),
+        (
+            "Tour length",
+            f"median {tour_min.get('median', '-')} min "
+            f"(from {tour_min.get('min', '-')} to {tour_min.get('max', '-')})",
+        ),
         ("Distance driven", f"{t['distance_m'] / 1000:.1f} km"),
-        ("Time-of-day variants", ", ".join(f"{k} {n}" for k, n in sorted(t["variants"].items()))
-         or "none"),
+        (
+            "Time-of-day variants",
+            ", ".join(f"{k} {n}" for k, n in sorted(t["variants"].items())) or "none",
+        ),
         ("Files skipped", str(len(skipped))),
     ]
-    causes = "".join(f"<tr><td>{e(c)}</td><td class=n>{n}</td></tr>"
-                     for c, n in t["failure_causes"].items()) or "<tr><td>none</td></tr>"
-    cols = ["tour", "robot", "start", "duration_s", "distance_m", "stops_visited",
-            "stops_skipped", "visitors", "introduction", "parts", "ended", "reason", "resumed"]
-    body = "".join("<tr>" + "".join(f"<td>{e(str(getattr(r, c)))}</td>" for c in cols)
-                   + "</tr>" for r in rows)
+    causes = (
+        "".join(
+            f"<tr><td>{e(c)}</td><td class=n>{n}</td></tr>" for c, n in t["failure_causes"].items()
+        )
+        or "<tr><td>none</td></tr>"
+    )
+    cols = [
+        "tour",
+        "robot",
+        "start",
+        "duration_s",
+        "distance_m",
+        "stops_visited",
+        "stops_skipped",
+        "visitors",
+        "introduction",
+        "parts",
+        "ended",
+        "reason",
+        "resumed",
+    ]
+    body = "".join(
+        "<tr>" + "".join(f"<td>{e(str(getattr(r, c)))}</td>" for c in cols) + "</tr>" for r in rows
+    )
     data = json.dumps(t).replace("</", "<\\/")  # raw text inside <script>: no entities
     page = f"""<!doctype html>
 <html lang="en"><head><meta charset="utf-8">
@@ -158,8 +199,12 @@ figure {{ margin: 0; }} figcaption {{ font-weight: 600; }} img {{ max-width: 100
 <table id="summary">{"".join(f"<tr><th>{e(k)}</th><td>{e(v)}</td></tr>" for k, v in summary)}
 </table>
 <h2>Plots</h2>
-<div class="figs">{"".join(f'<figure><figcaption>{e(name)}</figcaption><img alt="{e(name)}" '
-                          f'src="{url}"></figure>' for name, url in figures)}</div>
+<div class="figs">{
+        "".join(
+            f'<figure><figcaption>{e(name)}</figcaption><img alt="{e(name)}" src="{url}"></figure>'
+            for name, url in figures
+        )
+    }</div>
 <h2>Most frequent failure causes</h2>
 <table id="causes">{causes}</table>
 <h2>Tours</h2>

@@ -55,8 +55,7 @@ class Tour:
     def resumed(self) -> bool:
         """An executive started between the end of one of its pieces and the last event
         of the next: a new executive carried the tour on."""
-        return any(self.restarted(p.t1, q.t1)
-                   for p, q in itertools.pairwise(self.pieces))
+        return any(self.restarted(p.t1, q.t1) for p, q in itertools.pairwise(self.pieces))
 
 
 def join(files: list[FileFacts]) -> list[Tour]:
@@ -76,16 +75,23 @@ def _join(robot: str, files: list[FileFacts]) -> list[Tour]:
         prev = tours[-1] if tours else None
         open_ = prev is not None and not prev.last.ended
         if piece.started is not None:
-            if (open_ and prev is not None and piece.started_seq == prev.first.started_seq
-                    and prev.first.started is not None
-                    and not prev.restarted(prev.first.started, piece.started)):
+            if (
+                open_
+                and prev is not None
+                and piece.started_seq == prev.first.started_seq
+                and prev.first.started is not None
+                and not prev.restarted(prev.first.started, piece.started)
+            ):
                 prev.pieces.append(piece)  # `tour started` resent after a file's rotation
             else:
                 tours.append(Tour(robot, [piece], restarts))
         elif open_ and prev is not None:
-            if (piece.ended and prev.first.started is not None
-                    and piece.end_seq < prev.first.started_seq
-                    and not prev.restarted(prev.first.started, piece.t1)):
+            if (
+                piece.ended
+                and prev.first.started is not None
+                and piece.end_seq < prev.first.started_seq
+                and not prev.restarted(prev.first.started, piece.t1)
+            ):
                 # seqs only grow: the end of the tour before, resent into the tour file
                 piece = replace(piece, ended="", reason="", end_seq=0)
             prev.pieces.append(piece)  # rotated, or carried on by a restarted executive
@@ -145,11 +151,19 @@ def visits(tour: Tour) -> list[StopFacts]:
     for piece in tour.pieces:
         for stop in piece.stops:
             cut = out[-1] if out else None
-            if (cut is not None and last is not piece and cut.poi == stop.poi
-                    and cut.start is not None and stop.start is not None
-                    and tour.restarted(cut.start, stop.start)):
-                out[-1] = replace(stop, parts="".join(dict.fromkeys(cut.parts + stop.parts)),
-                                  before_restart=cut.seconds or 0.0)
+            if (
+                cut is not None
+                and last is not piece
+                and cut.poi == stop.poi
+                and cut.start is not None
+                and stop.start is not None
+                and tour.restarted(cut.start, stop.start)
+            ):
+                out[-1] = replace(
+                    stop,
+                    parts="".join(dict.fromkeys(cut.parts + stop.parts)),
+                    before_restart=cut.seconds or 0.0,
+                )
             else:
                 out.append(replace(stop))
             last = piece
@@ -175,16 +189,24 @@ def skipped(tour: Tour, site: Site, stops: list[StopFacts], ended: str) -> list[
         if tour.restarted(pieces[k - 1].t1, pieces[k].t1):
             before = [at[s.poi] for p in pieces[:k] for s in p.stops if s.poi in at]
             after = [at[s.poi] for p in pieces[k:] for s in p.stops if s.poi in at]
-            lost.update(order[max(before, default=-1) + 1:min(after, default=len(order))])
-    reach = len(order) if ended == "ended" else max(
-        (order.index(poi) + 1 for poi in reached if poi in order), default=0)
+            lost.update(order[max(before, default=-1) + 1 : min(after, default=len(order))])
+    reach = (
+        len(order)
+        if ended == "ended"
+        else max((order.index(poi) + 1 for poi in reached if poi in order), default=0)
+    )
     out = []
     for poi in order[:reach]:
         if poi in by_operator:
             out.append(f"{poi}: operator")
         elif poi not in visited:
-            why = ("navigation failed" if poi in failed else
-                   "not recorded (restart)" if poi in lost else "not visited")
+            why = (
+                "navigation failed"
+                if poi in failed
+                else "not recorded (restart)"
+                if poi in lost
+                else "not visited"
+            )
             out.append(f"{poi}: {why}")
     return out
 
@@ -198,19 +220,37 @@ def row(number: int, tour: Tour, site: Site) -> Row:
     invitations = sum(p.invitations for p in pieces)
     accepted = sum(p.accepted for p in pieces)
     declined = sum(p.declined for p in pieces)
-    introduction = ("none" if not invitations else "accepted" if accepted
-                    else "declined" if declined else "no answer")
+    introduction = (
+        "none"
+        if not invitations
+        else "accepted"
+        if accepted
+        else "declined"
+        if declined
+        else "no answer"
+    )
     seconds: dict[str, float] = {}
     for s in stops:
         if s.seconds is not None:
             seconds[s.poi] = round(seconds.get(s.poi, 0.0) + s.seconds, 1)
-    engagement = [{"poi": s.poi, "samples": s.samples, "edge_engaged": s.edge_engaged,
-                   "edge_votes": s.edge_total, "decision": s.decision}
-                  for s in stops if s.face_stream]
+    engagement = [
+        {
+            "poi": s.poi,
+            "samples": s.samples,
+            "edge_engaged": s.edge_engaged,
+            "edge_votes": s.edge_total,
+            "decision": s.decision,
+        }
+        for s in stops
+        if s.face_stream
+    ]
     return Row(
-        tour=number, robot=Path(tour.robot).name,
+        tour=number,
+        robot=Path(tour.robot).name,
         files=";".join(dict.fromkeys(Path(p.file).name for p in pieces)),
-        day=f"{local:%Y-%m-%d}", start=local.isoformat(timespec="seconds"), hour=local.hour,
+        day=f"{local:%Y-%m-%d}",
+        start=local.isoformat(timespec="seconds"),
+        hour=local.hour,
         duration_s=round(tour.last.t1 - start_t, 1),
         distance_m=round(sum(p.distance for p in pieces), 1),
         stops_visited=";".join(s.poi for s in stops),
@@ -219,8 +259,10 @@ def row(number: int, tour: Tour, site: Site) -> Row:
         approaches=sum(p.approaches for p in pieces),
         approaches_accepted=sum(p.approaches_ok for p in pieces),
         visitors=len({v for p in pieces for v in p.visitors}),
-        invitations=invitations, invitations_accepted=accepted,
-        invitations_declined=declined, introduction=introduction,
+        invitations=invitations,
+        invitations_accepted=accepted,
+        invitations_declined=declined,
+        introduction=introduction,
         engagement=json.dumps(engagement),
         parts="; ".join(f"{s.poi} {s.parts}" for s in stops),
         variants=";".join(dict.fromkeys(s.waypoint for s in stops if s.waypoint != s.poi)),
@@ -229,7 +271,10 @@ def row(number: int, tour: Tour, site: Site) -> Row:
         dock_retries=sum(p.dock_retries for p in pieces),
         operator="; ".join(o for p in pieces for o in p.operator),
         alerts="; ".join(a for p in pieces for a in p.alerts),
-        ended=ended, reason=tour.last.reason, resumed=tour.resumed)
+        ended=ended,
+        reason=tour.last.reason,
+        resumed=tour.resumed,
+    )
 
 
 def rows(files: list[FileFacts], site: Site) -> list[Row]:

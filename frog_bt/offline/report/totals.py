@@ -23,8 +23,12 @@ def totals(rows: list[Row], face_stops: list[str], unreadable: int = 0) -> dict[
     part_b: dict[str, float | None] = {}
     decided: dict[str, int] = {}
     for poi in face_stops:
-        gate = [v["decision"] for r in rows for v in json.loads(r.engagement)
-                if v["poi"] == poi and v["decision"] != "none"]
+        gate = [
+            v["decision"]
+            for r in rows
+            for v in json.loads(r.engagement)
+            if v["poi"] == poi and v["decision"] != "none"
+        ]
         decided[poi] = len(gate)
         part_b[poi] = _rate(gate.count("b"), len(gate))
     per_stop: dict[str, list[float]] = {}
@@ -74,6 +78,10 @@ def _spread(values: list[float]) -> dict[str, float] | None:
     if not values:
         return None
     ordered = sorted(values)
-    return {"n": len(values), "min": round(ordered[0], 1),
-            "median": round(statistics.median(ordered), 1), "max": round(ordered[-1], 1),
-            "mean": round(statistics.fmean(ordered), 1)}
+    return {
+        "n": len(values),
+        "min": round(ordered[0], 1),
+        "median": round(statistics.median(ordered), 1),
+        "max": round(ordered[-1], 1),
+        "mean": round(statistics.fmean(ordered), 1),
+    }
