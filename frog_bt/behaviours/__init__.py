@@ -11,6 +11,7 @@ from pathlib import Path
 from frog_bt.behaviours import (
     docking,
     engagement,
+    help,
     location,
     navigation,
     operator,
@@ -29,6 +30,7 @@ __all__ = [
     "FACTORY",
     "docking",
     "engagement",
+    "help",
     "load_tree",
     "location",
     "navigation",

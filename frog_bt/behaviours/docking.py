@@ -10,7 +10,8 @@ from frog_bt.behaviours.goal_leaf import Failure, GoalLeaf
 from frog_bt.behaviours.registry import register
 from frog_bt.model import keys
 from frog_bt.model.outcomes import DockingState, IncidentKind
-from frog_bt.tree.leaf import RUNNING, SUCCESS, Params, Status
+from frog_bt.tree import leaf
+from frog_bt.tree.leaf import RUNNING, SUCCESS, Status
 
 TARGET = {"dock": DockingState.DOCKED, "undock": DockingState.UNDOCKED}
 BUSY = {"dock": DockingState.DOCKING, "undock": DockingState.UNDOCKING}
@@ -30,7 +31,7 @@ class Docking(GoalLeaf):
     after ``timeout`` seconds (default: site ``timeouts.dock`` / ``timeouts.undock``).
     """
 
-    class Params(Params):
+    class Params(leaf.Params):  # qualified: mypy may take a bare Params for this one
         action: Literal["dock", "undock"] = Field(description="what to ask of the robot")
         timeout: float | None = Field(
             None,
@@ -39,6 +40,7 @@ class Docking(GoalLeaf):
             description=("seconds before it fails (default: site timeouts.dock / timeouts.undock)"),
         )
 
+    params: Params
     reads = (keys.DOCKING, keys.NOW)
 
     def default_timeout(self) -> float:

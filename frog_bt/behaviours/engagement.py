@@ -10,6 +10,7 @@ and sends the engagement meter every ``engagement.window`` seconds.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from typing import Any
 
 import py_trees
 from pydantic import Field
@@ -39,7 +40,7 @@ class FaceStream(FrogDecorator):
     reads = (keys.FACES, keys.NOW)
     writes = (keys.ICL, keys.ENGAGEMENT, keys.ENGAGEMENT_METER)
 
-    def provides(self) -> tuple[keys.Key[object], ...]:
+    def provides(self) -> tuple[keys.Key[Any], ...]:
         """What the child may read while the stream is on (the data-flow check)."""
         return self.writes
 
@@ -108,6 +109,7 @@ class DecideEngagement(Leaf):
             "telemetry (the POI, or introduction)",
         )
 
+    params: Params
     optional_reads = (keys.ENGAGEMENT,)
     writes = (keys.ENGAGED, keys.ENGAGEMENT_DECISION)
 

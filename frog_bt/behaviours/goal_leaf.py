@@ -10,6 +10,8 @@ The base owns the rest:
 * the command goes out through :meth:`~GoalLeaf.send_goal` only: in ``initialise``, or,
   while :meth:`~GoalLeaf.held` holds it (the operator's pause, ``/paused``, for a leaf
   that ``waits_while_paused``; then the subclass's own reason), on a later tick;
+* a pause while the goal of such a leaf is out stops the robot at once: a goal at its
+  own pose (``/pose``) replaces it, and the goal goes out again once the pause ends;
 * a goal answered on ``/FROG_response`` is followed on ``/goal`` (:func:`goal_state`):
   SUCCESS on 2, FAILURE on 3 or 4 or once another goal replaced it. A command answered
   elsewhere (docking, on ``/docking``) overrides :meth:`~GoalLeaf.poll`;
@@ -21,14 +23,16 @@ The base owns the rest:
 from __future__ import annotations
 
 import enum
-from typing import ClassVar
+from typing import ClassVar, Protocol
 
 from pydantic import BaseModel
 
 from frog_bt.model import keys
 from frog_bt.model.goals import Goal
+from frog_bt.model.ros import Pose
 from frog_bt.model.wire import SUCCEEDED
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Status
+from frog_bt.tree.node import NodeParams
 
 __all__ = ["Failure", "GoalLeaf", "goal_state"]
 
@@ -49,6 +53,13 @@ class Failure(enum.Enum):
     TIMED_OUT = "timed out"
 
 
+class TimedParams(NodeParams, Protocol):
+    """A goal leaf's ``Params``: with a ``timeout`` (seconds, None: the default)."""
+
+    @property
+    def timeout(self) -> float | None: ...
+
+
 class GoalLeaf(Leaf):
     """Base of the leaves that send a goal and wait for its answer (not a tree node).
 
@@ -58,6 +69,7 @@ class GoalLeaf(Leaf):
     """
 
     waits_while_paused: ClassVar[bool] = False  # the operator's pause holds the sending
+    params: TimedParams
 
     def __init_subclass__(cls, **kwargs: object) -> None:
         super().__init_subclass__(**kwargs)
@@ -66,6 +78,7 @@ class GoalLeaf(Leaf):
             keys.NOW.name: True,
             keys.GOAL.name: cls.poll is GoalLeaf.poll,
             keys.PAUSED.name: cls.waits_while_paused,
+            keys.POSE.name: cls.waits_while_paused,  # a pause stops the robot where it is
         }
         missing = [name for name, need in needed.items() if need and name not in declared]
         if missing:
@@ -157,7 +170,23 @@ class GoalLeaf(Leaf):
         self.begin()
         self._send_unless_held()
 
+    def _stop_for_pause(self) -> None:
+        """The operator paused while the goal is out: stop the robot now (a goal at its own
+        pose replaces this one) and forget the goal; :meth:`send_goal` sends it again once
+        the pause ends."""
+        self.ctx.actions.cancel(self.goal)
+        reading = self.get(keys.POSE)
+        if reading is not None:
+            here = reading.value
+            now = self.ctx.clock.now()
+            self.ctx.actions.stop(Pose(now, "map", here.x, here.y, here.qz, here.qw))
+            self.ctx.note(f"paused: stopped at ({here.x:.1f}, {here.y:.1f})")
+        self.goal = self.latest = None
+        self.sent_at = None
+
     def update(self) -> Status:
+        if self.sent_at is not None and self.waits_while_paused and self.get(keys.PAUSED):
+            self._stop_for_pause()
         if self.sent_at is None and not self._send_unless_held():
             return RUNNING
         assert self.sent_at is not None

@@ -86,6 +86,7 @@ class GuidedDrive(FrogDecorator):
     """
 
     Params = PoiParams
+    params: PoiParams
     reads = (keys.POSE, keys.NOW)
     optional_reads = (keys.WAYPOINT, keys.SPECIAL_DONE)
     writes = (keys.SPECIAL_DONE,)

@@ -30,11 +30,12 @@ class Navigate(GoalLeaf):
     """Drive to ``poi``, choosing its time-of-day variant from the project clock.
 
     Sends ``/GotoWayPoint`` in initialise (a new goal replaces the active one), or once
-    the operator's pause ends (``/paused``, optional: RUNNING until then).
-    Reads ``/now`` and ``/goal`` (its result); writes ``/target`` (the logical POI),
-    ``/waypoint`` (the variant chosen, e.g. ``POI1b``) and clears ``/skipped``. SUCCESS on
-    ``/FROG_response`` 2; FAILURE on 3 or 4, when another goal replaces this
-    one, or after ``timeout`` seconds (default: site ``timeouts.navigation``).
+    the operator's pause ends (``/paused``, optional: RUNNING until then). A pause while
+    it drives stops the robot at once (a goal at its own pose, ``/pose``); the goal goes
+    out again when the pause ends. Reads ``/now`` and ``/goal`` (its result); writes
+    ``/target`` (the logical POI), ``/waypoint`` (the variant chosen, e.g. ``POI1b``) and
+    clears ``/skipped``. SUCCESS on ``/FROG_response`` 2; FAILURE on 3 or 4, when another
+    goal replaces this one, or after ``timeout`` seconds (default: site ``timeouts.navigation``).
     """
 
     class Params(PoiParams):
@@ -45,8 +46,9 @@ class Navigate(GoalLeaf):
             description=("seconds before it fails (default: site timeouts.navigation)"),
         )
 
+    params: Params
     reads = (keys.NOW, keys.GOAL)
-    optional_reads = (keys.PAUSED,)
+    optional_reads = (keys.PAUSED, keys.POSE)
     writes = (keys.TARGET, keys.WAYPOINT, keys.SKIPPED)
     waits_while_paused = True
 
@@ -106,6 +108,7 @@ class SkipStop(Leaf):
     """
 
     Params = PoiParams
+    params: PoiParams
     writes = (keys.SKIPPED,)
 
     def update(self) -> Status:
@@ -123,6 +126,7 @@ class Skipped(Leaf):
     """Is ``poi`` being skipped? Reads ``/skipped`` (optional). SUCCESS if so, else FAILURE."""
 
     Params = PoiParams
+    params: PoiParams
     optional_reads = (keys.SKIPPED,)
 
     def update(self) -> Status:

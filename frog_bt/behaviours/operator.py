@@ -31,9 +31,13 @@ class OperatorSkip(FrogDecorator):
     """
 
     Params = PoiParams
+    params: PoiParams
     optional_reads = (keys.SKIP,)
     role = Role.STOP  # the core asks the running ones what a skip would leave
     _requested = False
+
+    def stop_poi(self) -> str:
+        return self.params.poi
 
     def initialise(self) -> None:
         self.skips = self.get(keys.SKIP) or 0

@@ -43,6 +43,7 @@ class Projector(FrogDecorator):
     class Params(PoiParams):
         pass
 
+    params: Params
     reads = (keys.POSE, keys.NOW)
     optional_reads = (keys.WAYPOINT,)
 

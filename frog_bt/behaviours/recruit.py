@@ -111,6 +111,7 @@ class ApproachVisitor(GoalLeaf):
     class Params(Params):
         timeout: float | None = Timeout
 
+    params: Params
     reads = (keys.VISITOR, keys.NOW, keys.GOAL)
     optional_reads = (keys.APPROACH_FAILED,)
     writes = (keys.APPROACH_FAILED,)
@@ -193,6 +194,7 @@ class WaitAnswer(Leaf):
     class Params(Params):
         timeout: float | None = Timeout
 
+    params: Params
     reads = (keys.EVENTS, keys.VISITOR, keys.NOW)
     optional_reads = (keys.DECLINED,)
     writes = (keys.DECLINED,)

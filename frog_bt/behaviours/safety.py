@@ -189,6 +189,7 @@ class Checkpointed(FrogDecorator):
             min_length=1, description=("the part's name in the checkpoint (unique in the tree)")
         )
 
+    params: Params
     optional_reads = (keys.VISITOR, keys.RESUME, keys.PROGRESS)
     writes = (keys.VISITOR, keys.RESUME, keys.PROGRESS)
     skips_child = True  # resumed: SUCCESS without the child (the data-flow check)

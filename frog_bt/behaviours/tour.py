@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import Field
 
@@ -70,6 +70,7 @@ class TourStatus(Leaf):
         )
         reason: str = Field("", description="why (with aborted; default: the abort reason)")
 
+    params: Params
     optional_reads = (keys.ABORT_REASON,)
     writes = (keys.FRONTEND_READY, keys.TOUR_STATE, keys.TOUR_REASON, keys.PROGRESS)
 
@@ -88,7 +89,10 @@ class TourStatus(Leaf):
         return SUCCESS
 
 
-TimeoutName = Literal[tuple(Timeouts.model_fields)]  # type: ignore[valid-type]
+if TYPE_CHECKING:
+    TimeoutName = str  # to the checker; pydantic checks the name against Timeouts' fields
+else:
+    TimeoutName = Literal[tuple(Timeouts.model_fields)]
 
 
 @register
@@ -113,6 +117,7 @@ class WaitEvent(Leaf):
             "failure", description="what a wait that ran out returns"
         )
 
+    params: Params
     reads = (keys.EVENTS, keys.NOW)
 
     def initialise(self) -> None:

@@ -14,7 +14,8 @@ from frog_bt.model.frontend import ContentDone, FrontendIdle, StartPoi
 from frog_bt.model.frontend import FinishPoi as FinishPoiCommand
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.model.ros import Pose, TrackedPeople
-from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Params, Status
+from frog_bt.tree import leaf
+from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Status
 
 
 def someone_within(people: TrackedPeople, pose: Pose, radius: float) -> bool:
@@ -36,7 +37,7 @@ class VisitorFollows(Leaf):
     with a note) rather than abandon them over a sensor dropout.
     """
 
-    class Params(Params):
+    class Params(leaf.Params):  # qualified: mypy may take a bare Params for this one
         radius: float | None = Field(
             None,
             gt=0,
@@ -55,6 +56,7 @@ class VisitorFollows(Leaf):
             ),
         )
 
+    params: Params
     reads = (keys.PEOPLE, keys.POSE, keys.NOW)
 
     def initialise(self) -> None:
@@ -120,6 +122,7 @@ class PlayContent(Leaf):
             ),
         )
 
+    params: Params
     reads = (keys.EVENTS, keys.NOW)
     optional_reads = (keys.WAYPOINT, keys.PAUSED)
 
@@ -175,6 +178,7 @@ class FinishPoi(Leaf):
     """Send ``finish_poi`` for ``poi``. SUCCESS."""
 
     Params = PoiParams
+    params: PoiParams
 
     def update(self) -> Status:
         self.ctx.send(FinishPoiCommand(self.params.poi))

@@ -126,7 +126,8 @@ async def start_people(
     from frog_bt.live.console.webhooks import Webhooks
     from frog_bt.runtime import logctx
 
-    webhooks = Webhooks(executive.site.alerts)
+    webhooks = Webhooks(executive.site.alerts,  # its ack links' key comes from the token
+                        ack_secret=settings.token if settings is not None else None)
     executive.observers.attach(executive, [webhooks])  # every alert change
     logctx.run_as(executive, webhooks.start)  # its lines are the executive's (console log)
     console = await start_console(executive, settings) if settings is not None else None

@@ -293,9 +293,10 @@ async def _main(
     summary = TourSummary(site) if args.once else None
     if summary is not None:
         attach_all(executive, [summary])
-    status = None
+    status: StatusLine | None = None
     if not args.quiet:  # on a terminal a countdown; in a journal, states only
-        status = StatusLine(source=lambda: executive.status_text(countdown=status.tty))
+        line = StatusLine(source=lambda: executive.status_text(countdown=line.tty))
+        status = line
     refresher = None
     if status is not None:
         attach_all(executive, [status])

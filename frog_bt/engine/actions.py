@@ -52,6 +52,13 @@ class Actions:
         self._publish("goto", pose, goal)
         return goal
 
+    def stop(self, here: Pose) -> Goal:
+        """Stop driving now: a goal at the robot's own pose replaces the active one
+        (CONTRACT §1: a new goal replaces the active one). The robot then stands."""
+        goal = self._replace(Goal(next(self._ids), "goto", "(stop here)", here.stamp, here))
+        self._publish("goto", here, goal)
+        return goal
+
     def approach(self, person_id: int) -> Goal:
         self.last_approach_at = now = self._clock.now()
         goal = self._replace(Goal(next(self._ids), "approach", str(person_id), now, person_id))

@@ -19,7 +19,7 @@ from frog_bt.engine.actions import Actions
 from frog_bt.model import keys
 from frog_bt.model.eventlog import EventLog
 from frog_bt.model.frontend import FrontendIdle, FrontendMessage
-from frog_bt.model.key import Key, Reading, Scope
+from frog_bt.model.key import Key, Readable, Reading, Scope
 from frog_bt.model.wire import Input, Keep
 
 T = TypeVar("T")
@@ -40,8 +40,10 @@ class Board:
     def _store(self, key: Key[Any]) -> dict[Key[Any], Any]:
         return self._lasting if key.lasting else self._values
 
-    def get(self, key: Key[T]) -> T | None:
-        return self._store(key).get(key)  # type: ignore[no-any-return]
+    def get(self, key: Readable[T]) -> T | None:
+        assert isinstance(key, Key)  # the one kind of Readable
+        value: T | None = self._store(key).get(key)  # the store holds every key's type
+        return value
 
     def set(self, key: Key[T], value: T | None) -> None:
         self._store(key)[key] = value

@@ -25,7 +25,7 @@ from frog_bt.engine.actions import Actions
 from frog_bt.engine.blackboard import Board, Inputs, Snapshot
 from frog_bt.engine.context import Context
 from frog_bt.engine.loaded import LoadedTree
-from frog_bt.engine.observed import Role, Trace
+from frog_bt.engine.observed import Observed, Role, Trace
 from frog_bt.engine.operator import Answer, Command, Operator
 from frog_bt.engine.standing import Standing
 from frog_bt.model import keys
@@ -86,7 +86,9 @@ class Core:
         self.ctx = Context(clock, site, self.actions, self._send_message, self.journal)
         self.snapshot = Snapshot(self.board, self.inputs, clock, self.actions)
         self.root = tree.root
-        self.stops = [n for n in tree.root.iterate() if getattr(n, "role", None) is Role.STOP]
+        self.stops = [
+            n for n in tree.root.iterate() if isinstance(n, Observed) and n.role is Role.STOP
+        ]
         self.seekers = [n for n in tree.root.iterate() if getattr(n, "role", None) is Role.SEEK]
         self.operator = Operator(self.board, standing, self._stops_now, site.operator.pause_max)
         self.pause_ran_out: AbortReason | None = None  # set by the tick it happened before
@@ -187,11 +189,7 @@ class Core:
 
     def _stops_now(self) -> list[str]:
         """The stops being visited or driven to now (what a skip would leave)."""
-        return [
-            n.params.poi
-            for n in self.stops  # type: ignore[attr-defined]
-            if n.status is Status.RUNNING
-        ]
+        return [n.stop_poi() for n in self.stops if n.status is Status.RUNNING]
 
     def command(self, command: Command, by: str = "") -> Answer:
         """Apply an operator command now: call it between ticks (it takes effect in the

@@ -47,7 +47,7 @@ class Trace:
 class Role(enum.Enum):
     """What the executive asks of a node, by what it declares rather than by its class."""
 
-    STOP = "stop"  # a stop being visited or driven to: what ``skip`` leaves (its params.poi)
+    STOP = "stop"  # a stop being visited or driven to: what ``skip`` leaves (its stop_poi())
     SEEK = "seek"  # the search for a visitor (an alert when it runs too long)
 
 
@@ -59,8 +59,13 @@ class Observed:
     stop_log: list[Behaviour] | None = None
     scope: Scope | None = None  # set by the loader on a node that starts a scope
     role: Role | None = None
+    status: py_trees.common.Status  # the py_trees base's
     _trace: Trace | None = None
     _board: Board | None = None
+
+    def stop_poi(self) -> str:
+        """A :attr:`Role.STOP` node's stop: the POI a skip would leave."""
+        raise NotImplementedError(f"{type(self).__name__} is not a stop")
 
     def setup(self, **kwargs: Any) -> None:
         self._trace = kwargs.get("trace")

@@ -22,7 +22,14 @@ from dataclasses import dataclass
 from frog_bt.engine.blackboard import Board
 from frog_bt.engine.standing import Standing
 from frog_bt.model import keys
-from frog_bt.model.outcomes import AbortCause, AbortReason, IncidentKind, TourState
+from frog_bt.model.help import Help, HelpAbout, HelpAnswer
+from frog_bt.model.outcomes import (
+    AbortCause,
+    AbortReason,
+    DockingState,
+    IncidentKind,
+    TourState,
+)
 
 
 class Command(enum.StrEnum):
@@ -33,6 +40,8 @@ class Command(enum.StrEnum):
     SERVICE_OFF = "service_off"
     SERVICE_ON = "service_on"
     ACK_ALERT = "ack_alert"  # the alerts' business, not the tree's (the executive answers it)
+    RETRY = "retry"  # the robot needs help: try the failed step again
+    DONE_BY_HAND = "done_by_hand"  # the robot needs help: a person did the step
 
 
 TREE_COMMANDS = frozenset(Command) - {Command.ACK_ALERT}
@@ -130,14 +139,56 @@ class Operator:
                 return Answer(False, "already in service")
             board.set(keys.IN_SERVICE, True)
             return Answer(True, "in service: tours start again")
+        if command in (Command.RETRY, Command.DONE_BY_HAND):
+            return self._answer_help(command)
         return Answer(False, f"{command} is not a tree command")
+
+    def _answer_help(self, command: Command) -> Answer:
+        """``retry`` or ``done_by_hand`` while the robot waits for a person; the node that
+        asked takes the answer at the next tick. ``done_by_hand`` is checked first against
+        what the robot reports (docked, undocked, no fault)."""
+        board = self.board
+        help_ = board.get(keys.HELP)
+        if help_ is None:
+            return Answer(False, "the robot does not need help now")
+        if board.get(keys.HELP_ANSWER) is not None:
+            return Answer(False, "an answer is already being acted on")
+        if command is Command.RETRY:
+            board.set(keys.HELP_ANSWER, HelpAnswer.RETRY)
+            return Answer(True, f"trying again: {help_.about.value}")
+        refusal = self._not_done(help_)
+        if refusal is not None:
+            return Answer(False, refusal)
+        board.set(keys.HELP_ANSWER, HelpAnswer.DONE_BY_HAND)
+        return Answer(True, f"going on: {help_.about.by_hand}")
+
+    def _not_done(self, help_: Help) -> str | None:
+        """Why ``done_by_hand`` cannot be true yet, from what the robot reports; None."""
+        about = help_.about
+        if about in (HelpAbout.DOCK, HelpAbout.HOME, HelpAbout.UNDOCK):
+            want = DockingState.UNDOCKED if about is HelpAbout.UNDOCK else DockingState.DOCKED
+            reading = self.board.get(keys.DOCKING)
+            state = reading.value if reading is not None else "nothing"
+            if state != want:
+                return (
+                    f"the robot reports {state} on /docking/state, not {want.value}: "
+                    "finish the step, then answer again"
+                )
+        if about is HelpAbout.FAULT:
+            reading = self.board.get(keys.DIAGNOSTICS)
+            if reading is not None and reading.value.faults:
+                return f"the robot still reports a fault: {'; '.join(reading.value.faults)}"
+        return None
 
     def _unpause(self) -> None:
         self.board.set(keys.PAUSED, False)
         self.standing.paused_since = None
 
     def check_pause(self, now: float) -> AbortReason | None:
-        """Before each tick: a pause that ran out ends the tour politely (its reason)."""
+        """Before each tick: a pause that ran out ends the tour politely (its reason). A
+        pause restored after a restart counts from the first tick that sees it."""
+        if self.paused_since is None and self.board.get(keys.PAUSED):
+            self.standing.paused_since = now
         if self.paused_since is None or now - self.paused_since < self.pause_max:
             return None
         self._unpause()

@@ -29,8 +29,10 @@ def running_child(node: Behaviour) -> Behaviour | None:
     if isinstance(node, py_trees.decorators.Decorator):
         child: Behaviour | None = node.decorated
         return child if child is not None and child.status is Status.RUNNING else None
-    if not isinstance(node, py_trees.composites.Parallel):
-        child = getattr(node, "current_child", None)
+    if isinstance(node, py_trees.composites.Composite) and not isinstance(
+        node, py_trees.composites.Parallel
+    ):
+        child = node.current_child
         if child is not None and child.status is Status.RUNNING:
             return child
     return next((c for c in node.children if c.status is Status.RUNNING), None)

@@ -36,6 +36,8 @@ from frog_bt.warning_limit import WarningLimiter
 log = logging.getLogger(__name__)
 
 Address = tuple[str, int]
+# What a datagram came from: (host, port), and for IPv6 also (flowinfo, scope_id).
+SockAddr = tuple[str, int, *tuple[int, ...]]
 # (direction "in" | "out", datagram, clock time): a tap for recordings (CONTRACT §6).
 DatagramTap = Callable[[str, bytes, float], None]
 
@@ -55,7 +57,7 @@ class _DatagramProtocol(asyncio.DatagramProtocol):
     def __init__(self, link: FrontendLink) -> None:
         self._link = link
 
-    def datagram_received(self, data: bytes, addr: tuple) -> None:  # type: ignore[override]
+    def datagram_received(self, data: bytes, addr: SockAddr) -> None:
         self._link._datagram_received(data, addr)
 
     def error_received(self, exc: Exception) -> None:
@@ -235,7 +237,7 @@ class FrontendLink:
         ):
             self._wakeup.set()
 
-    def _sendto(self, data: bytes, addr: tuple, now: float) -> None:
+    def _sendto(self, data: bytes, addr: SockAddr, now: float) -> None:
         assert self._transport is not None
         self._transport.sendto(data, addr)
         if self.on_datagram is not None:
@@ -273,7 +275,7 @@ class FrontendLink:
 
     # ------------------------------------------------------------ receiving
 
-    def _datagram_received(self, data: bytes, addr: tuple) -> None:
+    def _datagram_received(self, data: bytes, addr: SockAddr) -> None:
         now = self.clock.now()
         if addr[0] == self._endpoint.peer_host:
             self.last_heard = now

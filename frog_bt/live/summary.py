@@ -146,7 +146,8 @@ class TourSummary:
         ]
         if self.resumed:
             out.append(f"resumed:   {self.resumed}")
-        counts = Counter(i.kind for i in self.incidents if i.kind is not IncidentKind.RESUMED)
+        # by kind; a link's own count replaces its kind's (IncidentKind is a StrEnum)
+        counts = Counter[str](i.kind for i in self.incidents if i.kind is not IncidentKind.RESUMED)
         if frontend is not None and frontend.peer_restarts:
             counts["front end restarted"] = frontend.peer_restarts
         if frontend is not None and frontend.unacked:
@@ -167,10 +168,10 @@ MAX_LISTED = 12  # incidents listed one per line (the counts cover all of them)
 
 
 def _words(items: list[Any]) -> str:
-    items = [str(i) for i in items]
-    if len(items) <= 1:
-        return "".join(items)
-    return ", ".join(items[:-1]) + " and " + items[-1]
+    words = [str(i) for i in items]
+    if len(words) <= 1:
+        return "".join(words)
+    return ", ".join(words[:-1]) + " and " + words[-1]
 
 
 def _visitors(approached: list[int], recruited: list[int]) -> str:

@@ -11,6 +11,7 @@ gives the JSON fields of a message (without ``type`` and ``seq``).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Annotated, Any, ClassVar, Literal, Union
 
 import msgspec
@@ -167,7 +168,11 @@ class DatagramDecoder:
         self.table = table
         datagrams = {_datagram(cls): cls for cls in table.values()}
         self._plain = datagrams
-        self._decode = decoder(Union[(Ack, *datagrams)])  # type: ignore[arg-type]
+        # A Union made at run time is a type form, not a ``type[T]`` (no TypeForm before
+        # PEP 747): what it decodes is an Ack or one of the datagram classes.
+        self._decode: Callable[[bytes | str], Ack | FrontendMessage] = decoder(
+            Union[(Ack, *datagrams)]  # type: ignore[arg-type]
+        )
 
     def decode(self, data: bytes) -> tuple[int, FrontendMessage | None]:
         """``(seq, message)``, ``message`` None for an ack; DecodeError naming the field."""
@@ -175,7 +180,8 @@ class DatagramDecoder:
         if isinstance(datagram, Ack):
             return datagram.seq, None
         cls = self._plain[type(datagram)]
-        return datagram.seq, cls(*(getattr(datagram, f) for f in cls.__struct_fields__))
+        seq: int = msgspec.structs.asdict(datagram)["seq"]  # the datagram class's own field
+        return seq, cls(*(getattr(datagram, f) for f in cls.__struct_fields__))
 
 
 def decode_message(

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
 T = TypeVar("T")
+T_co = TypeVar("T_co", covariant=True)
 
 
 class Source(enum.Enum):
@@ -40,8 +41,20 @@ class Scope(enum.IntEnum):
         return self >= scope and self is not Scope.PROCESS
 
 
+class Readable(Generic[T_co]):
+    """A key as a read sees it: what :meth:`Board.get <frog_bt.engine.blackboard.Board.get>`
+    and a leaf's ``get`` take. :class:`Key` is invariant in its value type, so that a write
+    of the wrong type is an error; a read takes this covariant view of it, so that
+    ``bool(board.get(keys.PAUSED))`` or an f-string, whose context is ``object``, still
+    reads a ``Key[bool]`` (mypy infers from that outer context first: python/mypy#17654)."""
+
+    __slots__ = ()
+    name: str
+    lasting: bool
+
+
 @dataclass(frozen=True, slots=True, eq=False)
-class Key(Generic[T]):
+class Key(Readable[T]):
     """One value of the tour: ``name`` (as tree files, docs and telemetry show it), the
     ``type`` of its value (None is always allowed: not written yet, or cleared), its
     ``source``, its ``scope`` and what it means (``doc``). A ``lasting`` key is the

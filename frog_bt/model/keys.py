@@ -20,6 +20,7 @@ from typing import Any, TypeVar
 from frog_bt.maths.engagement import Decision, Samples
 from frog_bt.model.eventlog import EventLog
 from frog_bt.model.goals import Goal
+from frog_bt.model.help import Help, HelpAnswer
 from frog_bt.model.key import Key, Reading, Scope, Source
 from frog_bt.model.outcomes import AbortReason, Incident, TourState
 from frog_bt.model.progress import Progress, Resume
@@ -171,12 +172,40 @@ IN_SERVICE = _key(
     lasting=True,
 )
 
+# -- a person's help (the robot holds and asks; CONTRACT §7 help)
+HELP = _key(
+    "/help",
+    Help,
+    L,
+    Scope.PROCESS,
+    "the robot holds and waits for a person: about what, since when",
+    lasting=True,
+)
+HELP_ANSWER = _key(
+    "/help_answer",
+    HelpAnswer,
+    E,
+    Scope.PROCESS,
+    "a person's answer to /help (retry, done_by_hand), taken by the node that asked",
+    lasting=True,
+)
+HELP_RESTORED = _key(
+    "/help_restored",
+    Help,
+    E,
+    Scope.PROCESS,
+    "help still pending when the executive last stopped (restored at start-up)",
+    lasting=True,
+)
+
 # -- one tour
-DECLINED = _key("/declined", frozenset, L, Scope.TOUR, "visitor ids who said no this tour")
-APPROACH_FAILED = _key(
+DECLINED: Key[frozenset[int]] = _key(
+    "/declined", frozenset, L, Scope.TOUR, "visitor ids who said no this tour"
+)
+APPROACH_FAILED: Key[dict[int, float]] = _key(
     "/approach_failed", dict, L, Scope.TOUR, "visitor id -> project time an approach of them failed"
 )
-SPECIAL_DONE = _key(
+SPECIAL_DONE: Key[frozenset[str]] = _key(
     "/special_done", frozenset, L, Scope.TOUR, "special-content spots announced this tour"
 )
 VISITOR = _key("/visitor", int, L, Scope.TOUR, "the tracked id of the visitor being guided")

@@ -17,9 +17,8 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Annotated, Any, ClassVar, Generic, TypeVar
+from typing import Annotated, Any, ClassVar, Generic, Protocol, TypeVar
 
 import msgspec
 
@@ -322,15 +321,26 @@ class ClockMsg(msgspec.Struct, frozen=True):
 # ---------------------------------------------------------------- codecs by ROS type
 
 
+class Wire(Protocol[V]):
+    """What a wire Struct has: its ROS type name, its ``value()``, and ``of(value)``."""
+
+    ros_type: ClassVar[str]
+
+    def value(self) -> V: ...
+
+    @classmethod
+    def of(cls, value: V, /) -> Wire[V]: ...
+
+
 class RosType(Generic[V]):
     """One ROS type's codec: ``decode`` (a rosbridge ``msg``, as JSON text) and
     ``convert`` (the same as Python objects) give the value or raise DecodeError;
     ``encode`` gives the ``msg`` object of a value; ``schema`` its JSON schema."""
 
-    def __init__(self, wire: Any) -> None:
+    def __init__(self, wire: type[Wire[V]]) -> None:
         self.name: str = wire.ros_type
         self.wire = wire
-        self._decode: Callable[[bytes | str], Any] = decoder(wire)
+        self._decode = decoder(wire)
 
     def decode(self, raw: bytes | str) -> V:
         return self._decode(raw).value()
@@ -340,7 +350,8 @@ class RosType(Generic[V]):
 
     def encode(self, value: V) -> dict[str, Any]:
         """The ``msg`` object (JSON types: lists, not tuples)."""
-        return msgspec.json.decode(encode(self.wire.of(value)))  # NaN raises ValueError
+        msg: dict[str, Any] = msgspec.json.decode(encode(self.wire.of(value)))  # NaN: ValueError
+        return msg
 
     def schema(self) -> dict[str, Any]:
         return msgspec.json.schema(self.wire)

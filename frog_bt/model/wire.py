@@ -21,7 +21,7 @@ from __future__ import annotations
 import enum
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 from frog_bt.model import ros as msgs
 from frog_bt.model.frontend import COMMANDS, EVENTS
@@ -36,6 +36,8 @@ from frog_bt.model.ros import (
 )
 
 __all__ = ["CLOCK", "COMMANDS", "EVENTS", "INPUTS", "OUTPUTS", "Input", "Keep", "Response", "Topic"]
+
+T = TypeVar("T")
 
 
 class Keep(enum.Enum):
@@ -57,7 +59,7 @@ class Topic:
         return self.codec.name
 
 
-def input_key(name: str, type_: Any, doc: str) -> Key[Any]:
+def input_key(name: str, type_: type[T], doc: str) -> Key[T]:
     """The key an input's snapshot writes: ``Reading[T]`` for :attr:`Keep.LATEST`, a
     tuple for the others; kept for the executive's life."""
     return Key(name, type_, Source.INPUT, Scope.PROCESS, doc)

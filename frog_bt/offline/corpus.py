@@ -82,9 +82,9 @@ def replay_file(path: str, tree: str | None, site: Site) -> TourRow:
         reason = f"{type(exc).__name__}: {exc}".splitlines()[0][:200]
         return TourRow(path, "unreadable", reason=reason)
     div = result.divergence
-    bad = {"bad": result.bad_count, "bad_first": result.bad[0] if result.bad else ""}
+    bad, bad_first = result.bad_count, result.bad[0] if result.bad else ""
     if div is None:
-        return TourRow(path, "identical", recovered=recovered, **bad)
+        return TourRow(path, "identical", recovered=recovered, bad=bad, bad_first=bad_first)
     diff = differences(div.expected, div.got, site)
     recorded = div.expected.node if div.expected else ""
     replayed = div.got.node if div.got else ""
@@ -99,7 +99,8 @@ def replay_file(path: str, tree: str | None, site: Site) -> TourRow:
         replayed_node=replayed,
         signature=f"{node}: {what_differs(div.expected, div.got, site)}",
         recovered=recovered,
-        **bad,
+        bad=bad,
+        bad_first=bad_first,
     )
 
 

@@ -61,7 +61,7 @@ class Frame(msgspec.Struct):
 
 
 _decode_frame = decoder(Frame)
-_decode_any = decoder(Any)  # type: ignore[arg-type]
+_decode_any = decoder(Any)
 
 
 def decode_frame(text: str | bytes) -> Inbound:
@@ -151,7 +151,7 @@ class Session:
     subscriptions: dict[str, Subscription] = field(default_factory=dict)
     dropped: int = 0
     _queue: deque[tuple[str, Any]] = field(default_factory=deque)
-    _ids: itertools.count = field(default_factory=lambda: itertools.count(1))
+    _ids: itertools.count[int] = field(default_factory=lambda: itertools.count(1))
 
     def _id(self, op: str, topic: str) -> str:
         return f"{op}:{topic}:{next(self._ids)}"

@@ -36,7 +36,7 @@ from frog_bt.model.progress import EMPTY, Progress
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.rosbridge.link import LinkState
-from frog_bt.runtime import logctx
+from frog_bt.runtime import decisions, logctx
 from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
 from frog_bt.runtime.notify import Notifier
@@ -100,6 +100,7 @@ class Executive:
         self.core = self._core(site, tree)
         self.checkpoint = checkpoint
         self._saved: Progress = EMPTY
+        self._decided = decisions.NONE  # what staff decided, as last saved
         if checkpoint is not None and not fresh:
             self.core.board.set(keys.RESUME, load_checkpoint(checkpoint, site.checkpoint.max_age))
         self._wake = asyncio.Event()
@@ -113,8 +114,33 @@ class Executive:
         self._link_states = states(self)
         self.swaps = 0
         self.staff = Staff(self)  # operator commands and alerts
+        if checkpoint is not None and not fresh:
+            self._decided = decisions.load(decisions.path_for(checkpoint))
+            self._restore(self._decided)
         self.staff.book.listeners.append(self._on_alert)
         self.notifier = Notifier.from_env()  # systemd: READY, STATUS, watchdog pings
+
+    def _restore(self, decided: decisions.Decisions) -> None:
+        """What staff decided before a restart holds again: out of service, a pause (its
+        bound counts from now), the help the robot waits for, the alerts acknowledged."""
+        board = self.core.board
+        board.set(keys.IN_SERVICE, decided.in_service)
+        board.set(keys.PAUSED, decided.paused)
+        board.set(keys.HELP_RESTORED, decided.help)
+        self.staff.remembered_acks = set(decided.acknowledged)
+        if decided != decisions.NONE:
+            log.info("restored what staff decided: %s", decided.to_json())
+
+    def decided(self) -> decisions.Decisions:
+        """What staff decided now (saved beside the checkpoint whenever it changes)."""
+        board = self.core.board
+        help_ = board.get(keys.HELP) or board.get(keys.HELP_RESTORED)
+        return decisions.Decisions(
+            in_service=board.get(keys.IN_SERVICE) is not False,
+            paused=bool(board.get(keys.PAUSED)),
+            help=help_,
+            acknowledged=self.staff.acknowledged_ids(),
+        )
 
     def _core(self, site: Site, tree: LoadedTree) -> Core:
         """A core for ``tree``, on this executive's links, observers and standing state."""
@@ -341,6 +367,19 @@ class Executive:
                     "checkpoint",
                     f"cannot write the checkpoint {self.checkpoint}: {exc.strerror or exc}",
                 )
+        decided = self.decided()
+        if self.checkpoint is not None and decided != self._decided:
+            self._decided = decided
+            try:
+                decisions.save(decisions.path_for(self.checkpoint), decided)
+            except OSError as exc:
+                self._checkpoint_warnings.warn(
+                    "decisions", f"cannot keep what staff decided: {exc.strerror or exc}"
+                )
+        help_ = self.core.board.get(keys.HELP)
+        if help_ is not None and self.once:  # CONTRACT §5: --once exits with the reason
+            self.stop(f"needs help: {help_.what}", 1)
+            return
         if status == Status.SUCCESS:
             board = self.core.board
             if board.get(keys.TOUR_STATE) is TourState.ABORTED:

@@ -47,6 +47,7 @@ class Staff:
     link_since: dict[str, tuple[LinkStatus, float]] = field(default_factory=dict)
     _queue: list[Queued] = field(default_factory=list)
     _seeking_since: float | None = None
+    remembered_acks: set[str] = field(default_factory=set)  # acknowledged before a restart
     _pause_ran_out: bool = False
     _touring: bool = False
 
@@ -125,7 +126,15 @@ class Staff:
         """Raise or clear alerts from what the executive knows now (also between ticks:
         a robot out of reach does not tick)."""
         self.links_changed(now)
-        self.book.update(self.facts(now))
+        for alert in self.book.update(self.facts(now)):
+            if alert.state == "raised" and alert.id in self.remembered_acks:
+                self.book.acknowledge(alert.id, now)  # acknowledged before a restart
+        self.remembered_acks &= set(self.book.active)  # cleared since: forgotten
+
+    def acknowledged_ids(self) -> frozenset[str]:
+        """The alerts still up that a person has acknowledged (kept across a restart)."""
+        book = self.book
+        return frozenset(i for i in book.active if i not in book.unacknowledged)
 
     def facts(self, now: float) -> Facts:
         exe = self.executive

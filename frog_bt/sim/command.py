@@ -35,7 +35,8 @@ time just runs slower.
 
 Scenarios: --scenario takes a built-in name (default, morning, afternoon,
 bored, no_visitor, declines, wander_off, nav_failure, undock_failure, fault,
-silent_frontend) or the path of a YAML file. Every key is
+silent_frontend; and where the robot asks a person for help: dock_fails,
+undock_fails, home_fails, fault_persists) or the path of a YAML file. Every key is
 optional; `extends: NAME|FILE` starts from another scenario. Times called `at`
 are seconds of simulated time after the start.
 
@@ -103,6 +104,7 @@ from frog_bt.clock import SITE_TZ
 
 if TYPE_CHECKING:
     from frog_bt.sim.scenario import Scenario
+    from frog_bt.sim.site import PoiPose
     from frog_bt.sim.traffic import Record
 
 log = logging.getLogger(__name__)
@@ -258,7 +260,7 @@ def run(args: argparse.Namespace) -> int:
         return 2
 
 
-async def _serve(args: argparse.Namespace, scenario: Scenario, pois: dict) -> int:
+async def _serve(args: argparse.Namespace, scenario: Scenario, pois: dict[str, PoiPose]) -> int:
     from frog_bt.sim.simulator import Simulator
 
     sim = Simulator(

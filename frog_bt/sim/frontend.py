@@ -48,7 +48,7 @@ class _Timer:
     due: float
     kind: str  # idle | restart | introduction | answer | content
     poi: str = ""
-    part: str = ""
+    part: fm.Part | None = None  # a content timer's
 
 
 class FrontendModel:
@@ -164,6 +164,7 @@ class FrontendModel:
             yes = self._answer()
             return self._send(fm.UserPositive() if yes else fm.UserNegative(), now)
         self.playing = None
+        assert timer.part is not None, "a content timer has its part"
         return self._send(fm.ContentDone(timer.poi, timer.part), now)
 
     def restart(self, now: float) -> list[bytes]:

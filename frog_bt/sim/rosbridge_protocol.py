@@ -240,7 +240,8 @@ class BridgeServer:
 
     def _call_service(self, state: Client, frame: dict[str, Any], now: float) -> list[Action]:
         service = _text(frame, "service")
-        args = frame.get("args") if isinstance(frame.get("args"), dict) else {}
+        given = frame.get("args")
+        args: dict[str, Any] = given if isinstance(given, dict) else {}
         values: Any
         result = True
         if service == "/rosapi/get_time":

@@ -14,7 +14,7 @@ import asyncio
 import contextlib
 import logging
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from websockets.asyncio.server import Server, ServerConnection, serve
@@ -96,7 +96,7 @@ class RosbridgeServer:
         """Send one publish to every client subscribed to ``topic``."""
         self.dispatch(self.protocol.publish(topic, msg, self.now()))
 
-    def dispatch(self, actions: list[Action]) -> None:
+    def dispatch(self, actions: Sequence[Action]) -> None:
         for action in actions:
             if isinstance(action, Send):
                 self._enqueue(action.client, action.text)

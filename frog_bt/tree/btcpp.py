@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -37,6 +38,8 @@ from frog_bt.errors import TreeError
 from frog_bt.tree.catalogue import NodeType, catalogue
 from frog_bt.tree.factory import NodeFactory
 from frog_bt.yamlfile import load_yaml
+
+Load = Callable[[str], dict[str, Any]]  # a tree document, by the path that includes it
 
 CONTROLS = {
     ("Sequence", True): "Sequence",
@@ -76,7 +79,7 @@ class _Exporter:
         self.used: set[str] = set()
         self.stack: list[str] = []
 
-    def document(self, tree_id: str, data: dict[str, Any], load: Any) -> None:
+    def document(self, tree_id: str, data: dict[str, Any], load: Load) -> None:
         if tree_id in self.trees or tree_id in self.stack:
             return
         self.stack.append(tree_id)
@@ -88,7 +91,7 @@ class _Exporter:
             element.append(child)
         self.stack.pop()
 
-    def node(self, data: dict[str, Any], load: Any) -> list[ET.Element]:
+    def node(self, data: dict[str, Any], load: Load) -> list[ET.Element]:
         if "foreach" in data:
             stops = [] if self.site is None else self.site.tour.stops
             out = []
@@ -178,7 +181,7 @@ def to_xml(
     tree_path: Path,
     site: Site | None,
     factory: NodeFactory,
-    documents: dict[str, Any] | None = None,
+    documents: dict[str, dict[str, Any]] | None = None,
 ) -> str:
     """The tree file at ``tree_path`` (and what it includes) as BT.CPP v4 XML; with
     ``documents`` (an imported XML's), those instead of the files."""
@@ -186,7 +189,7 @@ def to_xml(
     def load(target: str, base: Path = tree_path.parent) -> dict[str, Any]:
         if documents is not None:
             return documents[Path(target).stem]
-        data = load_yaml(base / target, TreeError)
+        data: dict[str, Any] = load_yaml(base / target, TreeError)  # a tree file (YAML)
         return data
 
     exporter = _Exporter(site)
@@ -260,7 +263,7 @@ def _from_element(element: ET.Element) -> dict[str, Any]:
     return data
 
 
-def read_xml(path: Path) -> tuple[dict[str, Any], str]:
+def read_xml(path: Path) -> tuple[dict[str, dict[str, Any]], str]:
     """The tree documents of a BT.CPP v4 XML file (by BehaviorTree ID) and the main ID."""
     try:
         root = ET.parse(path).getroot()
@@ -268,7 +271,7 @@ def read_xml(path: Path) -> tuple[dict[str, Any], str]:
         raise TreeError(str(path), (), f"cannot read BT.CPP XML: {exc}") from None
     if root.get("BTCPP_format") != "4":
         raise TreeError(str(path), (), 'expected <root BTCPP_format="4">')
-    documents: dict[str, Any] = {}
+    documents: dict[str, dict[str, Any]] = {}
     for tree in root.findall("BehaviorTree"):
         children = list(tree)
         if len(children) != 1:

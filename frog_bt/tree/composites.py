@@ -26,14 +26,14 @@ SCOPE_DOC = (
 )
 
 
-class _Composite(Observed):
+class _Composite(Observed, py_trees.composites.Composite):
     Params: ClassVar[type[Params]]
 
     def initialise(self) -> None:
         self.start_scope()  # py_trees calls it from the tick, as the composite starts
 
     @classmethod
-    def build(cls, name: str, params: Any, children: list[Behaviour]) -> Behaviour:
+    def build(cls, name: str, params: Any, children: list[Behaviour]) -> _Composite:
         """The node for a tree file's entry: py_trees' composite, starting its scope."""
         node = cls._make(name, params, children)
         if params.scope is not None:

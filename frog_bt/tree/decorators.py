@@ -70,6 +70,8 @@ class Retry(FrogDecorator, py_trees.decorators.Retry):
             None, ge=1, description=("runs in all (null: until it succeeds)")
         )
 
+    params: Params
+
     def base_kwargs(self, params: Any) -> dict[str, Any]:
         return {"num_failures": params.attempts or math.inf}
 
@@ -88,6 +90,8 @@ class Timeout(FrogDecorator):
         seconds: float = Field(
             gt=0, allow_inf_nan=False, description=("project-clock seconds the child may run")
         )
+
+    params: Params
 
     def initialise(self) -> None:
         self.deadline = self.ctx.clock.now() + self.params.seconds

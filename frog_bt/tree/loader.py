@@ -44,7 +44,9 @@ from pydantic import BaseModel
 
 from frog_bt import resources
 from frog_bt.config import Site
-from frog_bt.engine.loaded import LoadedTree, Path_, Where
+from frog_bt.engine.loaded import LoadedTree as LoadedTree  # re-exported: what load gives
+from frog_bt.engine.loaded import Path_, Where
+from frog_bt.engine.observed import Observed
 from frog_bt.errors import TreeError, TreeErrors, format_path
 from frog_bt.model.key import Scope
 from frog_bt.model.keys import by_name
@@ -158,6 +160,7 @@ class _Builder:
             raise TreeError(file, (*path, "type"), f"expected a type name, got {_short(type_)}")
         name = self._subst(data.get("name", ""), file, (*path, "name"), variables)
         factory = self.factory
+        behaviour: Behaviour | None
         if type_ in factory.composites:
             behaviour = self._composite(type_, data, file, path, variables, name)
         elif type_ in factory.decorators:
@@ -291,7 +294,8 @@ class _Builder:
                 {k: v for k, v in data.items() if k != "foreach"}, file, path, {**variables, **stop}
             )
             for n in nodes:
-                n.scope = Scope.STOP  # type: ignore[attr-defined] - every built node is Observed
+                assert isinstance(n, Observed), n  # the loader builds only Observed nodes
+                n.scope = Scope.STOP
                 self.scopes[id(n)] = Scope.STOP
             out += nodes
         return out

@@ -12,13 +12,13 @@ connects. At run time ``setup`` hands the node the
 from __future__ import annotations
 
 from collections.abc import Iterator
-from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol, TypeVar
 
 import py_trees
 from pydantic import BaseModel, ConfigDict
 
 from frog_bt.engine.context import Context
-from frog_bt.model.key import Key, Source
+from frog_bt.model.key import Key, Readable, Source
 from frog_bt.model.outcomes import IncidentKind
 
 if TYPE_CHECKING:
@@ -35,7 +35,7 @@ class MissingValue(Exception):
     """A required key a tree node writes has no value yet (the tree was built wrong
     past the load-time check): the reading node fails with this reason."""
 
-    def __init__(self, key: Key[Any]) -> None:
+    def __init__(self, key: Readable[Any]) -> None:
         super().__init__(key.name)
         self.key = key
 
@@ -46,10 +46,20 @@ class Params(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
+class NodeParams(Protocol):
+    """What the base reads of a node's parameters (an instance of its ``Params``). A node
+    type that reads their fields declares ``params: Params`` in its class body, and the
+    checker holds ``self.params.poi``; a base may ask more of its subclasses' ``Params``
+    with a protocol of its own (``GoalLeaf``: a ``timeout``)."""
+
+    def model_dump(self, *, exclude_none: bool = ...) -> dict[str, Any]: ...
+
+
 class Declared:
     """Mixin for py_trees behaviours: declared parameters and keys, context, board."""
 
     Params: ClassVar[type[BaseModel]] = Params
+    params: NodeParams
     reads: ClassVar[tuple[Key[Any], ...]] = ()
     optional_reads: ClassVar[tuple[Key[Any], ...]] = ()
     writes: ClassVar[tuple[Key[Any], ...]] = ()
@@ -58,7 +68,7 @@ class Declared:
     def _declare(self, params: BaseModel | None) -> None:
         """Call from ``__init__`` once the py_trees base is initialised."""
         self._reads_any = bool(self.reads or self.optional_reads)  # blame: a decider
-        self.params: Any = params if params is not None else type(self).Params()
+        self.params = params if params is not None else type(self).Params()
         self._ctx: Context | None = None
         self._bb: Board | None = None
         self._trace_: Trace | None = None
@@ -77,7 +87,7 @@ class Declared:
             raise RuntimeError(f"{self.name}: ticked before setup(ctx=...)")
         return self._ctx
 
-    def get(self, key: Key[T]) -> T | None:
+    def get(self, key: Readable[T]) -> T | None:
         """The board's value of ``key`` (declared in ``reads``, ``optional_reads`` or
         ``writes``), None while nothing has written it.
 
@@ -93,7 +103,7 @@ class Declared:
             raise MissingValue(key)
         return value
 
-    def need(self, key: Key[T]) -> T:
+    def need(self, key: Readable[T]) -> T:
         """:meth:`get` for a key the snapshot always writes (``/now``, ``/events``)."""
         value = self.get(key)
         assert value is not None, f"{key.name} is written before every tick"
@@ -116,7 +126,7 @@ class Declared:
             if self._reads_any and self.status in ENDED:  # type: ignore[attr-defined]
                 trace.decided.append(self)  # type: ignore[arg-type]
         except MissingValue as missing:
-            self.feedback_message = f"no value for {missing.key.name}"  # type: ignore[attr-defined]
+            self.feedback_message = f"no value for {missing.key.name}"
             self.ctx.note(
                 f"{self.name}: no value for {missing.key.name}; failing",
                 incident=IncidentKind.MISSING_VALUE,

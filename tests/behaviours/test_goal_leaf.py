@@ -48,7 +48,7 @@ class Fetch(GoalLeaf):
 class PausedFetch(Fetch):
     """Fetch that waits while the operator pauses."""
 
-    optional_reads = (keys.PAUSED,)
+    optional_reads = (keys.PAUSED, keys.POSE)
     waits_while_paused = True
 
 
@@ -149,7 +149,17 @@ def test_the_operators_pause_holds_the_send_of_a_leaf_that_waits(bench):
     bench.core.board.set(keys.PAUSED, False)
     assert bench.tick() == RUNNING
     assert sent(bench) == ["/GotoWayPoint"]
-    bench.core.board.set(keys.PAUSED, True)  # a pause after the send holds nothing today
+    bench.pose(100.0, 30.0)
+    bench.core.board.set(keys.PAUSED, True)  # a pause while the goal is out: stop now
+    assert bench.tick() == RUNNING
+    stop = bench.take_published()[-1]
+    assert stop[0] == "/GotoWayPoint"
+    assert stop[1]["pose"]["position"]["x"] == 100.0  # a goal where the robot is
+    bench.ros("response", 2)  # the robot stands: that answers the stop, not the leaf
+    assert bench.tick() == RUNNING
+    bench.core.board.set(keys.PAUSED, False)  # resume: the goal again
+    assert bench.tick() == RUNNING
+    assert bench.take_published()[-1][1]["pose"]["position"]["x"] != 100.0
     bench.ros("response", 2)
     assert bench.tick() == SUCCESS
 
@@ -163,7 +173,7 @@ def test_the_pause_does_not_hold_a_leaf_that_does_not_wait(bench):
 def test_a_subclass_must_declare_what_the_base_reads():
     with pytest.raises(TypeError, match="Blind reads /goal without declaring it"):
         type("Blind", (GoalLeaf,), {"reads": (keys.NOW,)})
-    with pytest.raises(TypeError, match="Deaf reads /paused without declaring it"):
+    with pytest.raises(TypeError, match="Deaf reads /paused, /pose without declaring it"):
         type("Deaf", (GoalLeaf,), {"reads": (keys.NOW, keys.GOAL), "waits_while_paused": True})
 
 

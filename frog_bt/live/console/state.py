@@ -18,6 +18,7 @@ import py_trees
 from frog_bt.engine.walk import children, running_path
 from frog_bt.live.telemetry.site_map import poi_marks, tour_routes, zone_outlines
 from frog_bt.model import keys
+from frog_bt.model.help import Help
 from frog_bt.model.outcomes import TourState
 from frog_bt.runtime.logctx import OwnedBy
 from frog_bt.runtime.status import phase
@@ -119,6 +120,7 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock)
         "battery": diagnostics.value.battery if diagnostics is not None else None,
         "paused": bool(board.get(keys.PAUSED)),
         "in_service": board.get(keys.IN_SERVICE) is not False,
+        "help": _help(board.get(keys.HELP)),
         "touring": touring,
         "links": links,
         "links_for_s": {name: now - since[name][1] for name in links if name in since},
@@ -141,4 +143,17 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock)
         "path": running_names(core.root),
         "log": list(logs.lines),
         "time": now,
+    }
+
+
+def _help(help_: Help | None) -> dict[str, Any] | None:
+    """CONTRACT §7 ``help``: what is wrong, since when, the answers a person can give."""
+    if help_ is None:
+        return None
+    return {
+        "what": help_.what,
+        "since": help_.since,
+        "answers": list(help_.answers),
+        "about": help_.about.value,
+        "by_hand": help_.about.by_hand,
     }

@@ -45,7 +45,7 @@ class TelemetryObserver(ABC):
 
     def on_event(self, event: Event) -> None:
         if type(event) is LinksChanged:
-            self.on_links(event.t, event.links)  # type: ignore[union-attr]
+            self.on_links(event.t, event.links)
         else:
             self.rows.on_event(event)
 

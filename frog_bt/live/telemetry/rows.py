@@ -27,16 +27,18 @@ import py_trees
 from frog_bt.live.telemetry.layout import TreeIndex
 from frog_bt.model import keys
 from frog_bt.model.events import Event, FrontendIn, FrontendOut, RobotCommand, RobotInput, Ticked
+from frog_bt.model.key import Key
 from frog_bt.model.outcomes import Level
 from frog_bt.model.wire import INPUTS
 
 if TYPE_CHECKING:
     from frog_bt.config import Site
     from frog_bt.engine.core import Core
+    from frog_bt.engine.journal import Note
     from frog_bt.runtime.observer import Host
 
 Status = py_trees.common.Status
-ENGAGEMENT_KEYS = (keys.ENGAGEMENT_METER, keys.ENGAGEMENT_DECISION)
+ENGAGEMENT_KEYS: tuple[Key[Any], ...] = (keys.ENGAGEMENT_METER, keys.ENGAGEMENT_DECISION)
 
 
 @dataclass(slots=True)
@@ -54,13 +56,17 @@ class Batch:
 
     def restamp(self, t: float) -> None:
         """Give rows that arrived before the clock had a time (NaN) the time ``t``."""
-        for rows in (self.poses, self.inputs, self.outputs, self.events):
+        for rows in self._stamped():
             rows[:] = [(r[0], t, *r[2:]) if math.isnan(r[1]) else r for r in rows]
 
     def drop_unstamped(self) -> None:
         """Drop rows that still have no time (the clock never got one)."""
-        for rows in (self.poses, self.inputs, self.outputs, self.events):
+        for rows in self._stamped():
             rows[:] = [r for r in rows if not math.isnan(r[1])]
+
+    def _stamped(self) -> tuple[list[tuple[Any, ...]], ...]:
+        """The rows stamped with the time: ``(tick, t, ...)``."""
+        return (self.poses, self.inputs, self.outputs, self.events)
 
     def __len__(self) -> int:
         return (
@@ -97,7 +103,7 @@ class Rows:
         self._statuses: tuple[Status, ...] = ()
         self._current: list[Status] = []
         self._scan_all = True  # read every node's status at the next tick
-        self._last_note: tuple[float, str] | None = None
+        self._last_note: Note | None = None
         self._blackboard: dict[str, Any] = {}
         self._ticks_since_drain = 0
         self._unstamped = False

@@ -230,7 +230,9 @@ class Writer:
         )
         config = rr.StateConfiguration(
             values=list(STATES),
-            colors=np.array([STATUS_COLORS[Status[s]] for s in STATES], dtype=np.uint32),
+            colors=np.array(
+                [STATUS_COLORS[py_trees.common.Status[s]] for s in STATES], dtype=np.uint32
+            ),
         )
         for node in nodes:
             rec.log(status_path(node.key), config, static=True)

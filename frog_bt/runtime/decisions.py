@@ -1,0 +1,95 @@
+"""What staff decided, kept across a restart: a small file beside the checkpoint.
+
+Out of service, a pause, the help the robot waits for and the alerts a person has
+acknowledged must outlive the process (systemd's ``Restart=always`` brings a new one up
+at once): :func:`save` writes them atomically whenever they change, :func:`load` gives
+them back at start-up. ``--fresh`` (and ``--checkpoint none``) start without them.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from frog_bt.model.help import Help, HelpAbout
+
+__all__ = ["Decisions", "load", "path_for", "save"]
+
+VERSION = 1
+
+
+@dataclass(frozen=True, slots=True)
+class Decisions:
+    in_service: bool = True
+    paused: bool = False
+    help: Help | None = None
+    acknowledged: frozenset[str] = field(default_factory=frozenset)
+
+    def to_json(self) -> dict[str, object]:
+        return {
+            "version": VERSION,
+            "in_service": self.in_service,
+            "paused": self.paused,
+            "help": (
+                {"about": self.help.about.value, "since": self.help.since}
+                if self.help is not None
+                else None
+            ),
+            "acknowledged": sorted(self.acknowledged),
+        }
+
+
+NONE = Decisions()
+
+
+def path_for(checkpoint: Path) -> Path:
+    """The decisions file of the executive whose checkpoint is ``checkpoint``."""
+    return checkpoint.with_name(checkpoint.name + ".staff")
+
+
+def save(path: Path, decisions: Decisions) -> None:
+    """Write ``decisions`` atomically; none at all removes the file."""
+    if decisions == NONE:
+        with contextlib.suppress(FileNotFoundError):
+            path.unlink()
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".staff-", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            json.dump(decisions.to_json(), f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def load(path: Path) -> Decisions:
+    """The decisions in ``path``; none when there is no file or it cannot be read."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return NONE
+    if not isinstance(data, dict) or data.get("version") != VERSION:
+        return NONE
+    help_ = None
+    raw = data.get("help")
+    if isinstance(raw, dict):
+        with contextlib.suppress(ValueError, TypeError):
+            help_ = Help(HelpAbout(raw.get("about")), float(raw.get("since", 0.0)))
+    acked = data.get("acknowledged")
+    return Decisions(
+        in_service=data.get("in_service") is not False,
+        paused=data.get("paused") is True,
+        help=help_,
+        acknowledged=frozenset(a for a in acked if isinstance(a, str))
+        if isinstance(acked, list)
+        else frozenset(),
+    )

@@ -1,0 +1,163 @@
+"""When the robot needs a person (sim time): it holds, asks, and goes on when answered;
+what staff decide lasts (out of service before the front end is idle, across a restart);
+a pause stops the drive at once."""
+
+from __future__ import annotations
+
+import asyncio
+import math
+from pathlib import Path
+
+from tour import Running, after_ticks
+
+from frog_bt.engine.operator import Command
+from frog_bt.model import keys
+from frog_bt.model.help import HelpAbout
+from frog_bt.runtime import decisions
+
+DOCK_FAILS = {"docking": {"dock_failures": 3}}  # the tour's three tries fail, a fourth works
+
+
+def docked_by_hand(run: Running) -> None:
+    """A person pushes the simulated robot onto its charger."""
+    docking = run.sim.world.docking
+    docking.state, docking.docked = "docked", True
+
+
+def test_a_dock_that_fails_holds_and_asks_then_done_by_hand_carries_it_on() -> None:
+    async def main() -> None:
+        async with Running(DOCK_FAILS) as run:
+            exe = run.executive
+            await after_ticks(exe, lambda: exe.core.board.get(keys.HELP) is not None, 120)
+            help_ = exe.core.board.get(keys.HELP)
+            assert help_ is not None and help_.about is HelpAbout.DOCK
+            assert not exe._stopping.is_set()  # it waits for a person, it does not exit
+            await after_ticks(exe, lambda: "docking_failed" in exe.staff.book.active)
+            answer = await exe.staff.submit(Command.DONE_BY_HAND)
+            assert not answer.ok and "failed on /docking/state, not docked" in answer.text
+
+            docked_by_hand(run)
+            await after_ticks(exe, lambda: run.sim.world.docking_state == "docked")
+            await run.sim.wait_for(lambda r: r.channel == "/docking/state", 10)
+            await after_ticks(
+                exe, lambda: (exe.core.board.get(keys.DOCKING) or _no).value == "docked"
+            )
+            answer = await exe.staff.submit(Command.DONE_BY_HAND)
+            assert answer.ok, answer.text
+            await after_ticks(exe, lambda: exe.core.board.get(keys.HELP) is None)
+            await run.sim.wait_for(
+                lambda r: r.channel == "tour" and r.payload.get("state") == "ended", 30
+            )
+            await after_ticks(exe, lambda: "docking_failed" not in exe.staff.book.active)
+            assert not (await exe.staff.submit(Command.RETRY)).ok  # nothing to retry now
+
+    asyncio.run(main())
+
+
+class _No:
+    value = None
+
+
+_no = _No()
+
+
+def test_retry_tries_the_failed_step_again() -> None:
+    async def main() -> None:
+        async with Running(DOCK_FAILS) as run:
+            exe = run.executive
+            await after_ticks(exe, lambda: exe.core.board.get(keys.HELP) is not None, 120)
+            docks = len(run.sim.received("/docking/dock"))
+            assert (await exe.staff.submit(Command.RETRY)).ok
+            await run.sim.wait_for(
+                lambda r: r.channel == "tour" and r.payload.get("state") == "ended", 60
+            )
+            assert len(run.sim.received("/docking/dock")) > docks  # docked on the retry
+            assert run.sim.world.docking_state == "docked"
+            assert exe.core.board.get(keys.HELP) is None
+
+    asyncio.run(main())
+
+
+def test_a_restart_comes_back_still_waiting_for_a_person(tmp_path: Path) -> None:
+    checkpoint = tmp_path / "checkpoint.json"
+
+    async def main() -> None:
+        async with Running(DOCK_FAILS, checkpoint=checkpoint) as first:
+            exe = first.executive
+            await after_ticks(exe, lambda: exe.core.board.get(keys.HELP) is not None, 120)
+            saved = decisions.load(decisions.path_for(checkpoint))
+            assert saved.help is not None and saved.help.about is HelpAbout.DOCK
+            sim, listen = first.sim, first.listen
+            first.own_sim = False  # killed: the simulator (the robot) lives on
+        docks = len(sim.received("/docking/dock"))
+        async with Running({}, sim=sim, listen=listen, checkpoint=checkpoint) as second:
+            exe = second.executive
+            await after_ticks(exe, lambda: exe.core.board.get(keys.HELP) is not None)
+            help_ = exe.core.board.get(keys.HELP)
+            assert help_ is not None and help_.about is HelpAbout.DOCK
+            ticks = exe.core.ticks
+            await after_ticks(exe, lambda: exe.core.ticks >= ticks + 20)
+            assert len(sim.received("/docking/dock")) == docks  # not re-run unasked
+            assert exe.core.board.get(keys.TOUR_STATE) is not None or True
+        await sim.stop()
+
+    asyncio.run(main())
+
+
+def test_service_off_before_frontend_idle_keeps_the_robot_docked() -> None:
+    async def main() -> None:
+        async with Running({"frontend": {"idle_at": 30.0}}) as run:
+            exe = run.executive
+            await after_ticks(exe, lambda: bool(exe.core.ticks and exe.idle()))
+            answer = await exe.staff.submit(Command.SERVICE_OFF)
+            assert answer.ok and "no new tour starts" in answer.text
+            await run.sim.wait_for(lambda r: r.channel == "frontend_idle", 60)
+            ticks = exe.core.ticks
+            await after_ticks(exe, lambda: exe.core.ticks >= ticks + 30)
+            assert exe.core.board.get(keys.FRONTEND_READY)  # the front end said it is idle
+            assert run.sim.received("/docking/dock") == []  # and no undock went out
+            assert run.sim.received("tour") == []
+            assert (await exe.staff.submit(Command.SERVICE_ON)).ok
+            await run.sim.wait_for(
+                lambda r: r.channel == "tour" and r.payload.get("state") == "started", 30
+            )
+
+    asyncio.run(main())
+
+
+def test_a_pause_while_driving_stops_the_robot_within_one_tick() -> None:
+    async def main() -> None:
+        async with Running({}) as run:
+            exe, world = run.executive, run.sim.world
+            await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 60)
+            await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 60)  # off to POI0
+            ticks = exe.core.ticks
+            await after_ticks(exe, lambda: exe.core.ticks >= ticks + 3)  # under way
+            assert (await exe.staff.submit(Command.PAUSE)).ok
+            paused_at = exe.core.ticks
+            await run.sim.wait_for(
+                lambda r: r.channel == "/GotoWayPoint" and r.t >= 0 and _stop_goal(r, world),
+                10,
+            )
+            assert exe.core.ticks <= paused_at + 1  # sent in the tick after the pause
+            here = world.pose
+            ticks = exe.core.ticks
+            await after_ticks(exe, lambda: exe.core.ticks >= ticks + 30)  # seconds go by
+            there = world.pose
+            assert math.dist((here.x, here.y), (there.x, there.y)) < 0.05  # it stands
+            goals = len(run.sim.received("/GotoWayPoint"))
+            assert (await exe.staff.submit(Command.RESUME)).ok
+            await after_ticks(  # the goal again, and on its way
+                exe, lambda: math.dist((there.x, there.y), (world.pose.x, world.pose.y)) > 0.5
+            )
+            resent = run.sim.received("/GotoWayPoint")[goals:]
+            assert resent and resent[0].payload["pose"]["position"]["x"] == 104.0537  # POI0
+
+    asyncio.run(main())
+
+
+def _stop_goal(record, world) -> bool:
+    """A goal at the robot's own pose (not at a POI of the site)."""
+    position = record.payload.get("pose", {}).get("position", {})
+    x, y = position.get("x"), position.get("y")
+    return x is not None and math.dist((x, y), (world.pose.x, world.pose.y)) < 1.0
