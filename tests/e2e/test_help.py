@@ -161,3 +161,60 @@ def _stop_goal(record, world) -> bool:
     position = record.payload.get("pose", {}).get("position", {})
     x, y = position.get("x"), position.get("y")
     return x is not None and math.dist((x, y), (world.pose.x, world.pose.y)) < 1.0
+
+
+def test_an_undock_that_fails_asks_and_done_by_hand_starts_the_tour() -> None:
+    async def main() -> None:
+        async with Running({"docking": {"undock_failures": 1000}}) as run:
+            exe = run.executive
+            await after_ticks(exe, lambda: exe.core.board.get(keys.HELP) is not None, 120)
+            assert exe.core.board.get(keys.HELP).about is HelpAbout.UNDOCK  # type: ignore[union-attr]
+            docking = run.sim.world.docking  # a person pulls the robot off its charger
+            docking.state, docking.docked = "undocked", False
+            await after_ticks(
+                exe, lambda: (exe.core.board.get(keys.DOCKING) or _no).value == "undocked"
+            )
+            assert (await exe.staff.submit(Command.DONE_BY_HAND)).ok
+            await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 30)  # to POI0
+
+    asyncio.run(main())
+
+
+def test_a_blocked_way_home_asks_and_retry_drives_home_again() -> None:
+    blocked = {
+        "navigation": {"failures": [{"poi": "SHOP", "times": 3, "result": "aborted", "after": 2}]}
+    }
+
+    async def main() -> None:
+        async with Running(blocked) as run:
+            exe = run.executive
+            await after_ticks(exe, lambda: exe.core.board.get(keys.HELP) is not None, 120)
+            assert exe.core.board.get(keys.HELP).about is HelpAbout.HOME  # type: ignore[union-attr]
+            assert (await exe.staff.submit(Command.RETRY)).ok  # the way is clear now
+            await run.sim.wait_for(
+                lambda r: r.channel == "tour" and r.payload.get("state") == "ended", 60
+            )
+            assert run.sim.world.docking_state == "docked"
+
+    asyncio.run(main())
+
+
+def test_a_fault_that_persists_with_no_tour_asks_and_holds_until_it_clears() -> None:
+    fault = {
+        "frontend": {"idle_at": 10_000},
+        "faults": [
+            {"at": 1, "name": "motors", "level": 2, "message": "overheated", "duration": 20}
+        ],
+    }
+
+    async def main() -> None:
+        async with Running(fault) as run:
+            exe = run.executive
+            await after_ticks(exe, lambda: exe.core.board.get(keys.HELP) is not None, 60)
+            assert exe.core.board.get(keys.HELP).about is HelpAbout.FAULT  # type: ignore[union-attr]
+            refused = await exe.staff.submit(Command.DONE_BY_HAND)
+            assert not refused.ok and "still reports a fault" in refused.text
+            await after_ticks(exe, lambda: exe.core.board.get(keys.HELP) is None, 60)
+            assert run.sim.received("/docking/dock") == []  # no tour started meanwhile
+
+    asyncio.run(main())
