@@ -199,24 +199,84 @@ class OperatorCfg(_Model):
     pause_max: Positive = 300.0  # seconds an operator's pause may last; then the tour ends
 
 
+def _http_url_problem(url: str) -> str | None:
+    try:
+        parts = urlsplit(url)
+        parts.port  # noqa: B018 - a port that is not a number raises here
+    except ValueError as exc:
+        return f"expected an http:// or https:// URL ({exc})"
+    if parts.scheme not in ("http", "https") or not parts.hostname:
+        return "expected an http:// or https:// URL"
+    return None
+
+
+WebhookFormat = Literal["json", "ntfy", "alertmanager"]
+
+
+class Webhook(_Model):
+    """One destination of alert changes: ``url`` and the ``format`` it understands. A plain
+    URL string in ``alerts.webhooks`` means ``{url: URL, format: json}``.
+
+    * ``json``: the generic body, POSTed to ``url``;
+    * ``ntfy``: ``url`` is the topic's URL (``https://ntfy.sh/TOPIC``); ntfy's JSON
+      publish is POSTed to the server's root with ``topic`` = the last path segment;
+    * ``alertmanager``: ``url`` is Alertmanager's base URL; ``POST {url}/api/v2/alerts``.
+    """
+
+    url: str
+    format: WebhookFormat = "json"
+
+    @model_validator(mode="before")
+    @classmethod
+    def _plain_url(cls, data: Any) -> Any:
+        return {"url": data} if isinstance(data, str) else data
+
+    @model_validator(mode="after")
+    def _check(self) -> Webhook:
+        problem = _http_url_problem(self.url)
+        if problem:
+            # the URL itself is not repeated: it may carry a password or a key
+            raise ValueError(problem)
+        if self.format == "ntfy" and not urlsplit(self.url).path.strip("/"):
+            raise ValueError("an ntfy URL names its topic: https://HOST/TOPIC")
+        return self
+
+
+def _string_or_object(schema: dict[str, Any]) -> None:
+    # a plain URL string is accepted too (json): the schema says so
+    schema["items"] = {"anyOf": [{"type": "string", "format": "uri"}, schema["items"]]}
+
+
 class AlertsCfg(_Model):
     battery_below: Annotated[float, Field(ge=0, le=100)] = 25.0  # percent: ask for help below
     rosbridge_down_after: Positive = 60.0  # seconds without the robot before an alert
     frontend_silent_after: Positive = 60.0  # seconds of a silent front end before an alert
     no_visitor_after: Positive = 900.0  # seconds of searching for a visitor before an alert
-    webhooks: list[str] = []  # http(s) URLs: each alert change is POSTed there as JSON
+    # where each alert change goes: a URL (the generic JSON) or {url, format: json|ntfy|
+    # alertmanager}
+    webhooks: Annotated[list[Webhook], Field(json_schema_extra=_string_or_object)] = []
     webhook_timeout: Positive = 5.0  # seconds one POST may take
     webhook_attempts: Annotated[int, Field(ge=1, le=20)] = 5  # tries per alert and URL
     webhook_backoff: Positive = 1.0  # seconds before the 2nd try, doubling after each
+    robot: Annotated[str, Field(pattern=r"^[A-Za-z0-9_.-]{1,64}$")] = "frog"  # in keys, labels
+    console_url: str = ""  # the console as phones reach it: links in notifications ("": none)
+    escalate_every: Positive = 600.0  # seconds: an unacknowledged alert is told again
+    escalate_max: Annotated[int, Field(ge=0, le=100)] = 6  # ... at most this many times
+    ack_link_ttl: Positive = 86400.0  # seconds an acknowledgement link stays valid (wall)
 
-    @field_validator("webhooks")
+    @field_validator("console_url")
     @classmethod
-    def _urls(cls, urls: list[str]) -> list[str]:
-        for url in urls:
+    def _console_url(cls, url: str) -> str:
+        if url:
+            problem = _http_url_problem(url)
+            if problem:
+                raise ValueError(problem)
             parts = urlsplit(url)
-            if parts.scheme not in ("http", "https") or not parts.hostname:
-                raise ValueError(f"expected an http:// or https:// URL, got {url!r}")
-        return urls
+            if parts.username or parts.password or parts.query or parts.fragment:
+                raise ValueError(
+                    "expected the console's address alone (no user, password, query or fragment)"
+                )
+        return url.rstrip("/")
 
 
 class ConsoleCfg(_Model):
@@ -310,8 +370,10 @@ class Site(_Model):
                     raise _at(("variants", name, i, "waypoint"), _unknown(v.waypoint, known))
                 last = i == len(variants) - 1
                 if (v.until is None) != last:
-                    raise _at(("variants", name, i, "until"),
-                              "every variant but the last needs 'until'; the last has none")
+                    raise _at(
+                        ("variants", name, i, "until"),
+                        "every variant but the last needs 'until'; the last has none",
+                    )
         for key in ("dock", "recruit_at"):
             if getattr(self.tour, key) not in self.pois:
                 raise _at(("tour", key), _unknown(getattr(self.tour, key), known))
@@ -320,8 +382,10 @@ class Site(_Model):
                 raise _at(("zones", "arrival", key), _unknown(key, known))
         for i, stop in enumerate(self.tour.stops):
             if stop.poi not in self.pois and stop.poi not in self.variants:
-                raise _at(("tour", "stops", i, "poi"),
-                          _unknown(stop.poi, sorted({*self.pois, *self.variants})))
+                raise _at(
+                    ("tour", "stops", i, "poi"),
+                    _unknown(stop.poi, sorted({*self.pois, *self.variants})),
+                )
         return self
 
     # ------------------------------------------------------------ queries
@@ -338,8 +402,12 @@ class Site(_Model):
         :data:`WAYPOINT_TOLERANCE`), or its position as ``(x, y)`` when none does: the one
         waypoint match (summary, replay, report)."""
         for name, poi in self.pois.items():
-            near = (abs(poi.x - pose.x), abs(poi.y - pose.y), abs(poi.z - pose.qz),
-                    abs(poi.w - pose.qw))
+            near = (
+                abs(poi.x - pose.x),
+                abs(poi.y - pose.y),
+                abs(poi.z - pose.qz),
+                abs(poi.w - pose.qw),
+            )
             if max(near) < WAYPOINT_TOLERANCE:
                 return name
         return f"({pose.x:.1f}, {pose.y:.1f})"
@@ -363,8 +431,9 @@ def _at(path: tuple[str | int, ...], message: str) -> PathError:
 
 
 def _unknown(name: str, known: list[str]) -> str:
-    return f"unknown POI {name!r} (" + (f"known: {', '.join(known)})" if known
-                                        else "no POIs are defined)")
+    return f"unknown POI {name!r} (" + (
+        f"known: {', '.join(known)})" if known else "no POIs are defined)"
+    )
 
 
 def load_site(path: str | Path | None = None) -> Site:

@@ -13,7 +13,8 @@ from frog_bt.model.help import Help, HelpAbout, HelpAnswer
 from frog_bt.model.outcomes import DockingState, IncidentKind
 from frog_bt.model.progress import EMPTY
 from frog_bt.model.ros import Pose
-from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
+from frog_bt.tree import leaf
+from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Status
 
 # What a person's help is about, as the alerts name the incident behind it.
 INCIDENT = {
@@ -46,11 +47,12 @@ class AskForHelp(Leaf):
     on ``retry`` (the ``Retry`` above it tries the step again).
     """
 
-    class Params(Params):
+    class Params(leaf.Params):  # qualified: mypy may take a bare Params for this one
         about: Literal["undock", "dock", "home", "fault", "restored"] = Field(
             description="the step that could not be done (restored: a restart's pending help)"
         )
 
+    params: Params
     reads = (keys.NOW, keys.DIAGNOSTICS)
     optional_reads = (keys.HELP_ANSWER, keys.HELP_RESTORED, keys.POSE, keys.DOCKING)
     writes = (keys.HELP, keys.HELP_ANSWER, keys.HELP_RESTORED, keys.GAVE_UP, keys.PROGRESS)

@@ -114,10 +114,17 @@ class People:
     console: Console | None
     webhooks: Webhooks
 
-    async def close(self) -> None:
+    async def close(self, deliver: bool = False) -> None:
+        """Stop the console, then the webhooks: within a second, or (``deliver``: the
+        executive stops because the robot needs help, CONTRACT §5) once every alert is
+        delivered or its delivery has run out of attempts."""
         if self.console is not None:
             await self.console.close()
-        await self.webhooks.close(1.0)
+        cfg = self.webhooks.cfg
+        attempts_budget = cfg.webhook_attempts * cfg.webhook_timeout + cfg.webhook_backoff * (
+            2 ** max(0, cfg.webhook_attempts - 1)
+        )
+        await self.webhooks.close(attempts_budget + 1.0 if deliver else 1.0)
 
 
 async def start_people(
@@ -126,8 +133,10 @@ async def start_people(
     from frog_bt.live.console.webhooks import Webhooks
     from frog_bt.runtime import logctx
 
-    webhooks = Webhooks(executive.site.alerts,  # its ack links' key comes from the token
-                        ack_secret=settings.token if settings is not None else None)
+    webhooks = Webhooks(
+        executive.site.alerts,  # its ack links' key comes from the token
+        ack_secret=settings.token if settings is not None else None,
+    )
     executive.observers.attach(executive, [webhooks])  # every alert change
     logctx.run_as(executive, webhooks.start)  # its lines are the executive's (console log)
     console = await start_console(executive, settings) if settings is not None else None

@@ -322,7 +322,7 @@ async def _main(
             watcher.cancel()
         if refresher is not None:
             refresher.cancel()
-        await people.close()
+        await people.close(deliver=executive.outcome.code != 0)
         close_all(observers)
         if status is not None:
             status.close()

@@ -175,9 +175,9 @@ class Operator:
                     "finish the step, then answer again"
                 )
         if about is HelpAbout.FAULT:
-            reading = self.board.get(keys.DIAGNOSTICS)
-            if reading is not None and reading.value.faults:
-                return f"the robot still reports a fault: {'; '.join(reading.value.faults)}"
+            diagnostics = self.board.get(keys.DIAGNOSTICS)
+            if diagnostics is not None and diagnostics.value.faults:
+                return f"the robot still reports a fault: {'; '.join(diagnostics.value.faults)}"
         return None
 
     def _unpause(self) -> None:

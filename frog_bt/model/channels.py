@@ -79,17 +79,38 @@ class Operator(msgspec.Struct, frozen=True):
 
 
 class Alert(msgspec.Struct, frozen=True):
+    """One alert change (``state``: raised, cleared = resolved, acknowledged by a person).
+
+    The fields after ``since`` came later, each with a default, so older recordings still
+    decode: ``severity`` in ROS diagnostics' levels (REP-107), ``key`` the stable
+    deduplication key (``frog-bt:<robot>:<kind>[:<subject>]``), ``subject`` what it is
+    about (a stop), ``answers`` the operator commands that apply, ``what`` and ``todo``
+    the two halves of ``text`` (the sentence, what to do), ``repeat`` how many times it
+    has been told again unacknowledged (escalation; 0: the first telling) and ``waited``
+    the project-clock seconds since it was raised, at that repeat."""
+
     id: str
     kind: str
     text: str
     state: Literal["raised", "cleared", "acknowledged"]
     since: float
+    severity: Literal["WARN", "ERROR"] = "WARN"
+    key: str = ""
+    subject: str = ""
+    answers: tuple[str, ...] = ()
+    what: str = ""
+    todo: str = ""
+    repeat: int = 0
+    waited: float = 0.0
 
 
 TYPES: dict[str, tuple[str, type[msgspec.Struct]]] = {
-    TICK: ("frog_bt/Tick", Tick), BLAME: ("frog_bt/Blame", Blame),
-    TREE: ("frog_bt/Tree", Tree), PRIMER: ("frog_bt/Primer", Primer),
-    OPERATOR: ("frog_bt/Operator", Operator), ALERT: ("frog_bt/Alert", Alert),
+    TICK: ("frog_bt/Tick", Tick),
+    BLAME: ("frog_bt/Blame", Blame),
+    TREE: ("frog_bt/Tree", Tree),
+    PRIMER: ("frog_bt/Primer", Primer),
+    OPERATOR: ("frog_bt/Operator", Operator),
+    ALERT: ("frog_bt/Alert", Alert),
 }
 
 _ENCODER = msgspec.json.Encoder()
@@ -135,15 +156,19 @@ def _datagram_schema() -> dict[str, Any]:
     """Every front-end message's fields in one object: a datagram is one of them."""
     props: dict[str, Any] = {
         "type": {"type": "string", "description": "command, event or ack (CONTRACT §2)"},
-        "seq": {"type": "integer", "minimum": 0}}
+        "seq": {"type": "integer", "minimum": 0},
+    }
     for cls in (*COMMANDS.values(), *EVENTS.values()):
         props.update(struct_schema(cls, cls.type).get("properties", {}))
-    return {"type": "object", "title": DATAGRAM_TYPE, "properties": props,
-            "required": ["type", "seq"]}
+    return {
+        "type": "object",
+        "title": DATAGRAM_TYPE,
+        "properties": props,
+        "required": ["type", "seq"],
+    }
 
 
-OWN_SCHEMAS: dict[str, dict[str, Any]] = {DATAGRAM_TYPE: _datagram_schema(),
-                                          **schemas()}
+OWN_SCHEMAS: dict[str, dict[str, Any]] = {DATAGRAM_TYPE: _datagram_schema(), **schemas()}
 
 
 def schema_for(type_: str) -> dict[str, Any]:
@@ -155,8 +180,11 @@ def schema_for(type_: str) -> dict[str, Any]:
     return OWN_SCHEMAS.get(type_, {"type": "object"})
 
 
-OWN_TYPES = {FRONTEND_IN: DATAGRAM_TYPE, FRONTEND_OUT: DATAGRAM_TYPE,
-             **{channel: name for channel, (name, _) in TYPES.items()}}
+OWN_TYPES = {
+    FRONTEND_IN: DATAGRAM_TYPE,
+    FRONTEND_OUT: DATAGRAM_TYPE,
+    **{channel: name for channel, (name, _) in TYPES.items()},
+}
 
 
 def to_ns(t: float) -> int:

@@ -83,7 +83,7 @@ def load(path: Path) -> Decisions:
     raw = data.get("help")
     if isinstance(raw, dict):
         with contextlib.suppress(ValueError, TypeError):
-            help_ = Help(HelpAbout(raw.get("about")), float(raw.get("since", 0.0)))
+            help_ = Help(HelpAbout(raw.get("about", "")), float(raw.get("since", 0.0)))
     acked = data.get("acknowledged")
     return Decisions(
         in_service=data.get("in_service") is not False,

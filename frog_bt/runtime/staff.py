@@ -23,7 +23,7 @@ from frog_bt.engine.operator import Answer, Command
 from frog_bt.model import keys
 from frog_bt.model.events import OperatorDone
 from frog_bt.model.links import LinkStatus
-from frog_bt.model.outcomes import IncidentKind, TourState
+from frog_bt.model.outcomes import TourState
 from frog_bt.runtime.alerts import AlertBook, Facts
 
 if TYPE_CHECKING:
@@ -175,7 +175,7 @@ class Staff:
             ),
             seeking_since=self._seeking_since,
             gave_up=gave_up.text if gave_up is not None else "",
-            docking_gave_up=gave_up is not None and gave_up.kind is IncidentKind.DOCKING_FAILED,
+            help=board.get(keys.HELP),
             stops_given_up=tuple(core.journal.tally.stops_given_up()),  # until the next tour
             pause_ran_out=self._pause_ran_out,
         )

@@ -15,9 +15,13 @@ TOKEN = "staff-token-0123"
 
 
 @asynccontextmanager
-async def console_tour(scenario: dict[str, Any] | None = None, *, token: str | None = TOKEN,
-                       once: bool = True, **kwargs: Any
-                       ) -> AsyncIterator[tuple[Running, People, str]]:
+async def console_tour(
+    scenario: dict[str, Any] | None = None,
+    *,
+    token: str | None = TOKEN,
+    once: bool = True,
+    **kwargs: Any,
+) -> AsyncIterator[tuple[Running, People, str]]:
     """The rehearsal, what was started for the people around it, and the console's URL."""
     async with Running(scenario or {}, once=once, **kwargs) as run:
         people = await start_people(run.executive, ConsoleSettings("127.0.0.1", 0, token), [])
@@ -32,8 +36,10 @@ def auth(token: str = TOKEN) -> dict[str, str]:
     return {"Authorization": f"Bearer {token}"}
 
 
-async def command(session: aiohttp.ClientSession, url: str, body: Any,
-                  headers: dict[str, str] | None = None) -> tuple[int, dict[str, Any]]:
-    async with session.post(f"{url}/api/command", json=body,
-                            headers=auth() if headers is None else headers) as r:
+async def command(
+    session: aiohttp.ClientSession, url: str, body: Any, headers: dict[str, str] | None = None
+) -> tuple[int, dict[str, Any]]:
+    async with session.post(
+        f"{url}/api/command", json=body, headers=auth() if headers is None else headers
+    ) as r:
         return r.status, await r.json()

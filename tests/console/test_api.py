@@ -65,8 +65,18 @@ def test_every_command_and_every_refusal() -> None:
 
     answers = asyncio.run(main())
     assert [(status, body["ok"]) for status, body in answers] == [
-        (409, False), (409, False), (200, True), (409, False), (200, True), (200, True),
-        (200, True), (200, True), (409, False), (200, True), (409, False)]
+        (409, False),
+        (409, False),
+        (200, True),
+        (409, False),
+        (200, True),
+        (200, True),
+        (200, True),
+        (200, True),
+        (409, False),
+        (200, True),
+        (409, False),
+    ]
     texts = [body.get("did") or body.get("reason") for _, body in answers]
     assert texts[0] == "not at a stop or driving to one: nothing to skip"
     assert texts[5] == "skipping POI1: on to the next stop"
@@ -83,6 +93,7 @@ def test_auth_bad_input_size_and_rate_are_refused_with_one_line_and_change_nothi
             await run.sim.wait_for(is_("start_poi", poi="POI1", part="a"), 60)
             out = []
             async with aiohttp.ClientSession() as s:
+
                 async def post(data: bytes, headers: dict[str, str]) -> tuple[int, str]:
                     async with s.post(f"{url}/api/command", data=data, headers=headers) as r:
                         body = await r.json()
@@ -97,10 +108,13 @@ def test_auth_bad_input_size_and_rate_are_refused_with_one_line_and_change_nothi
                 out.append(await post(b'["home"]', auth()))
                 out.append(await post(b'{"command": "dance"}', auth()))
                 out.append(await post(b'{"command": "ack_alert"}', auth()))
-                out.append(await post(b'{"command": "home", "pad": "' + b"x" * 5000 + b'"}',
-                                      auth()))
-                statuses = [(await command(s, url, {"command": c}))[0]
-                            for c in ("pause", "resume", "pause", "resume")]
+                out.append(
+                    await post(b'{"command": "home", "pad": "' + b"x" * 5000 + b'"}', auth())
+                )
+                statuses = [
+                    (await command(s, url, {"command": c}))[0]
+                    for c in ("pause", "resume", "pause", "resume")
+                ]
             assert run.executive.core.board.get(keys.HOME) is None  # nobody sent it home
             out.append((statuses.count(429), str(statuses)))
             return out
@@ -114,7 +128,8 @@ def test_auth_bad_input_size_and_rate_are_refused_with_one_line_and_change_nothi
 
 
 def test_without_a_token_file_commands_are_off_and_off_loopback_it_does_not_start(
-        tmp_path: Path) -> None:
+    tmp_path: Path,
+) -> None:
     async def main() -> tuple[int, str]:
         async with console_tour(token=None) as (run, _people, url):
             await run.sim.wait_for(is_("tour", state="started"), 60)
@@ -124,15 +139,21 @@ def test_without_a_token_file_commands_are_off_and_off_loopback_it_does_not_star
             return status, body["reason"]
 
     assert asyncio.run(main()) == (
-        401, "commands are off: the console was started without a token file")
+        401,
+        "commands are off: the console was started without a token file",
+    )
 
     class Args:
         console = "0.0.0.0:8080"
         console_token_file = None
 
-    with pytest.raises(UsageError, match=re.escape(
+    with pytest.raises(
+        UsageError,
+        match=re.escape(
             "0.0.0.0 is not loopback: anyone on the network could steer the robot; give "
-            "--console-token-file")):
+            "--console-token-file"
+        ),
+    ):
         console_settings(Args())  # type: ignore[arg-type]
     short = tmp_path / "token"
     short.write_text("abc\n")

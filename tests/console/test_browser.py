@@ -20,8 +20,11 @@ from test_faults import is_
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 DRIVER = shutil.which("chromedriver")
 if not (CHROMIUM and DRIVER) and os.environ.get("CI") != "true":
-    pytest.skip("Debian's chromium and chromium-driver are not installed "
-                "(apt-get install chromium chromium-driver)", allow_module_level=True)
+    pytest.skip(
+        "Debian's chromium and chromium-driver are not installed "
+        "(apt-get install chromium chromium-driver)",
+        allow_module_level=True,
+    )
 
 from selenium import webdriver  # noqa: E402 - only where a browser can run it
 from selenium.webdriver.chrome.service import Service  # noqa: E402
@@ -35,8 +38,14 @@ WAIT = 60.0  # seconds any one thing may take to show in the page (a bound, not 
 def browser() -> webdriver.Chrome:
     options = webdriver.ChromeOptions()
     options.binary_location = CHROMIUM or "chromium"
-    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                "--window-size=1280,1600", "--no-proxy-server"):
+    for arg in (
+        "--headless=new",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-dev-shm-usage",
+        "--window-size=1280,1600",
+        "--no-proxy-server",
+    ):
         options.add_argument(arg)
     return webdriver.Chrome(service=Service(DRIVER or "chromedriver"), options=options)
 
@@ -70,8 +79,13 @@ def test_send_home_from_the_console_in_chromium() -> None:
             seen, answer = await asyncio.to_thread(drive, url)
             aborted = await run.sim.wait_for(is_("tour", state="aborted"), 60)
             outcome = await run.finish()
-            return seen, answer, aborted.payload["reason"], outcome.reason, \
-                run.sim.world.docking_state
+            return (
+                seen,
+                answer,
+                aborted.payload["reason"],
+                outcome.reason,
+                run.sim.world.docking_state,
+            )
 
     seen, answer, reason, outcome, docking = asyncio.run(main())
     assert seen == ["POI1 (POI1a)", "POI2 (POI2a)"]

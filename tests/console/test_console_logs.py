@@ -43,9 +43,16 @@ def test_a_handler_keeps_the_lines_of_its_owner_and_of_the_tasks_it_started() ->
         for handler in (lines_a, lines_b):
             log.removeHandler(handler)
     assert [line.split(": ", 1)[1] for line in lines_a.lines] == [
-        "a itself", "a's child", "a in a thread"]
+        "a itself",
+        "a's child",
+        "a in a thread",
+    ]
     assert [line.split(": ", 1)[1] for line in lines_b.lines] == [
-        "b itself", "b's child", "b in a thread", "b's, from outside"]
+        "b itself",
+        "b's child",
+        "b in a thread",
+        "b's, from outside",
+    ]
     assert logctx.owner() is None
 
 
@@ -57,14 +64,17 @@ def test_two_executives_in_one_process_each_console_shows_only_its_own_log() -> 
 
     async def main() -> tuple[list[str], list[str]]:
         async with console_tour() as (one, _p1, url1), console_tour() as (two, _p2, url2):
-            await asyncio.gather(one.sim.wait_for(is_("tour", state="started"), 60),
-                                 two.sim.wait_for(is_("tour", state="started"), 60))
+            await asyncio.gather(
+                one.sim.wait_for(is_("tour", state="started"), 60),
+                two.sim.wait_for(is_("tour", state="started"), 60),
+            )
             log.warning("the test's own line")  # no executive's
             async with aiohttp.ClientSession() as s:
                 # both refused, so neither tour changes; the staff logs each as it applies it
                 assert (await command(s, url1, {"command": "resume"}))[0] == 409
-                assert (await command(s, url2, {"command": "ack_alert", "id": "only-two"})
-                        )[0] == 409
+                assert (await command(s, url2, {"command": "ack_alert", "id": "only-two"}))[
+                    0
+                ] == 409
                 return await logs(s, url1), await logs(s, url2)
 
     first, second = asyncio.run(main())

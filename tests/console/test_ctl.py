@@ -40,4 +40,5 @@ def test_ctl_exit_codes_and_answers(tmp_path: Path, capsys: pytest.CaptureFixtur
     # nothing listens there: a connection error, bounded, exit 2
     assert main(["ctl", "home", "--console", "http://127.0.0.1:9", "--timeout", "5"]) == 2
     assert capsys.readouterr().err.startswith(
-        "frog-bt ctl: cannot reach the console at http://127.0.0.1:9:")
+        "frog-bt ctl: cannot reach the console at http://127.0.0.1:9:"
+    )

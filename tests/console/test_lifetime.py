@@ -15,8 +15,14 @@ from frog_bt.live.console.server import CLOSE_TIMEOUT, PAGES, ROUTES, SHOWN
 
 def test_the_routes_are_the_contracts_and_declared_once() -> None:
     assert sorted((r.method, r.path) for r in ROUTES) == [  # type: ignore[attr-defined]
-        ("GET", "/"), ("GET", "/api/site"), ("GET", "/api/state"), ("GET", "/api/stream"),
-        ("GET", "/api/tree"), ("POST", "/api/command")]
+        ("GET", "/"),
+        ("GET", "/ack/{alert_id}"),
+        ("GET", "/api/site"),
+        ("GET", "/api/state"),
+        ("GET", "/api/stream"),
+        ("GET", "/api/tree"),
+        ("POST", "/api/command"),
+    ]
 
 
 def test_closing_with_a_page_open_closes_the_page_and_drops_the_log_handler() -> None:
@@ -39,9 +45,13 @@ def test_closing_with_a_page_open_closes_the_page_and_drops_the_log_handler() ->
                 closing = await reading
                 await console.close()  # a second close does nothing
                 run.executive.stop("test over")
-                return (ws.close_code, str(closing.extra), handler_was_on,
-                        console.app[SHOWN].logs in frog_bt.handlers,
-                        len(console.app[PAGES].sockets))
+                return (
+                    ws.close_code,
+                    str(closing.extra),
+                    handler_was_on,
+                    console.app[SHOWN].logs in frog_bt.handlers,
+                    len(console.app[PAGES].sockets),
+                )
 
     code, reason, handler_was_on, handler_is_on, pages = asyncio.run(main())
     assert (code, reason) == (1001, "the console is stopping")

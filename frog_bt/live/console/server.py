@@ -8,6 +8,8 @@
 * ``GET /api/site`` — the static map; ``GET /api/tree`` — the whole tree, with statuses;
 * ``GET /api/stream`` — a WebSocket pushing the state at most every ``console.push_every``
   seconds, and within 50 ms of a new phase or a command;
+* ``GET /ack/{alert_id}?exp=&sig=`` — a notification's signed link acknowledges its alert
+  (:func:`get_ack`), answering a plain page;
 * ``POST /api/command`` — ``{"command": C}`` (``"id"`` with ``ack_alert``), with
   ``Authorization: Bearer TOKEN``: 200 ``{"ok": true, "did"}`` once applied at the next
   tick, 409 ``{"ok": false, "reason"}`` when the tour cannot do it now, 400 malformed or
@@ -30,6 +32,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import hmac
+import html
 import ipaddress
 import json
 import logging
@@ -42,6 +45,7 @@ from typing import TYPE_CHECKING, Any
 from aiohttp import WSCloseCode, WSMsgType, web
 
 from frog_bt.engine.operator import Command
+from frog_bt.live.console.acklink import Verdict, link_key, verify
 from frog_bt.live.console.day import Day
 from frog_bt.live.console.state import LogLines, StopClock, site_map, state, tree
 from frog_bt.runtime.status import phase
@@ -151,9 +155,12 @@ async def guard(request: web.Request, handler: Handler) -> web.StreamResponse:
     access = request.app[ACCESS]
     needs_token = request.method != "GET" or not access.loopback
     if needs_token and request.path.startswith("/api") and not authorised(access, request):
-        return refuse(401, "a valid token is needed (Authorization: Bearer TOKEN)"
-                      if access.token is not None else
-                      "commands are off: the console was started without a token file")
+        return refuse(
+            401,
+            "a valid token is needed (Authorization: Bearer TOKEN)"
+            if access.token is not None
+            else "commands are off: the console was started without a token file",
+        )
     if request.content_length is not None and request.content_length > access.max_body:
         return refuse(413, f"request body over {access.max_body} bytes")
     try:
@@ -219,8 +226,11 @@ async def push(app: web.Application) -> None:
             async with asyncio.timeout(PHASE_POLL):
                 await pages.changed.wait()
         now_phase = phase(core)
-        due = (pages.changed.is_set() or now_phase != last_phase
-               or loop.time() - last_at >= pages.push_every)
+        due = (
+            pages.changed.is_set()
+            or now_phase != last_phase
+            or loop.time() - last_at >= pages.push_every
+        )
         pages.changed.clear()
         last_phase = now_phase
         if not due or not pages.sockets:
@@ -247,9 +257,9 @@ async def post_command(request: web.Request) -> web.Response:
     try:
         body = await request.json()
     except (ValueError, UnicodeDecodeError):
-        return refuse(400, "the body is not JSON: send {\"command\": ...}")
+        return refuse(400, 'the body is not JSON: send {"command": ...}')
     if not isinstance(body, dict) or not isinstance(body.get("command"), str):
-        return refuse(400, "expected a JSON object with \"command\"")
+        return refuse(400, 'expected a JSON object with "command"')
     try:
         command = Command(body["command"])
     except ValueError:
@@ -257,15 +267,77 @@ async def post_command(request: web.Request) -> web.Response:
         return refuse(400, f"unknown command {body['command'][:40]!r} (known: {known})")
     alert_id = body.get("id", "")
     if command is Command.ACK_ALERT and (not isinstance(alert_id, str) or not alert_id):
-        return refuse(400, "ack_alert needs the alert's \"id\"")
+        return refuse(400, 'ack_alert needs the alert\'s "id"')
     if not request.app[ACCESS].limit.take():
         return refuse(429, "too many commands: wait a second")
     answer = await request.app[EXECUTIVE].staff.submit(
-        command, alert_id if isinstance(alert_id, str) else "")
+        command, alert_id if isinstance(alert_id, str) else ""
+    )
     request.app[PAGES].changed.set()
     if not answer.ok:
         return refuse(409, answer.text)
     return web.json_response({"ok": True, "did": answer.text})
+
+
+# ---------------------------------------------------------------- acknowledgement links
+
+
+def plain_page(status: int, title: str, text: str) -> web.Response:
+    """A small page of text: no script, no style, nothing fetched, never cached."""
+    body = (
+        '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">'
+        '<meta name="viewport" content="width=device-width">'
+        f"<title>{html.escape(title)}</title></head>\n<body><h1>{html.escape(title)}</h1>"
+        f"\n<p>{html.escape(text)}</p></body></html>\n"
+    )
+    return web.Response(
+        status=status,
+        text=body,
+        content_type="text/html",
+        headers={
+            "Content-Security-Policy": "default-src 'none'; frame-ancestors 'none'",
+            "X-Content-Type-Options": "nosniff",
+            "Cache-Control": "no-store",
+            "Referrer-Policy": "no-referrer",
+        },
+    )
+
+
+async def get_ack(request: web.Request) -> web.Response:
+    """``GET /ack/{alert_id}?exp=&sig=``: a signed link from a notification
+    (:mod:`~frog_bt.live.console.acklink`) acknowledges exactly its alert, through the
+    staff queue like ``ack_alert``. An expired, tampered or other alert's link: 403, and
+    nothing is acknowledged. Expiry is on the wall clock (the phone is)."""
+    access = request.app[ACCESS]
+    alert_id = request.match_info["alert_id"]
+    verdict = (
+        verify(
+            link_key(access.token),
+            alert_id,
+            request.query.get("exp", ""),
+            request.query.get("sig", ""),
+            time.time(),
+        )
+        if access.token is not None
+        else Verdict.BAD
+    )
+    if verdict is Verdict.EXPIRED:
+        return plain_page(
+            403,
+            "Link expired",
+            "This link has expired: nothing was acknowledged. Open the console to see the alerts.",
+        )
+    if verdict is not Verdict.VALID:
+        return plain_page(
+            403, "Not a valid link", "This link is not valid: nothing was acknowledged."
+        )
+    if not access.limit.take():
+        return plain_page(429, "Too many requests", "Wait a second, then open the link again.")
+    answer = await request.app[EXECUTIVE].staff.submit(Command.ACK_ALERT, alert_id)
+    request.app[PAGES].changed.set()
+    if not answer.ok:
+        return plain_page(409, "Nothing acknowledged", f"Not done: {answer.text}.")
+    return plain_page(200, "Acknowledged", f"Done: {answer.text}. Thank you.")
 
 
 ROUTES = [
@@ -275,6 +347,7 @@ ROUTES = [
     web.get("/api/tree", get_tree),
     web.get("/api/stream", get_stream),
     web.post("/api/command", post_command),
+    web.get("/ack/{alert_id}", get_ack, allow_head=False),  # HEAD acknowledges nothing
 ]
 
 
@@ -312,9 +385,13 @@ async def close_pages(app: web.Application) -> None:
         return
     with contextlib.suppress(TimeoutError):
         async with asyncio.timeout(CLOSE_TIMEOUT):
-            await asyncio.gather(*(ws.close(code=WSCloseCode.GOING_AWAY,
-                                            message=b"the console is stopping")
-                                   for ws in sockets), return_exceptions=True)
+            await asyncio.gather(
+                *(
+                    ws.close(code=WSCloseCode.GOING_AWAY, message=b"the console is stopping")
+                    for ws in sockets
+                ),
+                return_exceptions=True,
+            )
 
 
 def make_app(executive: Executive, *, token: str | None, loopback: bool) -> web.Application:
@@ -337,15 +414,17 @@ class Console:
     :meth:`attach` before the executive runs, :meth:`start` inside its loop, :meth:`close`
     on the way out."""
 
-    def __init__(self, executive: Executive, host: str, port: int,
-                 token: str | None = None) -> None:
+    def __init__(
+        self, executive: Executive, host: str, port: int, token: str | None = None
+    ) -> None:
         self.executive = executive
         self.host, self.port = host, port
         self.app = make_app(executive, token=token, loopback=is_loopback(host))
         self.bound_port: int | None = None
         # bounded, with pages still open
-        self._runner = web.AppRunner(self.app, access_log=None, handle_signals=False,
-                                     shutdown_timeout=CLOSE_TIMEOUT)
+        self._runner = web.AppRunner(
+            self.app, access_log=None, handle_signals=False, shutdown_timeout=CLOSE_TIMEOUT
+        )
         self._started = False
 
     def attach(self) -> None:

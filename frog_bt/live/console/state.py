@@ -125,7 +125,15 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock)
         "links": links,
         "links_for_s": {name: now - since[name][1] for name in links if name in since},
         "alerts": [
-            {"id": a.id, "kind": a.kind, "text": a.text, "since": a.since, "state": a.state}
+            {
+                "id": a.id,
+                "kind": a.kind,
+                "text": a.text,
+                "since": a.since,
+                "state": a.state,
+                "severity": a.severity,
+                "answers": list(a.answers),
+            }
             for a in executive.staff.book.shown()
         ],
         "tours": {"started": day.started, "completed": day.completed, "aborted": day.aborted},

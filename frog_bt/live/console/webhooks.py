@@ -1,14 +1,23 @@
-"""Alerts to people's phones: each alert change POSTed as JSON to every configured URL.
+"""Alerts to people's phones and to the site's alert router: each alert change POSTed to
+every destination of ``alerts.webhooks``, in the format it understands
+(:mod:`.alertbodies`: the generic JSON, ntfy, Alertmanager).
 
-Never on the tick: :meth:`Webhooks.notify` only queues (a bounded queue; the oldest is
-dropped, counted and logged, when a receiver is down for long). One asyncio task posts,
-each URL in turn, retrying a failed POST (a connection error, a timeout, a 5xx) after
-``webhook_backoff`` seconds, doubling, up to ``webhook_attempts`` tries; a 4xx is not
-retried (the receiver refuses the message). Retries wait in real time: the receiver is
-outside the project clock, like the rosbridge reconnect backoff.
+Never on the tick: :meth:`Webhooks.notify` only queues. Each destination has its own
+bounded queue and its own task (:class:`Destination`), so a dead receiver delays nobody
+else; when a queue is full its oldest change is dropped, counted and logged. A failed POST
+(a connection error, a timeout, a 5xx) is tried again after ``webhook_backoff`` seconds,
+doubling, up to ``webhook_attempts`` tries; a 4xx is not retried (the receiver refuses the
+message), nor is a 3xx: redirects are never followed, a body goes only where the site
+configuration says. Retries wait in real time: the receivers are outside the project
+clock, like the rosbridge reconnect backoff.
 
-The body: ``{"id", "kind", "text", "state", "since", "robot"}`` (``state``: raised,
-cleared or acknowledged; ``since``: epoch seconds the alert was raised).
+URLs may carry a password or a key: every log line shows them as ``scheme://host[:port]``
+(:func:`redact`). Bodies are bounded (:data:`BODY_MAX`), and of an answer at most
+:data:`ANSWER_MAX` bytes are read.
+
+With ``alerts.console_url`` set, a notification of an alert not yet acknowledged carries a
+signed link acknowledging it (:mod:`.acklink`; the key is derived from the console's
+token, which is passed in as ``ack_secret``).
 """
 
 from __future__ import annotations
@@ -16,127 +25,304 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
+import time
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
+from urllib.parse import urlsplit
 
 import msgspec
 
-from frog_bt.config import AlertsCfg
+from frog_bt.config import AlertsCfg, Webhook
+from frog_bt.live.console import alertbodies
+from frog_bt.live.console.acklink import ack_link, link_key
+from frog_bt.live.console.alertbodies import Outgoing, Sender
 from frog_bt.model.channels import Alert
 from frog_bt.model.events import AlertChanged, Event
 from frog_bt.warning_limit import WarningLimiter
 
 if TYPE_CHECKING:
+    import aiohttp
+
     from frog_bt.runtime.observer import Host
 
 log = logging.getLogger(__name__)
-QUEUE = 256  # alert changes waiting to be posted
+QUEUE = 256  # alert changes waiting to be posted, per destination
+BODY_MAX = 32_768  # bytes of a body sent (text fields are cut well before)
+ANSWER_MAX = 4096  # bytes of an answer read
+
+
+def redact(url: str) -> str:
+    """``url`` as it may be shown: ``scheme://host[:port]``, without user, password, path
+    or query (any of which may be a secret)."""
+    try:
+        parts = urlsplit(url)
+        port = parts.port
+    except ValueError:
+        return "<a malformed URL>"
+    if not parts.scheme or not parts.hostname:
+        return "<a malformed URL>"
+    host = f"[{parts.hostname}]" if ":" in parts.hostname else parts.hostname
+    return f"{parts.scheme}://{host}" + (f":{port}" if port is not None else "")
 
 
 @dataclass(slots=True)
 class WebhookStats:
     posted: int = 0  # POSTs answered 2xx
     retried: int = 0
-    failed: int = 0  # (alert, URL) given up on after its attempts, or refused (4xx)
+    failed: int = 0  # (alert, URL) given up on after its attempts, or refused (3xx, 4xx)
     dropped: int = 0  # alert changes dropped from a full queue
 
 
-class Webhooks:
-    """Posts alert changes to ``cfg.webhooks``; start it inside the event loop."""
+class Destination:
+    """One URL: its queue, its task, its retries. Alertmanager destinations also re-send
+    their firing alerts every :data:`~.alertbodies.REFRESH` seconds (Alertmanager's
+    clients keep firing alerts alive)."""
 
-    def __init__(self, cfg: AlertsCfg, robot: str = "frog") -> None:
+    def __init__(
+        self,
+        hook: Webhook,
+        cfg: AlertsCfg,
+        sender: Sender,
+        stats: WebhookStats,
+        wall: Callable[[], float],
+    ) -> None:
+        self.hook = hook
         self.cfg = cfg
-        self.robot = robot
-        self.stats = WebhookStats()
-        self._queue: deque[Alert] = deque()
+        self.sender = sender
+        self.stats = stats
+        self.wall = wall
+        self.shown = redact(hook.url)
+        self.url = alertbodies.target(hook)
+        self.refresh = alertbodies.REFRESH if hook.format == "alertmanager" else None
+        self.queue: deque[Outgoing] = deque()
+        self.firing: dict[str, Outgoing] = {}  # alertmanager: id -> latest, to re-send
+        self.busy = False
         self._ready = asyncio.Event()
-        self._task: asyncio.Task[None] | None = None
         self._warnings = WarningLimiter(60.0, logger=log)
+        self.task: asyncio.Task[None] | None = None
 
-    def start(self) -> None:
-        if self.cfg.webhooks and self._task is None:
-            self._task = asyncio.get_running_loop().create_task(self._run())
-
-    def attach(self, host: Host) -> None:
-        """An observer of the executive: it hears every alert change."""
-
-    def on_event(self, event: Event) -> None:
-        if type(event) is AlertChanged:
-            self.notify(event.t, event.alert)  # type: ignore[union-attr]
-
-    def notify(self, _now: float, alert: Alert) -> None:
-        """Queue one alert change."""
-        if not self.cfg.webhooks:
-            return
-        if len(self._queue) >= QUEUE:
-            self._queue.popleft()
+    def put(self, out: Outgoing) -> None:
+        if len(self.queue) >= QUEUE:
+            self.queue.popleft()
             self.stats.dropped += 1
-            self._warnings.warn("full", f"webhooks: queue full, {self.stats.dropped} alert "
-                                        "changes dropped so far")
-        self._queue.append(alert)
+            self._warnings.warn(
+                "full",
+                f"webhook {self.shown}: queue full, "
+                f"{self.stats.dropped} alert changes dropped so far",
+            )
+        self.queue.append(out)
         self._ready.set()
 
     @property
-    def pending(self) -> int:
-        return len(self._queue)
+    def idle(self) -> bool:
+        return not self.queue and not self.busy
 
-    async def _run(self) -> None:
+    async def run(self) -> None:
         import aiohttp
 
+        loop = asyncio.get_running_loop()
         timeout = aiohttp.ClientTimeout(total=self.cfg.webhook_timeout)
+        next_refresh = loop.time() + (self.refresh or 0.0)
         async with aiohttp.ClientSession(timeout=timeout) as session:
             while True:
-                await self._ready.wait()
+                with contextlib.suppress(TimeoutError):
+                    async with asyncio.timeout(
+                        None if self.refresh is None else next_refresh - loop.time()
+                    ):
+                        await self._ready.wait()
                 self._ready.clear()
-                while self._queue:
-                    alert = self._queue[0]
-                    body = msgspec.json.encode({**msgspec.structs.asdict(alert),
-                                                "robot": self.robot})
-                    for url in self.cfg.webhooks:
-                        await self._post(session, url, body, alert)
-                    self._queue.popleft()
+                if self.refresh is not None and loop.time() >= next_refresh:
+                    # alertmanager: say the firing ones still fire, however busy the queue
+                    next_refresh = loop.time() + self.refresh
+                    await self._refresh(session)
+                while self.queue:
+                    out = self.queue[0]
+                    self.busy = True
+                    try:
+                        self._track(out)
+                        await self._post(session, self._encode(out), out.alert.id)
+                    finally:
+                        self.busy = False
+                    if self.queue and self.queue[0] is out:
+                        self.queue.popleft()
 
-    async def _post(self, session: object, url: str, body: bytes, alert: Alert) -> None:
+    def _track(self, out: Outgoing) -> None:
+        if self.refresh is None:
+            return
+        if out.alert.state == "cleared":
+            self.firing.pop(out.alert.id, None)
+        else:
+            self.firing[out.alert.id] = out
+
+    async def _refresh(self, session: aiohttp.ClientSession) -> None:
+        if not self.firing:
+            return
+        now = self.wall()
+        outs = [Outgoing(o.alert, now, o.started, o.ack_url) for o in self.firing.values()]
+        await self._post(
+            session,
+            msgspec.json.encode(alertbodies.alertmanager(outs, self.sender)),
+            "(still firing)",
+        )
+
+    def _encode(self, out: Outgoing) -> bytes:
+        data = msgspec.json.encode(alertbodies.body(self.hook, out, self.sender))
+        if len(data) > BODY_MAX:  # text fields are cut well before: say so, send the gist
+            log.warning(
+                "webhook %s: alert %s body of %d bytes cut", self.shown, out.alert.id, len(data)
+            )
+            data = msgspec.json.encode(
+                {
+                    "id": out.alert.id,
+                    "kind": out.alert.kind,
+                    "state": out.alert.state,
+                    "robot": self.sender.robot,
+                }
+            )
+        return data
+
+    async def _post(self, session: aiohttp.ClientSession, data: bytes, what: str) -> None:
         import aiohttp
 
-        assert isinstance(session, aiohttp.ClientSession)
         delay = self.cfg.webhook_backoff
         for attempt in range(1, self.cfg.webhook_attempts + 1):
             try:
-                async with session.post(url, data=body, headers={
-                        "Content-Type": "application/json"}) as response:
+                async with session.post(
+                    self.url,
+                    data=data,
+                    allow_redirects=False,
+                    headers={"Content-Type": "application/json"},
+                ) as response:
+                    await response.content.read(ANSWER_MAX)  # at most; the rest is dropped
                     if response.status < 300:
                         self.stats.posted += 1
                         return
                     if response.status < 500:
                         self.stats.failed += 1
-                        log.warning("webhook %s refused alert %s: HTTP %d", url, alert.id,
-                                    response.status)
+                        log.warning(
+                            "webhook %s refused alert %s: HTTP %d%s",
+                            self.shown,
+                            what,
+                            response.status,
+                            " (redirects are not followed)" if response.status < 400 else "",
+                        )
                         return
                     why = f"HTTP {response.status}"
-            except (aiohttp.ClientError, TimeoutError, OSError) as exc:
-                why = f"{type(exc).__name__}: {exc}"[:120]
+            except (aiohttp.ClientError, TimeoutError, OSError, ValueError) as exc:
+                why = self._why(exc)
             if attempt == self.cfg.webhook_attempts:
                 break
             self.stats.retried += 1
-            log.info("webhook %s: %s; try %d of %d in %.1f s", url, why, attempt + 1,
-                     self.cfg.webhook_attempts, delay)
+            log.info(
+                "webhook %s: %s; try %d of %d in %.1f s",
+                self.shown,
+                why,
+                attempt + 1,
+                self.cfg.webhook_attempts,
+                delay,
+            )
             await asyncio.sleep(delay)
             delay *= 2
         self.stats.failed += 1
-        log.warning("webhook %s: alert %s not delivered after %d tries",
-                    url, alert.id, self.cfg.webhook_attempts)
+        log.warning(
+            "webhook %s: alert %s not delivered after %d tries (%s)",
+            self.shown,
+            what,
+            self.cfg.webhook_attempts,
+            why,
+        )
+
+    def _why(self, exc: BaseException) -> str:
+        text = str(exc)
+        for url in {self.hook.url, self.url}:
+            text = text.replace(url, self.shown)
+        parts = urlsplit(self.hook.url)
+        for part in (parts.username, parts.password, parts.query, parts.path):
+            if part and len(part) > 1:
+                text = text.replace(part, "…")
+        return f"{type(exc).__name__}: {text}"[:160]
+
+
+class Webhooks:
+    """Posts alert changes to ``cfg.webhooks``, one task per destination; start it inside
+    the event loop. ``ack_secret``: the console's token, from which the key of the
+    acknowledgement links is derived (None: no links). ``wall``: the wall clock
+    (epoch seconds) the receivers' times and the links' expiry are on."""
+
+    def __init__(
+        self,
+        cfg: AlertsCfg,
+        robot: str | None = None,
+        *,
+        ack_secret: str | None = None,
+        wall: Callable[[], float] = time.time,
+    ) -> None:
+        self.cfg = cfg
+        self.robot = robot or cfg.robot
+        self.stats = WebhookStats()
+        self.wall = wall
+        self._key = link_key(ack_secret) if ack_secret and cfg.console_url else None
+        self._started: dict[str, float] = {}  # alert id -> wall time it was raised
+        sender = Sender(self.robot, cfg.console_url)
+        # a plain URL is validated here too: ``model_copy(update=...)`` does not validate
+        hooks = [Webhook.model_validate(h) for h in cfg.webhooks]
+        self.destinations = [Destination(hook, cfg, sender, self.stats, wall) for hook in hooks]
+
+    def start(self) -> None:
+        loop = asyncio.get_running_loop()
+        for d in self.destinations:
+            if d.task is None:
+                d.task = loop.create_task(d.run(), name=f"webhook {d.shown}")
+
+    def attach(self, host: Host) -> None:
+        """An observer of the executive: it hears every alert change."""
+
+    def on_event(self, event: Event) -> None:
+        if isinstance(event, AlertChanged):
+            self.notify(event.t, event.alert)
+
+    def notify(self, _now: float, alert: Alert) -> None:
+        """Queue one alert change for every destination (O(destinations), no I/O)."""
+        if not self.destinations:
+            return
+        at = self.wall()
+        if alert.state == "raised" and alert.repeat == 0:
+            self._started[alert.id] = at
+        started = self._started.get(alert.id, at)
+        if alert.state == "cleared":
+            self._started.pop(alert.id, None)
+        out = Outgoing(alert, at, started, self.link(alert, at))
+        for d in self.destinations:
+            d.put(out)
+
+    def link(self, alert: Alert, at: float) -> str:
+        """The signed link acknowledging ``alert`` ("" without a console URL or a token,
+        or once it is acknowledged)."""
+        if self._key is None or alert.state == "acknowledged":
+            return ""
+        return ack_link(self.cfg.console_url, self._key, alert.id, int(at + self.cfg.ack_link_ttl))
+
+    @property
+    def pending(self) -> int:
+        return sum(len(d.queue) for d in self.destinations)
 
     async def close(self, timeout: float = 1.0) -> None:
         """Give what is queued up to ``timeout`` seconds, then stop."""
-        task, self._task = self._task, None
-        if task is None:
+        tasks = [d.task for d in self.destinations if d.task is not None]
+        for d in self.destinations:
+            d.task = None
+        if not tasks:
             return
         with contextlib.suppress(TimeoutError):
             async with asyncio.timeout(timeout):
-                while self._queue and not task.done():
+                while any(not d.idle for d in self.destinations) and not all(
+                    t.done() for t in tasks
+                ):
                     await asyncio.sleep(0.05)
-        task.cancel()
-        with contextlib.suppress(asyncio.CancelledError):
-            await task
+        for task in tasks:
+            task.cancel()
+        for task in tasks:
+            with contextlib.suppress(asyncio.CancelledError):
+                await task

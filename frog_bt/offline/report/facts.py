@@ -423,8 +423,9 @@ class _Pieces:
                 at = self._skipping()
                 if at is not None:
                     piece.operator_skips.append(at)
-        elif (isinstance(message, AlertMessage) and message.state == "raised"
-              and not message.repeat):  # a repeat is an escalation, not a new alert
+        elif (
+            isinstance(message, AlertMessage) and message.state == "raised" and not message.repeat
+        ):  # a repeat is an escalation, not a new alert
             piece.alerts.append(message.kind)
 
     def _skipping(self) -> str | None:
