@@ -30,6 +30,7 @@ if TYPE_CHECKING:
     from frog_bt.runtime.executive import Executive
 
 log = logging.getLogger(__name__)
+REMEMBER_ACKS = 120.0  # project seconds after start-up in which a restored ack applies
 APPLY_WITHIN = 5.0  # wall seconds a queued command waits for a tick before it is refused
 
 
@@ -48,6 +49,7 @@ class Staff:
     _queue: list[Queued] = field(default_factory=list)
     _seeking_since: float | None = None
     remembered_acks: set[str] = field(default_factory=set)  # acknowledged before a restart
+    _remember_until: float | None = None
     _pause_ran_out: bool = False
     _touring: bool = False
 
@@ -128,8 +130,12 @@ class Staff:
         self.links_changed(now)
         for alert in self.book.update(self.facts(now)):
             if alert.state == "raised" and alert.id in self.remembered_acks:
+                self.remembered_acks.discard(alert.id)
                 self.book.acknowledge(alert.id, now)  # acknowledged before a restart
-        self.remembered_acks &= set(self.book.active)  # cleared since: forgotten
+        if self._remember_until is None:
+            self._remember_until = now + REMEMBER_ACKS
+        elif now >= self._remember_until:
+            self.remembered_acks.clear()  # what did not come back since is forgotten
 
     def acknowledged_ids(self) -> frozenset[str]:
         """The alerts still up that a person has acknowledged (kept across a restart)."""

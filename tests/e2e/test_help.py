@@ -12,7 +12,7 @@ from tour import Running, after_ticks
 
 from frog_bt.engine.operator import Command
 from frog_bt.model import keys
-from frog_bt.model.help import HelpAbout
+from frog_bt.model.help import Help, HelpAbout
 from frog_bt.runtime import decisions
 
 DOCK_FAILS = {"docking": {"dock_failures": 3}}  # the tour's three tries fail, a fourth works
@@ -218,3 +218,50 @@ def test_a_fault_that_persists_with_no_tour_asks_and_holds_until_it_clears() -> 
             assert run.sim.received("/docking/dock") == []  # no tour started meanwhile
 
     asyncio.run(main())
+
+
+def test_out_of_service_and_an_acknowledged_alert_survive_a_restart(
+    tmp_path: Path,
+) -> None:
+    """Staff's decisions are written beside the checkpoint and restored by the next
+    executive: still out of service, the acknowledged alert not shown again."""
+    checkpoint = tmp_path / "checkpoint.json"
+    idle = {"frontend": {"idle_at": 10_000}}
+
+    async def main() -> None:
+        async with Running(idle, checkpoint=checkpoint) as first:
+            exe = first.executive
+            await after_ticks(exe, lambda: bool(exe.core.ticks and exe.idle()))
+            assert (await exe.staff.submit(Command.SERVICE_OFF)).ok
+            first.sim.world.battery.percentage = 20.0
+            await after_ticks(exe, lambda: "battery_low" in exe.staff.book.active)
+            assert (await exe.staff.submit(Command.ACK_ALERT, "battery_low")).ok
+            await after_ticks(exe, lambda: exe.decided() == exe._decided)  # saved
+            sim, listen = first.sim, first.listen
+            first.own_sim = False
+        saved = decisions.load(decisions.path_for(checkpoint))
+        assert not saved.in_service and saved.acknowledged == {"battery_low"}
+        async with Running(idle, sim=sim, listen=listen, checkpoint=checkpoint) as second:
+            exe = second.executive
+            await after_ticks(exe, lambda: "battery_low" in exe.staff.book.active)
+            assert exe.core.board.get(keys.IN_SERVICE) is False
+            assert "battery_low" not in exe.staff.book.unacknowledged  # not shown again
+        await sim.stop()
+
+    asyncio.run(main())
+
+
+def test_decisions_round_trip_and_a_damaged_file_is_none(tmp_path: Path) -> None:
+    path = tmp_path / "c.json.staff"
+    kept = decisions.Decisions(
+        in_service=False,
+        paused=True,
+        help=Help(HelpAbout.DOCK, 12.5),
+        acknowledged=frozenset({"fault"}),
+    )
+    decisions.save(path, kept)
+    assert decisions.load(path) == kept
+    decisions.save(path, decisions.NONE)  # nothing decided: no file
+    assert not path.exists() and decisions.load(path) == decisions.NONE
+    path.write_text("{not json")
+    assert decisions.load(path) == decisions.NONE
