@@ -99,11 +99,11 @@ class Timeouts(_Model):
 
 
 class Navigation(_Model):
-    attempts: int = Field(3, ge=1)
+    attempts: int = Field(default=3, ge=1)
 
 
 class DockingCfg(_Model):
-    attempts: int = Field(3, ge=1)  # tries of a dock or an undock before giving up
+    attempts: int = Field(default=3, ge=1)  # tries of a dock or an undock before giving up
 
 
 class Recruit(_Model):
@@ -163,7 +163,7 @@ class VolumeZone(ZoneShape):
 
 
 class Volume(_Model):
-    default: int = Field(100, ge=0, le=100)
+    default: int = Field(default=100, ge=0, le=100)
     hysteresis: NonNegative = 1.0  # metres outside a zone before leaving it
     zones: list[VolumeZone] = []
 

@@ -124,7 +124,7 @@ class People:
         attempts_budget = cfg.webhook_attempts * cfg.webhook_timeout + cfg.webhook_backoff * (
             2 ** max(0, cfg.webhook_attempts - 1)
         )
-        await self.webhooks.close(attempts_budget + 1.0 if deliver else 1.0)
+        await self.webhooks.finish(attempts_budget + 1.0 if deliver else 1.0)
 
 
 async def start_people(

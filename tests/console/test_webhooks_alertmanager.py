@@ -103,11 +103,11 @@ def test_a_real_alertmanager_shows_the_alert_active_then_resolved(alertmanager: 
         book.listeners.append(hooks.notify)
         hooks.start()
         book.update(Facts(now=100.0, faults=("motors: overheated",)))
-        await hooks.close(timeout=10.0)  # returns once delivered
+        await hooks.finish(timeout=10.0)  # returns once delivered
         active = await alerts(alertmanager)
         hooks.start()
         book.update(Facts(now=200.0))  # the fault is over
-        await hooks.close(timeout=10.0)
+        await hooks.finish(timeout=10.0)
         resolved = await alerts(alertmanager)
         return active, resolved, hooks.stats.posted, hooks.stats.failed
 

@@ -47,7 +47,7 @@ def test_a_dead_receiver_delays_nobody_else() -> None:
                 hooks.notify(0.0, alert(n))
             got = await healthy.wait_for(3, within=5.0)
             calls, retried = dead.calls, hooks.stats.retried
-            await hooks.close(timeout=0.1)
+            await hooks.finish(timeout=0.1)
             return [g.body["id"] for g in got], calls, retried
 
     ids, dead_calls, retried = asyncio.run(main())
@@ -65,7 +65,7 @@ def test_a_redirect_is_not_followed_and_is_a_failure(caplog: pytest.LogCaptureFi
             hooks.start()
             hooks.notify(0.0, alert(1))
             await bouncer.wait_calls(1)
-            await hooks.close()
+            await hooks.finish()
             return target.calls, bouncer.calls, hooks.stats.failed
 
     with caplog.at_level(logging.INFO, logger="frog_bt"):
@@ -94,7 +94,7 @@ def test_urls_are_redacted_in_every_log_line(caplog: pytest.LogCaptureFixture) -
                 )
                 hooks.start()
                 hooks.notify(0.0, alert(1))
-                await hooks.close(timeout=5.0)
+                await hooks.finish(timeout=5.0)
             return f"http://127.0.0.1:{port}", f"http://127.0.0.1:{rport}"
 
     with caplog.at_level(logging.DEBUG):
@@ -129,7 +129,7 @@ def test_bodies_sent_and_answers_read_are_bounded() -> None:
             hooks.start()
             hooks.notify(0.0, alert(1, text="<b>" + "overheated " * 20_000))  # from /diagnostic
             [got] = await r.wait_for(1)
-            await hooks.close()
+            await hooks.finish()
             return len(got.body["text"]), hooks.stats.posted
 
     text_length, posted = asyncio.run(main())
@@ -149,7 +149,7 @@ def test_an_alertmanager_destination_resends_its_firing_alerts() -> None:
             await r.wait_for(3)  # raised, then re-sent twice
             book.update(Facts(now=1.0))
             got = await r.wait_for(4)
-            await hooks.close()
+            await hooks.finish()
             return [
                 (g.body[0]["labels"]["kind"], g.body[0]["annotations"]["summary"]) for g in got[:3]
             ]

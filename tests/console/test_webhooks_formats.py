@@ -106,7 +106,7 @@ async def drive(cfg: AlertsCfg, receiver: Receiver, n: int, **facts: Any) -> lis
         book.update(Facts(now=2900.0))
         return await receiver.wait_for(n)
     finally:
-        await hooks.close()
+        await hooks.finish()
 
 
 def check_link(url: str, alert_id: str) -> None:
@@ -240,7 +240,7 @@ def test_no_links_without_a_console_url_or_a_token() -> None:
                 hooks.start()
                 book.update(Facts(now=1.0, battery=5.0))
                 out.append(await r.wait_for(1))
-                await hooks.close()
+                await hooks.finish()
         return out
 
     no_console, no_token = asyncio.run(main())

@@ -308,7 +308,11 @@ class Webhooks:
     def pending(self) -> int:
         return sum(len(d.queue) for d in self.destinations)
 
-    async def close(self, timeout: float = 1.0) -> None:
+    def close(self) -> None:
+        """As an observer: nothing to finish here (the sending tasks end in :meth:`finish`,
+        which the command that started them awaits)."""
+
+    async def finish(self, timeout: float = 1.0) -> None:
         """Give what is queued up to ``timeout`` seconds, then stop."""
         tasks = [d.task for d in self.destinations if d.task is not None]
         for d in self.destinations:
