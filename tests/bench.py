@@ -56,7 +56,7 @@ class Bench:
             self.clock,
             lambda topic, msg: self.published.append((topic, msg)),
             lambda message: self.sent.append(message),
-            emit=self.observers.emit,
+            emit=self.observers,
         )
 
     # inputs

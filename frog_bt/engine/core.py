@@ -69,7 +69,9 @@ class Core:
         self.clock = clock
         self._publish_topic = publish
         self._send = send
-        self.emit = emit  # the host's observers (None: nobody listens)
+        # The host's observers: a callable that is false while nobody listens (no event is
+        # built then: a replay without observers pays nothing for them), or None.
+        self.emit = emit
         # The executive's state, kept across trees (a reload hands the next core the same)
         standing = self.standing = standing if standing is not None else Standing(clock)
         self.blamed = "-"  # the node that sent the latest command (see who())
@@ -142,7 +144,7 @@ class Core:
         msg = OUTPUTS[role].codec.encode(value)
         self._publish_topic(topic, msg)
         emit = self.emit
-        if emit is not None:
+        if emit:
             now = self.clock.now()
             emit(RobotCommand(now, role, topic, value, msg, goal))
             emit(Blamed(now, topic, self.blamed, self.blamed_reads))
@@ -153,7 +155,7 @@ class Core:
             self.journal.tally.tour_started()
         self._send(message)
         emit = self.emit
-        if emit is not None:
+        if emit:
             now = self.clock.now()
             emit(FrontendOut(now, message))
             emit(Blamed(now, message.type, self.blamed, self.blamed_reads))
@@ -170,7 +172,7 @@ class Core:
         """Cache one decoded message (``value`` None: it did not decode, or the tree does
         not read its topic: told to the observers only); True when it calls for a tick."""
         now = self.clock.now()
-        if self.emit is not None:
+        if self.emit:
             self.emit(RobotInput(now, topic, value, raw))
         inp = self.table.get(topic)
         if inp is None or value is None:
@@ -181,7 +183,7 @@ class Core:
     def on_event(self, message: FrontendMessage) -> None:
         """Queue a new front-end event for the next tick's snapshot."""
         now = self.clock.now()
-        if self.emit is not None:
+        if self.emit:
             self.emit(FrontendIn(now, message))
         self.inputs.events.append((message, now))
 
@@ -196,7 +198,7 @@ class Core:
         next one). The observers hear it, with its answer and who sent it (``by``)."""
         now = self.clock.now()
         answer = self.operator.apply(command, now)
-        if self.emit is not None:
+        if self.emit:
             self.emit(
                 OperatorDone(now, self.ticks + 1, command.value, answer.ok, answer.text, by=by)
             )
@@ -216,7 +218,7 @@ class Core:
         touched.extend(self.root.tick())  # stopped nodes are already in it
         self.ticks += 1
         status = self.root.status
-        if self.emit is not None:
+        if self.emit:
             self.emit(Ticked(self.clock.now(), self.ticks, status.name))  # type: ignore[arg-type]
         touched.clear()
         return status

@@ -148,9 +148,7 @@ class Replay:
         self.period = 1.0 / site.executive.tick_hz
         self.clock = ManualClock(None)
         self.observers = Observers()  # attach with attach_all(replay, [...]) before run()
-        self.core = Core(
-            site, tree, self.clock, self._publish, self._send, emit=self.observers.emit
-        )
+        self.core = Core(site, tree, self.clock, self._publish, self._send, emit=self.observers)
         self.reader = Reader(site)  # the one decoder; its tally counts the bad messages
         self.endpoint = Endpoint(self._peer, EVENTS)  # the same dedup as the live link
         self._expected: deque[Command] = deque()

@@ -150,7 +150,7 @@ class Executive:
             self.clock,
             self.client.publish,
             self.link.send,
-            emit=self.observers.emit,
+            emit=self.observers,
             standing=self.standing,
         )
 

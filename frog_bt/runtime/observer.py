@@ -90,6 +90,8 @@ class Observers:
         for call in self._calls:
             call(event)
 
+    __call__ = emit  # a core's ``emit``: false while nobody listens
+
     def close(self) -> None:
         """Close in the reverse order of attaching (the last attached may use the first)."""
         for observer in reversed(self._observers):
