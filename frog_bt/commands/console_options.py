@@ -4,6 +4,8 @@ checked up front, and the console started and stopped around the executive."""
 from __future__ import annotations
 
 import argparse
+import logging
+import stat
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,6 +20,8 @@ if TYPE_CHECKING:
     from frog_bt.runtime.executive import Executive
 
 DEFAULT_HOST = "127.0.0.1"
+TOKEN_LENGTH = (16, 512)  # characters: long enough to guess at no rate, short enough for a header
+log = logging.getLogger(__name__)
 
 
 def add_console_arguments(p: argparse.ArgumentParser) -> None:
@@ -63,21 +67,7 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
     if text.isdigit() or text.startswith(":"):
         text = f"{DEFAULT_HOST}:{text.lstrip(':')}"
     host, port = parse_hostport(text, "--console")
-    token = None
-    if args.console_token_file is not None:
-        path = args.console_token_file
-        try:
-            token = path.read_text(encoding="utf-8").strip()
-        except (OSError, UnicodeDecodeError) as exc:
-            raise UsageError(
-                "--console-token-file",
-                path,
-                f"cannot read it: {getattr(exc, 'strerror', None) or exc}",
-            ) from None
-        if len(token) < 8:
-            raise UsageError(
-                "--console-token-file", path, "expected a token of at least 8 characters"
-            )
+    token = read_token(args.console_token_file) if args.console_token_file is not None else None
     if token is None and not is_loopback(host):
         raise UsageError(
             "--console",
@@ -86,6 +76,41 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
             "network could steer the robot; give --console-token-file",
         )
     return ConsoleSettings(host, port, token)
+
+
+def read_token(path: Path) -> str:
+    """The staff token in ``path``: visible ASCII (it goes into a header), 16 to 512
+    characters, else UsageError. A file that others than its owner can read or write is
+    used, with a warning that says the fix in one line."""
+    try:
+        token = path.read_text(encoding="utf-8").strip()
+        mode = path.stat().st_mode
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UsageError(
+            "--console-token-file", path, f"cannot read it: {getattr(exc, 'strerror', None) or exc}"
+        ) from None
+    shortest, longest = TOKEN_LENGTH
+    if not shortest <= len(token) <= longest:
+        raise UsageError(
+            "--console-token-file",
+            path,
+            f"expected a token of {shortest} to {longest} characters, found {len(token)}",
+        )
+    if not all("!" <= c <= "~" for c in token):
+        raise UsageError(
+            "--console-token-file",
+            path,
+            "expected a token of visible ASCII characters (no spaces; e.g. "
+            "python3 -c 'import secrets; print(secrets.token_urlsafe(32))')",
+        )
+    if mode & (stat.S_IRWXG | stat.S_IRWXO):
+        log.warning(
+            "--console-token-file %s: others than its owner may read or change it; "
+            "fix: chmod 600 %s",
+            path,
+            path,
+        )
+    return token
 
 
 async def start_console(executive: Executive, settings: ConsoleSettings) -> Console:

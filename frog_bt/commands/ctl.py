@@ -5,8 +5,10 @@
     frog-bt ctl status
 
 Exit 0 when the command was applied (``status``: the state was read), 1 when the tour
-refused it (the reason is printed), 2 for a usage error or when the console cannot be
-reached (within ``--timeout`` seconds).
+refused it (the reason is printed), 2 for a usage error, when the console cannot be
+reached (within ``--timeout`` seconds) or when its answer is not a clear yes: only
+``{"ok": true}`` counts as done. Redirects are never followed (the token would go with
+the request to wherever the redirect points).
 """
 
 from __future__ import annotations
@@ -47,6 +49,25 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
+class NoRedirects(urllib.request.HTTPRedirectHandler):
+    """A redirect is an answer (an error), not a place to send the token to."""
+
+    def redirect_request(self, *_args: object, **_kwargs: object) -> None:
+        return None
+
+
+OPENER = urllib.request.build_opener(NoRedirects)
+
+
+def _reason(body: bytes, default: str) -> str:
+    try:
+        answer = json.loads(body)
+    except (ValueError, RecursionError):
+        return default
+    reason = answer.get("reason") if isinstance(answer, dict) else None
+    return str(reason)[:300] if reason else default
+
+
 def _fail(text: str) -> int:
     print(f"frog-bt ctl: {text}", file=sys.stderr)
     return 2
@@ -75,22 +96,34 @@ def run(args: argparse.Namespace) -> int:
             f"{base}/api/command", method="POST", data=json.dumps(body).encode(), headers=headers
         )
     try:
-        with urllib.request.urlopen(request, timeout=args.timeout) as response:
-            answer = json.loads(response.read())
+        with OPENER.open(request, timeout=args.timeout) as response:
+            raw = response.read(1_000_000)
     except urllib.error.HTTPError as exc:
-        try:
-            reason = json.loads(exc.read()).get("reason", exc.reason)
-        except ValueError:
-            reason = exc.reason
+        if 300 <= exc.code < 400:
+            where = exc.headers.get("Location", "?") if exc.headers else "?"
+            return _fail(f"{exc.code}: the console redirects to {where[:200]}: not followed")
+        reason = _reason(exc.read(4096), str(exc.reason))
         if exc.code == 409:
             print(f"refused: {reason}")
             return 1
         return _fail(f"{exc.code}: {reason}")
     except (urllib.error.URLError, OSError, ValueError) as exc:
-        reason = getattr(exc, "reason", exc)
-        return _fail(f"cannot reach the console at {base}: {reason}")
+        why = exc.reason if isinstance(exc, urllib.error.URLError) else exc
+        return _fail(f"cannot reach the console at {base}: {why}")
+    try:
+        answer = json.loads(raw)
+    except (ValueError, RecursionError):
+        return _fail(f"the console's answer is not JSON: {raw[:80]!r}")
     if args.command == "status":
+        if not isinstance(answer, dict) or "phase" not in answer:
+            return _fail('the console\'s answer is not a state (no "phase")')
         print(json.dumps(answer, indent=1))
-    else:
-        print(f"done: {answer.get('did', '')}")
+        return 0
+    if not isinstance(answer, dict) or answer.get("ok") is not True:
+        reason = _reason(raw, "no reason given")
+        if isinstance(answer, dict) and answer.get("ok") is False:
+            print(f"refused: {reason}")
+            return 1
+        return _fail(f'the console did not say "ok": true (so nothing was done): {raw[:80]!r}')
+    print(f"done: {answer.get('did', '')}")
     return 0

@@ -158,7 +158,7 @@ def test_without_a_token_file_commands_are_off_and_off_loopback_it_does_not_star
     short = tmp_path / "token"
     short.write_text("abc\n")
     Args.console_token_file = short  # type: ignore[assignment]
-    with pytest.raises(UsageError, match="at least 8 characters"):
+    with pytest.raises(UsageError, match="16 to 512 characters"):
         console_settings(Args())  # type: ignore[arg-type]
     short.write_text("a-long-enough-token\n")
     settings = console_settings(Args())  # type: ignore[arg-type]

@@ -21,7 +21,9 @@ def test_the_routes_are_the_contracts_and_declared_once() -> None:
         ("GET", "/api/state"),
         ("GET", "/api/stream"),
         ("GET", "/api/tree"),
+        ("GET", "/console.js"),
         ("POST", "/api/command"),
+        ("POST", "/api/ticket"),
     ]
 
 

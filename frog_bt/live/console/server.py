@@ -1,13 +1,18 @@
 """The operator's console over HTTP (CONTRACT §7), in the executive's own event loop.
 
 :func:`make_app` builds the aiohttp application, :class:`Console` runs it
-(``web.AppRunner`` + ``TCPSite``). The routes, all in :data:`ROUTES`:
+(``web.AppRunner`` + :class:`~frog_bt.live.console.gate.GatedSite`). The routes, all in
+:data:`ROUTES`:
 
-* ``GET /`` — the page (one file, no build step, nothing fetched from elsewhere);
+* ``GET /`` — the page, and ``GET /console.js`` its script (nothing fetched from
+  elsewhere, nothing inline but the page's style, allowed by its hash);
 * ``GET /api/state`` — the state (:func:`frog_bt.live.console.state.state`);
-* ``GET /api/site`` — the static map; ``GET /api/tree`` — the whole tree, with statuses;
+* ``GET /api/site`` — the static map; ``GET /api/tree`` — the whole tree, with statuses
+  (both cached: serialised once per site, once per tick);
 * ``GET /api/stream`` — a WebSocket pushing the state at most every ``console.push_every``
-  seconds, and within 50 ms of a new phase or a command;
+  seconds, and within 50 ms of a new phase or a command (:mod:`~.stream`);
+* ``POST /api/ticket`` — with the token: a one-use ticket for ``/api/stream?ticket=``, so
+  that off loopback the token never travels in a URL (:mod:`~.bearer`);
 * ``GET /ack/{alert_id}?exp=&sig=`` — a notification's signed link acknowledges its alert
   (:func:`get_ack`), answering a plain page;
 * ``POST /api/command`` — ``{"command": C}`` (``"id"`` with ``ack_alert``), with
@@ -15,58 +20,62 @@
   tick, 409 ``{"ok": false, "reason"}`` when the tour cannot do it now, 400 malformed or
   unknown, 401 no or wrong token, 413 too large, 429 too many commands a second.
 
-Every refusal is one line of JSON ``{"ok": false, "reason": ...}`` and changes nothing.
-The token is compared in constant time and never logged or recorded. Reads need no token
-while the console listens on loopback; elsewhere they need it too (and the console does
-not start on such an address without a token file).
+Every request passes :func:`guard` first: a ``Host`` or ``Origin`` that is not the
+console's gets 403 (:mod:`~.origins`); then the token, where one is needed (only the
+``Bearer`` scheme; failed attempts throttled per address, 429, and logged once a minute);
+then the body's size. Every refusal is one line of JSON ``{"ok": false, "reason": ...}``
+and changes nothing; every answer carries a strict Content-Security-Policy
+(:data:`SECURITY_HEADERS`). The token is compared in constant time and never logged or
+recorded. Reads need no token when the console listens on loopback and the request names
+a loopback host and came through no proxy; elsewhere they need it too (and the console
+does not start off loopback without a token file).
 
 What one console keeps lives in its application, under typed keys: :data:`EXECUTIVE`,
-:data:`ACCESS` (who may do what), :data:`SHOWN` (the day, the log lines, the stop clock)
-and :data:`PAGES` (the open WebSockets). Its lifetime is the application's: the log
-handler and the pusher start with it and end with it (``cleanup_ctx``), the pages are
-closed, within :data:`CLOSE_TIMEOUT`, as it shuts down (``on_shutdown``).
+:data:`ACCESS` (who may do what), :data:`SHOWN` (the day, the log lines, the stop clock,
+the cached reads) and :data:`PAGES` (the open WebSockets). Its lifetime is the
+application's: the log handler and the pusher start with it and end with it
+(``cleanup_ctx``), the pages are closed, within :data:`CLOSE_TIMEOUT`, as it shuts down
+(``on_shutdown``).
 """
 
 from __future__ import annotations
 
 import asyncio
+import base64
 import contextlib
-import hmac
+import hashlib
 import html
-import ipaddress
 import json
 import logging
+import re
 import time
 from collections.abc import AsyncIterator, Awaitable, Callable
 from dataclasses import dataclass, field
 from importlib import resources
 from typing import TYPE_CHECKING, Any
 
-from aiohttp import WSCloseCode, WSMsgType, web
+from aiohttp import web
 
 from frog_bt.engine.operator import Command
 from frog_bt.live.console.acklink import Verdict, link_key, verify
+from frog_bt.live.console.bearer import Failures, Tickets, bearer, matches
 from frog_bt.live.console.day import Day
+from frog_bt.live.console.gate import Door, GatedSite, OutOfFiles, connection_cap
+from frog_bt.live.console.origins import Origins, is_loopback, split_host
 from frog_bt.live.console.state import LogLines, StopClock, site_map, state, tree
+from frog_bt.live.console.stream import CLOSE_TIMEOUT, Pages, close_all, serve
 from frog_bt.runtime.status import phase
 
 if TYPE_CHECKING:
     from frog_bt.runtime.executive import Executive
 
+__all__ = ["ACCESS", "CLOSE_TIMEOUT", "PAGES", "ROUTES", "SHOWN", "Console", "is_loopback"]
+
 log = logging.getLogger(__name__)
 Handler = Callable[[web.Request], Awaitable[web.StreamResponse]]
-SEND_TIMEOUT = 2.0  # seconds a pushed state may take to reach one page; then it is dropped
 PHASE_POLL = 0.05  # wall seconds between looks at the phase (a new one is pushed at once)
-CLOSE_TIMEOUT = 1.0  # seconds the pages, then the open requests, get when the console stops
-
-
-def is_loopback(host: str) -> bool:
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
+HEADER_TIMEOUT = 10.0  # seconds a connection may take to send a whole request header
+PROXIED = ("Forwarded", "X-Forwarded-For", "X-Real-IP")  # a request that came via a proxy
 
 
 def refuse(status: int, reason: str) -> web.Response:
@@ -97,37 +106,88 @@ class RateLimit:
 
 @dataclass
 class Access:
-    """Who may do what: the staff token (None: commands are off), whether reads are open
-    (on loopback), the largest body and the command rate."""
+    """Who may do what: the staff token (None: commands are off), whether the console
+    listens on loopback, the console's own origins, the largest body, the command rate,
+    the failed attempts and the stream tickets."""
 
     token: str | None
     loopback: bool
     max_body: int
     limit: RateLimit
+    origins: Origins
+    failures: Failures = field(default_factory=Failures)
+    tickets: Tickets = field(default_factory=Tickets)
 
 
 @dataclass
 class Shown:
-    """What the page shows beside the executive's own state."""
+    """What the page shows beside the executive's own state, and the reads kept between
+    changes (the tree per core and tick, the map per site)."""
 
     day: Day
     logs: LogLines
     stop_clock: StopClock
+    cached: dict[str, tuple[object, int, bytes]] = field(default_factory=dict)
+
+    def cache(self, name: str, owner: object, version: int, make: Callable[[], Any]) -> bytes:
+        """``make()`` as JSON bytes, made again only when ``owner`` or ``version`` changed."""
+        held = self.cached.get(name)
+        if held is not None and held[0] is owner and held[1] == version:
+            return held[2]
+        body = json.dumps(make()).encode()
+        self.cached[name] = (owner, version, body)
+        return body
 
 
-@dataclass
-class Pages:
-    """The open pages, and the nudge that pushes the state to them at once."""
+@dataclass(frozen=True)
+class Assets:
+    """The page, its script and the policy that allows exactly them."""
 
-    push_every: float
-    sockets: set[web.WebSocketResponse] = field(default_factory=set)
-    changed: asyncio.Event = field(default_factory=asyncio.Event)
+    page: str
+    script: str
+    policy: str
 
 
 EXECUTIVE: web.AppKey[Executive] = web.AppKey("executive")
 ACCESS = web.AppKey("access", Access)
 SHOWN = web.AppKey("shown", Shown)
 PAGES = web.AppKey("pages", Pages)
+ASSETS = web.AppKey("assets", Assets)
+
+
+def load_assets() -> Assets:
+    files = resources.files("frog_bt.live.console")
+    page = files.joinpath("page.html").read_text("utf-8")
+    styles = re.findall(r"<style>(.*?)</style>", page, re.DOTALL)
+    hashes = " ".join(
+        f"'sha256-{base64.b64encode(hashlib.sha256(s.encode()).digest()).decode()}'" for s in styles
+    )
+    policy = (
+        "default-src 'self'; script-src 'self'; "
+        f"style-src 'self' {hashes}; img-src 'self'; connect-src 'self'; "
+        "object-src 'none'; base-uri 'none'; form-action 'self'; frame-ancestors 'none'; "
+        "require-trusted-types-for 'script'"
+    )
+    return Assets(page, files.joinpath("console.js").read_text("utf-8"), policy)
+
+
+SECURITY_HEADERS = {
+    "X-Content-Type-Options": "nosniff",
+    "X-Frame-Options": "DENY",
+    "Referrer-Policy": "no-referrer",
+    "Cross-Origin-Opener-Policy": "same-origin",
+    "Cross-Origin-Resource-Policy": "same-origin",
+}
+
+
+async def secure_headers(request: web.Request, response: web.StreamResponse) -> None:
+    """Every answer: the page's policy (or, for JSON and plain pages, one that allows
+    nothing), no sniffing, no framing, no referrer."""
+    response.headers.setdefault("Content-Security-Policy", request.app[ASSETS].policy)
+    for name, value in SECURITY_HEADERS.items():
+        response.headers.setdefault(name, value)
+    if request.path.startswith("/api"):
+        response.headers.setdefault("Cache-Control", "no-store")
 
 
 def snapshot(app: web.Application) -> dict[str, Any]:
@@ -138,29 +198,54 @@ def snapshot(app: web.Application) -> dict[str, Any]:
 # ---------------------------------------------------------------- guard
 
 
-def authorised(access: Access, request: web.Request) -> bool:
-    """The bearer token, compared in constant time (a page's reads, whose WebSocket
-    cannot send a header, may give it as ``?token=`` instead)."""
-    if access.token is None:
+def reached(request: web.Request) -> str | None:
+    """The local address the connection came in on (the console's own, on 0.0.0.0)."""
+    transport = request.transport
+    sockname = transport.get_extra_info("sockname") if transport is not None else None
+    return str(sockname[0]) if isinstance(sockname, tuple) and sockname else None
+
+
+def reads_open(access: Access, request: web.Request) -> bool:
+    """Reads without a token: the console is on loopback, the request names a loopback
+    host and came through no proxy (behind a proxy, anyone could be asking)."""
+    if not access.loopback or any(name in request.headers for name in PROXIED):
         return False
-    scheme, _, value = request.headers.get("Authorization", "").partition(" ")
-    if scheme.lower() != "bearer" and request.method == "GET":
-        value = request.query.get("token", "")
-    return hmac.compare_digest(value.strip().encode(), access.token.encode())
+    host = split_host(request.headers.get("Host", ""))
+    return host is not None and is_loopback(host[0])
+
+
+def token_refusal(access: Access, request: web.Request) -> web.Response | None:
+    """None when the request may go on; else the 401 or 429 to answer."""
+    address = request.remote or "?"
+    if not access.failures.allowed(address):
+        return refuse(429, "too many failed attempts from this address: wait a minute")
+    if matches(bearer(request.headers.get("Authorization")), access.token):
+        return None
+    if request.path == "/api/stream" and access.tickets.spend(request.query.get("ticket", "")):
+        return None
+    access.failures.failed(address)
+    return refuse(
+        401,
+        "a valid token is needed (Authorization: Bearer TOKEN)"
+        if access.token is not None
+        else "commands are off: the console was started without a token file",
+    )
 
 
 @web.middleware
 async def guard(request: web.Request, handler: Handler) -> web.StreamResponse:
-    """Auth, size and refusals as one line of JSON, in one place."""
+    """Origins, auth, size and refusals as one line of JSON, in one place."""
     access = request.app[ACCESS]
-    needs_token = request.method != "GET" or not access.loopback
-    if needs_token and request.path.startswith("/api") and not authorised(access, request):
-        return refuse(
-            401,
-            "a valid token is needed (Authorization: Bearer TOKEN)"
-            if access.token is not None
-            else "commands are off: the console was started without a token file",
-        )
+    here = reached(request)
+    if not access.origins.host_ok(request.headers.get("Host"), here):
+        return refuse(403, "this console does not answer to that Host")
+    if not access.origins.origin_ok(request.headers.get("Origin"), here):
+        return refuse(403, "a page from another origin may not use this console")
+    needs_token = request.method != "GET" or not reads_open(access, request)
+    if needs_token and request.path.startswith("/api"):
+        refusal = token_refusal(access, request)
+        if refusal is not None:
+            return refusal
     if request.content_length is not None and request.content_length > access.max_body:
         return refuse(413, f"request body over {access.max_body} bytes")
     try:
@@ -176,48 +261,52 @@ async def guard(request: web.Request, handler: Handler) -> web.StreamResponse:
 # ---------------------------------------------------------------- reads
 
 
-async def get_page(_request: web.Request) -> web.Response:
-    page = resources.files("frog_bt.live.console").joinpath("page.html").read_text("utf-8")
-    return web.Response(text=page, content_type="text/html")
+async def get_page(request: web.Request) -> web.Response:
+    return web.Response(text=request.app[ASSETS].page, content_type="text/html")
+
+
+async def get_script(request: web.Request) -> web.Response:
+    return web.Response(text=request.app[ASSETS].script, content_type="text/javascript")
 
 
 async def get_state(request: web.Request) -> web.Response:
     return web.json_response(snapshot(request.app))
 
 
+def _json(body: bytes) -> web.Response:
+    return web.Response(body=body, content_type="application/json")
+
+
 async def get_site(request: web.Request) -> web.Response:
-    return web.json_response(site_map(request.app[EXECUTIVE]))
+    executive = request.app[EXECUTIVE]
+    shown = request.app[SHOWN]
+    return _json(shown.cache("site", executive.site, 0, lambda: site_map(executive)))
 
 
 async def get_tree(request: web.Request) -> web.Response:
-    return web.json_response(tree(request.app[EXECUTIVE].core.root))
+    core = request.app[EXECUTIVE].core
+    return _json(request.app[SHOWN].cache("tree", core, core.ticks, lambda: tree(core.root)))
+
+
+async def post_ticket(request: web.Request) -> web.Response:
+    tickets = request.app[ACCESS].tickets
+    return web.json_response({"ok": True, "ticket": tickets.issue(), "expires_in": tickets.ttl})
 
 
 # ---------------------------------------------------------------- pushed state
 
 
-async def get_stream(request: web.Request) -> web.WebSocketResponse:
-    pages = request.app[PAGES]
-    ws = web.WebSocketResponse(heartbeat=30.0)
-    await ws.prepare(request)
-    pages.sockets.add(ws)
-    try:
-        await ws.send_str(json.dumps(snapshot(request.app)))
-        async for message in ws:  # the page sends nothing; this waits for it to go
-            if message.type == WSMsgType.ERROR:
-                break
-    finally:
-        pages.sockets.discard(ws)
-    return ws
+async def get_stream(request: web.Request) -> web.StreamResponse:
+    return await serve(request, request.app[PAGES], json.dumps(snapshot(request.app)))
 
 
 async def push(app: web.Application) -> None:
     """The state to every page every ``push_every`` seconds, and within
-    :data:`PHASE_POLL` of a new phase or a command; a page that does not take it within
-    :data:`SEND_TIMEOUT` is dropped. The phase is looked at here, between ticks, not
+    :data:`PHASE_POLL` of a new phase or a command (each page takes it at its own pace:
+    :mod:`~frog_bt.live.console.stream`). The phase is looked at here, between ticks, not
     after each tick: the console costs the tick nothing."""
     loop = asyncio.get_running_loop()
-    pages, core = app[PAGES], app[EXECUTIVE].core
+    pages, executive, failures = app[PAGES], app[EXECUTIVE], app[ACCESS].failures
     last, last_at, last_phase = "", 0.0, ""
     while True:
         # asyncio.timeout, not wait_for: on Python 3.11 wait_for can swallow a cancel
@@ -225,7 +314,8 @@ async def push(app: web.Application) -> None:
         with contextlib.suppress(TimeoutError):
             async with asyncio.timeout(PHASE_POLL):
                 await pages.changed.wait()
-        now_phase = phase(core)
+        failures.flush()  # the failed attempts of the last minute, once a minute
+        now_phase = phase(executive.core)
         due = (
             pages.changed.is_set()
             or now_phase != last_phase
@@ -233,30 +323,30 @@ async def push(app: web.Application) -> None:
         )
         pages.changed.clear()
         last_phase = now_phase
-        if not due or not pages.sockets:
+        if not due or not pages.open:
             continue
         last_at = loop.time()
         text = json.dumps(snapshot(app))
-        if text == last:
-            continue
-        last = text
-        for ws in list(pages.sockets):
-            try:
-                async with asyncio.timeout(SEND_TIMEOUT):
-                    await ws.send_str(text)
-            except (TimeoutError, ConnectionError, RuntimeError):
-                pages.sockets.discard(ws)
-                with contextlib.suppress(Exception):
-                    await ws.close()
+        if text != last:
+            last = text
+            pages.offer(text)
 
 
 # ---------------------------------------------------------------- commands
 
+UTF8 = (None, "utf-8", "utf8")
+
 
 async def post_command(request: web.Request) -> web.Response:
     try:
-        body = await request.json()
-    except (ValueError, UnicodeDecodeError):
+        charset = request.charset
+    except ValueError:
+        charset = "?"
+    if (charset.lower() if charset else None) not in UTF8:
+        return refuse(400, "the body must be JSON in UTF-8 (no other charset)")
+    try:
+        body = json.loads((await request.read()).decode("utf-8"))
+    except (ValueError, UnicodeDecodeError, RecursionError):
         return refuse(400, 'the body is not JSON: send {"command": ...}')
     if not isinstance(body, dict) or not isinstance(body.get("command"), str):
         return refuse(400, 'expected a JSON object with "command"')
@@ -342,10 +432,12 @@ async def get_ack(request: web.Request) -> web.Response:
 
 ROUTES = [
     web.get("/", get_page),
+    web.get("/console.js", get_script),
     web.get("/api/state", get_state),
     web.get("/api/site", get_site),
     web.get("/api/tree", get_tree),
     web.get("/api/stream", get_stream),
+    web.post("/api/ticket", post_ticket),
     web.post("/api/command", post_command),
     web.get("/ack/{alert_id}", get_ack, allow_head=False),  # HEAD acknowledges nothing
 ]
@@ -379,52 +471,68 @@ async def pusher(app: web.Application) -> AsyncIterator[None]:
 
 async def close_pages(app: web.Application) -> None:
     """Every open page told the console is going, all within :data:`CLOSE_TIMEOUT`."""
-    pages = app[PAGES]
-    sockets, pages.sockets = list(pages.sockets), set()
-    if not sockets:
-        return
-    with contextlib.suppress(TimeoutError):
-        async with asyncio.timeout(CLOSE_TIMEOUT):
-            await asyncio.gather(
-                *(
-                    ws.close(code=WSCloseCode.GOING_AWAY, message=b"the console is stopping")
-                    for ws in sockets
-                ),
-                return_exceptions=True,
-            )
+    await close_all(app[PAGES])
 
 
-def make_app(executive: Executive, *, token: str | None, loopback: bool) -> web.Application:
+def make_app(
+    executive: Executive, *, token: str | None, loopback: bool, origins: Origins | None = None
+) -> web.Application:
     """``executive``'s console as an application: its routes, its state, its lifetime.
-    ``token`` (None: commands are off); ``loopback``: whether reads need no token."""
+    ``token`` (None: commands are off); ``loopback``: whether reads may need no token;
+    ``origins``: the console's own (bound by :class:`Console` once it listens)."""
     cfg = executive.site.console
     app = web.Application(middlewares=[guard], client_max_size=cfg.max_body)
     app[EXECUTIVE] = executive
-    app[ACCESS] = Access(token, loopback, cfg.max_body, RateLimit(cfg.commands_per_second))
+    app[ACCESS] = Access(
+        token,
+        loopback,
+        cfg.max_body,
+        RateLimit(cfg.commands_per_second),
+        origins or Origins("127.0.0.1", executive.site.alerts.console_url),
+    )
     app[SHOWN] = Shown(Day(), LogLines(owner=executive), StopClock())
     app[PAGES] = Pages(cfg.push_every)
+    app[ASSETS] = load_assets()
     app.add_routes(ROUTES)
     app.cleanup_ctx.extend([log_lines, pusher])
     app.on_shutdown.append(close_pages)
+    app.on_response_prepare.append(secure_headers)
     return app
 
 
 class Console:
     """One executive's console on ``host:port`` (0: any free port, then :attr:`bound_port`):
     :meth:`attach` before the executive runs, :meth:`start` inside its loop, :meth:`close`
-    on the way out."""
+    on the way out. At most ``max_connections`` connections at once (and at most half the
+    process's descriptors: :func:`~frog_bt.live.console.gate.connection_cap`)."""
 
     def __init__(
-        self, executive: Executive, host: str, port: int, token: str | None = None
+        self,
+        executive: Executive,
+        host: str,
+        port: int,
+        token: str | None = None,
+        *,
+        max_connections: int | None = None,
+        header_timeout: float = HEADER_TIMEOUT,
     ) -> None:
         self.executive = executive
         self.host, self.port = host, port
-        self.app = make_app(executive, token=token, loopback=is_loopback(host))
-        self.bound_port: int | None = None
-        # bounded, with pages still open
-        self._runner = web.AppRunner(
-            self.app, access_log=None, handle_signals=False, shutdown_timeout=CLOSE_TIMEOUT
+        self.origins = Origins(host, executive.site.alerts.console_url)
+        self.app = make_app(
+            executive, token=token, loopback=is_loopback(host), origins=self.origins
         )
+        self.door = Door(connection_cap() if max_connections is None else max_connections)
+        self.bound_port: int | None = None
+        # bounded, with pages still open; keepalive_timeout is also the header deadline
+        self._runner = web.AppRunner(
+            self.app,
+            access_log=None,
+            handle_signals=False,
+            shutdown_timeout=CLOSE_TIMEOUT,
+            keepalive_timeout=header_timeout,
+        )
+        self._out_of_files: OutOfFiles | None = None
         self._started = False
 
     def attach(self) -> None:
@@ -435,8 +543,11 @@ class Console:
         """Listen; OSError when the address cannot be bound (then :meth:`close`)."""
         self._started = True
         await self._runner.setup()
-        await web.TCPSite(self._runner, self.host, self.port).start()
-        self.bound_port = int(self._runner.addresses[0][1])
+        site = GatedSite(self._runner, self.host, self.port, self.door)
+        await site.start()
+        self.bound_port = site.port
+        self.origins.bound(site.port)
+        self._out_of_files = OutOfFiles(asyncio.get_running_loop(), site.listening())
         log.warning("console at http://%s:%d/", self.host, self.bound_port)
 
     async def close(self) -> None:
@@ -444,4 +555,6 @@ class Console:
         and the log handler gone. Once; nothing to do when never started."""
         if self._started:
             self._started = False
+            if self._out_of_files is not None:
+                self._out_of_files.close()
             await self._runner.cleanup()
