@@ -121,6 +121,32 @@ def main() -> int:
         sorted(t["tours_per_day"].values()),
         [manifest["tours_per_day"]] * manifest["days"],
     )
+    causes = {(c["cause"], c["detail"]): c["events"] for c in t["failure_causes"]}
+    check(
+        "failure causes, each event once",
+        {k: n for k, n in causes.items() if k[0] != "approach rejected"},
+        {
+            k: n
+            for k, n in {
+                ("fault", "motors"): kinds.count("fault"),
+                ("invitation declined", ""): kinds.count("declines"),
+                ("visitor lost", ""): kinds.count("wander_off"),
+                ("navigation retry", ""): kinds.count("nav_failure"),
+            }.items()
+            if n
+        },
+    )
+    check(
+        "funnel: visitors who started",
+        t["funnel"]["started"],
+        n + kinds.count("wander_off"),
+    )
+    check("funnel: finished", t["funnel"]["finished"], n - kinds.count("fault"))
+    check(
+        "failures that needed a person (the faults' alerts)",
+        t["reliability"]["failures_needing_a_person"],
+        kinds.count("fault"),
+    )
     near("completion rate vs seeding", t["completion_rate"], 1 - weights["fault"], n)
     # a visitor who wanders off on the way to POI2 has heard POI1, and the next one
     # hears it again: one more (engaged) visit of POI1 per wanderer

@@ -7,7 +7,10 @@ restart that resumed it), and writes:
   -o FILE.html    the report: summary, plots and every tour, in one self-contained
                   file (no network needed to open it)
   --csv FILE      one row per tour, for pandas or R
-  --parquet FILE  the same rows as Parquet
+  --parquet FILE  the same rows as Parquet (lists as list columns, zoned times)
+  --json FILE     the totals, the rows and the files skipped
+  --compare DIR…  a second season beside the first: every rate in both, and the
+                  difference with its 95 % interval
 
 The recordings in one directory are one robot's: give each robot its own. A file that
 is not a recording, or is damaged beyond reading, is reported and skipped; one cut
@@ -26,6 +29,7 @@ import importlib.util
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 from frog_bt.commands.options import add_tree_and_config
 
@@ -48,6 +52,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--json", type=Path, metavar="FILE", help="write the totals and the rows as JSON"
     )
     p.add_argument(
+        "--compare",
+        type=Path,
+        nargs="+",
+        metavar="FILE_OR_DIR",
+        help="a second season (or tree version) to set beside the first",
+    )
+    p.add_argument(
         "--jobs",
         type=int,
         default=1,
@@ -62,45 +73,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
-def run(args: argparse.Namespace) -> int:
-    from frog_bt.commands.replay import CountBar
-    from frog_bt.config import load_site
-    from frog_bt.errors import DefinitionError, error_lines
+def _season(
+    paths: list[Path], site: Any, pool: Any, bar: Any, quiet: bool = False
+) -> tuple[list[Any], list[Any], dict[str, Any], list[str]]:
+    """Read one season: facts, rows, totals (with reliability and provenance), skipped."""
     from frog_bt.offline.corpus import recordings
-    from frog_bt.offline.executors import ExecutorError, executor
-    from frog_bt.offline.report import outputs
     from frog_bt.offline.report.corpus import read_corpus
+    from frog_bt.offline.report.provenance import provenance
+    from frog_bt.offline.report.reliability import reliability
     from frog_bt.offline.report.rows import rows as tour_rows
     from frog_bt.offline.report.totals import totals
 
-    for wanted, module in ((args.output, "matplotlib"), (args.parquet, "pyarrow")):
-        if wanted is not None and importlib.util.find_spec(module) is None:
-            print(f"frog-bt report: {wanted} needs {module}: {outputs.EXTRA}", file=sys.stderr)
-            return 2  # said before reading anything
-    if args.jobs < 1:
-        print(f"frog-bt report: --jobs {args.jobs}: expected 1 or more", file=sys.stderr)
-        return 2
-    try:
-        site = load_site(args.config)
-    except DefinitionError as exc:
-        for line in error_lines(exc):
-            print(f"frog-bt report: {line}", file=sys.stderr)
-        return 2
-    missing = [str(f) for f in args.files if not f.exists()]
-    if missing:
-        print(f"frog-bt report: no such file or directory: {', '.join(missing)}", file=sys.stderr)
-        return 2
-    files = recordings(args.files)
-    if not files:
-        print("frog-bt report: no recordings (*.mcap) found", file=sys.stderr)
-        return 2
-    bar = None if args.quiet or not sys.stderr.isatty() else CountBar(sys.stderr, "report", "files")
-    try:
-        with executor(args.jobs, args.scheduler) as pool:
-            facts = read_corpus(files, site, pool, bar)
-    except ExecutorError as exc:
-        print(f"frog-bt report: {exc}", file=sys.stderr)
-        return 2
+    facts = read_corpus(recordings(paths), site, pool, bar)
     if bar is not None:
         bar.clear()
     skipped = [f"{f.file}: {f.error}" for f in facts if f.error]
@@ -115,9 +99,63 @@ def run(args: argparse.Namespace) -> int:
                 f"({'; '.join(f.bad_first)})",
                 file=sys.stderr,
             )
-    rows = tour_rows([f for f in facts if not f.error], site)
+    read = [f for f in facts if not f.error]
+    rows = tour_rows(read, site)
     face_stops = [s.poi for s in site.tour.stops if s.face_stream]
-    t = totals(rows, face_stops, unreadable=len(skipped))
+    order = [s.poi for s in site.tour.stops if s.content]
+    t = totals(rows, face_stops, unreadable=len(skipped), order=order)
+    t["reliability"] = reliability(read, rows)
+    t["provenance"] = provenance(facts, skipped)
+    return facts, rows, t, skipped
+
+
+def run(args: argparse.Namespace) -> int:
+    from frog_bt.commands.replay import CountBar
+    from frog_bt.config import load_site
+    from frog_bt.errors import DefinitionError, error_lines
+    from frog_bt.offline.corpus import recordings
+    from frog_bt.offline.executors import ExecutorError, executor
+    from frog_bt.offline.report import outputs
+    from frog_bt.offline.report.compare import compare
+
+    for wanted, module in (
+        (args.output, "matplotlib"),
+        (args.parquet, "pyarrow"),
+        (True, "scipy"),
+    ):
+        if wanted and importlib.util.find_spec(module) is None:
+            what = "the report" if wanted is True else wanted
+            print(f"frog-bt report: {what} needs {module}: {outputs.EXTRA}", file=sys.stderr)
+            return 2  # said before reading anything
+    if args.jobs < 1:
+        print(f"frog-bt report: --jobs {args.jobs}: expected 1 or more", file=sys.stderr)
+        return 2
+    try:
+        site = load_site(args.config)
+    except DefinitionError as exc:
+        for line in error_lines(exc):
+            print(f"frog-bt report: {line}", file=sys.stderr)
+        return 2
+    other = list(args.compare or [])
+    missing = [str(f) for f in [*args.files, *other] if not f.exists()]
+    if missing:
+        print(f"frog-bt report: no such file or directory: {', '.join(missing)}", file=sys.stderr)
+        return 2
+    files = recordings(args.files)
+    if not files or (other and not recordings(other)):
+        print("frog-bt report: no recordings (*.mcap) found", file=sys.stderr)
+        return 2
+    bar = None if args.quiet or not sys.stderr.isatty() else CountBar(sys.stderr, "report", "files")
+    try:
+        with executor(args.jobs, args.scheduler) as pool:
+            _, rows, t, skipped = _season(args.files, site, pool, bar)
+            if other:
+                _, _, t_b, _ = _season(other, site, pool, bar)
+                name = ", ".join(str(p) for p in args.files)
+                t["compare"] = compare(t, t_b, name, ", ".join(str(p) for p in other))
+    except ExecutorError as exc:
+        print(f"frog-bt report: {exc}", file=sys.stderr)
+        return 2
     rate = t["completion_rate"]
     print(
         f"frog-bt report: {len(files)} files, {t['tours']} tours, {t['completed']} "
@@ -132,7 +170,7 @@ def run(args: argparse.Namespace) -> int:
         if args.json:
             args.json.write_text(
                 json.dumps(
-                    {"totals": t, "tours": [r.as_dict() for r in rows], "skipped": skipped},
+                    {"totals": t, "tours": [r.as_json() for r in rows], "skipped": skipped},
                     indent=1,
                 )
                 + "\n"

@@ -312,7 +312,9 @@ class Recorder:
             OPERATOR,
             event.t,
             channels.encode(
-                channels.Operator(event.tick, event.command, event.ok, event.text, event.id)
+                channels.Operator(
+                    event.tick, event.command, event.ok, event.text, event.id, event.by
+                )
             ),
         )
 

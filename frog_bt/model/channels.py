@@ -76,6 +76,7 @@ class Operator(msgspec.Struct, frozen=True):
     ok: bool
     text: str  # what it did, or why it was refused
     id: str = ""  # ack_alert: the alert
+    by: str = ""  # who sent it: console, ctl, link (empty when unknown; added later)
 
 
 class Alert(msgspec.Struct, frozen=True):

@@ -21,7 +21,7 @@ from frog_bt.config import load_site
 from frog_bt.model import channels
 from frog_bt.model.frontend import AskTour, FinishPoi, StartPoi, Tour, UserPositive
 from frog_bt.offline.report.facts import FileFacts, Piece, StopFacts, _Pieces
-from frog_bt.offline.report.rows import join, rows
+from frog_bt.offline.report.rows import Played, StopTime, join, rows
 from frog_bt.recordings.reader import FrontendIn, FrontendOut, Primed
 from frog_bt.runtime.observer import attach_all
 
@@ -55,14 +55,30 @@ def test_the_figures_are_those_the_corpus_was_seeded_with(corpus, tmp_path) -> N
     for s in seeded:
         hour = str(datetime.fromisoformat(s["start"]).hour)
         hours[hour] = hours.get(hour, 0) + 1
-    assert t["tours_per_hour"] == hours
+    span = range(min(map(int, hours)), max(map(int, hours)) + 1)
+    assert t["tours_per_hour"] == {str(h): hours.get(str(h), 0) for h in span}  # gaps as 0
     # the fault aborts its tour; every other kind completes
     assert t["completed"] == len(seeded) - kinds.count("fault")
     assert [r["ended"] for r in tours] == ["aborted" if k == "fault" else "ended" for k in kinds]
-    assert t["failure_causes"] == {
-        "aborted: electronics fault: motors: motor driver overheated": 1,
-        "fault: motors: motor driver overheated": 1,
+    # one typed taxonomy, each event once: the fault (not its abort again), the
+    # declines, the visitors lost
+    causes = {(c["cause"], c["detail"]): c["events"] for c in t["failure_causes"]}
+    expected = {
+        ("fault", "motors"): kinds.count("fault"),
+        ("invitation declined", ""): kinds.count("declines"),
+        ("visitor lost", ""): kinds.count("wander_off"),
     }
+    assert causes == {k: n for k, n in expected.items() if n}
+    assert t["visitors_lost"] == kinds.count("wander_off")
+    # the funnel: every visitor starts; one who wanders off reaches POI1 only
+    funnel = t["funnel"]
+    assert funnel["started"] == 6 + kinds.count("wander_off")
+    assert funnel["POI1"] == 6 + kinds.count("wander_off")
+    assert funnel["POI2"] == 6 and funnel["finished"] == 6 - kinds.count("fault")
+    # rates carry their Wilson interval
+    completion = t["rates"]["completion"]
+    assert completion["k"] == t["completed"] and completion["n"] == 6
+    assert completion["low"] < completion["rate"] <= completion["high"] <= 1.0
     # one invitation each; a second after a decline or a visitor who wandered off
     assert t["invitations"] == 6 + kinds.count("declines") + kinds.count("wander_off")
     assert t["invitations_declined"] == kinds.count("declines")
@@ -73,7 +89,7 @@ def test_the_figures_are_those_the_corpus_was_seeded_with(corpus, tmp_path) -> N
     assert t["gate_decisions"] == {"POI1": 6 + lost, "POI2": 6}
     assert t["part_b_rate"] == {"POI1": (5 + lost) / (6 + lost), "POI2": 5 / 6}
     for r, kind in zip(tours, kinds, strict=True):
-        engagement = json.loads(r["engagement"])
+        engagement = r["engagement"]
         assert [e["poi"] for e in engagement] == (
             ["POI1", "POI1", "POI2"] if kind == "wander_off" else ["POI1", "POI2"]
         )
@@ -83,7 +99,7 @@ def test_the_figures_are_those_the_corpus_was_seeded_with(corpus, tmp_path) -> N
     site = load_site()
     for r, s in zip(tours, seeded, strict=True):
         at = datetime.fromisoformat(s["start"]).time()
-        assert r["variants"].split(";")[0] == site.waypoint_for("POI1", at)
+        assert r["variants"][0] == site.waypoint_for("POI1", at)
     assert t["distance_m"] > 0 and all(r["distance_m"] > 100 for r in tours)
     assert t["resumed"] == 0
 
@@ -111,9 +127,14 @@ def test_csv_parquet_and_a_self_contained_html(corpus, tmp_path) -> None:
     with open(tmp_path / "r.csv", newline="") as f:
         table = list(csv.DictReader(f))
     assert len(table) == 6 and table[0]["day"] == "2026-06-01"
-    parquet = pq.read_table(tmp_path / "r.parquet").to_pylist()
-    assert [r["tour"] for r in parquet] == [int(r["tour"]) for r in table]
-    assert [r["ended"] for r in parquet] == [r["ended"] for r in table]
+    parquet = pq.read_table(tmp_path / "r.parquet")
+    assert str(parquet.schema.field("day").type) == "date32[day]"
+    assert str(parquet.schema.field("start").type) == "timestamp[us, tz=Europe/Madrid]"
+    assert str(parquet.schema.field("stops_visited").type) == "list<element: string>"
+    got = parquet.to_pylist()
+    assert [r["tour"] for r in got] == [int(r["tour"]) for r in table]
+    assert [r["ended"] for r in got] == [r["ended"] for r in table]
+    assert ["; ".join(r["stops_visited"]) for r in got] == [r["stops_visited"] for r in table]
 
     class Page(HTMLParser):
         def __init__(self) -> None:
@@ -138,7 +159,7 @@ def test_csv_parquet_and_a_self_contained_html(corpus, tmp_path) -> None:
 
     page = Page()
     page.feed(out.read_text())
-    assert len(page.images) >= 5
+    assert len(page.images) >= 7
     assert all(src.startswith("data:image/png;base64,") for src in page.images)
     assert page.links == []  # nothing to fetch: it opens offline
     assert json.loads(page.totals)["tours"] == 6
@@ -259,8 +280,18 @@ def test_the_pieces_of_a_tour_are_joined_into_one() -> None:
         first.ended,
         first.duration_s,
         first.resumed,
-    ) == ("a", "1.mcap;2.mcap", "POI1;POI2", "POI1 ab; POI2 ab", 120.0, "ended", 800.0, True)
-    assert json.loads(first.time_at_stops) == {"POI1": 20.0, "POI2": 50.0}  # 20 + 30
+    ) == (
+        "a",
+        ["1.mcap", "2.mcap"],
+        ["POI1", "POI2"],
+        [Played("POI1", "ab"), Played("POI2", "ab")],
+        120.0,
+        "ended",
+        800.0,
+        True,
+    )
+    assert first.time_at_stops == [StopTime("POI1", 20.0), StopTime("POI2", 50.0)]  # 20 + 30
+    assert first.restarts == 1 and [str(i) for i in first.incidents] == ["restart"]
 
 
 def test_a_tour_file_opening_with_the_tour_befores_end_resent_is_read_whole() -> None:
@@ -295,7 +326,7 @@ def test_a_tour_file_opening_with_the_tour_befores_end_resent_is_read_whole() ->
         row.ended,
         row.duration_s,
         row.resumed,
-    ) == (1, 1, "POI1", "ended", 199.0, False)
+    ) == (1, 1, ["POI1"], "ended", 199.0, False)
 
 
 def test_mistakes_are_one_line_and_exit_2(tmp_path, capsys) -> None:
@@ -373,8 +404,8 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
     got = report(tmp_path, str(day))
     assert got["totals"]["tours"] == 1 and got["totals"]["resumed"] == 1
     (row,) = got["tours"]
-    assert row["resumed"] and row["ended"] == "ended" and len(row["files"].split(";")) >= 3
-    assert row["stops_visited"] == "POI1;POI2;POI3;POI4;POI5;END"  # POI2 once: resumed there
+    assert row["resumed"] and row["ended"] == "ended" and len(row["files"]) >= 3
+    assert row["stops_visited"] == ["POI1", "POI2", "POI3", "POI4", "POI5", "END"]  # POI2 once
 
 
 def test_without_the_fleet_extra_scheduler_says_which(

@@ -30,6 +30,14 @@ def report(tmp_path: Path, *args: str) -> dict[str, Any]:
     return json.loads(target.read_text())
 
 
+def stop_seconds(row: dict[str, Any]) -> dict[str, float]:
+    return {s["poi"]: s["seconds"] for s in row["time_at_stops"]}
+
+
+def causes(row: dict[str, Any]) -> list[tuple[str, str]]:
+    return [(i["cause"], i["detail"]) for i in row["incidents"]]
+
+
 def day_of(kind: str) -> str:
     return KINDS[kind][2][:10]
 
@@ -62,9 +70,9 @@ def test_each_row_is_what_the_robot_was_told_and_did(robot_day, by_kind, kind) -
     _, seen_all = robot_day
     seen, row = seen_all[kind], by_kind[kind]
     v = visits(seen, restarted=kind == "resumed")
-    assert row["stops_visited"] == ";".join(poi for poi, _, _ in v)
-    assert row["parts"] == "; ".join(f"{poi} {parts}" for poi, parts, _ in v)
-    assert row["variants"] == ";".join(dict.fromkeys(wp for poi, _, wp in v if wp != poi))
+    assert row["stops_visited"] == [poi for poi, _, _ in v]
+    assert row["parts"] == [{"poi": poi, "parts": parts} for poi, parts, _ in v]
+    assert row["variants"] == list(dict.fromkeys(wp for poi, _, wp in v if wp != poi))
     assert row["approaches"] == sum(t == "/ApproachPeopleFar" for t, _ in seen.ros)
     assert row["invitations"] == len(seen.of("ask_tour"))
     assert row["invitations_accepted"] == seen.answers.count("user_positive")
@@ -77,26 +85,26 @@ def test_each_row_is_what_the_robot_was_told_and_did(robot_day, by_kind, kind) -
     assert row["distance_m"] == pytest.approx(seen.path_m, rel=0.01, abs=1.0)
     assert row["resumed"] is (kind == "resumed")
     assert row["robot"] == "frog1"
-    seconds = json.loads(row["time_at_stops"])
+    seconds = stop_seconds(row)
     assert list(seconds) == list(dict.fromkeys(poi for poi, _, _ in v))
     assert all(s > 0 for s in seconds.values())
 
 
 def test_what_each_kind_of_tour_shows(by_kind) -> None:
     def gate(kind: str) -> list[tuple[str, str]]:
-        return [(e["poi"], e["decision"]) for e in json.loads(by_kind[kind]["engagement"])]
+        return [(e["poi"], e["decision"]) for e in by_kind[kind]["engagement"]]
 
     # the time-of-day variants: after 13:00 the afternoon waypoints
-    assert by_kind["afternoon"]["variants"] == "POI1b;POI2b"
-    assert by_kind["bored"]["variants"] == "POI1a;POI2a"
+    assert by_kind["afternoon"]["variants"] == ["POI1b", "POI2b"]
+    assert by_kind["bored"]["variants"] == ["POI1a", "POI2a"]
     # the engagement gate: part b for an engaged visitor, none for a bored one
     assert gate("afternoon") == [("POI1", "b"), ("POI2", "b")]
     assert gate("bored") == [("POI1", "a only"), ("POI2", "a only")]
-    for e in json.loads(by_kind["bored"]["engagement"]):
+    for e in by_kind["bored"]["engagement"]:
         assert e["samples"] > 0 and e["edge_engaged"] == 0 and e["edge_votes"] > 0
-    for e in json.loads(by_kind["afternoon"]["engagement"]):
+    for e in by_kind["afternoon"]["engagement"]:
         assert e["edge_engaged"] == e["edge_votes"] > 0
-    assert by_kind["bored"]["parts"] == "; ".join(f"{s} a" for s in STOPS)
+    assert by_kind["bored"]["parts"] == [{"poi": s, "parts": "a"} for s in STOPS]
     # a visitor says no, another says yes: one tour, two invitations, one visitor
     declines = by_kind["declines"]
     assert (
@@ -114,15 +122,19 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
         home["introduction"],
         home["ended"],
         home["reason"],
-        home["operator"],
+        [(c["command"], c["ok"]) for c in home["operator"]],
         home["stops_visited"],
         home["stops_skipped"],
         home["visitors"],
-    ) == ("declined", "aborted", "operator", "home (ok)", "", "", 0)
+        home["interventions"],
+    ) == ("declined", "aborted", "operator", [("home", True)], [], [], 0, 1)
+    assert causes(home) == [("invitation declined", ""), ("operator", "home")]
     # POI1 cannot be reached: three goals (two retries), skipped with its reason
     nav = by_kind["nav_failure"]
-    assert nav["stops_skipped"] == "POI1: navigation failed"
-    assert nav["stops_visited"] == ";".join(STOPS[1:])
+    assert nav["stops_skipped"] == [{"poi": "POI1", "why": "navigation failed"}]
+    assert nav["stops_visited"] == STOPS[1:]
+    assert causes(nav).count(("navigation retry", "")) == 2
+    assert ("stop given up", "POI1") in causes(nav)
     assert (nav["nav_retries"], nav["dock_retries"]) == (2, 0)
     assert gate("nav_failure") == [("POI2", "b")]
     # a motor fault on the way: the tour aborted with its reason, the fault listed
@@ -130,14 +142,22 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
     assert (fault["ended"], fault["reason"], fault["faults"]) == (
         "aborted",
         "electronics fault: motors: motor driver overheated",
-        "motors: motor driver overheated",
+        ["motors: motor driver overheated"],
     )
-    assert fault["stops_skipped"] == ""  # it never reached the stops after the abort
+    assert fault["stops_skipped"] == []  # it never reached the stops after the abort
+    # the alert raised as it aborts is the tour's; the fault is counted once
+    assert [(a["kind"], a["severity"]) for a in fault["alerts"]] == [("fault", "ERROR")]
+    assert causes(fault) == [("fault", "motors")]
     # the operator skips POI3 during its content and POI4 on the way there
     skips = by_kind["operator_skips"]
-    assert skips["stops_skipped"] == "POI3: operator; POI4: operator"
-    assert skips["stops_visited"] == "POI1;POI2;POI3;POI5;END"
-    assert skips["operator"] == "skip (ok); skip (ok)"
+    assert skips["stops_skipped"] == [
+        {"poi": "POI3", "why": "operator"},
+        {"poi": "POI4", "why": "operator"},
+    ]
+    assert skips["stops_visited"] == ["POI1", "POI2", "POI3", "POI5", "END"]
+    assert [(c["command"], c["ok"]) for c in skips["operator"]] == [("skip", True)] * 2
+    assert skips["interventions"] == 2
+    assert causes(skips) == [("operator", "skip")] * 2
     # the first undock fails and is tried again
     assert (
         by_kind["undock_failure"]["dock_retries"],
@@ -146,10 +166,10 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
     # a visitor lost on the way: back to POI0, a second visitor, POI1 again for them
     wander = by_kind["wander_off"]
     assert (wander["visitors"], wander["approaches"], wander["invitations"]) == (2, 2, 2)
-    assert wander["stops_visited"] == "POI1;POI1;POI2;POI3;POI4;POI5;END"
+    assert wander["stops_visited"] == ["POI1", *STOPS]
+    assert wander["visitors_lost"] == 1 and causes(wander) == [("visitor lost", "")]
     assert (
-        json.loads(wander["time_at_stops"])["POI1"]
-        > json.loads(by_kind["afternoon"]["time_at_stops"])["POI1"] * 1.5
+        stop_seconds(wander)["POI1"] > stop_seconds(by_kind["afternoon"])["POI1"] * 1.5
     )  # both visits added
     for kind in KINDS:
         if kind != "undock_failure":
@@ -161,17 +181,17 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
 def test_a_tour_resumed_after_a_restart_is_one_row(by_kind) -> None:
     row = by_kind["resumed"]
     # idle and tour file of the first executive, idle and tour file of the second
-    assert len(row["files"].split(";")) == 4
+    assert len(row["files"]) == 4
     assert row["resumed"] is True and row["ended"] == "ended"
-    assert row["stops_visited"] == ";".join(STOPS)  # POI2, cut by the restart, once
-    assert row["parts"] == "; ".join(f"{s} {'ab' if s in ('POI1', 'POI2') else 'a'}" for s in STOPS)
+    assert row["stops_visited"] == STOPS  # POI2, cut by the restart, once
+    assert row["parts"] == [
+        {"poi": s, "parts": "ab" if s in ("POI1", "POI2") else "a"} for s in STOPS
+    ]
+    assert row["restarts"] == 1 and causes(row) == [("restart", "")]
     assert (row["approaches"], row["invitations"], row["visitors"]) == (1, 1, 1)
     # POI2's time: its part a before the restart and the whole visit after it
-    others = [
-        json.loads(by_kind[k]["time_at_stops"])["POI2"]
-        for k in ("afternoon", "declines", "undock_failure")
-    ]
-    assert json.loads(row["time_at_stops"])["POI2"] > max(others)
+    others = [stop_seconds(by_kind[k])["POI2"] for k in ("afternoon", "declines", "undock_failure")]
+    assert stop_seconds(row)["POI2"] > max(others)
     assert by_kind["totals"]["resumed"] == 1
 
 
@@ -185,7 +205,7 @@ def test_resends_across_a_rotation_are_not_new_tours(robot_day, by_kind) -> None
     ]
     assert started  # `tour started`, unacked, sent again after the rotation
     row = by_kind["unacked"]
-    assert len(row["files"].split(";")) == 2 and row["ended"] == "ended"
+    assert len(row["files"]) == 2 and row["ended"] == "ended"
     assert row["resumed"] is False
 
 
@@ -196,7 +216,15 @@ def test_the_totals_and_rates(robot_day, by_kind) -> None:
     assert t["tours"] == len(KINDS) and t["completed"] == len(KINDS) - aborted
     assert t["completion_rate"] == pytest.approx((len(KINDS) - aborted) / len(KINDS))
     assert t["tours_per_day"] == {day_of(kind): 1 for kind in KINDS}
-    assert t["tours_per_hour"] == {"10": len(KINDS) - 2, "11": 1, "15": 1}
+    # the hours with no tours are there, as zero
+    assert t["tours_per_hour"] == {
+        "10": len(KINDS) - 2,
+        "11": 1,
+        "12": 0,
+        "13": 0,
+        "14": 0,
+        "15": 1,
+    }
     answers = [a for s in seen.values() for a in s.answers]
     assert t["invitations"] == len(answers)
     assert t["invitation_acceptance"] == pytest.approx(
@@ -216,13 +244,32 @@ def test_the_totals_and_rates(robot_day, by_kind) -> None:
         assert t["part_b_rate"][poi] == pytest.approx(
             sum("b" in parts for parts in decided) / len(decided)
         )
-    assert t["failure_causes"] == {
-        "stop skipped: operator": 2,
-        "aborted: operator": 1,
-        "stop skipped: navigation failed": 1,
-        "aborted: electronics fault: motors: motor driver overheated": 1,
-        "fault: motors: motor driver overheated": 1,
+    assert {(c["cause"], c["detail"]): c["events"] for c in t["failure_causes"]} == {
+        ("operator", "skip"): 2,
+        ("operator", "home"): 1,
+        ("navigation retry", ""): 2,
+        ("stop given up", "POI1"): 1,
+        ("fault", "motors"): 1,
+        ("invitation declined", ""): 2,
+        ("visitor lost", ""): 1,
+        ("dock retry", ""): 1,
+        ("restart", ""): 1,
     }
+    # the field reliability: interventions told apart, per 100 tours
+    rel = t["reliability"]
+    assert rel["interventions"] == {
+        "help answered": 0,
+        "home": 1,
+        "skip": 2,
+        "alert acknowledged": 0,
+    }
+    assert rel["interventions_per_100_tours"] == pytest.approx(round(300 / len(KINDS), 1))
+    assert rel["failures_needing_a_person"] == 1  # the fault (an ERROR alert)
+    assert rel["robot_days"] == len(KINDS) and rel["hours_in_service"] > 0
+    assert 0 < rel["autonomy"] < 1
+    assert rel["km_per_robot_day"] == pytest.approx(
+        sum(s.path_m for s in seen.values()) / 1000 / len(KINDS), rel=0.02
+    )
     assert t["distance_m"] == pytest.approx(sum(s.path_m for s in seen.values()), rel=0.01)
     played = Counter(
         wp for k in KINDS for wp in {wp for poi, _, wp in visits(seen[k]) if wp != poi}
@@ -243,8 +290,15 @@ def test_csv_and_parquet_read_back_as_the_rows(robot_day, tmp_path) -> None:
     )
     with open(tmp_path / "r.csv", newline="", encoding="utf-8") as f:
         table = list(csv.DictReader(f))
-    assert table == [{k: str(v) for k, v in r.items()} for r in got["tours"]]
-    assert pq.read_table(tmp_path / "r.parquet").to_pylist() == got["tours"]
+    assert [r["tour"] for r in table] == [str(r["tour"]) for r in got["tours"]]
+    for line, r in zip(table, got["tours"], strict=True):
+        assert line["stops_visited"] == "; ".join(r["stops_visited"])
+        assert line["start"] == r["start"] and line["ended"] == r["ended"]
+    parquet = pq.read_table(tmp_path / "r.parquet").to_pylist()
+    for p, r in zip(parquet, got["tours"], strict=True):
+        assert p["day"].isoformat() == r["day"]
+        assert p["start"].isoformat() == r["start"]
+        assert {**p, "day": r["day"], "start": r["start"]} == r
 
 
 class Page(HTMLParser):
@@ -276,14 +330,16 @@ def test_the_html_is_one_self_contained_page(robot_day, tmp_path) -> None:
     got = report(tmp_path, str(directory), "-o", str(tmp_path / "r.html"))
     page = Page()
     page.feed((tmp_path / "r.html").read_text(encoding="utf-8"))
-    assert len(page.images) == 6  # per day, per hour, part b, length, per stop, distance
+    # per day, per hour, part b, length, per stop, funnel, daily trends, distance
+    assert len(page.images) == 8
     assert all(src.startswith("data:image/png;base64,") for src in page.images)
     assert page.links == []  # nothing fetched: it opens offline
     assert json.loads(page.scripts["totals"]) == got["totals"]
     text = " ".join(page.text)
     rate = got["totals"]["completion_rate"]
-    assert f"{100 * rate:.1f} %" in text and "Most frequent failure causes" in text
-    assert "stop skipped: navigation failed" in text
+    assert f"{100 * rate:.1f} %" in text and "Failure causes (each event once)" in text
+    assert "stop given up" in text and "Field reliability" in text
+    assert "innerHTML" not in (tmp_path / "r.html").read_text(encoding="utf-8")
 
 
 def test_cut_and_foreign_files_are_said_and_the_rest_is_read(robot_day, tmp_path, capsys) -> None:
@@ -315,7 +371,7 @@ def test_cut_and_foreign_files_are_said_and_the_rest_is_read(robot_day, tmp_path
     rows = {r["day"]: r for r in got["tours"]}
     resumed = rows[day_of("resumed")]
     assert resumed["resumed"] is True and resumed["ended"] == "ended"
-    assert resumed["stops_visited"].endswith("POI3;POI4;POI5;END")
+    assert resumed["stops_visited"][-4:] == ["POI3", "POI4", "POI5", "END"]
     home = rows[day_of("declined_then_home")]  # from its tour file alone
     assert (home["ended"], home["introduction"], home["resumed"]) == ("aborted", "declined", False)
 
@@ -329,8 +385,8 @@ def test_two_robots_tours_at_the_same_time_stay_apart(robot_day, tmp_path) -> No
             shutil.copy(path, tmp_path / robot / path.name)
     got = report(tmp_path, str(tmp_path / "frog1"), str(tmp_path / "frog2"))
     assert [(r["robot"], r["resumed"], r["stops_visited"]) for r in got["tours"]] == [
-        ("frog1", True, ";".join(STOPS)),
-        ("frog2", True, ";".join(STOPS)),
+        ("frog1", True, STOPS),
+        ("frog2", True, STOPS),
     ]
 
 

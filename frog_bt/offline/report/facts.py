@@ -32,6 +32,7 @@ and read past.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -41,9 +42,10 @@ import numpy as np
 from frog_bt.config import Site
 from frog_bt.engine.operator import Command as OperatorCommand
 from frog_bt.maths.engagement import decide
-from frog_bt.model.channels import ALERT, FRONTEND_IN, FRONTEND_OUT, OPERATOR, PRIMER, from_ns
+from frog_bt.model.channels import ALERT, FRONTEND_IN, FRONTEND_OUT, OPERATOR, PRIMER, TREE, from_ns
 from frog_bt.model.channels import Alert as AlertMessage
 from frog_bt.model.channels import Operator as OperatorMessage
+from frog_bt.model.channels import Tree as TreeMessage
 from frog_bt.model.frontend import (
     AskTour,
     ContentDone,
@@ -70,7 +72,8 @@ from frog_bt.recordings.reader import (
 )
 
 JUMP = 10.0  # metres: a pose step this long is a relocalisation, not a drive
-OWN = (FRONTEND_IN, FRONTEND_OUT, OPERATOR, ALERT, PRIMER)
+OWN = (FRONTEND_IN, FRONTEND_OUT, OPERATOR, ALERT, PRIMER, TREE)
+HOUR = 3600.0  # distance is summed per clock hour (cheap), then per local day
 ROS_ROLES = (
     "pose",
     "goto",
@@ -142,14 +145,38 @@ class Piece:
     invitations: int = 0
     accepted: int = 0
     declined: int = 0
-    faults: list[str] = field(default_factory=list)
-    operator: list[str] = field(default_factory=list)  # "skip (ok)", "home (refused)"
+    approaches_rejected: int = 0  # approaches answered 3/4
+    faults: list[tuple[str, str]] = field(default_factory=list)  # (name, message), each once
     operator_skips: list[str] = field(default_factory=list)  # stops the operator skipped
-    alerts: list[str] = field(default_factory=list)  # kinds raised
 
     def of_a_tour(self) -> bool:
         """Something only a tour does happened in it."""
         return bool(self.stops or self.invitations or self.approaches or self.goals or self.ended)
+
+
+@dataclass(frozen=True)
+class OperatorCall:
+    """An operator command and its answer, as ``/frog_bt/operator`` recorded it."""
+
+    t: float
+    command: str
+    ok: bool
+    text: str
+    id: str = ""  # ack_alert: the alert
+    by: str = ""  # console, ctl, link ("" when not recorded)
+
+
+@dataclass(frozen=True)
+class AlertChange:
+    """One change of an alert, as ``/frog_bt/alert`` recorded it."""
+
+    t: float
+    id: str
+    kind: str
+    state: str  # raised | cleared | acknowledged
+    severity: str = "WARN"
+    repeat: int = 0  # an escalation (the alert told again), not a new alert
+    subject: str = ""
 
 
 @dataclass
@@ -157,6 +184,12 @@ class FileFacts:
     file: str
     pieces: list[Piece] = field(default_factory=list)
     restarts: list[float] = field(default_factory=list)  # an executive started here
+    end: float = 0.0  # last message, seconds
+    operator: list[OperatorCall] = field(default_factory=list)  # all, in or out of tours
+    alerts: list[AlertChange] = field(default_factory=list)  # all, in or out of tours
+    metres: dict[int, float] = field(default_factory=dict)  # clock hour -> metres driven
+    library: str = ""  # what wrote it (frog-bt and its version)
+    tree: str = ""  # sha256 (12 hex) of the tree that ran, from /frog_bt/tree
     error: str = ""  # unreadable: why (the file is reported and skipped)
     recovered: str = ""  # a file cut short: what was read of it
     start: float = 0.0  # first message, seconds
@@ -195,6 +228,11 @@ class _Pieces:
         self.stream_on = False
         self.samples: list[tuple[float, float]] = []  # (t, level) while the stream is on
         self.seen: set[int] = set()  # front-end seqs sent (a resend has the same one)
+        self.operator: list[OperatorCall] = []
+        self.alerts: list[AlertChange] = []
+        self.metres: dict[int, float] = {}
+        self.tree = ""
+        self.last: float | None = None  # the latest record's time
         self.face_stops = {s.poi for s in site.tour.stops if s.face_stream}
         self.stop_of = stop_of(site)
         self.near = site.engagement.near
@@ -212,6 +250,7 @@ class _Pieces:
 
     def take(self, record: Record) -> None:
         """One record of the file (acks, ticks and bad messages tell nothing here)."""
+        self.last = record.t
         if isinstance(record, RobotInput):
             self.robot_input(record)
         elif isinstance(record, RobotCommand):
@@ -365,10 +404,13 @@ class _Pieces:
         piece = self.back if self.back is not None else self.piece
         t, role, value = received.t, received.role, received.value
         if role == "pose" and isinstance(value, Pose):
-            if self.pose is not None and piece is not None:
+            if self.pose is not None:
                 step = math.hypot(value.x - self.pose[0], value.y - self.pose[1])
-                if step < JUMP:
-                    piece.distance += step
+                if 0.0 < step < JUMP:
+                    hour = int(t // HOUR)
+                    self.metres[hour] = self.metres.get(hour, 0.0) + step
+                    if piece is not None:
+                        piece.distance += step
             self.pose = (value.x, value.y)
         elif role == "response" and isinstance(value, int):
             self._response(Response.of(value), piece)
@@ -392,9 +434,9 @@ class _Pieces:
         elif role == "diagnostic" and piece is not None and isinstance(value, Diagnostics):
             for status in value.statuses:
                 if status.level == DiagnosticLevel.ERROR:
-                    name = f"{status.name}: {status.message}"
-                    if name not in piece.faults:
-                        piece.faults.append(name)
+                    fault = (status.name, status.message)
+                    if fault not in piece.faults:
+                        piece.faults.append(fault)
 
     def _response(self, response: Response | None, piece: Piece | None) -> None:
         """A goal's or an approach's end (an active or unknown code changes nothing)."""
@@ -402,8 +444,11 @@ class _Pieces:
             return
         if self.approach:
             self.approach = False
-            if response is SUCCEEDED and piece is not None:
-                piece.approaches_ok += 1
+            if piece is not None:
+                if response is SUCCEEDED:
+                    piece.approaches_ok += 1
+                else:
+                    piece.approaches_rejected += 1
         elif self.goal is not None:
             if response is not SUCCEEDED:
                 self.failed = self.goal
@@ -412,25 +457,44 @@ class _Pieces:
             self.goal = None
 
     def own(self, record: Own) -> None:
-        piece = self.piece
-        if piece is None:
-            return
+        """Operator commands and alert changes, in or out of a tour (rows assign them to
+        tours by time: an alert raised as a tour aborts is raised on the drive home)."""
         message = record.message
         if isinstance(message, OperatorMessage):
-            ok = "ok" if message.ok else "refused"
-            piece.operator.append(f"{message.command} ({ok})")
-            if message.command == OperatorCommand.SKIP and message.ok:
+            self.operator.append(
+                OperatorCall(
+                    record.t,
+                    message.command,
+                    message.ok,
+                    message.text,
+                    message.id,
+                    message.by,
+                )
+            )
+            piece = self.back if self.back is not None else self.piece
+            if piece is not None and message.command == OperatorCommand.SKIP and message.ok:
                 at = self._skipping()
                 if at is not None:
                     piece.operator_skips.append(at)
-        elif (
-            isinstance(message, AlertMessage) and message.state == "raised" and not message.repeat
-        ):  # a repeat is an escalation, not a new alert
-            piece.alerts.append(message.kind)
+        elif isinstance(message, AlertMessage):
+            self.alerts.append(
+                AlertChange(
+                    record.t,
+                    message.id,
+                    message.kind,
+                    message.state,
+                    message.severity,
+                    message.repeat,
+                    message.subject,
+                )
+            )
+        elif isinstance(message, TreeMessage) and not self.tree:
+            self.tree = hashlib.sha256(message.xml.encode()).hexdigest()[:12]
 
     def _skipping(self) -> str | None:
         """The stop an operator's skip leaves: the one playing, or the one driven to."""
-        assert self.piece is not None
+        if self.piece is None:
+            return None
         stops = self.piece.stops
         if stops and stops[-1].end is None:
             return stops[-1].poi
@@ -459,6 +523,12 @@ def read_file(path: str, site: Site) -> FileFacts:
             path,
             pieces.finish(),
             restarts,
+            end=pieces.last if pieces.last is not None else (start or 0.0),
+            operator=pieces.operator,
+            alerts=pieces.alerts,
+            metres=pieces.metres,
+            library=_library(Path(path)),
+            tree=pieces.tree,
             recovered=recording.recovered,
             start=start or 0.0,
             bad=tally.count,
@@ -468,3 +538,14 @@ def read_file(path: str, site: Site) -> FileFacts:
         return FileFacts(path, error=str(exc).replace(f"{path}: ", ""))
     except Exception as exc:  # a damaged file must not stop the corpus
         return FileFacts(path, error=f"{type(exc).__name__}: {exc}".splitlines()[0][:200])
+
+
+def _library(path: Path) -> str:
+    """The MCAP header's ``library`` (``frog-bt 0.1.0``): which version wrote the file."""
+    try:
+        from mcap.reader import make_reader
+
+        with open(path, "rb") as stream:
+            return str(make_reader(stream).get_header().library)
+    except Exception:  # a damaged header: the version is unknown, the file still read
+        return ""

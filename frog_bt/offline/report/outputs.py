@@ -9,12 +9,15 @@ from __future__ import annotations
 
 import base64
 import csv
-import html
+import dataclasses
 import io
-import json
+import types
+import typing
+from datetime import date, datetime
 from pathlib import Path
 from typing import Any
 
+from frog_bt.clock import SITE_TZ
 from frog_bt.offline.report.rows import Row
 
 EXTRA = "pip install 'frog-bt[report]'"
@@ -25,20 +28,46 @@ class MissingExtra(ImportError):
 
 
 def write_csv(rows: list[Row], path: Path) -> None:
+    """One row per tour, one plain column per figure (lists joined with '; ')."""
     with open(path, "w", newline="", encoding="utf-8") as f:
         writer = csv.DictWriter(f, fieldnames=Row.columns())
         writer.writeheader()
         for r in rows:
-            writer.writerow(r.as_dict())
+            writer.writerow(r.as_text())
+
+
+def _arrow_type(pa: Any, hint: Any) -> Any:
+    """The Arrow type of a Row field's Python type (one declaration: the dataclass)."""
+    args = [a for a in typing.get_args(hint) if a is not type(None)]
+    origin = typing.get_origin(hint)
+    if origin is list:
+        return pa.list_(_arrow_type(pa, args[0]))
+    if origin in (types.UnionType, typing.Union):
+        return _arrow_type(pa, args[0])
+    if dataclasses.is_dataclass(hint):
+        hints = typing.get_type_hints(hint)
+        return pa.struct(
+            [(f.name, _arrow_type(pa, hints[f.name])) for f in dataclasses.fields(hint)]
+        )
+    if hint is datetime:
+        return pa.timestamp("us", tz=SITE_TZ.key)
+    simple = {bool: pa.bool_(), int: pa.int64(), float: pa.float64(), date: pa.date32()}
+    return simple.get(hint, pa.string())  # str, and str enums
+
+
+def parquet_schema(pa: Any) -> Any:
+    hints = typing.get_type_hints(Row)
+    return pa.schema([(f.name, _arrow_type(pa, hints[f.name])) for f in dataclasses.fields(Row)])
 
 
 def write_parquet(rows: list[Row], path: Path) -> None:
+    """The rows with lists as list columns, ``day`` a date, ``start`` a zoned timestamp."""
     try:
         import pyarrow as pa
         import pyarrow.parquet as pq
     except ImportError as exc:
         raise MissingExtra(f"--parquet needs pyarrow: {EXTRA}") from exc
-    table = pa.Table.from_pylist([r.as_dict() for r in rows])
+    table = pa.Table.from_pylist([r.as_dict() for r in rows], schema=parquet_schema(pa))
     pq.write_table(table, path)
 
 
@@ -94,8 +123,8 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
     hist("Tour length", [r.duration_s / 60 for r in rows], "minutes")
     stop_times: dict[str, list[float]] = {}
     for r in rows:
-        for poi, s in json.loads(r.time_at_stops).items():
-            stop_times.setdefault(poi, []).append(s)
+        for st in r.time_at_stops:
+            stop_times.setdefault(st.poi, []).append(st.seconds)
     if stop_times:
         fig, ax = plt.subplots(figsize=(5.2, 2.7))
         ax.boxplot(list(stop_times.values()))
@@ -103,6 +132,24 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
         ax.set_ylabel("seconds")
         ax.grid(axis="y", alpha=0.3)
         out.append(("Time at each stop", _png(fig)))
+        plt.close(fig)
+    if t["funnel"]:
+        bar("Where visitors drop out", t["funnel"], "stop", "visitors", rotate=True)
+    days = t["per_day"]
+    if days:
+        fig, ax = plt.subplots(figsize=(5.2, 2.7))
+        for name, key in (("completion", "completion"), ("part b", "part_b")):
+            daily = [d[key] for d in days.values()]
+            xs = [i for i, r in enumerate(daily) if r["rate"] is not None]
+            ys = [100 * daily[i]["rate"] for i in xs]
+            lo = [100 * (daily[i]["rate"] - daily[i]["low"]) for i in xs]
+            hi = [100 * (daily[i]["high"] - daily[i]["rate"]) for i in xs]
+            ax.errorbar(xs, ys, yerr=[lo, hi], marker="o", capsize=3, label=name)
+        ax.set_xticks(range(len(days)), list(days), rotation=45)
+        ax.set_ylabel("% (95 % interval)")
+        ax.legend(loc="lower left")
+        ax.grid(axis="y", alpha=0.3)
+        out.append(("Per day: completion and part b", _png(fig)))
         plt.close(fig)
     bar(
         "Distance driven per day",
@@ -114,104 +161,15 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
     return out
 
 
-def _pct(x: float | None) -> str:
-    return "-" if x is None else f"{100 * x:.1f} %"
-
-
 def write_html(
-    rows: list[Row], t: dict[str, Any], path: Path, title: str, skipped: list[str]
+    rows: list[Row],
+    t: dict[str, Any],
+    path: Path,
+    title: str,
+    skipped: list[str],
+    extra: str = "",
 ) -> None:
-    e = html.escape
-    figures = plots(rows, t)
-    tour_min = t["tour_minutes"] or {}
-    summary = [
-        (
-            "Tours",
-            f"{t['tours']} ({t['completed']} completed, {t['resumed']} resumed after a restart)",
-        ),
-        ("Completion rate", _pct(t["completion_rate"])),
-        ("Approach success", f"{_pct(t['approach_success'])} of {t['approaches']} approaches"),
-        (
-            "Invitation acceptance",
-            f"{_pct(t['invitation_acceptance'])} of "
-            f"{t['invitations']} invitations "
-            f"({t['invitations_declined']} declined)",
-        ),
-        ("Visitors reached", f"{t['visitors']} (said yes to a tour)"),
-        *(
-            (f"Part b at {poi}", f"{_pct(r)} of {t['gate_decisions'][poi]} visits")
-            for poi, r in t["part_b_rate"].items()
-        ),
-        (
-            "Tour length",
-            f"median {tour_min.get('median', '-')} min "
-            f"(from {tour_min.get('min', '-')} to {tour_min.get('max', '-')})",
-        ),
-        ("Distance driven", f"{t['distance_m'] / 1000:.1f} km"),
-        (
-            "Time-of-day variants",
-            ", ".join(f"{k} {n}" for k, n in sorted(t["variants"].items())) or "none",
-        ),
-        ("Files skipped", str(len(skipped))),
-    ]
-    causes = (
-        "".join(
-            f"<tr><td>{e(c)}</td><td class=n>{n}</td></tr>" for c, n in t["failure_causes"].items()
-        )
-        or "<tr><td>none</td></tr>"
-    )
-    cols = [
-        "tour",
-        "robot",
-        "start",
-        "duration_s",
-        "distance_m",
-        "stops_visited",
-        "stops_skipped",
-        "visitors",
-        "introduction",
-        "parts",
-        "ended",
-        "reason",
-        "resumed",
-    ]
-    body = "".join(
-        "<tr>" + "".join(f"<td>{e(str(getattr(r, c)))}</td>" for c in cols) + "</tr>" for r in rows
-    )
-    data = json.dumps(t).replace("</", "<\\/")  # raw text inside <script>: no entities
-    page = f"""<!doctype html>
-<html lang="en"><head><meta charset="utf-8">
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<title>{e(title)}</title>
-<style>
-body {{ font: 15px/1.45 system-ui, sans-serif; margin: 2em auto; max-width: 72em;
-        padding: 0 1em; color: #1d2733; }}
-h1 {{ font-size: 1.6em; }} h2 {{ font-size: 1.2em; margin-top: 2em; }}
-table {{ border-collapse: collapse; }} td, th {{ padding: .25em .7em; text-align: left;
-        border-bottom: 1px solid #dde3ea; vertical-align: top; }}
-td.n {{ text-align: right; }} .figs {{ display: flex; flex-wrap: wrap; gap: 1em; }}
-figure {{ margin: 0; }} figcaption {{ font-weight: 600; }} img {{ max-width: 100%; }}
-.tours td {{ font-size: .85em; }} .skip {{ color: #8a4b00; }}
-.wide {{ overflow-x: auto; }}
-</style></head><body>
-<h1>{e(title)}</h1>
-<h2>Summary</h2>
-<table id="summary">{"".join(f"<tr><th>{e(k)}</th><td>{e(v)}</td></tr>" for k, v in summary)}
-</table>
-<h2>Plots</h2>
-<div class="figs">{
-        "".join(
-            f'<figure><figcaption>{e(name)}</figcaption><img alt="{e(name)}" src="{url}"></figure>'
-            for name, url in figures
-        )
-    }</div>
-<h2>Most frequent failure causes</h2>
-<table id="causes">{causes}</table>
-<h2>Tours</h2>
-<div class="wide"><table class="tours" id="tours"><tr>{"".join(f"<th>{c}</th>" for c in cols)}</tr>
-{body}</table></div>
-{"".join(f'<p class="skip">skipped: {e(s)}</p>' for s in skipped)}
-<script type="application/json" id="totals">{data}</script>
-</body></html>
-"""
-    path.write_text(page, encoding="utf-8")
+    """The page (:mod:`frog_bt.offline.report.page`) with this module's plots."""
+    from frog_bt.offline.report.page import page
+
+    path.write_text(page(rows, t, plots(rows, t), title, skipped, extra), encoding="utf-8")

@@ -20,16 +20,41 @@ one visit, its times added.
 from __future__ import annotations
 
 import bisect
+import enum
 import itertools
-import json
 from dataclasses import asdict, dataclass, field, fields, replace
-from datetime import datetime
+from datetime import date, datetime
 from pathlib import Path
 from typing import Any
 
 from frog_bt.clock import SITE_TZ
 from frog_bt.config import Site
-from frog_bt.offline.report.facts import FileFacts, Piece, StopFacts, stop_of
+from frog_bt.engine.operator import Command
+from frog_bt.offline.report.alerts import Episode, episodes
+from frog_bt.offline.report.causes import Cause, Incident
+from frog_bt.offline.report.facts import FileFacts, OperatorCall, Piece, StopFacts, stop_of
+
+NAV_FAILED = "navigation failed"
+OPERATOR_SKIP = "operator"
+NOT_RECORDED = "not recorded (restart)"
+
+
+class Intervention(enum.StrEnum):
+    """A person had to act (docs/REPORT.md, field reliability)."""
+
+    HELP = "help answered"  # retry, done_by_hand: the robot held and asked
+    HOME = "home"
+    SKIP = "skip"
+    ACK = "alert acknowledged"
+
+
+INTERVENING = {
+    Command.RETRY: Intervention.HELP,
+    Command.DONE_BY_HAND: Intervention.HELP,
+    Command.HOME: Intervention.HOME,
+    Command.SKIP: Intervention.SKIP,
+    Command.ACK_ALERT: Intervention.ACK,
+}
 
 
 @dataclass
@@ -52,6 +77,11 @@ class Tour:
         return i < len(self.restarts) and self.restarts[i] <= until
 
     @property
+    def start(self) -> float:
+        """``tour started``, or the first event read when that is not in the corpus."""
+        return self.first.started if self.first.started is not None else self.first.t0
+
+    @property
     def resumed(self) -> bool:
         """An executive started between the end of one of its pieces and the last event
         of the next: a new executive carried the tour on."""
@@ -60,9 +90,7 @@ class Tour:
 
 def join(files: list[FileFacts]) -> list[Tour]:
     """The tours of the corpus, in order of their first event."""
-    robots: dict[str, list[FileFacts]] = {}
-    for f in files:
-        robots.setdefault(str(Path(f.file).parent), []).append(f)
+    robots = by_robot(files)
     tours = [t for robot, group in robots.items() for t in _join(robot, group)]
     return sorted(tours, key=lambda t: (t.first.t0, t.robot))
 
@@ -101,36 +129,116 @@ def _join(robot: str, files: list[FileFacts]) -> list[Tour]:
     return tours
 
 
+@dataclass(frozen=True)
+class Skip:
+    poi: str
+    why: str  # navigation failed | operator | not recorded (restart) | not visited
+
+    def __str__(self) -> str:
+        return f"{self.poi}: {self.why}"
+
+
+@dataclass(frozen=True)
+class StopTime:
+    poi: str
+    seconds: float  # from part a to finish_poi, the visits of the stop added
+
+    def __str__(self) -> str:
+        return f"{self.poi} {self.seconds:g} s"
+
+
+@dataclass(frozen=True)
+class Played:
+    poi: str
+    parts: str  # "a", "ab"
+
+    def __str__(self) -> str:
+        return f"{self.poi} {self.parts}"
+
+
+@dataclass(frozen=True)
+class Visit:
+    """One visit of a face-stream stop: what the engagement gate saw and did."""
+
+    poi: str
+    waypoint: str  # the time-of-day variant played
+    samples: int  # face samples stored (near and facing) to the end of part a
+    edge_engaged: int
+    edge_votes: int
+    decision: str  # b | a only | none
+
+    def __str__(self) -> str:
+        return f"{self.poi} {self.decision} ({self.edge_engaged}/{self.edge_votes})"
+
+
+@dataclass(frozen=True)
+class Call:
+    """An operator command during the tour, with its answer."""
+
+    at_s: float  # seconds from the tour's start
+    command: str
+    ok: bool
+    by: str  # console, ctl, link ("" when not recorded)
+    text: str
+
+    def __str__(self) -> str:
+        return f"{self.command} ({'ok' if self.ok else 'refused'})"
+
+
+@dataclass(frozen=True)
+class AlertRow:
+    """An alert raised during the tour: its acknowledgement and resolution."""
+
+    id: str
+    kind: str
+    severity: str
+    raised_s: float  # seconds from the tour's start
+    acknowledged_s: float | None  # seconds from the raise (None: never)
+    acknowledged_by: str
+    cleared_s: float | None  # seconds from the raise (None: not in the recordings)
+    repeats: int  # told again unacknowledged
+
+    def __str__(self) -> str:
+        ack = "" if self.acknowledged_s is None else f", ack {self.acknowledged_s:g} s"
+        return f"{self.kind}{ack}"
+
+
 @dataclass
 class Row:
-    """One tour: the columns of the CSV and Parquet files (docs/REPORT.md)."""
+    """One tour: the columns of the CSV, Parquet and JSON outputs (docs/REPORT.md).
+    Lists stay lists (Parquet list columns, JSON arrays); CSV shows them as text."""
 
     tour: int
     robot: str  # the directory of its recordings
-    files: str  # the recordings it was read from, ';'-separated
-    day: str  # local date, YYYY-MM-DD
-    start: str  # local time of `tour started` (of its first event when not recorded)
+    files: list[str]  # the recordings it was read from
+    day: date  # local date
+    start: datetime  # local time of `tour started` (of its first event when not recorded)
     hour: int
     duration_s: float
     distance_m: float
-    stops_visited: str  # ';'-separated, in order (a stop visited again is listed again)
-    stops_skipped: str  # 'POI2: navigation failed; POI3: operator'
-    time_at_stops: str  # JSON {poi: seconds from part a to finish_poi, visits added}
+    stops_visited: list[str]  # in order (a stop visited again is listed again)
+    stops_skipped: list[Skip]
+    time_at_stops: list[StopTime]
     approaches: int
     approaches_accepted: int
+    approaches_rejected: int
     visitors: int  # people approached who said yes
+    visitors_lost: int  # visitors who stopped following: another was recruited
     invitations: int  # ask_tour sent
     invitations_accepted: int
     invitations_declined: int
     introduction: str  # accepted | declined | no answer | none
-    engagement: str  # JSON [{poi, samples, edge_engaged, edge_votes, decision}] per visit
-    parts: str  # 'POI1 ab; POI2 a; ...'
-    variants: str  # waypoints played that are time-of-day variants, ';'-separated
-    faults: str
+    engagement: list[Visit]
+    parts: list[Played]
+    variants: list[str]  # waypoints played that are time-of-day variants
+    faults: list[str]  # 'name: message'
     nav_retries: int  # goals sent again to the waypoint whose goal had just failed
     dock_retries: int  # dock/undock sent again after the docking failed
-    operator: str
-    alerts: str
+    restarts: int  # executives started during the tour (it was resumed)
+    operator: list[Call]
+    alerts: list[AlertRow]
+    interventions: int  # a person acted: help answered, home, skip, alert acknowledged
+    incidents: list[Incident]
     ended: str  # ended | aborted | cut (the recordings stop first)
     reason: str
     resumed: bool
@@ -140,7 +248,28 @@ class Row:
         return [f.name for f in fields(cls)]
 
     def as_dict(self) -> dict[str, Any]:
+        """Python values (dates, times, lists of dicts): for Parquet."""
         return asdict(self)
+
+    def as_json(self) -> dict[str, Any]:
+        """JSON values: the date and time as ISO 8601 text (the time with its offset)."""
+        return {
+            **self.as_dict(),
+            "day": self.day.isoformat(),
+            "start": self.start.isoformat(timespec="seconds"),
+        }
+
+    def as_text(self) -> dict[str, str]:
+        """One plain column per figure, for CSV: lists shown joined with '; '."""
+        out: dict[str, str] = {}
+        for name, value in self.as_json().items():
+            if name in ("start", "day"):
+                out[name] = value
+            elif isinstance(value, list):
+                out[name] = "; ".join(str(v) for v in getattr(self, name))
+            else:
+                out[name] = str(value)
+        return out
 
 
 def visits(tour: Tour) -> list[StopFacts]:
@@ -170,7 +299,7 @@ def visits(tour: Tour) -> list[StopFacts]:
     return out
 
 
-def skipped(tour: Tour, site: Site, stops: list[StopFacts], ended: str) -> list[str]:
+def skipped(tour: Tour, site: Site, stops: list[StopFacts], ended: str) -> list[Skip]:
     """'POI: why' for each content stop of the tour order not visited, or left by the
     operator; for a tour that did not end, only up to the last stop it reached. Why:
     ``navigation failed`` (a goal there answered 3/4), ``operator`` (a skip accepted there
@@ -198,24 +327,21 @@ def skipped(tour: Tour, site: Site, stops: list[StopFacts], ended: str) -> list[
     out = []
     for poi in order[:reach]:
         if poi in by_operator:
-            out.append(f"{poi}: operator")
+            out.append(Skip(poi, OPERATOR_SKIP))
         elif poi not in visited:
-            why = (
-                "navigation failed"
-                if poi in failed
-                else "not recorded (restart)"
-                if poi in lost
-                else "not visited"
-            )
-            out.append(f"{poi}: {why}")
+            why = NAV_FAILED if poi in failed else NOT_RECORDED if poi in lost else "not visited"
+            out.append(Skip(poi, why))
     return out
 
 
-def row(number: int, tour: Tour, site: Site) -> Row:
+def row(
+    number: int, tour: Tour, site: Site, calls: list[OperatorCall], alerts: list[Episode]
+) -> Row:
+    """The row of one tour; ``calls`` and ``alerts``: those of its time span."""
     pieces = tour.pieces
     stops = visits(tour)
     ended = tour.last.ended or "cut"
-    start_t = tour.first.started if tour.first.started is not None else tour.first.t0
+    start_t = tour.start
     local = datetime.fromtimestamp(start_t, SITE_TZ)
     invitations = sum(p.invitations for p in pieces)
     accepted = sum(p.accepted for p in pieces)
@@ -233,50 +359,137 @@ def row(number: int, tour: Tour, site: Site) -> Row:
     for s in stops:
         if s.seconds is not None:
             seconds[s.poi] = round(seconds.get(s.poi, 0.0) + s.seconds, 1)
-    engagement = [
-        {
-            "poi": s.poi,
-            "samples": s.samples,
-            "edge_engaged": s.edge_engaged,
-            "edge_votes": s.edge_total,
-            "decision": s.decision,
-        }
-        for s in stops
-        if s.face_stream
-    ]
-    return Row(
+    skips = skipped(tour, site, stops, ended)
+    visitors = len({v for p in pieces for v in p.visitors})
+    faults = list(dict.fromkeys(f for p in pieces for f in p.faults))
+    ops = [Call(round(c.t - start_t, 1), c.command, c.ok, c.by, c.text) for c in calls]
+    restarts = sum(tour.restarted(p.t1, q.t1) for p, q in itertools.pairwise(pieces))
+    base = Row(
         tour=number,
         robot=Path(tour.robot).name,
-        files=";".join(dict.fromkeys(Path(p.file).name for p in pieces)),
-        day=f"{local:%Y-%m-%d}",
-        start=local.isoformat(timespec="seconds"),
+        files=list(dict.fromkeys(Path(p.file).name for p in pieces)),
+        day=local.date(),
+        start=local.replace(microsecond=0),
         hour=local.hour,
         duration_s=round(tour.last.t1 - start_t, 1),
         distance_m=round(sum(p.distance for p in pieces), 1),
-        stops_visited=";".join(s.poi for s in stops),
-        stops_skipped="; ".join(skipped(tour, site, stops, ended)),
-        time_at_stops=json.dumps(seconds),
+        stops_visited=[s.poi for s in stops],
+        stops_skipped=skips,
+        time_at_stops=[StopTime(poi, t) for poi, t in seconds.items()],
         approaches=sum(p.approaches for p in pieces),
         approaches_accepted=sum(p.approaches_ok for p in pieces),
-        visitors=len({v for p in pieces for v in p.visitors}),
+        approaches_rejected=sum(p.approaches_rejected for p in pieces),
+        visitors=visitors,
+        visitors_lost=max(0, visitors - 1),
         invitations=invitations,
         invitations_accepted=accepted,
         invitations_declined=declined,
         introduction=introduction,
-        engagement=json.dumps(engagement),
-        parts="; ".join(f"{s.poi} {s.parts}" for s in stops),
-        variants=";".join(dict.fromkeys(s.waypoint for s in stops if s.waypoint != s.poi)),
-        faults="; ".join(dict.fromkeys(f for p in pieces for f in p.faults)),
+        engagement=[
+            Visit(s.poi, s.waypoint, s.samples, s.edge_engaged, s.edge_total, s.decision)
+            for s in stops
+            if s.face_stream
+        ],
+        parts=[Played(s.poi, s.parts) for s in stops],
+        variants=list(dict.fromkeys(s.waypoint for s in stops if s.waypoint != s.poi)),
+        faults=[f"{name}: {message}" for name, message in faults],
         nav_retries=sum(p.nav_retries for p in pieces),
         dock_retries=sum(p.dock_retries for p in pieces),
-        operator="; ".join(o for p in pieces for o in p.operator),
-        alerts="; ".join(a for p in pieces for a in p.alerts),
+        restarts=restarts,
+        operator=ops,
+        alerts=[
+            AlertRow(
+                e.id,
+                e.kind,
+                e.severity,
+                round(e.raised - start_t, 1),
+                None if e.to_acknowledge is None else round(e.to_acknowledge, 1),
+                e.acknowledged_by,
+                None if e.cleared is None else round(e.cleared - e.raised, 1),
+                e.repeats,
+            )
+            for e in alerts
+        ],
+        interventions=sum(intervention(c) is not None for c in calls),
+        incidents=[],
         ended=ended,
         reason=tour.last.reason,
         resumed=tour.resumed,
     )
+    base.incidents = incidents(base, [name for name, _ in faults], calls, alerts)
+    return base
+
+
+def intervention(call: OperatorCall) -> Intervention | None:
+    """What a person did with an accepted command, when it is an intervention."""
+    if not call.ok or call.command not in INTERVENING:
+        return None
+    return INTERVENING[Command(call.command)]
+
+
+def incidents(
+    r: Row, fault_names: list[str], calls: list[OperatorCall], alerts: list[Episode]
+) -> list[Incident]:
+    """The tour's incidents, each event once (:mod:`frog_bt.offline.report.causes`)."""
+    out = [Incident(Cause.NAV_RETRY)] * r.nav_retries
+    out += [Incident(Cause.STOP_GIVEN_UP, s.poi) for s in r.stops_skipped if s.why == NAV_FAILED]
+    out += [Incident(Cause.APPROACH_REJECTED)] * r.approaches_rejected
+    out += [Incident(Cause.INVITATION_DECLINED)] * r.invitations_declined
+    out += [Incident(Cause.VISITOR_LOST)] * r.visitors_lost
+    out += [Incident(Cause.DOCK_RETRY)] * r.dock_retries
+    out += [Incident(Cause.FAULT, name) for name in dict.fromkeys(fault_names)]
+    for e in alerts:
+        if e.help:
+            out.append(Incident(Cause.HELP_NEEDED, e.kind))
+        elif not (e.kind == "fault" and fault_names) and e.kind != "stop_given_up":
+            out.append(Incident(Cause.ALERT, e.kind))  # (those two are counted above)
+    told = [c.command for c in calls if c.ok and c.command in (Command.HOME, Command.SKIP)]
+    out += [Incident(Cause.OPERATOR, command) for command in told]
+    out += [Incident(Cause.RESTART)] * r.restarts
+    if r.ended == "aborted" and not fault_names and Command.HOME not in told:
+        out.append(Incident(Cause.ABORTED, r.reason or "?"))
+    elif r.ended == "cut":
+        out.append(Incident(Cause.CUT))
+    return out
 
 
 def rows(files: list[FileFacts], site: Site) -> list[Row]:
     """One row per tour of the corpus, numbered from 1 in order of their start."""
-    return [row(i, t, site) for i, t in enumerate(join(files), 1)]
+    out = []
+    robots = by_robot(files)
+    tours = join(files)
+    spans: dict[str, list[tuple[float, float, int]]] = {}
+    for i, t in enumerate(tours):
+        spans.setdefault(t.robot, []).append((t.start, t.last.t1, i))
+    calls: dict[int, list[OperatorCall]] = {}
+    alerts: dict[int, list[Episode]] = {}
+    for robot, group in robots.items():
+        own = spans.get(robot, [])
+        robot_calls = [c for f in group for c in f.operator]
+        for c in sorted(robot_calls, key=lambda c: c.t):
+            k = _during(own, c.t)
+            if k is not None:
+                calls.setdefault(k, []).append(c)
+        for e in episodes([a for f in group for a in f.alerts], robot_calls):
+            k = _during(own, e.raised)
+            if k is not None:
+                alerts.setdefault(k, []).append(e)
+    for i, t in enumerate(tours):
+        out.append(row(i + 1, t, site, calls.get(i, []), alerts.get(i, [])))
+    return out
+
+
+def by_robot(files: list[FileFacts]) -> dict[str, list[FileFacts]]:
+    """The files of each robot (its directory)."""
+    robots: dict[str, list[FileFacts]] = {}
+    for f in files:
+        robots.setdefault(str(Path(f.file).parent), []).append(f)
+    return robots
+
+
+def _during(spans: list[tuple[float, float, int]], t: float) -> int | None:
+    """The tour whose span holds ``t`` (the latest to start, when two overlap)."""
+    for start, end, i in reversed(spans):
+        if start <= t <= end:
+            return i
+    return None
