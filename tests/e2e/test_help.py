@@ -265,3 +265,31 @@ def test_decisions_round_trip_and_a_damaged_file_is_none(tmp_path: Path) -> None
     assert not path.exists() and decisions.load(path) == decisions.NONE
     path.write_text("{not json")
     assert decisions.load(path) == decisions.NONE
+
+
+def test_a_pause_survives_a_restart_and_the_resumed_tour_waits(tmp_path: Path) -> None:
+    checkpoint = tmp_path / "checkpoint.json"
+
+    async def main() -> None:
+        async with Running({}, checkpoint=checkpoint) as first:
+            exe = first.executive
+            await first.sim.wait_for(
+                lambda r: r.channel == "start_poi" and r.payload.get("poi") == "POI1", 60
+            )
+            assert (await exe.staff.submit(Command.PAUSE)).ok
+            await after_ticks(exe, lambda: exe.decided() == exe._decided)  # saved
+            sim, listen = first.sim, first.listen
+            first.own_sim = False
+        assert decisions.load(decisions.path_for(checkpoint)).paused
+        goals = len(sim.received("/GotoWayPoint"))
+        async with Running({}, sim=sim, listen=listen, checkpoint=checkpoint) as second:
+            exe = second.executive
+            ticks = exe.core.ticks
+            await after_ticks(exe, lambda: exe.core.ticks >= ticks + 50)
+            assert exe.core.board.get(keys.PAUSED) is True
+            assert len(sim.received("/GotoWayPoint")) == goals  # it drives nowhere
+            assert (await exe.staff.submit(Command.RESUME)).ok
+            await after_ticks(exe, lambda: len(sim.received("/GotoWayPoint")) > goals)
+        await sim.stop()
+
+    asyncio.run(main())
