@@ -337,6 +337,7 @@ class RunCfg(_Model):
 
 
 class Site(_Model):
+    language: Literal["en", "es"] = "en"  # what staff read: the console, alerts, webhooks, ctl
     pois: dict[str, Poi]
     variants: dict[str, list[Variant]] = {}
     tour: Tour
@@ -358,6 +359,14 @@ class Site(_Model):
     alerts: AlertsCfg = AlertsCfg()
     console: ConsoleCfg = ConsoleCfg()
     topics: dict[Literal[tuple(INPUTS) + tuple(OUTPUTS)], str] = {}  # type: ignore[valid-type]
+
+    def name(self, poi: str) -> str:
+        """A stop or waypoint by the name staff know it by (POI2 or POI2a: Hunting
+        Courtyard); the code itself when the site names neither."""
+        found = self.pois.get(poi)
+        if found is None and self.variants.get(poi):
+            found = self.pois.get(self.variants[poi][0].waypoint)
+        return found.name if found is not None and found.name else poi
 
     @model_validator(mode="after")
     def _cross_check(self) -> Site:

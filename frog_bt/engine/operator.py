@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 from frog_bt.engine.blackboard import Board
 from frog_bt.engine.standing import Standing
+from frog_bt.i18n import N_, Msg
 from frog_bt.model import keys
 from frog_bt.model.help import Help, HelpAbout, HelpAnswer
 from frog_bt.model.outcomes import (
@@ -44,16 +45,29 @@ class Command(enum.StrEnum):
     DONE_BY_HAND = "done_by_hand"  # the robot needs help: a person did the step
 
 
+# the step ``retry`` tries again, in words (``trying again: dock``)
+_STEP = {
+    HelpAbout.UNDOCK: N_("undock"),
+    HelpAbout.DOCK: N_("dock"),
+    HelpAbout.HOME: N_("home"),
+    HelpAbout.FAULT: N_("fault"),
+}
 TREE_COMMANDS = frozenset(Command) - {Command.ACK_ALERT}
 SENT_HOME = AbortReason(AbortCause.OPERATOR, "operator")
 
 
 @dataclass(frozen=True, slots=True)
 class Answer:
-    """``ok``: applied, and ``text`` says what it did; else ``text`` says why not."""
+    """``ok``: applied, and ``words`` say what it did; else ``words`` say why not (a
+    :class:`~frog_bt.i18n.Msg`, shown in the reader's language; ``text`` is the English
+    sentence that is logged and recorded)."""
 
     ok: bool
-    text: str
+    words: Msg | str
+
+    @property
+    def text(self) -> str:
+        return str(self.words)
 
 
 class Operator:
@@ -95,53 +109,59 @@ class Operator:
         board = self.board
         if command is Command.HOME:
             if not self._touring():
-                return Answer(False, "no tour is running: the robot is at the dock or going there")
+                return Answer(
+                    False, Msg("no tour is running: the robot is at the dock or going there")
+                )
             if board.get(keys.HOME) is not None or board.get(keys.ABORT_REASON) is not None:
-                return Answer(False, "the tour is already ending: the robot is going home")
+                return Answer(False, Msg("the tour is already ending: the robot is going home"))
             board.set(keys.HOME, SENT_HOME)
             self._unpause()
-            return Answer(True, "ending the tour: the robot goes home and docks")
+            return Answer(True, Msg("ending the tour: the robot goes home and docks"))
         if command is Command.SKIP:
             stops = list(self.stops())
             if not self._touring() or not stops:
-                return Answer(False, "not at a stop or driving to one: nothing to skip")
+                return Answer(False, Msg("not at a stop or driving to one: nothing to skip"))
             if board.get(keys.HOME) is not None or board.get(keys.ABORT_REASON) is not None:
-                return Answer(False, "the tour is ending: nothing to skip")
+                return Answer(False, Msg("the tour is ending: nothing to skip"))
             board.set(keys.SKIP, (board.get(keys.SKIP) or 0) + 1)
-            return Answer(True, f"skipping {stops[-1]}: on to the next stop")
+            return Answer(True, Msg("skipping {stop}: on to the next stop", stop=stops[-1]))
         if command is Command.PAUSE:
             if board.get(keys.PAUSED):
-                return Answer(False, "already paused")
+                return Answer(False, Msg("already paused"))
             if not self._touring():
-                return Answer(False, "no tour is running (service_off keeps the robot docked)")
+                return Answer(False, Msg("no tour is running (service_off keeps the robot docked)"))
             board.set(keys.PAUSED, True)
             self.standing.paused_since = now
             return Answer(
-                True, f"pausing at the next step (at most {self.pause_max:g} s, then the tour ends)"
+                True,
+                Msg(
+                    "pausing at the next step (at most {seconds} s, then the tour ends)",
+                    seconds=f"{self.pause_max:g}",
+                ),
             )
         if command is Command.RESUME:
             if not board.get(keys.PAUSED):
-                return Answer(False, "not paused")
+                return Answer(False, Msg("not paused"))
             self._unpause()
-            return Answer(True, "resuming the tour")
+            return Answer(True, Msg("resuming the tour"))
         if command is Command.SERVICE_OFF:
             if not board.get(keys.IN_SERVICE):
-                return Answer(False, "already out of service")
+                return Answer(False, Msg("already out of service"))
             board.set(keys.IN_SERVICE, False)
             return Answer(
                 True,
-                "out of service: this tour finishes, then no new tour starts"
+                Msg("out of service: this tour finishes, then no new tour starts")
                 if self._touring()
-                else "out of service: no new tour starts",
+                else Msg("out of service: no new tour starts"),
             )
         if command is Command.SERVICE_ON:
             if board.get(keys.IN_SERVICE):
-                return Answer(False, "already in service")
+                return Answer(False, Msg("already in service"))
             board.set(keys.IN_SERVICE, True)
-            return Answer(True, "in service: tours start again")
+            return Answer(True, Msg("in service: tours start again"))
         if command in (Command.RETRY, Command.DONE_BY_HAND):
             return self._answer_help(command)
-        return Answer(False, f"{command} is not a tree command")
+        return Answer(False, Msg("{command} is not a tree command", command=command.value))
 
     def _answer_help(self, command: Command) -> Answer:
         """``retry`` or ``done_by_hand`` while the robot waits for a person; the node that
@@ -150,19 +170,19 @@ class Operator:
         board = self.board
         help_ = board.get(keys.HELP)
         if help_ is None:
-            return Answer(False, "the robot does not need help now")
+            return Answer(False, Msg("the robot does not need help now"))
         if board.get(keys.HELP_ANSWER) is not None:
-            return Answer(False, "an answer is already being acted on")
+            return Answer(False, Msg("an answer is already being acted on"))
         if command is Command.RETRY:
             board.set(keys.HELP_ANSWER, HelpAnswer.RETRY)
-            return Answer(True, f"trying again: {help_.about.value}")
+            return Answer(True, Msg("trying again: {step}", step=Msg(_STEP[help_.about])))
         refusal = self._not_done(help_)
         if refusal is not None:
             return Answer(False, refusal)
         board.set(keys.HELP_ANSWER, HelpAnswer.DONE_BY_HAND)
-        return Answer(True, f"going on: {help_.about.by_hand}")
+        return Answer(True, Msg("going on: {done}", done=Msg(help_.about.by_hand)))
 
-    def _not_done(self, help_: Help) -> str | None:
+    def _not_done(self, help_: Help) -> Msg | None:
         """Why ``done_by_hand`` cannot be true yet, from what the robot reports; None."""
         about = help_.about
         if about in (HelpAbout.DOCK, HelpAbout.HOME, HelpAbout.UNDOCK):
@@ -170,14 +190,19 @@ class Operator:
             reading = self.board.get(keys.DOCKING)
             state = reading.value if reading is not None else "nothing"
             if state != want:
-                return (
-                    f"the robot reports {state} on /docking/state, not {want.value}: "
-                    "finish the step, then answer again"
+                return Msg(
+                    "the robot reports {state} on /docking/state, not {want}: "
+                    "finish the step, then answer again",
+                    state=str(state),
+                    want=want.value,
                 )
         if about is HelpAbout.FAULT:
             diagnostics = self.board.get(keys.DIAGNOSTICS)
             if diagnostics is not None and diagnostics.value.faults:
-                return f"the robot still reports a fault: {'; '.join(diagnostics.value.faults)}"
+                return Msg(
+                    "the robot still reports a fault: {faults}",
+                    faults="; ".join(diagnostics.value.faults),
+                )
         return None
 
     def _unpause(self) -> None:

@@ -10,6 +10,8 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
+from frog_bt.i18n import N_
+
 __all__ = ["Help", "HelpAbout", "HelpAnswer"]
 
 
@@ -38,16 +40,16 @@ class HelpAbout(enum.StrEnum):
 
 
 _WHAT = {
-    HelpAbout.UNDOCK: "The robot could not leave its charger after all its attempts.",
-    HelpAbout.DOCK: "The robot could not dock after all its attempts.",
-    HelpAbout.HOME: "The robot could not get back to its charger.",
-    HelpAbout.FAULT: "The robot reports an electronics fault that does not go away.",
+    HelpAbout.UNDOCK: N_("The robot could not leave its charger after all its attempts."),
+    HelpAbout.DOCK: N_("The robot could not dock after all its attempts."),
+    HelpAbout.HOME: N_("The robot could not get back to its charger."),
+    HelpAbout.FAULT: N_("The robot reports an electronics fault that does not go away."),
 }
 _BY_HAND = {
-    HelpAbout.UNDOCK: "a person moved the robot off the charger (the robot reports undocked)",
-    HelpAbout.DOCK: "a person put the robot on its charger (the robot reports docked)",
-    HelpAbout.HOME: "a person put the robot on its charger (the robot reports docked)",
-    HelpAbout.FAULT: "a person fixed the fault (the robot no longer reports it)",
+    HelpAbout.UNDOCK: N_("a person moved the robot off the charger (the robot reports undocked)"),
+    HelpAbout.DOCK: N_("a person put the robot on its charger (the robot reports docked)"),
+    HelpAbout.HOME: N_("a person put the robot on its charger (the robot reports docked)"),
+    HelpAbout.FAULT: N_("a person fixed the fault (the robot no longer reports it)"),
 }
 
 

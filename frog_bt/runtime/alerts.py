@@ -24,6 +24,7 @@ from typing import Literal
 from msgspec.structs import replace
 
 from frog_bt.config import AlertsCfg
+from frog_bt.i18n import Msg, translator
 from frog_bt.model.channels import Alert
 from frog_bt.model.help import Help, HelpAbout
 
@@ -75,12 +76,15 @@ KINDS: dict[str, Kind] = {
 OTHER = Kind("WARN", ("ack_alert",))  # a kind not in the table
 
 
+NO_TODO = Msg("")
+
+
 @dataclass(frozen=True, slots=True)
 class Condition:
     kind: str  # docking_failed, stop_given_up, fault, battery_low, rosbridge_down, ...
     subject: str  # what it is about (the stop), "" when the kind says it all
-    what: str  # one plain sentence: what is wrong
-    todo: str = ""  # what to do
+    what: Msg  # one plain sentence: what is wrong
+    todo: Msg = NO_TODO  # what to do
 
     @property
     def id(self) -> str:
@@ -88,7 +92,13 @@ class Condition:
 
     @property
     def text(self) -> str:
-        return f"{self.what} {self.todo}" if self.todo else self.what
+        return self.say()
+
+    def say(self, language: str = "en") -> str:
+        """What is wrong and what to do, in ``language``."""
+        words = translator(language)
+        what, todo = self.what.say(words), self.todo.say(words)
+        return f"{what} {todo}" if todo else what
 
 
 def dedup_key(robot: str, kind: str, subject: str = "") -> str:
@@ -100,33 +110,33 @@ _HELP_CONDITIONS = {
     HelpAbout.DOCK: Condition(
         "docking_failed",
         "",
-        "The robot could not dock after all its attempts.",
-        "Put it on its charger by hand and answer Done by hand, or clear the way and answer "
-        "Try again.",
+        Msg("The robot could not dock after all its attempts."),
+        Msg("Put it on its charger by hand and press Done, or clear the way and press Try again."),
     ),
     HelpAbout.UNDOCK: Condition(
         "undocking_failed",
         "",
-        "The robot could not leave its charger after all its attempts.",
-        "Move it off the charger by hand and answer Done by hand, or answer Try again.",
+        Msg("The robot could not leave its charger after all its attempts."),
+        Msg("Move it off the charger by hand and press Done, or press Try again."),
     ),
     HelpAbout.HOME: Condition(
         "gave_up",
         "home",
-        "The robot could not get back to its charger.",
-        "Bring it to its charger and answer Done by hand, or clear the way and answer Try again.",
+        Msg("The robot could not get back to its charger."),
+        Msg("Bring it to its charger and press Done, or clear the way and press Try again."),
     ),
     HelpAbout.FAULT: Condition(
         "fault_persists",
         "",
-        "The robot reports an electronics fault that does not go away; it starts no tour.",
-        "Call the robot team; answer Done by hand once the fault is fixed.",
+        Msg("The robot reports an electronics fault that does not go away; it starts no tour."),
+        Msg("Call the robot team; press Done once the fault is fixed."),
     ),
 }
 
 
-def conditions(f: Facts, cfg: AlertsCfg) -> list[Condition]:
-    """The conditions that hold now, in the order a person should read them."""
+def conditions(f: Facts, cfg: AlertsCfg, names: Callable[[str], str] = str) -> list[Condition]:
+    """The conditions that hold now, in the order a person should read them (``names``:
+    a stop's name as staff know it)."""
     out: list[Condition] = []
     if f.help is not None:  # the robot holds and waits for a person's answer
         out.append(_HELP_CONDITIONS[f.help.about])
@@ -135,8 +145,8 @@ def conditions(f: Facts, cfg: AlertsCfg) -> list[Condition]:
             Condition(
                 "gave_up",
                 "",
-                f"The robot stopped the tour: {f.gave_up}.",
-                "Check it, then restart it.",
+                Msg("The robot stopped the tour: {why}.", why=f.gave_up),
+                Msg("Check it, then restart it."),
             )
         )
     for stop in f.stops_given_up:
@@ -144,8 +154,8 @@ def conditions(f: Facts, cfg: AlertsCfg) -> list[Condition]:
             Condition(
                 "stop_given_up",
                 stop,
-                f"The robot could not reach {stop} and skipped it.",
-                "Check that the way there is clear.",
+                Msg("The robot could not reach {stop} and skipped it.", stop=names(stop)),
+                Msg("Check that the way there is clear."),
             )
         )
     if f.faults:
@@ -153,8 +163,10 @@ def conditions(f: Facts, cfg: AlertsCfg) -> list[Condition]:
             Condition(
                 "fault",
                 "",
-                f"The robot reports an electronics fault: {'; '.join(f.faults)}.",
-                "Call the robot team.",
+                Msg(
+                    "The robot reports an electronics fault: {faults}.", faults="; ".join(f.faults)
+                ),
+                Msg("Call the robot team."),
             )
         )
     if f.battery is not None and f.battery < cfg.battery_below:
@@ -162,8 +174,8 @@ def conditions(f: Facts, cfg: AlertsCfg) -> list[Condition]:
             Condition(
                 "battery_low",
                 "",
-                f"The battery is at {f.battery:.0f}%.",
-                "Make sure the robot can reach its charger.",
+                Msg("The battery is at {percent}%.", percent=f"{f.battery:.0f}"),
+                Msg("Make sure the robot can reach its charger."),
             )
         )
     if (
@@ -174,9 +186,11 @@ def conditions(f: Facts, cfg: AlertsCfg) -> list[Condition]:
             Condition(
                 "rosbridge_down",
                 "",
-                "The executive cannot reach the robot "
-                f"(rosbridge) for {f.now - f.rosbridge_down_since:.0f} s.",
-                "Check that the robot is on and on the network.",
+                Msg(
+                    "The executive cannot reach the robot (rosbridge) for {seconds} s.",
+                    seconds=f"{f.now - f.rosbridge_down_since:.0f}",
+                ),
+                Msg("Check that the robot is on and on the network."),
             )
         )
     if (
@@ -187,9 +201,11 @@ def conditions(f: Facts, cfg: AlertsCfg) -> list[Condition]:
             Condition(
                 "frontend_silent",
                 "",
-                "The screen and sound (front end) do "
-                f"not answer for {f.now - f.frontend_silent_since:.0f} s.",
-                "Restart the front end.",
+                Msg(
+                    "The screen and sound (front end) do not answer for {seconds} s.",
+                    seconds=f"{f.now - f.frontend_silent_since:.0f}",
+                ),
+                Msg("Restart the front end."),
             )
         )
     if f.seeking_since is not None and f.now - f.seeking_since >= cfg.no_visitor_after:
@@ -197,8 +213,11 @@ def conditions(f: Facts, cfg: AlertsCfg) -> list[Condition]:
             Condition(
                 "no_visitor",
                 "",
-                f"No visitor has been found for {(f.now - f.seeking_since) / 60:.0f} min.",
-                "Check that the robot stands where visitors pass and that its camera sees.",
+                Msg(
+                    "No visitor has been found for {minutes} min.",
+                    minutes=f"{(f.now - f.seeking_since) / 60:.0f}",
+                ),
+                Msg("Check that the robot stands where visitors pass and that its camera sees."),
             )
         )
     if f.pause_ran_out:
@@ -206,8 +225,8 @@ def conditions(f: Facts, cfg: AlertsCfg) -> list[Condition]:
             Condition(
                 "pause_ran_out",
                 "",
-                "The tour was paused too long and ended.",
-                "The robot is going back to its dock.",
+                Msg("The tour was paused too long and ended."),
+                Msg("The robot is going back to its dock."),
             )
         )
     return out
@@ -228,6 +247,8 @@ class AlertBook:
     test drives it by moving ``Facts.now``."""
 
     cfg: AlertsCfg
+    language: str = "en"  # the site's: alert texts and webhooks speak it
+    names: Callable[[str], str] = str  # a stop's name as staff know it (POI2: its site name)
     listeners: list[Listener] = field(default_factory=list)
     active: dict[str, Alert] = field(default_factory=dict)  # id -> raised, not cleared
     unacknowledged: dict[str, Alert] = field(default_factory=dict)  # id -> latest state
@@ -236,7 +257,7 @@ class AlertBook:
     def update(self, facts: Facts) -> list[Alert]:
         """Compare the conditions now with the alerts up, and escalate what waits too
         long; the changes (also told to the listeners and logged)."""
-        now_ids: dict[str, Condition] = {c.id: c for c in conditions(facts, self.cfg)}
+        now_ids: dict[str, Condition] = {c.id: c for c in conditions(facts, self.cfg, self.names)}
         changes: list[Alert] = []
         for cid, condition in now_ids.items():
             if cid not in self.active:
@@ -258,15 +279,15 @@ class AlertBook:
         return Alert(
             condition.id,
             condition.kind,
-            condition.text,
+            condition.say(self.language),
             "raised",
             now,
             severity=kind.severity,
             key=dedup_key(self.cfg.robot, condition.kind, condition.subject),
             subject=condition.subject,
             answers=kind.answers,
-            what=condition.what,
-            todo=condition.todo,
+            what=condition.what.say(translator(self.language)),
+            todo=condition.todo.say(translator(self.language)),
         )
 
     def _escalations(self, now: float) -> list[Alert]:

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 from py_trees.common import Status
 
 from frog_bt.engine.operator import Answer, Command
+from frog_bt.i18n import Msg
 from frog_bt.model import keys
 from frog_bt.model.events import OperatorDone
 from frog_bt.model.links import LinkStatus
@@ -30,6 +31,8 @@ if TYPE_CHECKING:
     from frog_bt.runtime.executive import Executive
 
 log = logging.getLogger(__name__)
+if log.level == logging.NOTSET:  # a person steered the robot: at INFO, always in the log
+    log.setLevel(logging.INFO)
 REMEMBER_ACKS = 120.0  # project seconds after start-up in which a restored ack applies
 APPLY_WITHIN = 5.0  # wall seconds a queued command waits for a tick before it is refused
 
@@ -54,7 +57,8 @@ class Staff:
     _touring: bool = False
 
     def __post_init__(self) -> None:
-        self.book = AlertBook(self.executive.site.alerts)
+        site = self.executive.site
+        self.book = AlertBook(site.alerts, language=site.language, names=site.name)
 
     # ------------------------------------------------------------ commands
 
@@ -71,8 +75,10 @@ class Staff:
                 self._queue.remove(queued)
                 return Answer(
                     False,
-                    "the executive is not ticking now (is the robot "
-                    "reachable?): nothing was changed",
+                    Msg(
+                        "the executive is not ticking now (is the robot "
+                        "reachable?): nothing was changed"
+                    ),
                 )
             return await answer  # applied meanwhile
 
@@ -85,9 +91,11 @@ class Staff:
                 now = core.clock.now()
                 ack = self.book.acknowledge(queued.alert_id, now)
                 answer = (
-                    Answer(True, f"alert {ack.id} acknowledged")
+                    Answer(True, Msg("alert {id} acknowledged", id=ack.id))
                     if ack is not None
-                    else Answer(False, f"no alert {queued.alert_id!r} to acknowledge")
+                    else Answer(
+                        False, Msg("no alert {id} to acknowledge", id=repr(queued.alert_id))
+                    )
                 )
                 core.journal.note(f"operator: ack_alert {queued.alert_id}: {answer.text}")
                 self.executive.emit(
@@ -102,8 +110,8 @@ class Staff:
                 )
             else:
                 answer = core.command(queued.command)
-            # a person steered the robot: always in the log (warning level reaches it)
-            log.warning(
+            # a person steered the robot: always in the log (at INFO, the log's level)
+            log.info(
                 "operator %s: %s%s", queued.command, "" if answer.ok else "refused: ", answer.text
             )
             if not queued.answer.done():

@@ -40,6 +40,6 @@ async def command(
     session: aiohttp.ClientSession, url: str, body: Any, headers: dict[str, str] | None = None
 ) -> tuple[int, dict[str, Any]]:
     async with session.post(
-        f"{url}/api/command", json=body, headers=auth() if headers is None else headers
+        f"{url}/api/command?lang=en", json=body, headers=auth() if headers is None else headers
     ) as r:
         return r.status, await r.json()

@@ -76,7 +76,11 @@ def test_a_low_battery_alert_reaches_the_webhook_after_a_retry_is_cleared_and_ac
         ("battery_low", "cleared"),
         ("battery_low", "acknowledged"),
     ]
-    assert got[0]["text"] == ("The battery is at 22%. Make sure the robot can reach its charger.")
+    # the site speaks Spanish (config/site.yaml language: es): so do its webhooks
+    assert got[0]["text"] == (
+        "Al robot le queda un 22 % de batería. "
+        "Asegúrese de que el robot puede llegar a su cargador."
+    )
     assert raised == ["raised"] and shown == ["cleared"] and status == 200
     assert retried == 1  # the first POST got a 503 and was tried again
 

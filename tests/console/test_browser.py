@@ -57,16 +57,19 @@ def drive(url: str) -> tuple[list[str], str]:
         wait = WebDriverWait(driver, WAIT, poll_frequency=0.05)
         driver.get(url)
         stop = driver.find_element(By.ID, "stop")
-        wait.until(lambda d: stop.text.startswith("POI1"))
+        wait.until(lambda d: stop.text == "Almohad wall")  # stops by their site names
         seen = [stop.text]
-        wait.until(lambda d: stop.text.startswith("POI2"))  # the stop changes in the page
+        wait.until(lambda d: stop.text == "Hunting Courtyard")  # the stop changes in the page
         seen.append(stop.text)
-        driver.find_element(By.CSS_SELECTOR, "button[data-command=home]").click()
+        home = driver.find_element(By.CSS_SELECTOR, "button[data-command=home]")
+        home.click()  # one tap arms it, the second confirms
+        wait.until(lambda d: home.text.startswith("Pulse otra vez"))
+        home.click()
         prompt = wait.until(expected_conditions.alert_is_present())
         prompt.send_keys(TOKEN)
         prompt.accept()
         answer = driver.find_element(By.ID, "answer")
-        wait.until(lambda d: answer.text.startswith(("Done", "Not done")))
+        wait.until(lambda d: answer.text.startswith(("Hecho", "No se ha hecho")))
         return seen, answer.text
     finally:
         driver.quit()
@@ -88,6 +91,7 @@ def test_send_home_from_the_console_in_chromium() -> None:
             )
 
     seen, answer, reason, outcome, docking = asyncio.run(main())
-    assert seen == ["POI1 (POI1a)", "POI2 (POI2a)"]
-    assert answer == "Done: ending the tour: the robot goes home and docks"
+    assert seen == ["Almohad wall", "Hunting Courtyard"]
+    # the page speaks the site's language (config/site.yaml: es)
+    assert answer == "Hecho: termina la visita: el robot vuelve a la base y se pone a cargar"
     assert (reason, outcome, docking) == ("operator", "tour aborted: operator", "docked")

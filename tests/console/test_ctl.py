@@ -33,8 +33,17 @@ def test_ctl_exit_codes_and_answers(tmp_path: Path, capsys: pytest.CaptureFixtur
         return out
 
     refused, done = asyncio.run(run())
-    assert refused == (1, "refused: not at a stop or driving to one: nothing to skip", "")
-    assert done == (0, "done: ending the tour: the robot goes home and docks", "")
+    # ctl answers in the site's language (config/site.yaml: es)
+    assert refused == (
+        1,
+        "refused: no está en ninguna parada ni yendo a una: no hay nada que saltar",
+        "",
+    )
+    assert done == (
+        0,
+        "done: termina la visita: el robot vuelve a la base y se pone a cargar",
+        "",
+    )
     assert main(["ctl", "ack_alert"]) == 2
     assert "ack_alert needs the alert's id" in capsys.readouterr().err
     # nothing listens there: a connection error, bounded, exit 2

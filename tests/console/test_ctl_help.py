@@ -40,5 +40,5 @@ def test_ctl_answers_a_robot_that_needs_help(
         return out
 
     before, retried = asyncio.run(run())
-    assert before == (1, "refused: the robot does not need help now")
-    assert retried[0] == 0 and retried[1].startswith("done: trying again")
+    assert before == (1, "refused: ahora el robot no necesita ayuda")  # the site speaks Spanish
+    assert retried[0] == 0 and retried[1].startswith("done: lo vuelve a intentar")

@@ -55,7 +55,9 @@ def test_a_failed_dock_is_shown_escalated_and_answered_from_the_api() -> None:
 
     out = asyncio.run(main())
     help_ = out["state"]["help"]
-    assert help_["what"] == "The robot could not dock after all its attempts."
+    assert help_["what"] == (  # in the site's language (config/site.yaml: es)
+        "El robot no ha conseguido acoplarse a su cargador tras varios intentos."
+    )
     assert help_["answers"] == ["retry", "done_by_hand", "service_off"]
     assert isinstance(help_["since"], float)
     assert out["refused"][0] == 409 and "not docked" in out["refused"][1]["reason"]

@@ -21,7 +21,9 @@ def test_the_routes_are_the_contracts_and_declared_once() -> None:
         ("GET", "/api/state"),
         ("GET", "/api/stream"),
         ("GET", "/api/tree"),
+        ("GET", "/api/words"),
         ("GET", "/console.js"),
+        ("GET", "/favicon.ico"),
         ("POST", "/api/command"),
         ("POST", "/api/ticket"),
     ]

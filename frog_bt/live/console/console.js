@@ -1,16 +1,32 @@
 // The console page's script (served as /console.js; the page's policy allows no other).
 // Everything the executive, the robot or the site says is inserted as text (textContent,
 // DOM and SVG nodes), never as markup: a fault's message is shown, never run.
+// Words: the page's English is the catalogs' msgid; /api/words?lang= gives them in the
+// chosen language (remembered in localStorage), t() fills in {fields}.
 "use strict";
 const $ = (id) => document.getElementById(id);
 const SVG = "http://www.w3.org/2000/svg";
-const WORDS = {connected:"connected", reconnecting:"reconnecting", connecting:"connecting", closed:"closed",
-  acking:"answering", "not heard":"not heard yet", silent:"silent", wall:"wall clock", "/clock":"simulated clock",
-  "waiting for /clock":"waiting for the clock"};
 const HEALTH = {connected:"ok", acking:"ok", wall:"ok", "/clock":"ok", connecting:"wait", reconnecting:"wait",
   "not heard":"wait", silent:"bad", "waiting for /clock":"bad", closed:"off"};
-const NAMES = {rosbridge:"Robot (rosbridge)", frontend:"Screen and sound (front end)", clock:"Clock"};
-let site = null, latest = null;
+const LINK_WORDS = () => ({connected: t("connected"), reconnecting: t("reconnecting"), connecting: t("connecting"),
+  closed: t("closed"), acking: t("answering"), "not heard": t("not heard yet"), silent: t("silent"),
+  wall: t("wall clock"), "/clock": t("simulated clock"), "waiting for /clock": t("waiting for the clock")});
+const LINK_NAMES = () => ({rosbridge: t("The robot"), frontend: t("Screen and sound"), clock: t("Clock")});
+const CONFIRM_FOR = 6000;  // ms a first tap waits for the confirming one
+let site = null, latest = null, words = {}, lang = "en", armed = null;
+
+function t(msgid, args) {  // msgid in the chosen language, {fields} filled in
+  let text = words[msgid] || msgid;
+  for (const [k, v] of Object.entries(args || {})) text = text.split(`{${k}}`).join(String(v));
+  return text;
+}
+
+function tw(wire) {  // a sentence from the server: [msgid, {field: value or [msgid, {...}]}]
+  if (!wire) return "";
+  const args = {};
+  for (const [k, v] of Object.entries(wire[1] || {})) args[k] = Array.isArray(v) ? tw(v) : v;
+  return t(wire[0], args);
+}
 
 function el(tag, attrs, ...children) {  // an HTML element; children are nodes or text
   const e = document.createElement(tag);
@@ -29,55 +45,155 @@ function svg(tag, attrs, ...children) {  // an SVG element; text children become
 function duration(s) {
   if (s === null || s === undefined) return "–";
   s = Math.max(0, Math.round(s));
-  return s < 90 ? `${s} s` : `${Math.floor(s / 60)} min ${s % 60} s`;
+  return s < 90 ? t("{s} s", {s}) : t("{m} min {s} s", {m: Math.floor(s / 60), s: s % 60});
 }
 
-function token() {
-  let t = sessionStorage.getItem("frog-token");
-  if (!t) { t = prompt("Staff token (asked once per session):"); if (t) sessionStorage.setItem("frog-token", t); }
-  return t;
+// ------------------------------------------------------------------ words
+
+async function loadWords(wanted) {
+  const r = await fetch(`/api/words?lang=${encodeURIComponent(wanted)}`, {headers: authHeaders()});
+  if (!r.ok) return;
+  const body = await r.json();
+  words = body.words; lang = body.language;
+  document.documentElement.lang = lang;
+  $("lang").value = lang;
+  document.querySelectorAll("[data-w]").forEach((e) => {
+    if (!e.dataset.msgid) e.dataset.msgid = e.textContent.trim();
+    e.textContent = t(e.dataset.msgid);
+  });
+  document.title = t("FROG – tour robot");
+  $("map").setAttribute("aria-label", t("Map"));
+  drawLegend();
+  if (latest) render(latest);
+}
+
+$("lang").addEventListener("change", () => {
+  localStorage.setItem("frog-lang", $("lang").value);
+  loadWords($("lang").value);
+});
+
+// ------------------------------------------------------------------ the staff code
+
+function token(why) {
+  let code = sessionStorage.getItem("frog-token");
+  if (!code) {
+    code = prompt(why || t("Staff code (asked once per session):"));
+    if (code) { sessionStorage.setItem("frog-token", code); $("login").hidden = true; }
+    else showLogin(t("Without the staff code the robot can be neither shown nor steered from here."));
+  }
+  return code;
 }
 
 function authHeaders() {  // the token travels in a header, never in a URL
-  const t = sessionStorage.getItem("frog-token");
-  return t ? {"Authorization": "Bearer " + t} : {};
+  const code = sessionStorage.getItem("frog-token");
+  return code ? {"Authorization": "Bearer " + code} : {};
+}
+
+function showLogin(why) {
+  $("login-why").textContent = why;
+  $("login").hidden = false;
+}
+
+function refused() {  // a wrong code: say so, forget it, ask again
+  sessionStorage.removeItem("frog-token");
+  return token(t("That staff code was not accepted. Enter it again:"));
+}
+
+$("login-again").addEventListener("click", () => { if (token()) start(); });
+
+// ------------------------------------------------------------------ commands
+
+function answer(ok, text) {
+  $("answer").className = ok ? "ok" : "bad";
+  $("answer").textContent = text;
 }
 
 async function send(command, extra) {
-  const t = token();
-  if (!t) return;
-  $("answer").textContent = "…";
+  let code = token();
+  if (!code) return;
+  answer(true, "…");
   try {
-    const r = await fetch("/api/command", {method:"POST", headers:{"Content-Type":"application/json",
-      "Authorization":"Bearer " + t}, body: JSON.stringify(Object.assign({command}, extra || {}))});
-    const body = await r.json();
-    if (r.status === 401) sessionStorage.removeItem("frog-token");
-    $("answer").className = body.ok ? "ok" : "bad";
-    $("answer").textContent = body.ok ? `Done: ${body.did}` : `Not done: ${body.reason}`;
+    for (let tries = 0; tries < 2; tries++) {
+      const r = await fetch(`/api/command?lang=${encodeURIComponent(lang)}`, {method: "POST",
+        headers: {"Content-Type": "application/json", "Authorization": "Bearer " + code},
+        body: JSON.stringify(Object.assign({command}, extra || {}))});
+      if (r.status === 401) { code = refused(); if (!code) { answer(false, t("Not done: no staff code.")); return; } continue; }
+      const body = await r.json();
+      if (r.status === 429) { answer(false, t("Not done: too many tries. Wait a moment and try again.")); return; }
+      answer(body.ok, body.ok ? t("Done: {what}", {what: body.did}) : t("Not done: {why}", {why: body.reason}));
+      return;
+    }
   } catch (e) {
-    $("answer").className = "bad"; $("answer").textContent = "Not done: no answer from the robot's computer";
+    answer(false, t("Not done: no answer from the robot's computer"));
   }
 }
 
-document.querySelectorAll("button[data-command]").forEach((b) =>
-  b.addEventListener("click", () => send(b.dataset.command)));
+function disarm() {
+  if (!armed) return;
+  armed.button.classList.remove("confirm");
+  armed.button.textContent = t(armed.button.dataset.msgid);
+  clearTimeout(armed.timer); armed = null;
+}
+
+document.querySelectorAll("button[data-command]").forEach((b) => b.addEventListener("click", () => {
+  if (b.dataset.confirm && !(armed && armed.button === b)) {  // one more tap to be sure
+    disarm();
+    b.classList.add("confirm");
+    b.textContent = t("Tap again to confirm: {what}", {what: t(b.dataset.msgid)});
+    armed = {button: b, timer: setTimeout(disarm, CONFIRM_FOR)};
+    return;
+  }
+  disarm();
+  send(b.dataset.command);
+}));
 
 async function read(path) {  // reads need the token only when the console is not on loopback
   let r = await fetch(path, {headers: authHeaders()});
-  if (r.status === 401) { sessionStorage.removeItem("frog-token"); token(); r = await fetch(path, {headers: authHeaders()}); }
-  return r.json();
+  if (r.status === 401) {
+    if (!(sessionStorage.getItem("frog-token") ? refused() : token())) return null;
+    r = await fetch(path, {headers: authHeaders()});
+    if (r.status === 401) { refused(); return null; }
+  }
+  return r.ok ? r.json() : null;
 }
 
 $("show-tree").addEventListener("click", async () => {
   const box = $("tree");
-  if (!box.hidden) { box.hidden = true; $("show-tree").textContent = "Show the whole tree"; return; }
+  if (!box.hidden) { box.hidden = true; $("show-tree").textContent = t("Show the whole tree"); return; }
+  const root = await read("/api/tree");
+  if (!root) return;
   const lines = [];
   (function walk(n, depth) {
     lines.push(`${"  ".repeat(depth)}${n.status === "RUNNING" ? "▶" : n.status === "SUCCESS" ? "✓" : n.status === "FAILURE" ? "✗" : "·"} ${n.name}`);
     n.children.forEach((c) => walk(c, depth + 1));
-  })(await read("/api/tree"), 0);
-  box.textContent = lines.join("\n"); box.hidden = false; $("show-tree").textContent = "Hide the tree";
+  })(root, 0);
+  box.textContent = lines.join("\n"); box.hidden = false; $("show-tree").textContent = t("Hide the tree");
 });
+
+// ------------------------------------------------------------------ the map
+
+const COLOURS = {stop: "#1f2937", dock: "#14532d", recruit: "#7c3aed", robot: "#2563eb", person: "#f59e0b"};
+
+function drawLegend() {
+  const item = (colour, text) => { const sw = el("span", {}); sw.style.background = colour; return el("li", {}, sw, text); };
+  $("legend").replaceChildren(item(COLOURS.robot, t("the robot")), item(COLOURS.person, t("a person")),
+    item(COLOURS.stop, t("a stop of the tour")), item(COLOURS.dock, t("the charger")),
+    item(COLOURS.recruit, t("where it looks for visitors")));
+}
+
+function placeLabels(marks, size) {  // labels above their mark, moved down or aside when they would overlap
+  const placed = [];
+  for (const m of [...marks].sort((a, b) => a.y - b.y)) {
+    const w = m.text.length * size * 0.55, h = size * 1.1;
+    let x = m.x, y = m.y - size * 0.9;
+    for (const dy of [0, size * 2.1, -size * 1.2, size * 3.3, size * 4.5]) {
+      const cand = {x: m.x, y: m.y - size * 0.9 + dy};
+      if (!placed.some((p) => Math.abs(p.x - cand.x) < (p.w + w) / 2 && Math.abs(p.y - cand.y) < h)) { x = cand.x; y = cand.y; break; }
+    }
+    placed.push({x, y, w, text: m.text});
+  }
+  return placed;
+}
 
 function drawMap(s) {
   if (!site) return;
@@ -86,84 +202,101 @@ function drawMap(s) {
   site.zones.forEach((z) => z.points.forEach((p) => pts.push(p)));
   if (s && s.robot) pts.push([s.robot.x, s.robot.y]);
   const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
-  const minx = Math.min(...xs) - 5, maxx = Math.max(...xs) + 5, miny = Math.min(...ys) - 5, maxy = Math.max(...ys) + 5;
+  const minx = Math.min(...xs) - 12, maxx = Math.max(...xs) + 12, miny = Math.min(...ys) - 6, maxy = Math.max(...ys) + 8;
   const w = maxx - minx, h = maxy - miny, k = 100 / w;
-  const X = (x) => ((x - minx) * k).toFixed(2), Y = (y) => ((maxy - y) * k).toFixed(2);
-  const u = Math.max(100, h * k) / 60;  // one unit of marks and text, whatever the site's shape
-  const map = $("map");
-  map.setAttribute("viewBox", `0 0 100 ${(h * k).toFixed(2)}`);
+  const X = (x) => (x - minx) * k, Y = (y) => (maxy - y) * k;
+  const narrow = $("map").clientWidth < 500;
+  const u = narrow ? 2.6 : 1.6;  // one unit of marks and text, in viewBox units (the map is 100 wide)
+  $("map").setAttribute("viewBox", `0 0 100 ${(h * k).toFixed(2)}`);
   const out = [];
-  const points = (ps) => ps.map((p) => X(p[0]) + "," + Y(p[1])).join(" ");
+  const points = (ps) => ps.map((p) => X(p[0]).toFixed(2) + "," + Y(p[1]).toFixed(2)).join(" ");
   site.zones.forEach((z) => out.push(svg("polygon", {points: points(z.points),
-    fill: z.kind === "volume" ? "#bbf7d0" : "#fbcfe8", "fill-opacity": ".6", stroke: "#9ca3af",
-    "stroke-width": u / 8}, svg("title", {}, z.label))));
+    fill: z.kind === "volume" ? "#bbf7d0" : "#fbcfe8", "fill-opacity": ".5", stroke: "#9ca3af",
+    "stroke-width": u / 10}, svg("title", {}, z.label))));
   site.routes.slice(0, 1).forEach((r) => out.push(svg("polyline", {points: points(r.points), fill: "none",
-    stroke: "#a78bfa", "stroke-width": u / 4, "stroke-dasharray": `${u} ${u / 2}`})));
-  site.pois.forEach((p) => {
-    out.push(svg("circle", {cx: X(p.x), cy: Y(p.y), r: u / 2, fill: "#1f2937"}));
-    out.push(svg("text", {x: X(p.x), y: Y(p.y) - u, "font-size": 1.4 * u, "text-anchor": "middle"}, p.label));
-  });
+    stroke: "#a78bfa", "stroke-width": u / 5, "stroke-dasharray": `${u} ${u / 2}`})));
+  const colour = (p) => p.label === site.dock ? COLOURS.dock : p.label === site.recruit_at ? COLOURS.recruit : COLOURS.stop;
+  const marks = site.pois.map((p) => ({x: X(p.x), y: Y(p.y), text: p.name, colour: colour(p)}));
+  marks.forEach((m) => out.push(svg("circle", {cx: m.x, cy: m.y, r: u / 2.5, fill: m.colour})));
   if (s) {
-    s.people.forEach((p) => out.push(svg("circle", {cx: X(p[0]), cy: Y(p[1]), r: u * .7, fill: "#f59e0b"},
-      svg("title", {}, "a person"))));
+    s.people.forEach((p) => out.push(svg("circle", {cx: X(p[0]), cy: Y(p[1]), r: u * .5, fill: COLOURS.person},
+      svg("title", {}, t("a person")))));
     if (s.robot) {
-      const a = -s.robot.yaw, cx = +X(s.robot.x), cy = +Y(s.robot.y);
-      out.push(svg("g", {transform: `translate(${cx},${cy}) rotate(${a * 180 / Math.PI}) scale(${u})`},
-        svg("circle", {r: 1.2, fill: "#2563eb"}), svg("path", {d: "M0,-.5 L1.9,0 L0,.5 z", fill: "#fff"}),
-        svg("title", {}, "the robot")));
+      const a = -s.robot.yaw, cx = X(s.robot.x), cy = Y(s.robot.y);
+      out.push(svg("g", {transform: `translate(${cx},${cy}) rotate(${a * 180 / Math.PI}) scale(${u * .6})`, opacity: ".85"},
+        svg("circle", {r: 1.2, fill: COLOURS.robot}), svg("path", {d: "M0,-.5 L1.9,0 L0,.5 z", fill: "#fff"}),
+        svg("title", {}, t("the robot"))));
     }
   }
-  map.replaceChildren(...out);
+  placeLabels(marks, u * 1.5).forEach((l) => {
+    out.push(svg("text", {x: Math.min(Math.max(l.x, l.w / 2), 100 - l.w / 2), y: l.y, "font-size": u * 1.5,
+      "text-anchor": "middle", "paint-order": "stroke", stroke: "#fff", "stroke-width": u / 3, fill: "#111"}, l.text));
+  });
+  $("map").replaceChildren(...out);
 }
+
+// ------------------------------------------------------------------ the state
 
 function linkRow(name, st, since) {
   const dot = el("span", {class: "dot"});
   dot.style.background = `var(--${HEALTH[st] || "off"})`;
-  return el("div", {class: "link"}, el("span", {}, dot, NAMES[name] || name),
-    el("span", {}, `${WORDS[st] || st}, ${duration(since)}`));
+  return [el("dt", {}, dot, LINK_NAMES()[name] || name),
+    el("dd", {}, t("{state}, for {time}", {state: LINK_WORDS()[st] || st, time: duration(since)}))];
 }
 
 function alertRow(a) {
-  const button = el("button", {}, "Acknowledge");
+  const button = el("button", {}, t("Seen"));
   button.dataset.ack = a.id;
   button.addEventListener("click", () => send("ack_alert", {id: a.id}));
   const state = a.state === "cleared" ? "cleared" : "raised";
-  return el("div", {class: `alert ${state}`},
-    el("span", {}, el("strong", {}, a.state === "raised" ? "The robot needs help" : "Solved", ":"), " ", a.text),
+  return el("div", {class: `alert ${state}`, role: "alert"},
+    el("span", {}, el("strong", {}, a.state === "raised" ? t("The robot needs help") : t("Solved"), ":"), " ", a.text),
     button);
 }
 
+function holdingRow(a) {
+  return el("div", {class: "alert holding"}, el("span", {}, el("strong", {}, t("Still true"), ":"), " ", a.text));
+}
+
+function name(code) { return (site && site.names && site.names[code]) || code; }
+
 function render(s) {
   latest = s;
-  $("phase").textContent = s.phase;
+  $("phase").textContent = tw(s.words.doing);
+  $("doing").textContent = tw(s.words.doing);
   $("paused").hidden = !s.paused;
   $("help").hidden = !s.help;
   if (s.help) {
-    $("help-what").textContent = s.help.what;
-    $("help-since").textContent = `Waiting for ${duration(s.time - s.help.since)}.`;
-    $("help-hand").textContent = s.help.by_hand || "a person did the step";
+    $("help-what").textContent = tw(s.words.help.what);
+    $("help-since").textContent = t("Waiting for {time}.", {time: duration(s.time - s.help.since)});
+    $("help-hand").textContent = tw(s.words.help.by_hand);
   }
   $("service").hidden = s.in_service;
-  $("stop").textContent = s.stop ? (s.waypoint && s.waypoint !== s.stop ? `${s.stop} (${s.waypoint})` : s.stop) : "– (no tour)";
-  $("next").textContent = s.next_stop || "–";
-  $("atstop").textContent = duration(s.at_stop_s);
-  $("visitor").textContent = s.visitor === null ? "–" : `person ${s.visitor}`;
-  $("battery").textContent = s.battery === null ? "–" : `${Math.round(s.battery)}%`;
+  $("stop").textContent = s.stop ? name(s.stop) : s.touring ? t("looking for a visitor") : t("no tour now");
+  const first = site && site.stops.length ? name(site.stops[0]) : "–";
+  $("next").textContent = s.next_stop ? name(s.next_stop) : s.touring && !s.stop ? first : "–";
+  $("atstop").textContent = s.stop ? (s.at_stop_s === null ? t("on the way") : duration(s.at_stop_s)) : "–";
+  $("visitor").textContent = s.visitor === null ? "–" : t("on a tour");
+  $("battery").textContent = s.battery === null ? "–" : `${Math.round(s.battery)} %`;
   $("meter").style.width = s.engagement === null || s.engagement === undefined ? "0" : `${Math.round((s.engagement + 1) * 50)}%`;
-  $("links").replaceChildren(...Object.entries(s.links).map(([name, st]) => linkRow(name, st, s.links_for_s[name])));
+  $("links").replaceChildren(...Object.entries(s.links).flatMap(([n, st]) => linkRow(n, st, s.links_for_s[n])));
   for (const k of ["started", "completed", "aborted"]) $(k).textContent = s.tours[k];
   $("visitors").textContent = s.day.visitors; $("skipped").textContent = s.day.skipped;
   $("last").replaceChildren(...s.day.last.map((l) => el("li", {}, l)));
   $("path").textContent = s.path.join("  ›  ");
   $("log").textContent = s.log.join("\n");
   $("alerts").replaceChildren(...s.alerts.map(alertRow));
+  $("holding").replaceChildren(...(s.holding || []).map(holdingRow));
+  document.querySelectorAll("button[data-command]").forEach((b) => {
+    b.disabled = !(s.can || []).includes(b.dataset.command);
+    if (b.disabled && armed && armed.button === b) disarm();
+  });
   drawMap(s);
 }
 
 async function streamURL() {  // off loopback: a one-use ticket, so the token stays out of URLs
   const base = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/api/stream`;
-  const t = sessionStorage.getItem("frog-token");
-  if (!t) return base;
+  if (!sessionStorage.getItem("frog-token")) return base;
   try {
     const r = await fetch("/api/ticket", {method: "POST", headers: authHeaders()});
     if (r.ok) return `${base}?ticket=${encodeURIComponent((await r.json()).ticket)}`;
@@ -178,4 +311,15 @@ async function connect() {
   ws.addEventListener("close", () => { $("offline").hidden = false; setTimeout(connect, 2000); });
 }
 
-read("/api/site").then((s) => { site = s; drawMap(latest); connect(); });
+let started = false;
+async function start() {
+  if (started) return;
+  const s = await read("/api/site");
+  if (!s) return;  // no code, or a wrong one: the page says so and offers to ask again
+  started = true; site = s; $("login").hidden = true;
+  await loadWords(localStorage.getItem("frog-lang") || site.language || "es");
+  drawMap(latest); connect();
+}
+
+window.addEventListener("resize", () => drawMap(latest));
+start();

@@ -48,6 +48,7 @@ import html
 import json
 import logging
 import re
+import socket
 import time
 from collections.abc import AsyncIterator, Awaitable, Callable
 from dataclasses import dataclass, field
@@ -57,6 +58,7 @@ from typing import TYPE_CHECKING, Any
 from aiohttp import web
 
 from frog_bt.engine.operator import Command
+from frog_bt.i18n import LANGUAGES, Msg, catalog, language, say
 from frog_bt.live.console.acklink import Verdict, link_key, verify
 from frog_bt.live.console.bearer import Failures, Tickets, bearer, matches
 from frog_bt.live.console.day import Day
@@ -67,11 +69,14 @@ from frog_bt.live.console.stream import CLOSE_TIMEOUT, Pages, close_all, serve
 from frog_bt.runtime.status import phase
 
 if TYPE_CHECKING:
+    from frog_bt.config import Site
     from frog_bt.runtime.executive import Executive
 
 __all__ = ["ACCESS", "CLOSE_TIMEOUT", "PAGES", "ROUTES", "SHOWN", "Console", "is_loopback"]
 
 log = logging.getLogger(__name__)
+if log.level == logging.NOTSET:  # where the console is: at INFO, always in the log
+    log.setLevel(logging.INFO)
 Handler = Callable[[web.Request], Awaitable[web.StreamResponse]]
 PHASE_POLL = 0.05  # wall seconds between looks at the phase (a new one is pushed at once)
 HEADER_TIMEOUT = 10.0  # seconds a connection may take to send a whole request header
@@ -269,6 +274,42 @@ async def get_script(request: web.Request) -> web.Response:
     return web.Response(text=request.app[ASSETS].script, content_type="text/javascript")
 
 
+FAVICON = (
+    '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 32 32">'
+    '<rect width="32" height="32" rx="7" fill="#14532d"/>'
+    '<circle cx="11" cy="12" r="4.5" fill="#fff"/><circle cx="21" cy="12" r="4.5" fill="#fff"/>'
+    '<circle cx="11" cy="12" r="2" fill="#14532d"/><circle cx="21" cy="12" r="2" fill="#14532d"/>'
+    '<path d="M7 21 Q16 28 25 21" stroke="#fff" stroke-width="2.5" fill="none"/></svg>'
+)
+
+
+async def get_favicon(request: web.Request) -> web.Response:
+    return web.Response(
+        text=FAVICON, content_type="image/svg+xml", headers={"Cache-Control": "max-age=86400"}
+    )
+
+
+async def get_words(request: web.Request) -> web.Response:
+    """``GET /api/words?lang=es``: every sentence of the catalogs in that language (the
+    page translates its own words and the state's with them), as JSON text."""
+    lang = language(request.query.get("lang") or request.app[EXECUTIVE].site.language)
+    return web.json_response({"language": lang, "languages": LANGUAGES, "words": catalog(lang)})
+
+
+def by_name(words: Msg | str, site: Site) -> Msg | str:
+    """An answer with its stop by the name staff know it by (``skipping Hunting
+    Courtyard``, not ``skipping POI2``)."""
+    if not isinstance(words, Msg):
+        return words
+    args = {k: site.name(v) if k == "stop" and isinstance(v, str) else v for k, v in words.args}
+    return Msg(words.msgid, **args)
+
+
+def asked_language(request: web.Request) -> str:
+    """The language an answer is given in: ``?lang=`` (the page's), else the site's."""
+    return language(request.query.get("lang") or request.app[EXECUTIVE].site.language)
+
+
 async def get_state(request: web.Request) -> web.Response:
     return web.json_response(snapshot(request.app))
 
@@ -364,9 +405,10 @@ async def post_command(request: web.Request) -> web.Response:
         command, alert_id if isinstance(alert_id, str) else ""
     )
     request.app[PAGES].changed.set()
+    words = say(by_name(answer.words, request.app[EXECUTIVE].site), asked_language(request))
     if not answer.ok:
-        return refuse(409, answer.text)
-    return web.json_response({"ok": True, "did": answer.text})
+        return refuse(409, words)
+    return web.json_response({"ok": True, "did": words})
 
 
 # ---------------------------------------------------------------- acknowledgement links
@@ -433,6 +475,8 @@ async def get_ack(request: web.Request) -> web.Response:
 ROUTES = [
     web.get("/", get_page),
     web.get("/console.js", get_script),
+    web.get("/favicon.ico", get_favicon),
+    web.get("/api/words", get_words),
     web.get("/api/state", get_state),
     web.get("/api/site", get_site),
     web.get("/api/tree", get_tree),
@@ -548,7 +592,17 @@ class Console:
         self.bound_port = site.port
         self.origins.bound(site.port)
         self._out_of_files = OutOfFiles(asyncio.get_running_loop(), site.listening())
-        log.warning("console at http://%s:%d/", self.host, self.bound_port)
+        log.info("console at %s", self.url)
+
+    @property
+    def url(self) -> str:
+        """The console's address as a browser opens it (on 0.0.0.0: this machine's name)."""
+        host = self.host
+        if host in ("0.0.0.0", "", "::"):
+            host = socket.gethostname() or "127.0.0.1"
+        if ":" in host:
+            host = f"[{host}]"
+        return f"http://{host}:{self.bound_port}/"
 
     async def close(self) -> None:
         """The pages closed, the open requests given :data:`CLOSE_TIMEOUT`, then the pusher

@@ -16,6 +16,8 @@ from typing import TYPE_CHECKING, Any
 import py_trees
 
 from frog_bt.engine.walk import children, running_path
+from frog_bt.i18n import Msg, say
+from frog_bt.live.console.phrase import Situation, of, phrase
 from frog_bt.live.telemetry.site_map import poi_marks, tour_routes, zone_outlines
 from frog_bt.model import keys
 from frog_bt.model.help import Help
@@ -43,27 +45,32 @@ class LogLines(logging.Handler):
         super().__init__(logging.INFO)
         self.lines: deque[str] = deque(maxlen=size)
         self.addFilter(OwnedBy(owner))
-        self.setFormatter(
-            logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s", "%H:%M:%S")
-        )
+        self.setFormatter(logging.Formatter("%(asctime)s %(message)s", "%H:%M:%S"))
 
     def emit(self, record: logging.LogRecord) -> None:
-        try:
-            self.lines.append(self.format(record))
+        try:  # staff read the message; a warning says so, the logger's name is for the team
+            line = self.format(record)
+            if record.levelno >= logging.WARNING:
+                time, _, rest = line.partition(" ")
+                line = f"{time} {record.levelname.capitalize()}: {rest}"
+            self.lines.append(line)
         except Exception:  # a log line must never break the executive
             self.handleError(record)
 
 
 class StopClock:
-    """When the current stop began (the console shows the time spent there)."""
+    """When the robot arrived at the current stop (the console shows the time spent there,
+    not the drive to it)."""
 
     def __init__(self) -> None:
         self.stop: str | None = None
         self.since: float | None = None
 
-    def seen(self, stop: str | None, now: float) -> float | None:
+    def seen(self, stop: str | None, now: float, arrived: bool = True) -> float | None:
         if stop != self.stop:
-            self.stop, self.since = stop, now if stop is not None else None
+            self.stop, self.since = stop, None
+        if stop is not None and arrived and self.since is None:
+            self.since = now
         return None if self.since is None else now - self.since
 
 
@@ -81,17 +88,36 @@ def tree(node: Behaviour) -> dict[str, Any]:
     }
 
 
+DRIVING = ("Navigate", "GuidedDrive")
+
+
 def site_map(executive: Executive) -> dict[str, Any]:
-    """The static map: POIs, the tour's routes, the zones (metres, map frame)."""
+    """The static map: POIs (with the names staff know them by; functional waypoints,
+    those without content or a place in the tour, left out), the tour's routes, the zones
+    (metres, map frame)."""
     site = executive.site
+    shown = {site.tour.dock, site.tour.recruit_at}
+    for stop in site.tour.stops:
+        shown.add(stop.poi)
+        shown.update(v.waypoint for v in site.variants.get(stop.poi, []))
+    marks, named = [], set()
+    for m in poi_marks(site):
+        name = site.name(m.label)
+        if m.label not in shown or name in named:
+            continue  # a second variant of a stop is the same place for staff
+        named.add(name)
+        marks.append({"label": m.label, "name": name, "x": m.x, "y": m.y})
     return {
-        "pois": [{"label": m.label, "x": m.x, "y": m.y} for m in poi_marks(site)],
+        "pois": marks,
         "routes": [{"label": r.label, "points": r.points} for r in tour_routes(site)],
         "zones": [
             {"label": z.label, "kind": z.kind, "points": z.points} for z in zone_outlines(site)
         ],
         "stops": [s.poi for s in site.tour.stops],
+        "names": {s.poi: site.name(s.poi) for s in site.tour.stops},
         "dock": site.tour.dock,
+        "recruit_at": site.tour.recruit_at,
+        "language": site.language,
     }
 
 
@@ -109,18 +135,39 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock)
     people = board.get(keys.PEOPLE)
     links = {name: status.value for name, status in executive.links.items()}
     since = executive.staff.link_since
+    site = executive.site
+    path = running_path(core.root)
+    steps = [of(node) for node in path]
+    help_ = board.get(keys.HELP)
+    doing = phrase(
+        steps,
+        Situation(
+            paused=bool(board.get(keys.PAUSED)),
+            in_service=board.get(keys.IN_SERVICE) is not False,
+            needs_help=help_ is not None,
+            going_home=board.get(keys.HOME) is not None or board.get(keys.ABORT_REASON) is not None,
+            dock=site.tour.dock,
+            recruit_at=site.tour.recruit_at,
+        ),
+        site.name,
+    )
+    arrived = not any(step.kind in DRIVING for step in steps)
+    book = executive.staff.book
     return {
         "phase": phase(core),
+        "doing": say(doing, site.language),
         "stop": stop,
+        "stop_name": site.name(stop) if stop is not None else None,
         "next_stop": following,
+        "next_stop_name": site.name(following) if following is not None else None,
         "waypoint": board.get(keys.WAYPOINT) if touring else None,
-        "at_stop_s": stop_clock.seen(stop, now),
+        "at_stop_s": stop_clock.seen(stop, now, arrived),
         "visitor": board.get(keys.VISITOR) if touring else None,
         "engagement": board.get(keys.ENGAGEMENT_METER),
         "battery": diagnostics.value.battery if diagnostics is not None else None,
         "paused": bool(board.get(keys.PAUSED)),
         "in_service": board.get(keys.IN_SERVICE) is not False,
-        "help": _help(board.get(keys.HELP)),
+        "help": _help(help_, site.language),
         "touring": touring,
         "links": links,
         "links_for_s": {name: now - since[name][1] for name in links if name in since},
@@ -134,8 +181,17 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock)
                 "severity": a.severity,
                 "answers": list(a.answers),
             }
-            for a in executive.staff.book.shown()
+            for a in book.shown()
         ],
+        # acknowledged, and still true: the page says so until it is resolved
+        "holding": [
+            {"id": a.id, "kind": a.kind, "text": a.text, "since": a.since}
+            for cid, a in sorted(book.active.items(), key=lambda item: item[1].since)
+            if cid not in book.unacknowledged
+        ],
+        "words": {"doing": doing.wire(), "help": _help_words(help_)},
+        "can": _can(board, touring, help_ is not None, executive),
+        "language": site.language,
         "tours": {"started": day.started, "completed": day.completed, "aborted": day.aborted},
         "day": {"visitors": day.visitors, "skipped": day.skipped, "last": list(day.last)},
         "robot": (
@@ -148,20 +204,47 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock)
             if people is not None
             else []
         ),
-        "path": running_names(core.root),
+        "path": [node.name for node in path],
         "log": list(logs.lines),
         "time": now,
     }
 
 
-def _help(help_: Help | None) -> dict[str, Any] | None:
-    """CONTRACT §7 ``help``: what is wrong, since when, the answers a person can give."""
+def _help(help_: Help | None, language: str) -> dict[str, Any] | None:
+    """CONTRACT §7 ``help``: what is wrong, since when, the answers a person can give (in
+    the site's language)."""
     if help_ is None:
         return None
     return {
-        "what": help_.what,
+        "what": say(Msg(help_.what), language),
         "since": help_.since,
         "answers": list(help_.answers),
         "about": help_.about.value,
-        "by_hand": help_.about.by_hand,
+        "by_hand": say(Msg(help_.about.by_hand), language),
     }
+
+
+def _help_words(help_: Help | None) -> dict[str, Any] | None:
+    """``help``'s sentences for a page that speaks another language than the site."""
+    if help_ is None:
+        return None
+    return {"what": Msg(help_.what).wire(), "by_hand": Msg(help_.about.by_hand).wire()}
+
+
+def _can(board: Any, touring: bool, needs_help: bool, executive: Executive) -> list[str]:
+    """The commands that can apply now (the page enables only their buttons; the
+    executive still decides, and says why not)."""
+    ending = board.get(keys.HOME) is not None or board.get(keys.ABORT_REASON) is not None
+    paused = bool(board.get(keys.PAUSED))
+    in_service = board.get(keys.IN_SERVICE) is not False
+    can = []
+    if touring and not ending:
+        can += ["home", "skip"]
+    if touring and not paused:
+        can.append("pause")
+    if paused:
+        can.append("resume")
+    can.append("service_off" if in_service else "service_on")
+    if needs_help:
+        can += ["retry", "done_by_hand"]
+    return can
