@@ -18,6 +18,11 @@ COMMANDS = {
     "render": ("frog_bt.commands.render", "draw a tour tree"),
     "check": ("frog_bt.commands.check", "check a tour tree and the site config; draw nothing"),
     "leaves": ("frog_bt.commands.leaves", "list every node type: parameters, keys, docs"),
+    "verify": ("frog_bt.commands.verify", "prove a tour tree: every run, every property"),
+    "coverage": (
+        "frog_bt.commands.coverage",
+        "which nodes recorded tours ran, with which outcomes",
+    ),
     "schema": ("frog_bt.commands.schema", "print the JSON Schema of tree files or the site"),
     "replay": ("frog_bt.commands.replay", "re-run a recorded tour offline"),
     "report": ("frog_bt.commands.report", "what recorded tours tell: rows, totals, plots"),

@@ -3,8 +3,10 @@
 Loads the site configuration and the tree as `frog-bt run` does (includes,
 foreach, parameters, the order-aware data-flow check) and reports every error
 found, one line each: `FILE:LINE:COLUMN: PATH: what was expected`, sorted by
-file and line. Exit 0 when both are valid, 2 otherwise. No robot, no network:
-fast enough for an editor's save hook.
+file and line. Then, when it is fast enough (a bounded number of states), it proves
+the tree as `frog-bt verify` does and lists each property that does not hold
+(`--no-verify` skips that). Exit 0 when both are valid and every property holds, 2
+otherwise. No robot, no network: fast enough for an editor's save hook.
 
 Examples:
 
@@ -21,14 +23,17 @@ from frog_bt.commands.options import add_tree_argument, load_tree_argument
 from frog_bt.config import DEFAULT_CONFIG
 from frog_bt.errors import DefinitionError, TreeErrors, UsageError
 
+VERIFY_STATES = 200_000  # beyond this, check leaves the proof to `frog-bt verify`
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_tree_argument(p)
+    p.add_argument("--no-verify", action="store_true", help="do not prove the tree's properties")
 
 
 def run(args: argparse.Namespace) -> int:
     try:
-        _, _, tree = load_tree_argument(args)
+        _, site, tree = load_tree_argument(args)
     except UsageError as exc:
         print(f"frog-bt: {exc}", file=sys.stderr)
         return 2
@@ -41,5 +46,35 @@ def run(args: argparse.Namespace) -> int:
         print(exc, file=sys.stderr)
         return 2
     nodes = sum(1 for _ in tree.nodes())
-    print(f"ok: {tree.file} ({nodes} nodes), {args.config or DEFAULT_CONFIG}")
+    proved = ""
+    if not args.no_verify:
+        from frog_bt.verify import designer
+        from frog_bt.verify.explore import TooBig
+        from frog_bt.verify.model import compile_tree
+        from frog_bt.verify.prove import prove
+
+        try:
+            props = designer.read_properties(tree.file) if tree.file.endswith("yaml") else []
+            errors = designer.check_names(tree.file, props, compile_tree(tree, site))
+            if errors:
+                for error in errors:
+                    print(error, file=sys.stderr)
+                return 2
+            verdict = prove(tree, site, props, limit=VERIFY_STATES)
+        except DefinitionError as exc:
+            print(exc, file=sys.stderr)
+            return 2
+        except TooBig:
+            proved = "; not proved (too many states: run frog-bt verify)"
+        else:
+            for broken in verdict.broken:
+                print(
+                    f"{tree.file}: property {broken.name} does not hold: {broken.run.note} "
+                    "(frog-bt verify shows the run)",
+                    file=sys.stderr,
+                )
+            if verdict.broken:
+                return 2
+            proved = f"; {len(verdict.checked)} properties hold"
+    print(f"ok: {tree.file} ({nodes} nodes), {args.config or DEFAULT_CONFIG}{proved}")
     return 0

@@ -105,12 +105,12 @@ class _Builder:
         data = self.read(path)
         if not isinstance(data, dict):
             raise TreeError(str(path), (), "expected a mapping with a 'root' node")
-        unknown = set(data) - {"root", "description"}
+        unknown = set(data) - {"root", "description", "properties"}
         if unknown:
             raise TreeError(
                 str(path),
                 (sorted(unknown)[0],),
-                "unknown key (a tree file has 'root' and 'description')",
+                "unknown key (a tree file has 'root', 'description' and 'properties')",
             )
         if "root" not in data:
             raise TreeError(str(path), ("root",), "missing required key")

@@ -36,6 +36,45 @@ COMMON = {
 }
 
 
+_NAME = {"type": "string", "minLength": 1, "description": "a node's name in the tree"}
+PROPERTY = {
+    "description": "a property `frog-bt verify` proves (docs/TREES.md, proving your tree)",
+    "anyOf": [
+        {
+            "title": "never together",
+            "type": "object",
+            "additionalProperties": False,
+            "required": ["never"],
+            "properties": {
+                "never": {"type": "array", "items": _NAME, "minItems": 2, "maxItems": 2},
+                "together": {"type": "boolean"},
+            },
+        },
+        {
+            "title": "after, within, reaches",
+            "type": "object",
+            "additionalProperties": False,
+            "required": ["after", "within", "reaches"],
+            "properties": {
+                "after": _NAME,
+                "within": {"type": "integer", "minimum": 0},
+                "reaches": _NAME,
+            },
+        },
+        {
+            "title": "between, never",
+            "type": "object",
+            "additionalProperties": False,
+            "required": ["between", "never"],
+            "properties": {
+                "between": {"type": "array", "items": _NAME, "minItems": 2, "maxItems": 2},
+                "never": _NAME,
+            },
+        },
+    ],
+}
+
+
 def _params(cls: Any, defs: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
     schema = cls.Params.model_json_schema(ref_template="#/$defs/{model}")
     defs.update(schema.pop("$defs", {}))
@@ -107,7 +146,11 @@ def tree_schema(factory: NodeFactory) -> dict[str, Any]:
         "type": "object",
         "additionalProperties": False,
         "required": ["root"],
-        "properties": {"description": {"type": "string"}, "root": NODE},
+        "properties": {
+            "description": {"type": "string"},
+            "root": NODE,
+            "properties": {"type": "array", "items": PROPERTY},
+        },
         "$defs": defs,
     }
 

@@ -1,0 +1,120 @@
+"""What recorded tours ran: per node of the tree, how often it ran and its outcomes.
+
+The recordings' tick channel (``/frog_bt/tick``) has each tick's number and the root's
+status, not every node's; so each recording is replayed on the tree
+(:class:`~frog_bt.offline.replay.Replay`, which ticks exactly where the live executive
+did) with a :class:`Counter` attached as an observer: after each tick it reads the nodes
+the tick touched (``core.touched``: ticked or stopped) and their statuses. Nodes are
+counted by their place in the tree (pre-order), so one tree file counts across tours.
+"""
+
+from __future__ import annotations
+
+import html
+from collections import Counter as Tally
+from dataclasses import dataclass, field
+from typing import Any
+
+from frog_bt.engine.loaded import LoadedTree
+from frog_bt.model.events import Event, Ticked
+from frog_bt.verify.model import Model, preorder
+
+RUNNING = "RUNNING"
+
+
+@dataclass(slots=True)
+class NodeCount:
+    runs: int = 0  # times it started (ticked while not running)
+    ticks: int = 0
+    outcomes: Tally[str] = field(default_factory=Tally)  # SUCCESS, FAILURE, INVALID (stopped)
+
+
+class Counter:
+    """An observer of a replay (``attach`` / ``on_event`` / ``close``) that counts what
+    each node of its tree did; counts add up over several replays of one tree file."""
+
+    def __init__(self, counts: list[NodeCount]) -> None:
+        self.counts = counts
+        self.host: Any = None
+        self._last: dict[int, str] = {}
+        self._index: dict[int, int] = {}
+
+    def attach(self, host: Any) -> None:
+        self.host = host
+        self._index = {id(b): i for i, b in enumerate(preorder(host.core.tree.root))}
+
+    def on_event(self, event: Event) -> None:
+        if not isinstance(event, Ticked):
+            return
+        seen: set[int] = set()
+        for node in self.host.core.touched:
+            i = self._index.get(id(node))
+            if i is None or i in seen:
+                continue  # a node stopped and ticked again in one tick counts once
+            seen.add(i)
+            status = node.status.name
+            before = self._last.get(i, "INVALID")
+            count = self.counts[i]
+            if status == "INVALID":  # stopped
+                if before == RUNNING:
+                    count.outcomes["INVALID"] += 1
+            else:
+                count.ticks += 1
+                if before != RUNNING:
+                    count.runs += 1
+                if status != RUNNING:
+                    count.outcomes[status] += 1
+            self._last[i] = status
+
+    def close(self) -> None:
+        pass
+
+
+def never_run(counts: list[NodeCount]) -> list[int]:
+    return [i for i, c in enumerate(counts) if c.runs == 0]
+
+
+def lines(model: Model, counts: list[NodeCount]) -> list[str]:
+    """One line per node, indented as the tree: runs, outcomes, or never run."""
+    depth = [0] * len(model.nodes)
+    out = []
+    for n in model.nodes:
+        if n.parent >= 0:
+            depth[n.index] = depth[n.parent] + 1
+        c = counts[n.index]
+        what = (
+            "never run"
+            if c.runs == 0
+            else f"ran {c.runs}x: "
+            + ", ".join(f"{k.lower()} {v}" for k, v in sorted(c.outcomes.items()))
+        )
+        out.append(f"{'  ' * depth[n.index]}{n.label()}: {what}")
+    return out
+
+
+def page(tree: LoadedTree, model: Model, counts: list[NodeCount], files: int) -> str:
+    """A self-contained HTML page (no script): the tree as a table, nodes never run marked."""
+    rows = []
+    depth = [0] * len(model.nodes)
+    for n in model.nodes:
+        if n.parent >= 0:
+            depth[n.index] = depth[n.parent] + 1
+        c = counts[n.index]
+        cls = ' class="never"' if c.runs == 0 else ""
+        outcomes = ", ".join(f"{k.lower()} {v}" for k, v in sorted(c.outcomes.items()))
+        rows.append(
+            f'<tr{cls}><td style="padding-left:{depth[n.index]}em">'
+            f"{html.escape(n.label())}</td><td>{c.runs}</td><td>{html.escape(outcomes)}</td></tr>"
+        )
+    never = len(never_run(counts))
+    return (
+        '<!doctype html><html><head><meta charset="utf-8"><title>frog-bt coverage</title>'
+        "<style>body{font-family:sans-serif}td{padding:0 1em}"
+        "tr.never td{color:#999;background:#fee}</style></head><body>"
+        f"<h1>Coverage of {html.escape(tree.file)}</h1>"
+        f"<p>{files} recordings; {len(model.nodes) - never} of {len(model.nodes)} nodes ran; "
+        f"{never} never ran (shaded).</p>"
+        "<table><tr><th>node</th><th>runs</th><th>outcomes</th></tr>"
+        + "".join(rows)
+        + "</table></body></html>\n"
+    )

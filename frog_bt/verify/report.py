@@ -1,0 +1,115 @@
+"""What verify says: a summary line, or per broken property its shortest run as numbered
+ticks, and the tree drawn with the nodes of the run marked (Mermaid or Graphviz dot)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from frog_bt.verify.graph import Run
+from frog_bt.verify.model import Model
+from frog_bt.verify.prove import Verdict
+from frog_bt.verify.tick import Step
+from frog_bt.verify.world import By, Event
+
+
+def summary(verdict: Verdict) -> str:
+    g = verdict.graph
+    held = len(verdict.checked) - len({b.name for b in verdict.broken})
+    return (
+        f"verified: {len(g.states)} states, {g.transitions} transitions, "
+        f"{held} properties hold ({g.seconds:.1f} s)"
+    )
+
+
+def tick_line(model: Model, step: Step) -> str:
+    """The inputs and outcomes of one tick that matter: what was chosen (quiet defaults
+    left out), what waited, and the events."""
+    parts = []
+    for c in step.choices:
+        if c.by is By.QUIET:
+            continue
+        if c.node < 0:
+            parts.append(f"{c.what}: {c.value}" if c.what != "operator" else f"operator: {c.value}")
+        else:
+            chooser = model.nodes[c.node]
+            what = "" if c.what == "outcome" else f"{c.what} "
+            parts.append(f"{chooser.label()} {what}{c.value}")
+    for kind, index, _ in step.events:
+        if kind is not Event.RETRY:
+            parts.append(f"[{kind.value}: {model.nodes[index].label()}]")
+        else:
+            parts.append(f"[{model.nodes[index].label()} tries again]")
+    for index, why in step.waits:
+        parts.append(f"{model.nodes[index].label()} {why}")
+    return "; ".join(parts) or "nothing new"
+
+
+def run_lines(model: Model, run: Run) -> list[str]:
+    out = []
+    for k, (_, step, _) in enumerate(run.ticks, 1):
+        mark = (
+            "  (the loop starts here)"
+            if run.loop_from is not None and k - 1 == run.loop_from
+            else ""
+        )
+        out.append(f"  {k:3d}. {tick_line(model, step)}{mark}")
+    if run.loop_from is not None:
+        out.append(f"       ... and again from tick {run.loop_from + 1}, for ever")
+    if run.note:
+        out.append(f"  => {run.note}")
+    return out
+
+
+def broken_text(verdict: Verdict, fmt: str | None = None) -> str:
+    lines = []
+    for b in verdict.broken:
+        lines.append(f"broken: {b.name}: {b.meaning}")
+        lines.append(f"  the shortest run ({len(b.run.ticks)} ticks):")
+        lines += run_lines(verdict.model, b.run)
+        if fmt:
+            lines.append(draw(verdict.model, run_nodes(b.run), b.run.nodes, fmt))
+    held = len(verdict.checked) - len({b.name for b in verdict.broken})
+    g = verdict.graph
+    lines.append(
+        f"{len({b.name for b in verdict.broken})} properties broken, {held} hold "
+        f"({len(g.states)} states, {g.transitions} transitions)"
+    )
+    return "\n".join(lines)
+
+
+def run_nodes(run: Run) -> set[int]:
+    return {i for _, step, _ in run.ticks for i, _ in step.ticked}
+
+
+def draw(model: Model, marked: Iterable[int], strong: Iterable[int], fmt: str) -> str:
+    """The tree as Mermaid or dot text: ``marked`` nodes (the run) filled, ``strong`` ones
+    (where it broke) outlined red."""
+    marked, strong = set(marked), set(strong)
+    if fmt == "dot":
+        lines = ["digraph tree {", '  node [shape=box, fontname="sans-serif"];']
+        for n in model.nodes:
+            style = ""
+            if n.index in strong:
+                style = ', style="filled,bold", fillcolor="#f4cccc", color="#cc0000", penwidth=2'
+            elif n.index in marked:
+                style = ', style=filled, fillcolor="#d9ead3"'
+            label = n.name.replace('"', "'")
+            lines.append(f'  n{n.index} [label="{label}"{style}];')
+            if n.parent >= 0:
+                lines.append(f"  n{n.parent} -> n{n.index};")
+        lines.append("}")
+        return "\n".join(lines)
+    lines = ["flowchart TD"]
+    for n in model.nodes:
+        label = n.name.replace('"', "'")
+        lines.append(f'  n{n.index}["{label}"]')
+        if n.parent >= 0:
+            lines.append(f"  n{n.parent} --> n{n.index}")
+    lines.append("  classDef run fill:#d9ead3")
+    lines.append("  classDef broke fill:#f4cccc,stroke:#cc0000,stroke-width:2px")
+    run = sorted(marked - strong)
+    if run:
+        lines.append("  class " + ",".join(f"n{i}" for i in run) + " run")
+    if strong:
+        lines.append("  class " + ",".join(f"n{i}" for i in sorted(strong)) + " broke")
+    return "\n".join(lines)

@@ -1,0 +1,62 @@
+"""The abstract world a verified tree runs in: the values of the keys guards read, the
+labels of choices and the events properties watch.
+
+A state is the tree's (each node running or not, with its small counters) and the
+world's: the tuple :data:`INITIAL` indexed by the constants below. The robot starts
+docked, in service, with no tour.
+"""
+
+from __future__ import annotations
+
+import enum
+
+# World slots (an index into the world tuple).
+STARTED = 0  # /tour_state is started
+ABORT = 1  # /abort_reason latched (MustAbort .. ClearAbort)
+HOME = 2  # the operator's home (or a pause that ran out) is pending
+PAUSED = 3  # /paused
+IN_SERVICE = 4  # /in_service
+DOCKED = 5  # the robot is on its charger
+SKIPPED = 6  # /skipped: the POI being skipped, or None
+HOMING = 7  # since home was asked: the dock sequence (or a person's help) was reached
+WORLD_NAMES = ("started", "abort", "home", "paused", "in_service", "docked", "skipped", "homing")
+INITIAL: tuple[object, ...] = (False, False, False, False, True, True, None, False)
+
+# Statuses in the compiled model (py_trees': INVALID is "not running", 0).
+RUNNING, SUCCESS, FAILURE = 1, 2, 3
+STATUS_NAMES = {RUNNING: "running", SUCCESS: "success", FAILURE: "failure"}
+
+
+class By(enum.Enum):
+    """Who decides a choice. A loop of ticks in which only the robot decided (no person,
+    front end or operator did anything) is a loop the robot is stuck in."""
+
+    ROBOT = "robot"  # the robot's own outcome (navigation, docking), or time running out
+    WORLD = "world"  # a person, the front end, the operator, the diagnostics
+    QUIET = "quiet"  # nothing happened (no command, no fault): the default
+
+
+class Role(enum.Enum):
+    """What a leaf is to the built-in properties."""
+
+    NONE = "none"
+    DRIVE = "drive"  # sends the robot across the floor to a POI (a pause holds it)
+    CONTENT = "content"  # plays a stop's content (a pause holds its start)
+    SPEAK = "speak"  # says something to the visitor at once (introduction, question)
+    DOCK = "dock"
+    UNDOCK = "undock"
+    IDLE = "idle"  # waits, with no tour, for the next one
+    HELP = "help"  # holds and asks a person
+
+
+class Event(enum.Enum):
+    """What happened in a tick that a property watches."""
+
+    DRIVE = "drive goal sent"
+    CONTENT = "content started"
+    SPEAK = "visitor addressed"
+    UNDOCK = "undock sent"
+    DOCK = "dock sent"
+    TOUR_STARTED = "tour started"
+    RETRY = "retry"
+    HELP = "help asked"

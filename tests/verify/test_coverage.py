@@ -1,0 +1,38 @@
+"""``frog-bt coverage``: a seeded recording replayed, its nodes counted, the never-run
+ones marked."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+
+from frog_bt.cli import main
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "recording"))
+
+from recorded_tour import record_tour
+
+
+def test_coverage_of_a_recorded_tour(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # the seeding: one whole tour of the default scenario, nothing going wrong
+    (tmp_path / "season").mkdir()
+    recorded = record_tour(tmp_path / "season" / "tour.mcap")
+    assert recorded.outcome.code == 0, recorded.outcome.reason
+    page = tmp_path / "coverage.html"
+    assert main(["coverage", str(tmp_path / "season"), "-o", str(page)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    line = {text.strip().split(":")[0]: text for text in out}
+    # what the tour did ran...
+    assert "ran 1x: success 1" in line["Docking 'Docking undock'"]
+    assert "success 1" in line["Navigate 'Navigate POI1'"]
+    # ...and what nothing in it called for never did
+    assert "failure" in line["Sequence 'Abort politely'"]  # its guard fails every tick
+    assert line["ClearAbort"].endswith("never run")
+    assert line["SkipStop 'SkipStop POI1'"].endswith("never run")
+    assert line["AskForHelp 'AskForHelp undock'"].endswith("never run")
+    assert out[-2].startswith("1 recordings: ") and "never ran" in out[-2]
+    html = page.read_text()
+    assert '<tr class="never"><td style="padding-left:3em">ClearAbort</td>' in html
+    assert "<script" not in html

@@ -1,0 +1,200 @@
+"""``frog-bt verify``: the shipped tree proves; the old service_off shape and five
+mutations of the shipped tree each break their property, with the shortest run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from frog_bt.behaviours import FACTORY
+from frog_bt.behaviours.navigation import Navigate
+from frog_bt.behaviours.registry import DECORATOR_TYPES, LEAF_TYPES
+from frog_bt.cli import main
+from frog_bt.model import keys
+from frog_bt.tree.factory import NodeFactory
+from frog_bt.tree.leaf import RUNNING, SUCCESS, Leaf, Status
+from frog_bt.verify.abstraction import Abstraction
+from frog_bt.verify.properties import BUILT_IN
+from frog_bt.verify.world import By, Role
+from tests.verify.mutate import copy, lines, run_of, verdict
+
+
+def test_the_shipped_tree_holds_every_property(capsys: pytest.CaptureFixture[str]) -> None:
+    v = verdict(None)
+    assert v.ok, [(b.name, b.run.note) for b in v.broken]
+    assert set(BUILT_IN) <= set(v.checked)
+    assert v.graph.seconds < 30
+    assert main(["verify"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("verified: ") and "7 properties hold" in out
+
+
+OLD_READY = """                    - type: Sequence
+                      name: Ready to start
+                      memory: false        # checked again on every tick: service_off
+                      children:            # holds even while the front end is awaited
+                        - {type: AskForHelp, about: restored, name: Still waiting for a person}
+                        - {type: WaitInService, name: Wait while out of service}
+                        - {type: AskForHelp, about: fault, name: Hold while a fault persists}
+                        - {type: WaitFrontendIdle, name: Wait for the front end}
+"""
+OLD_SHAPE = """                    - {type: WaitInService, name: Wait while out of service}
+                    - {type: WaitFrontendIdle, name: Wait for the front end}
+"""
+
+
+def test_the_old_service_off_bug_is_found(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # WaitInService checked once, then WaitFrontendIdle, in "Start a tour" (memory: true)
+    tour = copy(tmp_path, {"tour.yaml": [(OLD_READY, OLD_SHAPE)]})
+    v = verdict(tour)
+    assert [b.name for b in v.broken] == ["service-off-obeyed"]
+    run = run_of(v, "service-off-obeyed")
+    assert lines(v, run) == [
+        "WaitFrontendIdle 'Wait for the front end' running",
+        "operator: service_off; WaitFrontendIdle 'Wait for the front end' success; "
+        "[tour started: TourStatus 'TourStatus started']; "
+        "[undock sent: Docking 'Docking undock']",
+    ]
+    assert main(["verify", str(tour), "--format", "mermaid"]) == 1
+    out = capsys.readouterr().out
+    assert "broken: service-off-obeyed" in out and "  2. operator: service_off" in out
+    assert "flowchart TD" in out and " broke" in out
+
+
+def test_abort_guard_removed_breaks_home_obeyed(tmp_path: Path) -> None:
+    abort = """      - type: Sequence
+        name: Abort politely
+        memory: true
+        children:
+          - {type: MustAbort}
+          - {type: TourStatus, state: aborted}
+          - {include: home.yaml}
+          - {type: ClearAbort}
+"""
+    v = verdict(copy(tmp_path, {"tour.yaml": [(abort, "")]}))
+    run = run_of(v, "home-obeyed")
+    text = lines(v, run)
+    assert any("operator: home" in t for t in text)
+    assert "[content started: PlayContent 'PlayContent POI1 a" in text[-1]
+    assert run.note == "content started after home"
+
+
+def test_a_retry_bound_removed_breaks_bounded_retries(tmp_path: Path) -> None:
+    tour = copy(tmp_path, {"goto.yaml": [('attempts: "{nav_attempts}"', "attempts: null")]})
+    v = verdict(tour)
+    run = run_of(v, "bounded-retries")
+    assert run.loop_from is not None
+    loop = lines(v, run)[run.loop_from :]
+    assert all("Guide a visitor" not in t for t in loop)
+    assert any(
+        "Navigate 'Navigate POI0' failure; [Retry 'Go to POI0' tries again]" in t for t in loop
+    )
+    assert run.note == "Retry 'Go to POI0' retries for ever on the robot's own failures"
+
+
+class NavigateNoPause(Navigate):
+    """Navigate with its pause hold taken out (the mutation)."""
+
+    optional_reads = (keys.POSE,)
+    waits_while_paused = False
+
+
+class WaitWhilePaused(Leaf):
+    """A pause guard as a leaf: RUNNING while ``/paused``, else SUCCESS."""
+
+    optional_reads = (keys.PAUSED,)
+    verify = Abstraction(role=Role.NONE, rule=lambda t, n, aux, starting: _paused(t, n))
+
+    def update(self) -> Status:
+        return RUNNING if self.get(keys.PAUSED) else SUCCESS
+
+
+def _paused(t: object, n: object) -> tuple[int, int]:
+    from frog_bt.verify.world import PAUSED
+    from frog_bt.verify.world import RUNNING as R
+    from frog_bt.verify.world import SUCCESS as S
+
+    if t.world[PAUSED]:  # type: ignore[attr-defined]
+        t.waits(n, By.WORLD, "paused")  # type: ignore[attr-defined]
+        return R, 0
+    return S, 0
+
+
+def test_the_pause_guard_after_the_drive_breaks_pause_obeyed(tmp_path: Path) -> None:
+    # pause is modelled from the leaves: one that reads /paused holds its action while
+    # paused (Navigate, PlayContent); here the drive ignores it, the guard comes after
+    factory = NodeFactory(
+        [*(c for c in LEAF_TYPES if c is not Navigate), NavigateNoPause, WaitWhilePaused],
+        DECORATOR_TYPES,
+    )
+    goto = """  child: {type: Navigate, poi: "{poi}"}"""
+    moved = """  child:
+    type: Sequence
+    name: "Drive to {poi}, then mind the pause"
+    memory: true
+    children:
+      - {type: NavigateNoPause, poi: "{poi}"}
+      - {type: WaitWhilePaused}"""
+    v = verdict(copy(tmp_path, {"goto.yaml": [(goto, moved)]}), factory)
+    run = run_of(v, "pause-obeyed")
+    text = lines(v, run)
+    assert any("operator: pause" in t for t in text)
+    assert "[drive goal sent: NavigateNoPause" in text[-1]
+    assert run.note == "drive goal sent while paused"
+    assert FACTORY.leaves["Navigate"] is Navigate  # the tour's factory is untouched
+
+
+def test_the_dock_failure_branch_made_to_loop_breaks_ends_well(tmp_path: Path) -> None:
+    tour = copy(tmp_path, {"home.yaml": [("      - {type: AskForHelp, about: home}\n", "")]})
+    v = verdict(tour)
+    run = run_of(v, "ends-well")
+    assert run.loop_from is not None
+    loop = lines(v, run)[run.loop_from :]
+    assert any("Navigate 'Navigate SHOP' failure" in t for t in loop)  # the way home fails,
+    assert any("[Retry 'Home, or ask for help' tries again]" in t for t in loop)  # again
+    assert all("AskForHelp" not in t for t in loop)
+
+
+def test_content_in_parallel_with_a_drive_breaks_no_content_while_driving(
+    tmp_path: Path,
+) -> None:
+    drive = """                child: {include: goto.yaml}"""
+    parallel = """                child:
+                  type: Parallel
+                  name: "Drive and talk to {poi}"
+                  children:
+                    - {include: goto.yaml}
+                    - {type: PlayContent, poi: "{poi}", part: a}"""
+    v = verdict(copy(tmp_path, {"visit_poi.yaml": [(drive, parallel)]}))
+    run = run_of(v, "no-content-while-driving")
+    text = lines(v, run)
+    assert "[drive goal sent: Navigate 'Navigate POI1']" in text[-1]
+    assert "[content started: PlayContent 'PlayContent POI1 a']" in text[-1]
+    assert run.note.endswith("while Navigate 'Navigate POI1' drives")
+
+
+def test_a_deleted_engagement_decision_is_a_dead_read(tmp_path: Path) -> None:
+    decide = "            - {type: DecideEngagement, about: introduction}\n"
+    v = verdict(copy(tmp_path, {"recruit.yaml": [(decide, "")]}))
+    runs = [b.run for b in v.broken if b.name == "no-dead-reads"]
+    assert any(r.note == "AskTour reads /engaged, which no run writes before it" for r in runs)
+
+
+def test_designer_properties(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    props = """
+properties:
+  - {never: [Guide to POI1, Present POI1], together: true}
+  - {between: [TourStatus aborted, TourStatus started], never: Docking undock}
+  - {after: Docking undock, within: 1, reaches: Go to POI0}
+"""
+    tour = copy(tmp_path, {})
+    tour.write_text(tour.read_text() + props)
+    v = verdict(tour)
+    assert [b.name for b in v.broken] == ["after 'Docking undock', within 1 ticks, 'Go to POI0'"]
+    assert v.broken[0].run.note == "'Go to POI0' not started within 1 ticks"
+    tour.write_text(tour.read_text() + "  - {never: [No such node, Undock], together: true}\n")
+    assert main(["check", str(tour)]) == 2
+    assert "no node named 'No such node' in the tree" in capsys.readouterr().err
