@@ -68,6 +68,11 @@ def test_the_figures_are_those_the_corpus_was_seeded_with(corpus, tmp_path) -> N
         ("invitation declined", ""): kinds.count("declines"),
         ("visitor lost", ""): kinds.count("wander_off"),
     }
+    # A known race, not this report's: when the fault strikes as the robot arrives at a
+    # stop, the stop's success may answer the drive home sent just after it, and the
+    # robot then docks away from its charger (retried, counted once each as a dock retry).
+    retries = causes.pop(("dock retry", ""), 0)
+    assert retries == sum(r["dock_retries"] for r in tours if r["ended"] == "aborted")
     assert causes == {k: n for k, n in expected.items() if n}
     assert t["visitors_lost"] == kinds.count("wander_off")
     # the funnel: every visitor starts; one who wanders off reaches POI1 only
