@@ -63,10 +63,7 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
             f"needs the console extra ({exc.name} is missing): pip install 'frog-bt[console]'",
         ) from None
 
-    text = str(args.console)
-    if text.isdigit() or text.startswith(":"):
-        text = f"{DEFAULT_HOST}:{text.lstrip(':')}"
-    host, port = parse_hostport(text, "--console")
+    host, port = console_address(str(args.console))
     token = read_token(args.console_token_file) if args.console_token_file is not None else None
     if token is None and not is_loopback(host):
         raise UsageError(
@@ -76,6 +73,14 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
             "network could steer the robot; give --console-token-file",
         )
     return ConsoleSettings(host, port, token)
+
+
+def console_address(text: str, what: str = "--console") -> tuple[str, int]:
+    """``PORT``, ``:PORT`` (both on 127.0.0.1) or ``HOST:PORT`` as (host, port);
+    UsageError naming ``what`` when malformed."""
+    if text.isdigit() or text.startswith(":"):
+        text = f"{DEFAULT_HOST}:{text.lstrip(':')}"
+    return parse_hostport(text, what)
 
 
 def read_token(path: Path) -> str:

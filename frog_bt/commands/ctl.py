@@ -1,28 +1,43 @@
 """Send one operator command to a running executive's console, and print its answer.
 
-    frog-bt ctl home|skip|pause|resume|service_off|service_on [--console URL] [--token-file F]
+    frog-bt ctl home|skip|pause|resume|service_off|service_on|retry|done_by_hand
     frog-bt ctl ack_alert ID
-    frog-bt ctl status
+    frog-bt ctl status [--json]
+    [--console PORT|:PORT|HOST:PORT|URL] [--token-file F] [--timeout S]
+
+``--console`` (or ``FROG_BT_CONSOLE``) is what ``run --console`` was given (``8080``,
+``:8080``, ``0.0.0.0:8080``: a wildcard address is reached on loopback) or the console's
+URL (``http://frog:8080``, behind a proxy ``https://...``); default ``127.0.0.1:8080``.
+``status`` prints the robot's state as plain lines in the site's words; ``--json``, the
+state as the console gives it.
 
 Exit 0 when the command was applied (``status``: the state was read), 1 when the tour
 refused it (the reason is printed), 2 for a usage error, when the console cannot be
 reached (within ``--timeout`` seconds) or when its answer is not a clear yes: only
 ``{"ok": true}`` counts as done. Redirects are never followed (the token would go with
-the request to wherever the redirect points).
+the request to wherever the redirect points). Output into a closed pipe (``| head -1``)
+ends quietly.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import urllib.error
 import urllib.request
 from pathlib import Path
+from typing import Any
 
+from frog_bt.commands.console_options import console_address
 from frog_bt.engine.operator import Command
+from frog_bt.errors import UsageError
+from frog_bt.i18n import N_, Msg, translator
 
-DEFAULT_CONSOLE = "http://127.0.0.1:8080"
+DEFAULT_CONSOLE = "127.0.0.1:8080"
+ENV = "FROG_BT_CONSOLE"
+WILDCARDS = {"0.0.0.0": "127.0.0.1", "::": "::1", "": "127.0.0.1"}  # listen-on-all: ask loopback
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -34,9 +49,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("id", nargs="?", help="with ack_alert: the alert's id")
     p.add_argument(
         "--console",
-        metavar="URL",
-        default=DEFAULT_CONSOLE,
-        help=f"the console's address (default: {DEFAULT_CONSOLE})",
+        metavar="ADDRESS",
+        help="the console: PORT, :PORT, HOST:PORT (as run --console) or a URL "
+        f"(default: ${ENV}, else {DEFAULT_CONSOLE})",
+    )
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help="with status: the state as JSON, as the console gives it",
     )
     p.add_argument(
         "--token-file",
@@ -73,10 +93,39 @@ def _fail(text: str) -> int:
     return 2
 
 
+def console_url(text: str | None) -> str:
+    """The console's base URL from what ``--console`` or ``FROG_BT_CONSOLE`` says:
+    a URL as it is, ``PORT``, ``:PORT`` or ``HOST:PORT`` as ``run --console`` reads them
+    (a wildcard host reached on loopback); UsageError when it is none of those."""
+    text = (text or "").strip() or DEFAULT_CONSOLE
+    if "://" in text:
+        return text.rstrip("/")
+    host, port = console_address(text.rstrip("/"))
+    host = WILDCARDS.get(host, host)
+    return f"http://[{host}]:{port}" if ":" in host else f"http://{host}:{port}"
+
+
 def run(args: argparse.Namespace) -> int:
-    base = args.console.rstrip("/")
-    if "://" not in base:
-        base = f"http://{base}"
+    try:
+        return _run(args)
+    except BrokenPipeError:  # `frog-bt ctl status | head -1`: the reader has gone
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # the interpreter's last flush goes nowhere
+        return 0
+
+
+def _say(text: str) -> None:
+    print(text)
+    sys.stdout.flush()  # a closed pipe shows here, where it is caught
+
+
+def _run(args: argparse.Namespace) -> int:
+    given = args.console if args.console is not None else os.environ.get(ENV)
+    try:
+        base = console_url(given)
+    except UsageError as exc:
+        where = "--console" if args.console is not None else ENV
+        return _fail(f"{where} {given}: {exc.detail}, or a URL")
     headers = {"Content-Type": "application/json"}
     if args.token_file is not None:
         try:
@@ -104,7 +153,7 @@ def run(args: argparse.Namespace) -> int:
             return _fail(f"{exc.code}: the console redirects to {where[:200]}: not followed")
         reason = _reason(exc.read(4096), str(exc.reason))
         if exc.code == 409:
-            print(f"refused: {reason}")
+            _say(f"refused: {reason}")
             return 1
         return _fail(f"{exc.code}: {reason}")
     except (urllib.error.URLError, OSError, ValueError) as exc:
@@ -117,13 +166,100 @@ def run(args: argparse.Namespace) -> int:
     if args.command == "status":
         if not isinstance(answer, dict) or "phase" not in answer:
             return _fail('the console\'s answer is not a state (no "phase")')
-        print(json.dumps(answer, indent=1))
+        if args.json:
+            _say(json.dumps(answer, indent=1))
+        else:
+            _say("\n".join(state_lines(answer)))
         return 0
     if not isinstance(answer, dict) or answer.get("ok") is not True:
         reason = _reason(raw, "no reason given")
         if isinstance(answer, dict) and answer.get("ok") is False:
-            print(f"refused: {reason}")
+            _say(f"refused: {reason}")
             return 1
         return _fail(f'the console did not say "ok": true (so nothing was done): {raw[:80]!r}')
-    print(f"done: {answer.get('did', '')}")
+    _say(f"done: {answer.get('did', '')}")
     return 0
+
+
+# ------------------------------------------------------------------ status, in words
+
+LINKS = {"rosbridge": N_("The robot"), "frontend": N_("Screen and sound"), "clock": N_("Clock")}
+LINK_STATES = {
+    "connected": N_("connected"),
+    "reconnecting": N_("reconnecting"),
+    "connecting": N_("connecting"),
+    "closed": N_("closed"),
+    "acking": N_("answering"),
+    "not heard": N_("not heard yet"),
+    "silent": N_("silent"),
+    "wall": N_("wall clock"),
+    "/clock": N_("simulated clock"),
+    "waiting for /clock": N_("waiting for the clock"),
+}
+DAY = (
+    ("started", N_("Tours started")),
+    ("completed", N_("Completed")),
+    ("aborted", N_("Ended early")),
+)
+
+
+def state_lines(state: dict[str, Any]) -> list[str]:
+    """The console's state as plain lines, in the site's words (``state["language"]``):
+    what the robot is doing, the stop, the battery, what staff decided, a person needed,
+    alerts, connections and the day so far."""
+    words = translator(state.get("language"))
+
+    def w(msgid: str, **args: Any) -> str:
+        return Msg(msgid, **args).say(words)
+
+    def field(label: str, value: object) -> str:
+        return f"{w(label)}: {value}"
+
+    def duration(seconds: object) -> str:
+        s = max(0, round(float(seconds))) if isinstance(seconds, int | float) else 0
+        return w(N_("{s} s"), s=s) if s < 90 else w(N_("{m} min {s} s"), m=s // 60, s=s % 60)
+
+    out = [str(state.get("doing") or state.get("phase") or "")]
+    if state.get("stop_name"):
+        stop = state["stop_name"]
+    else:
+        stop = w(N_("looking for a visitor")) if state.get("touring") else w(N_("no tour now"))
+    out.append(field(N_("Stop"), stop))
+    if state.get("next_stop_name"):
+        out.append(field(N_("Next stop"), state["next_stop_name"]))
+    if state.get("stop_name") and state.get("at_stop_s") is not None:
+        out.append(field(N_("Time at this stop"), duration(state["at_stop_s"])))
+    if state.get("battery") is not None:
+        out.append(field(N_("Battery"), f"{round(state['battery'])} %"))
+    if state.get("paused"):
+        out.append(w(N_("Paused")))
+    if state.get("in_service") is False:
+        out.append(w(N_("Out of service")))
+    help_ = state.get("help")
+    if isinstance(help_, dict):
+        out.append(field(N_("The robot is waiting for a person"), help_.get("what", "")))
+        if help_.get("by_hand"):
+            out.append(f"  {field(N_('Done'), help_['by_hand'])}")
+        answers = " | ".join(f"frog-bt ctl {a}" for a in help_.get("answers", []))
+        out.append("  " + Msg("Answer with: {commands}", commands=answers).say(words))
+    for alert in state.get("alerts", []):
+        raised = alert.get("state") == "raised"
+        label = N_("The robot needs help") if raised else N_("Solved")
+        out.append(field(label, alert.get("text", "")))
+        seen = Msg("mark it seen: frog-bt ctl ack_alert {id}", id=alert.get("id", ""))
+        out.append("  " + seen.say(words))
+    for alert in state.get("holding", []):
+        out.append(field(N_("Still true"), alert.get("text", "")))
+    since = state.get("links_for_s", {})
+    links = [
+        f"{w(LINKS.get(name, name))} {w(LINK_STATES.get(st, st))} ({duration(since.get(name))})"
+        for name, st in state.get("links", {}).items()
+    ]
+    out.append(field(N_("Connections"), ", ".join(links)))
+    tours, day = state.get("tours", {}), state.get("day", {})
+    counts = [f"{w(label)} {tours.get(key, 0)}" for key, label in DAY]
+    counts += [f"{w(N_('Visitors'))} {day.get('visitors', 0)}"]
+    counts += [f"{w(N_('Stops skipped'))} {day.get('skipped', 0)}"]
+    out.append(field(N_("The day so far"), ", ".join(counts)))
+    out += [f"  {line}" for line in day.get("last", [])]
+    return out

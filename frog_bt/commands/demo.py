@@ -7,6 +7,11 @@ recruited, what went wrong (stops skipped and why, navigation retries, failed
 approaches, content timeouts, front-end restarts, aborts), and how much
 simulated and wall time the tour took. Exits 0 only when the tour ended docked
 with every stop visited.
+
+With --console the tour runs at a speed a person can follow (2x unless --speed says
+otherwise), and the console stays open after the tour, so that the day and the last tour
+can be read, until Ctrl-C (SIGINT or SIGTERM). The default --timeout grows as the speed
+falls: 300 wall seconds at the default 50x, the same simulated time at any other speed.
 """
 
 from __future__ import annotations
@@ -14,6 +19,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import logging
+import signal
 import sys
 import time
 from pathlib import Path
@@ -31,7 +37,15 @@ from frog_bt.errors import DefinitionError, UsageError, error_lines
 from frog_bt.tree.loader import LoadedTree
 
 if TYPE_CHECKING:
+    from frog_bt.live.console.server import Console
+    from frog_bt.live.summary import TourSummary
+    from frog_bt.rehearsal import Rehearsal
+    from frog_bt.runtime.executive import Outcome
     from frog_bt.sim.scenario import Scenario
+
+CONSOLE_SPEED = 2.0  # with --console: slow enough to follow on the page
+TIMEOUT = 300.0  # wall seconds at REFERENCE_SPEED; the same simulated time at any speed
+REFERENCE_SPEED = 50.0
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -41,13 +55,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="NAME|FILE",
         help="simulator scenario (default: default)",
     )
-    p.add_argument("--speed", type=float, help="sim-time speed factor (default: the scenario's)")
+    p.add_argument(
+        "--speed",
+        type=float,
+        help=f"sim-time speed factor (default: the scenario's; with --console {CONSOLE_SPEED:g})",
+    )
     add_tree_and_config(p)
     p.add_argument(
         "--timeout",
         type=float,
-        default=300.0,
-        help="give up after this many wall seconds (default: 300)",
+        help=f"give up after this many wall seconds (default: {TIMEOUT:g} at "
+        f"{REFERENCE_SPEED:g}x, longer when slower)",
     )
     p.add_argument(
         "--record",
@@ -80,9 +98,18 @@ def run(args: argparse.Namespace) -> int:
         for line in error_lines(exc):
             print(f"frog-bt: {line}", file=sys.stderr)
         return 2
-    if args.speed:
-        scenario = scenario.model_copy(update={"speed": args.speed})
+    speed, args.timeout = pace(args.speed, args.timeout, scenario.speed, bool(args.console))
+    scenario = scenario.model_copy(update={"speed": speed})
     return asyncio.run(_demo(site, tree, scenario, args))
+
+
+def pace(
+    speed: float | None, timeout: float | None, scenario_speed: float, console: bool
+) -> tuple[float, float]:
+    """The speed (``--speed``, else 2x with a console, else the scenario's) and the wall
+    timeout (``--timeout``, else long enough for what 300 s give at 50x)."""
+    chosen = speed or (CONSOLE_SPEED if console else scenario_speed)
+    return chosen, timeout or max(TIMEOUT, TIMEOUT * REFERENCE_SPEED / chosen)
 
 
 async def _demo(site: Site, tree: LoadedTree, scenario: Scenario, args: argparse.Namespace) -> int:
@@ -114,18 +141,60 @@ async def _demo(site: Site, tree: LoadedTree, scenario: Scenario, args: argparse
                 print(f"frog-bt: {exc}", file=sys.stderr)
                 rehearsal.executive.stop(str(exc), 2)
                 return 2
+            timed_out = False
             try:
                 outcome = await rehearsal.finish(args.timeout)
             except TimeoutError:
-                outcome = rehearsal.executive.outcome
-                outcome.code, outcome.reason = (
-                    1,
-                    (f"no docked finish within {args.timeout:g} s of wall time"),
-                )
+                timed_out = True
+        outcome = rehearsal.executive.outcome
+        if timed_out:  # said after the executive stopped (stopping says "no tour ended")
+            outcome.code, outcome.reason = (
+                1,
+                f"no docked finish within {args.timeout:g} s of wall time "
+                f"(--timeout {args.timeout:g} at --speed {scenario.speed:g}): "
+                "give a longer --timeout",
+            )
+        close_all(observers)
+        observers.clear()
+        code = _report(args, scenario, summary, rehearsal, outcome, wall0, sim0, rerun)
+        if people is not None and people.console is not None:
+            await _hold_open(people.console)
+        return code
     finally:
         if people is not None:
             await people.close()
         close_all(observers)
+
+
+async def _hold_open(console: Console) -> None:
+    """Keep the console open, the last state on it, until SIGINT or SIGTERM."""
+    loop = asyncio.get_running_loop()
+    stop = asyncio.Event()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        loop.add_signal_handler(sig, stop.set)
+    print(
+        f"frog-bt demo: the console stays open at http://{console.host}:{console.bound_port}/ "
+        "(Ctrl-C to end)",
+        flush=True,
+    )
+    try:
+        await stop.wait()
+    finally:
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            loop.remove_signal_handler(sig)
+
+
+def _report(
+    args: argparse.Namespace,
+    scenario: Scenario,
+    summary: TourSummary,
+    rehearsal: Rehearsal,
+    outcome: Outcome,
+    wall0: float,
+    sim0: float,
+    rerun: str | None,
+) -> int:
+    """Print the tour's summary; the exit code."""
     clock = rehearsal.executive.clock
     wall, simulated = time.monotonic() - wall0, rehearsal.sim.clock.now() - sim0
     print(

@@ -8,14 +8,23 @@ DIR/config/site.yaml, copied from the packaged ones. Then:
 
 Existing files are left alone unless --force. With --service, also DIR/frog-bt.service:
 a systemd unit (Type=notify, a watchdog, Restart=always) that runs the executive with
-that folder's files as an ordinary user; it prints how to install it (docs/DEPLOY.md).
+that folder's files as an ordinary user, and DIR/state/ and DIR/recordings/ for it to
+write. Run as root, it creates that user when there is none (``useradd --system``;
+where it cannot, it prints the one command that does) and gives it those two folders;
+it prints how to install the unit (docs/DEPLOY.md).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import pwd
+import shlex
 import shutil
+import subprocess
 import sys
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from frog_bt import resources
@@ -67,17 +76,111 @@ WantedBy=multi-user.target
 """
 
 
+def default_user() -> str:
+    """You; ``frog`` when you are root (the executive needs no root)."""
+    import getpass
+
+    return "frog" if os.geteuid() == 0 else getpass.getuser()
+
+
 def unit_text(target: Path, user: str | None = None) -> str:
     """The systemd unit for a site folder (absolute paths; no root at run time)."""
-    import getpass
-    import os
-    import shutil as sh
-
     folder = target.resolve()
-    exe = sh.which("frog-bt") or str(Path(sys.argv[0]).resolve())
-    if user is None:
-        user = "frog" if os.geteuid() == 0 else getpass.getuser()
+    beside = Path(sys.executable).parent / "frog-bt"  # this installation's, first
+    exe = (
+        str(beside)
+        if beside.is_file()
+        else shutil.which("frog-bt") or str(Path(sys.argv[0]).resolve())
+    )
+    user = user or default_user()
     return UNIT.format(unit=folder / "frog-bt.service", user=user, dir=folder, exe=exe)
+
+
+SERVICE_FOLDERS = ("state", "recordings")  # what the unit's user writes
+
+
+@dataclass(frozen=True, slots=True)
+class ServiceUser:
+    """What ``init --service`` does about the unit's user: create it (``create``, the
+    command), then give it ``folders`` (``chown``); ``exists`` when it already does."""
+
+    name: str
+    exists: bool
+    create: tuple[str, ...]
+    folders: tuple[Path, ...]
+    root: bool  # run as root: it does these itself; else it says them
+
+    def commands(self) -> list[str]:
+        """The shell commands that do it by hand (as root)."""
+        out = [] if self.exists else [shlex.join(self.create)]
+        if self.folders:
+            out.append(shlex.join(["chown", "-R", f"{self.name}:", *map(str, self.folders)]))
+        return out
+
+
+def service_user(
+    target: Path,
+    user: str,
+    *,
+    euid: int | None = None,
+    exists: Callable[[str], bool] | None = None,
+) -> ServiceUser:
+    """The plan for ``user`` (inspected by tests without creating anyone)."""
+    euid = os.geteuid() if euid is None else euid
+    known = (exists or _user_exists)(user)
+    nologin = shutil.which("nologin") or "/usr/sbin/nologin"
+    create = (
+        "useradd", "--system", "--user-group", "--no-create-home",
+        "--home-dir", str(target.resolve()), "--shell", nologin, user,
+    )  # fmt: skip
+    mine = known and euid != 0 and pwd.getpwnam(user).pw_uid == euid
+    folders = () if mine else tuple(target.resolve() / f for f in SERVICE_FOLDERS)
+    return ServiceUser(user, known, create, folders, root=euid == 0)
+
+
+def _user_exists(name: str) -> bool:
+    try:
+        pwd.getpwnam(name)
+    except KeyError:
+        return False
+    return True
+
+
+def give_folders(plan: ServiceUser) -> list[str]:
+    """As root: create the user when it can and give it the folders; what is left for a
+    person to do, as commands (empty when done)."""
+    if not plan.root:
+        return plan.commands()
+    if not plan.exists:
+        if shutil.which(plan.create[0]) is None:
+            return plan.commands()
+        done = subprocess.run(plan.create, capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            why = (done.stderr or done.stdout).strip().splitlines()
+            print(f"frog-bt: {shlex.join(plan.create)}: {why[-1] if why else done.returncode}")
+            return plan.commands()
+        print(f"created the system user {plan.name}")
+    entry = pwd.getpwnam(plan.name)
+    for folder in plan.folders:
+        for place in (folder, *folder.rglob("*")):
+            os.chown(place, entry.pw_uid, entry.pw_gid)
+        folder.chmod(0o750)
+    if plan.folders:
+        print(f"gave {', '.join(str(f) for f in plan.folders)} to {plan.name}")
+        closed = _closed_to(plan.folders[0].parent, entry.pw_uid, entry.pw_gid)
+        if closed is not None:
+            return [f"chmod o+x {shlex.quote(str(closed))}"]
+    return []
+
+
+def _closed_to(folder: Path, uid: int, gid: int) -> Path | None:
+    """The first folder on the way to ``folder`` that the user cannot pass, if any."""
+    for place in (*reversed(folder.parents), folder):
+        st = place.stat()
+        who = 6 if st.st_uid == uid else 3 if st.st_gid == gid else 0
+        if not (st.st_mode >> who) & 0o1:
+            return place
+    return None
 
 
 def copies(target: Path) -> list[tuple[Path, Path]]:
@@ -111,14 +214,17 @@ def run(args: argparse.Namespace) -> int:
     if args.service and service.exists() and not args.force:
         print(f"frog-bt: {service}: exists; give --force to overwrite", file=sys.stderr)
         return 2
+    user = args.user or default_user()
+    todo: list[str] = []
     try:
         for src, dst in plan:
             dst.parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(src, dst)
         if args.service:
-            for folder in ("state", "recordings"):
+            for folder in SERVICE_FOLDERS:
                 (args.dir / folder).mkdir(exist_ok=True)
-            service.write_text(unit_text(args.dir, args.user), encoding="utf-8")
+            service.write_text(unit_text(args.dir, user), encoding="utf-8")
+            todo = give_folders(service_user(args.dir, user))
     except OSError as exc:
         where = exc.filename or args.dir
         print(f"frog-bt: {where}: cannot write: {exc.strerror or exc}", file=sys.stderr)
@@ -132,8 +238,12 @@ def run(args: argparse.Namespace) -> int:
         f"  frog-bt run --tree {tree} --config {site} ..."
     )
     if args.service:
+        if todo:
+            sudo = "" if os.geteuid() == 0 else "sudo "
+            steps = "\n".join(f"  {sudo}{c}" for c in todo)
+            print(f"\nThe service runs as {user}, who must exist and own its folders:\n{steps}")
         print(
-            f"wrote {service}\n\nInstall the service (it runs as an ordinary user):\n"
+            f"wrote {service}\n\nInstall the service (it runs as {user}, not root):\n"
             f"  sudo cp {service.resolve()} /etc/systemd/system/\n"
             "  sudo systemctl daemon-reload && sudo systemctl enable --now frog-bt\n"
             "  journalctl -u frog-bt -f"

@@ -146,16 +146,19 @@ def _stopped(pid: int) -> bool:
 
 
 def test_init_service_writes_a_notify_unit_with_a_watchdog_for_that_folder(tmp_path: Path) -> None:
+    import getpass
+
     from frog_bt.cli import main
 
     site = tmp_path / "alcazar"
-    assert main(["init", str(site), "--service", "--user", "frog"]) == 0
+    me = getpass.getuser()  # a user that exists: as root, init would create another one
+    assert main(["init", str(site), "--service", "--user", me]) == 0
     unit = (site / "frog-bt.service").read_text()
     for line in (
         "Type=notify",
         "Restart=always",
         "WatchdogSec=10",
-        "User=frog",
+        f"User={me}",
         f"--tree {site.resolve()}/trees/tour.yaml",
         f"--config {site.resolve()}/config/site.yaml",
         f"--checkpoint {site.resolve()}/state/checkpoint.json",

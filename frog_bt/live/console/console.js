@@ -181,16 +181,18 @@ function drawLegend() {
     item(COLOURS.recruit, t("where it looks for visitors")));
 }
 
-function placeLabels(marks, size) {  // labels above their mark, moved down or aside when they would overlap
+function placeLabels(marks, size) {  // labels above their mark, moved below or aside when they would cover another label or mark
   const placed = [];
+  const dots = marks.map((m) => ({x: m.x, y: m.y}));
   for (const m of [...marks].sort((a, b) => a.y - b.y)) {
     const w = m.text.length * size * 0.55, h = size * 1.1;
-    let x = m.x, y = m.y - size * 0.9;
-    for (const dy of [0, size * 2.1, -size * 1.2, size * 3.3, size * 4.5]) {
-      const cand = {x: m.x, y: m.y - size * 0.9 + dy};
-      if (!placed.some((p) => Math.abs(p.x - cand.x) < (p.w + w) / 2 && Math.abs(p.y - cand.y) < h)) { x = cand.x; y = cand.y; break; }
-    }
-    placed.push({x, y, w, text: m.text});
+    const free = (c) => !placed.some((p) => Math.abs(p.x - c.x) < (p.w + w) / 2 && Math.abs(p.y - c.y) < h)
+      && !dots.some((d) => (d.x !== m.x || d.y !== m.y) && Math.abs(d.x - c.x) < w / 2 + size * .3
+        && d.y > c.y - h * .8 && d.y < c.y + size * .4);
+    const candidates = [[0, -0.9], [0, 1.6], [w / 2 + size * .5, 0.35], [-w / 2 - size * .5, 0.35], [0, -2.0], [0, 2.7]]
+      .map(([dx, dy]) => ({x: m.x + dx, y: m.y + dy * size}));
+    const at = candidates.find(free) || candidates[0];
+    placed.push({x: at.x, y: at.y, w, text: m.text});
   }
   return placed;
 }
@@ -205,9 +207,11 @@ function drawMap(s) {
   const minx = Math.min(...xs) - 12, maxx = Math.max(...xs) + 12, miny = Math.min(...ys) - 6, maxy = Math.max(...ys) + 8;
   const w = maxx - minx, h = maxy - miny, k = 100 / w;
   const X = (x) => (x - minx) * k, Y = (y) => (maxy - y) * k;
-  const narrow = $("map").clientWidth < 500;
-  const u = narrow ? 2.6 : 1.6;  // one unit of marks and text, in viewBox units (the map is 100 wide)
-  $("map").setAttribute("viewBox", `0 0 100 ${(h * k).toFixed(2)}`);
+  const tall = h * k;  // the viewBox's height (it is 100 wide)
+  // one unit of marks and text, in viewBox units: labels about 13 px whatever the screen
+  const px = Math.min(($("map").clientWidth || 300) / 100, 0.8 * window.innerHeight / tall);
+  const u = 13 / 1.5 / px;
+  $("map").setAttribute("viewBox", `0 0 100 ${tall.toFixed(2)}`);
   const out = [];
   const points = (ps) => ps.map((p) => X(p[0]).toFixed(2) + "," + Y(p[1]).toFixed(2)).join(" ");
   site.zones.forEach((z) => out.push(svg("polygon", {points: points(z.points),
@@ -258,7 +262,10 @@ function holdingRow(a) {
   return el("div", {class: "alert holding"}, el("span", {}, el("strong", {}, t("Still true"), ":"), " ", a.text));
 }
 
-function name(code) { return (site && site.names && site.names[code]) || code; }
+function name(code) {  // a stop or a place (the charger) by the name staff know it by
+  const poi = site && site.pois.find((p) => p.label === code);
+  return (site && site.names && site.names[code]) || (poi && poi.name) || code;
+}
 
 function render(s) {
   latest = s;

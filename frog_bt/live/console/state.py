@@ -98,6 +98,8 @@ def site_map(executive: Executive) -> dict[str, Any]:
     site = executive.site
     shown = {site.tour.dock, site.tour.recruit_at}
     for stop in site.tour.stops:
+        if not stop.content:
+            continue  # a functional waypoint (TEMP): the robot passes it, staff need not
         shown.add(stop.poi)
         shown.update(v.waypoint for v in site.variants.get(stop.poi, []))
     marks, named = [], set()
