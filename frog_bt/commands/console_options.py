@@ -60,7 +60,8 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
         raise UsageError(
             "--console",
             args.console,
-            f"needs the console extra ({exc.name} is missing): pip install 'frog-bt[console]'",
+            f"needs the console extra ({exc.name} is missing): "
+            "pip install -e '.[console]' from a checkout",
         ) from None
 
     host, port = console_address(str(args.console))

@@ -189,6 +189,10 @@ class Core:
 
     # ------------------------------------------------------------ operator commands
 
+    def stops_now(self) -> list[str]:
+        """The stops being visited or driven to now (what a skip would leave)."""
+        return self._stops_now()
+
     def _stops_now(self) -> list[str]:
         """The stops being visited or driven to now (what a skip would leave)."""
         return [n.stop_poi() for n in self.stops if n.status is Status.RUNNING]

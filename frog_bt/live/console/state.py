@@ -240,9 +240,11 @@ def _can(board: Any, touring: bool, needs_help: bool, executive: Executive) -> l
     paused = bool(board.get(keys.PAUSED))
     in_service = board.get(keys.IN_SERVICE) is not False
     can = []
-    if touring and not ending:
-        can += ["home", "skip"]
-    if touring and not paused:
+    if touring and not ending and not needs_help:
+        can.append("home")
+        if executive.core.stops_now():  # at a stop or driving to one
+            can.append("skip")
+    if touring and not paused and not needs_help:
         can.append("pause")
     if paused:
         can.append("resume")
