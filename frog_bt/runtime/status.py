@@ -20,10 +20,12 @@ import py_trees
 
 from frog_bt.engine.core import Core
 from frog_bt.engine.walk import running_path
+from frog_bt.i18n import say
 from frog_bt.model import keys
 from frog_bt.model.events import Event, Ticked
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.observer import Host
+from frog_bt.runtime.phrase import doing
 
 
 def phase(core: Core) -> str:
@@ -109,7 +111,7 @@ def status_line(core: Core) -> str:
     battery = diagnostics.value.battery if diagnostics is not None else None
     visitor = board.get(keys.VISITOR)
     parts = [
-        phase(core),
+        say(doing(core), core.site.language),  # in the staff's words
         f"poi {board.get(keys.WAYPOINT) or '-'}",
         f"tip {tip.name if tip else '-'}",
         f"visitor {visitor if visitor is not None else '-'}",

@@ -12,7 +12,7 @@ import pytest
 
 from frog_bt import i18n
 from frog_bt.i18n import Msg, translator
-from frog_bt.live.console.phrase import Situation, Step, phrase
+from frog_bt.runtime.phrase import Situation, Step, phrase
 
 babel_messages = pytest.importorskip("babel.messages")
 from babel.messages.extract import extract_from_dir  # noqa: E402

@@ -17,12 +17,13 @@ import py_trees
 
 from frog_bt.engine.walk import children, running_path
 from frog_bt.i18n import Msg, say
-from frog_bt.live.console.phrase import Situation, of, phrase
 from frog_bt.live.telemetry.site_map import poi_marks, tour_routes, zone_outlines
 from frog_bt.model import keys
 from frog_bt.model.help import Help
 from frog_bt.model.outcomes import TourState
 from frog_bt.runtime.logctx import OwnedBy
+from frog_bt.runtime.phrase import doing as phrase_of
+from frog_bt.runtime.phrase import of
 from frog_bt.runtime.status import phase
 
 if TYPE_CHECKING:
@@ -138,21 +139,10 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock)
     links = {name: status.value for name, status in executive.links.items()}
     since = executive.staff.link_since
     site = executive.site
-    path = running_path(core.root)
+    path = list(running_path(core.root))
     steps = [of(node) for node in path]
     help_ = board.get(keys.HELP)
-    doing = phrase(
-        steps,
-        Situation(
-            paused=bool(board.get(keys.PAUSED)),
-            in_service=board.get(keys.IN_SERVICE) is not False,
-            needs_help=help_ is not None,
-            going_home=board.get(keys.HOME) is not None or board.get(keys.ABORT_REASON) is not None,
-            dock=site.tour.dock,
-            recruit_at=site.tour.recruit_at,
-        ),
-        site.name,
-    )
+    doing = phrase_of(core)
     arrived = not any(step.kind in DRIVING for step in steps)
     book = executive.staff.book
     return {

@@ -11,8 +11,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
+from frog_bt.engine.walk import running_path
 from frog_bt.i18n import Msg
+from frog_bt.model import keys
+
+if TYPE_CHECKING:
+    from frog_bt.engine.core import Core
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,3 +96,22 @@ def _say(step: Step, now: Situation, names: Callable[[str], str]) -> Msg | None:
     if kind == "WaitEvent" and step.event == "finish_introduction":
         return Msg("Introducing itself to a visitor")
     return None
+
+
+def doing(core: Core) -> Msg:
+    """What the robot is doing now, as one plain sentence (the console and the status
+    line say it in the site's language)."""
+    board = core.board
+    site = core.site
+    return phrase(
+        [of(node) for node in running_path(core.root)],
+        Situation(
+            paused=bool(board.get(keys.PAUSED)),
+            in_service=board.get(keys.IN_SERVICE) is not False,
+            needs_help=board.get(keys.HELP) is not None,
+            going_home=board.get(keys.HOME) is not None or board.get(keys.ABORT_REASON) is not None,
+            dock=site.tour.dock,
+            recruit_at=site.tour.recruit_at,
+        ),
+        site.name,
+    )
