@@ -4,7 +4,9 @@ Each recording is replayed on the tree (the recordings' tick channel has the roo
 status per tick, not each node's; a replay ticks exactly where the executive did), and
 every node's runs and outcomes are counted over all of them. Printed as the tree, one
 line per node, with the nodes the recordings never ran marked; `-o FILE.html` writes the
-same as a self-contained page. Exit 0, or 2 when no recording could be read.
+same as a self-contained page. `--jobs N` replays N files at a time (processes),
+`--scheduler ADDRESS` on a dask.distributed cluster: the same Executor seam as
+`frog-bt report`. Exit 0, or 2 when no recording could be read.
 
 Examples:
 
@@ -17,6 +19,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from frog_bt.commands.options import tree_argument, writable_file
 from frog_bt.errors import DefinitionError, UsageError
@@ -27,6 +30,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--tree", dest="tree_option", type=Path, metavar="FILE", help="tree file")
     p.add_argument("--config", type=Path, metavar="FILE", help="site configuration")
     p.add_argument("-o", "--output", type=Path, metavar="FILE.html", help="write a page")
+    p.add_argument("--jobs", type=int, default=1, metavar="N", help="replay N files at a time")
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="replay on this dask.distributed scheduler (tcp://HOST:PORT) instead",
+    )
     p.set_defaults(tree=None)
 
 
@@ -34,9 +43,8 @@ def run(args: argparse.Namespace) -> int:
     from frog_bt.behaviours import load_tree
     from frog_bt.config import load_site
     from frog_bt.offline.corpus import recordings
-    from frog_bt.offline.replay import Replay
-    from frog_bt.recordings.commands import ReplayError
-    from frog_bt.verify.coverage import Counter, NodeCount, lines, never_run, page
+    from frog_bt.offline.executors import ExecutorError, executor
+    from frog_bt.verify.coverage import NodeCount, add, lines, never_run, page
     from frog_bt.verify.model import compile_tree
 
     try:
@@ -51,16 +59,19 @@ def run(args: argparse.Namespace) -> int:
     model = compile_tree(tree, site)
     counts = [NodeCount() for _ in model.nodes]
     read = 0
-    for path in recordings(args.paths):
-        try:
-            replay = Replay(path, site, load_tree(tree_path, site))  # a fresh tree each
-        except (ReplayError, OSError) as exc:
-            print(f"frog-bt: {path}: {exc}", file=sys.stderr)
-            continue
-        counter = Counter(counts)
-        replay.observers.attach(replay, [counter])
-        replay.run()
-        read += 1
+    files = list(recordings(args.paths))
+    try:
+        with executor(max(1, args.jobs), args.scheduler) as pool:
+            done = pool.map(count_file, files, [tree_path] * len(files), [args.config] * len(files))
+            for path, got in done:
+                if isinstance(got, str):
+                    print(f"frog-bt: {path}: {got}", file=sys.stderr)
+                    continue
+                add(counts, got)
+                read += 1
+    except ExecutorError as exc:
+        print(f"frog-bt coverage: {exc}", file=sys.stderr)
+        return 2
     if not read:
         print("frog-bt: no recording could be read", file=sys.stderr)
         return 2
@@ -74,3 +85,28 @@ def run(args: argparse.Namespace) -> int:
         args.output.write_text(page(tree, model, counts, read), encoding="utf-8")
         print(f"wrote {args.output}")
     return 0
+
+
+def count_file(
+    path: Path, tree_file: Path | None, config: Path | None
+) -> tuple[str, list[Any] | str]:
+    """One recording's counts, replayed in a worker (``--jobs``, ``--scheduler``): the
+    site and the tree are loaded there, so only paths cross to it; the counts, or why the
+    file could not be read."""
+    from frog_bt.behaviours import load_tree
+    from frog_bt.config import load_site
+    from frog_bt.offline.replay import Replay
+    from frog_bt.recordings.commands import ReplayError
+    from frog_bt.verify.coverage import Counter, NodeCount
+    from frog_bt.verify.model import preorder
+
+    site = load_site(config)
+    tree = load_tree(tree_file, site)
+    counts = [NodeCount() for _ in preorder(tree.root)]
+    try:
+        replay = Replay(path, site, tree)
+    except (ReplayError, OSError) as exc:
+        return str(path), str(exc)
+    replay.observers.attach(replay, [Counter(counts)])
+    replay.run()
+    return str(path), counts

@@ -118,3 +118,11 @@ def page(tree: LoadedTree, model: Model, counts: list[NodeCount], files: int) ->
         + "".join(rows)
         + "</table></body></html>\n"
     )
+
+
+def add(total: list[NodeCount], more: list[NodeCount]) -> None:
+    """Add one file's counts to ``total`` (node by node: the same tree file)."""
+    for into, count in zip(total, more, strict=True):
+        into.runs += count.runs
+        into.ticks += count.ticks
+        into.outcomes.update(count.outcomes)

@@ -36,3 +36,10 @@ def test_coverage_of_a_recorded_tour(tmp_path: Path, capsys: pytest.CaptureFixtu
     html = page.read_text()
     assert '<tr class="never"><td style="padding-left:3em">ClearAbort</td>' in html
     assert "<script" not in html
+    # the same counts through the Executor seam (two worker processes, two copies)
+    (tmp_path / "season" / "copy.mcap").write_bytes(recorded.path.read_bytes())
+    assert main(["coverage", str(tmp_path / "season"), "--jobs", "2"]) == 0
+    doubled = capsys.readouterr().out.splitlines()
+    assert doubled[-1].startswith("2 recordings: ")
+    twice = {text.strip().split(":")[0]: text for text in doubled}
+    assert "ran 2x: success 2" in twice["Docking 'Docking undock'"]
