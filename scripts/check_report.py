@@ -4,10 +4,12 @@ three outputs: the HTML (parsed: its totals), the CSV and the Parquet rows.
 
     .venv/bin/python scripts/check_report.py season/ [--jobs 2]
 
-Two kinds of check: the figures the seeded kinds of visitor imply, exactly (a fault
-aborts its tour, a bored visitor gets no part b, a decliner and a visitor who wanders
-off make a second invitation), and the rates against the seeding weights, within three
-binomial standard deviations. Prints one line per check and exits 1 if any fails.
+Two kinds of check: the figures the seeded kinds of visitor and help events imply,
+exactly (a fault aborts its tour, a bored visitor gets no part b, a decliner and a
+visitor who wanders off make a second invitation; a dock answered by hand, a home, a
+skip, an alert acknowledged after a known delay and a restart are each one
+intervention, resumed tour or cause), and the rates against the seeding weights, within
+three binomial standard deviations. Prints one line per check and exits 1 if any fails.
 """
 
 from __future__ import annotations
@@ -21,6 +23,8 @@ import sys
 import tempfile
 from html.parser import HTMLParser
 from pathlib import Path
+
+DOCK_ATTEMPTS = 3  # config/site.yaml docking.attempts: a dock_help tour's fail, then it asks
 
 
 class Totals(HTMLParser):
@@ -48,7 +52,11 @@ def main() -> int:
     manifest = json.loads((a.corpus / "corpus.json").read_text())
     kinds = [t["kind"] for t in manifest["tours"]]
     weights = manifest["weights"]
+    seeded_help = manifest.get("help", {})
     n = len(kinds)
+    helped = sum(k in seeded_help.get("kinds", []) for k in kinds)
+    drawn = (n - helped) / n  # the share of tours drawn by the weights
+    ended = n - kinds.count("fault") - kinds.count("home")
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp)
         subprocess.run(
@@ -102,11 +110,11 @@ def main() -> int:
         [(r["tour"], r["ended"]) for r in parquet],
         [(int(r["tour"]), r["ended"]) for r in rows],
     )
-    check("completed", t["completed"], n - kinds.count("fault"))
+    check("completed", t["completed"], ended)
     check(
-        "aborted tours are the faults",
+        "aborted tours are the faults and the homes",
         [r["ended"] == "aborted" for r in rows],
-        [k == "fault" for k in kinds],
+        [k in ("fault", "home") for k in kinds],
     )
     check("invitations", t["invitations"], n + kinds.count("declines") + kinds.count("wander_off"))
     check("invitations declined", t["invitations_declined"], kinds.count("declines"))
@@ -122,6 +130,12 @@ def main() -> int:
         [manifest["tours_per_day"]] * manifest["days"],
     )
     causes = {(c["cause"], c["detail"]): c["events"] for c in t["failure_causes"]}
+    dock_retries = (DOCK_ATTEMPTS - 1) * kinds.count("dock_help")
+    # A known race, not the report's: a fault striking as the robot arrives at a stop
+    # may leave it docking away from its charger, retried (tests/report/test_report.py)
+    extra_retries = sum(
+        int(r["dock_retries"]) for r, k in zip(rows, kinds, strict=True) if k == "fault"
+    )
     check(
         "failure causes, each event once",
         {k: n for k, n in causes.items() if k[0] != "approach rejected"},
@@ -132,6 +146,12 @@ def main() -> int:
                 ("invitation declined", ""): kinds.count("declines"),
                 ("visitor lost", ""): kinds.count("wander_off"),
                 ("navigation retry", ""): kinds.count("nav_failure"),
+                ("help needed", "docking_failed"): kinds.count("dock_help"),
+                ("dock retry", ""): dock_retries + extra_retries,
+                ("operator", "home"): kinds.count("home"),
+                ("operator", "skip"): kinds.count("skip"),
+                ("alert", "battery_low"): kinds.count("ack_alert"),
+                ("restart", ""): kinds.count("restart"),
             }.items()
             if n
         },
@@ -141,13 +161,86 @@ def main() -> int:
         t["funnel"]["started"],
         n + kinds.count("wander_off"),
     )
-    check("funnel: finished", t["funnel"]["finished"], n - kinds.count("fault"))
+
+    def short(poi: str) -> int:
+        """Fault tours aborted before ``poi`` (where a fault strikes is not seeded)."""
+        return sum(
+            k == "fault" and poi not in r["stops_visited"].split("; ")
+            for r, k in zip(rows, kinds, strict=True)
+        )
+
+    check("funnel: POI2", t["funnel"]["POI2"], n - short("POI2"))
+    check("funnel: POI3", t["funnel"]["POI3"], n - short("POI3"))
     check(
-        "failures that needed a person (the faults' alerts)",
-        t["reliability"]["failures_needing_a_person"],
-        kinds.count("fault"),
+        "funnel: POI4, POI5 (the homes sent back at POI3 not there)",
+        [t["funnel"]["POI4"], t["funnel"]["POI5"]],
+        [n - kinds.count("home") - short(poi) for poi in ("POI4", "POI5")],
     )
-    near("completion rate vs seeding", t["completion_rate"], 1 - weights["fault"], n)
+    check("funnel: finished", t["funnel"]["finished"], ended)
+    rel = t["reliability"]
+    check(
+        "failures that needed a person (the faults' and the docks' alerts)",
+        rel["failures_needing_a_person"],
+        kinds.count("fault") + kinds.count("dock_help"),
+    )
+    interventions = {
+        "help answered": kinds.count("dock_help"),
+        "home": kinds.count("home"),
+        "skip": kinds.count("skip"),
+        "alert acknowledged": kinds.count("ack_alert"),
+    }
+    check("interventions, told apart", rel["interventions"], interventions)
+    check(
+        "interventions per 100 tours",
+        rel["interventions_per_100_tours"],
+        round(100 * sum(interventions.values()) / n, 1),
+    )
+    check(
+        "CSV: interventions per tour",
+        [int(r["interventions"]) for r in rows],
+        [int(k in ("dock_help", "home", "skip", "ack_alert")) for k in kinds],
+    )
+    check(
+        "Parquet: interventions per tour = CSV",
+        [r["interventions"] for r in parquet],
+        [int(r["interventions"]) for r in rows],
+    )
+    check("resumed tours (the restarts)", t["resumed"], kinds.count("restart"))
+    check(
+        "CSV and Parquet: resumed",
+        [[r["resumed"] == "True" for r in rows], [r["resumed"] for r in parquet]],
+        [[k == "restart" for k in kinds]] * 2,
+    )
+    check("alerts acknowledged", rel["acknowledged"], kinds.count("ack_alert"))
+    if kinds.count("ack_alert"):
+        ack = seeded_help["ack_after_s"]
+        median = rel["time_to_acknowledge_s"]["median"]
+        # the executive applies an answer at its next tick
+        check(f"time to acknowledge, median, within 1 s of {ack:g}", abs(median - ack) <= 1.0, True)
+        waits = [
+            a["acknowledged_s"]
+            for r in parquet
+            for a in r["alerts"]
+            if a["kind"] == "battery_low" and a["acknowledged_s"] is not None
+        ]
+        check(
+            "Parquet: battery alerts acknowledged within 1 s of the delay",
+            [abs(w - ack) <= 1.0 for w in waits],
+            [True] * kinds.count("ack_alert"),
+        )
+    autonomy = rel["autonomy"]
+    check(
+        "autonomy below 1 when someone was needed",
+        autonomy is not None and (autonomy < 1.0 or not helped + kinds.count("fault")),
+        True,
+    )
+    # the help tours (engaged visitors; the homes aborted) in place of drawn ones
+    near(
+        "completion rate vs seeding",
+        t["completion_rate"],
+        1 - drawn * weights.get("fault", 0.0) - kinds.count("home") / n,
+        n,
+    )
     # a visitor who wanders off on the way to POI2 has heard POI1, and the next one
     # hears it again: one more (engaged) visit of POI1 per wanderer
     check(
@@ -155,19 +248,20 @@ def main() -> int:
         t["gate_decisions"]["POI1"],
         t["gate_decisions"]["POI2"] + kinds.count("wander_off"),
     )
+    w = {k: drawn * weights.get(k, 0.0) for k in ("bored", "declines", "wander_off")}
     for poi, rate in t["part_b_rate"].items():
-        extra = weights["wander_off"] if poi == "POI1" else 0.0
+        extra = w["wander_off"] if poi == "POI1" else 0.0
         near(
             f"part-b rate at {poi} vs seeding",
             rate,
-            1 - weights["bored"] / (1 + extra),
+            1 - w["bored"] / (1 + extra),
             t["gate_decisions"][poi],
         )
-    asked = 1 + weights["declines"] + weights["wander_off"]
+    asked = 1 + w["declines"] + w["wander_off"]
     near(
         "invitation acceptance vs seeding",
         t["invitation_acceptance"],
-        1 - weights["declines"] / asked,
+        1 - w["declines"] / asked,
         t["invitations"],
     )
     print(f"{n} tours: {'all checks hold' if not failures else f'{failures} failed'}")

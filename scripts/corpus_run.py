@@ -18,11 +18,35 @@ kind            weight  what happens
 ``fault``       0.05    a motor driver error 5 minutes in: the tour is aborted
 ==============  ======  =====================================================
 
-``corpus.json`` beside the files lists every tour as seeded (file, day, local start,
-kind), the seed and the weights, so that a test can hold the report's figures
-against them.
+Then the season's help events, ``--help-each N`` tours of each kind below (default 4;
+none from :func:`make` unless asked), put in place of tours drawn above by a second
+generator of the same seed (so the tours drawn above do not change), each with the
+default scenario's engaged visitor:
 
-    scripts/corpus --out season/ --days 10 --tours-per-day 20 --jobs 2
+===============  ===========================================================================
+help kind        what happens
+===============  ===========================================================================
+``dock_help``    the dock at the end fails 3 times: the robot holds and asks; a person puts it
+                 on its charger and answers ``done_by_hand`` (``HELP_AFTER_S`` later)
+``home``         the operator sends the robot home during POI3's content: aborted
+``skip``         the operator skips POI3 during its content
+``ack_alert``    the battery drops to 24 % at POI1 (the alert is below 25 %, the abort below
+                 20 %); a person acknowledges ``battery_low`` ``ACK_AFTER_S`` after its raise
+``restart``      the executive stops during POI3's content; a new one resumes the tour from
+                 its checkpoint. Its two files go in a directory of their own
+                 (``resumed-NNNN/``): the season's tours overlap in time, a robot's could
+                 not, and the report joins a resumed tour's pieces within one robot's
+                 directory
+===============  ===========================================================================
+
+Operator commands go through the executive's staff (``by``: console), as the console
+sends them.
+
+``corpus.json`` beside the files lists every tour as seeded (file, day, local start,
+kind), the seed, the weights and the help events, so that a test can hold the report's
+figures against them.
+
+    scripts/corpus --out season/ --days 10 --tours-per-day 20 --help-each 4 --jobs 2
 """
 
 from __future__ import annotations
@@ -34,7 +58,7 @@ import random
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from datetime import datetime, timedelta
 from pathlib import Path
 from typing import Any
@@ -55,6 +79,10 @@ SCENARIO = {
     "nav_failure": "nav_failure",
     "fault": "fault",
 }
+HELP_KINDS = ("dock_help", "home", "skip", "ack_alert", "restart")
+HELP_AFTER_S = 60.0  # simulated seconds from the help request to the person's done_by_hand
+ACK_AFTER_S = 90.0  # simulated seconds from the battery_low alert's raise to its acknowledgement
+LOW_BATTERY = 24.0  # percent: below the alert (25), above the abort (20)
 FAST: dict[str, Any] = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
 FIRST_DAY = "2026-06-01"
 TZ = "+02:00"  # the site's summer time (Europe/Madrid)
@@ -70,8 +98,17 @@ class Seeded:
     file: str = ""  # relative to the corpus directory
 
 
-def plan(days: int, per_day: int, seed: int) -> list[Seeded]:
-    """The tours of a season, from ``seed``: in start order, numbered from 1."""
+def plan(
+    days: int,
+    per_day: int,
+    seed: int,
+    help_each: int = 0,
+    weights: dict[str, float] | None = None,
+) -> list[Seeded]:
+    """The tours of a season, from ``seed``: in start order, numbered from 1; then
+    ``help_each`` tours of each help kind in place of tours drawn at random (a second
+    generator, so that the others are those ``help_each=0`` draws)."""
+    weights = weights or KINDS
     rng = random.Random(seed)
     out: list[Seeded] = []
     first = datetime.fromisoformat(f"{FIRST_DAY}T00:00:00{TZ}")
@@ -89,7 +126,7 @@ def plan(days: int, per_day: int, seed: int) -> list[Seeded]:
         )
         for start in starts:
             number += 1
-            kind = rng.choices(list(KINDS), weights=list(KINDS.values()))[0]
+            kind = rng.choices(list(weights), weights=list(weights.values()))[0]
             start = start.replace(microsecond=0)
             name = f"{start:%Y%m%d-%H%M%S}-tour{number:04d}.mcap"
             out.append(
@@ -97,57 +134,200 @@ def plan(days: int, per_day: int, seed: int) -> list[Seeded]:
                     number, f"{day:%Y-%m-%d}", start.isoformat(), kind, rng.randrange(1 << 30), name
                 )
             )
+    if help_each:
+        chosen = random.Random(f"help:{seed}").sample(range(len(out)), len(HELP_KINDS) * help_each)
+        for i, number in enumerate(chosen):
+            kind = HELP_KINDS[i % len(HELP_KINDS)]
+            tour = out[number]
+            file = tour.file
+            if kind == "restart":
+                file = f"resumed-{tour.number:04d}/{file}"
+            out[number] = replace(tour, kind=kind, file=file)
     return out
 
 
-def record(tour: Seeded, directory: str) -> dict[str, Any]:
-    """Run and record one tour (in a worker process); what happened, in brief."""
-    from frog_bt.config import load_site
-    from frog_bt.live.recording import Recorder
-    from frog_bt.rehearsal import Rehearsal
-    from frog_bt.runtime.observer import attach_all
+def _scenario(tour: Seeded, fast: dict[str, Any]) -> Any:
     from frog_bt.sim import scenario_from
 
-    path = Path(directory) / tour.file
-    scenario = scenario_from(
-        SCENARIO[tour.kind], {**FAST, "start_time": tour.start, "seed": tour.seed}
+    data: dict[str, Any] = {**fast, "start_time": tour.start, "seed": tour.seed}
+    if tour.kind == "dock_help":
+        data["docking"] = {**data.get("docking", {}), "dock_failures": 3}
+    return scenario_from(SCENARIO.get(tour.kind, "default"), data)
+
+
+def _start_poi(poi: str) -> Any:
+    return lambda r: (
+        r.direction == "in" and r.channel == "start_poi" and r.payload.get("poi") == poi
     )
 
+
+async def _until(executive: Any, ok: Any, limit: float = 600.0) -> None:
+    """Wait on the executive's (simulated) clock until ``ok()``, one second at a time."""
+    await executive.clock.wait_ready()
+    end = executive.clock.now() + limit
+    while not ok():
+        if executive.clock.now() > end:
+            raise TimeoutError("the rehearsal did not get there in time")
+        await executive.clock.sleep(1.0)
+
+
+async def _help(tour: Seeded, r: Any) -> None:
+    """What the person does in a help tour (while the executive runs it)."""
+    from frog_bt.engine.operator import Command
+    from frog_bt.model.events import AlertChanged
+    from frog_bt.runtime.observer import listen
+
+    exe, sim = r.executive, r.sim
+    if tour.kind == "dock_help":
+        await _until(exe, lambda: "docking_failed" in exe.staff.book.active, 1800)
+        await exe.clock.sleep(HELP_AFTER_S)
+        docking = sim.world.docking  # a person puts the robot on its charger
+        docking.state, docking.docked = "docked", True
+        for _ in range(30):  # until the executive has seen /docking/state say docked
+            await exe.clock.sleep(1.0)
+            if (await exe.staff.submit(Command.DONE_BY_HAND)).ok:
+                return
+        raise RuntimeError("done_by_hand was never accepted")
+    if tour.kind in ("home", "skip"):
+        await sim.wait_for(_start_poi("POI3"), 60)
+        command = Command.HOME if tour.kind == "home" else Command.SKIP
+        answer = await exe.staff.submit(command)
+        assert answer.ok, answer.text
+    elif tour.kind == "ack_alert":
+        raised: list[float] = []
+        listen(
+            exe,
+            lambda e: (
+                raised.append(e.t)
+                if e.alert.kind == "battery_low" and e.alert.state == "raised"
+                else None
+            ),
+            AlertChanged,
+        )
+        await sim.wait_for(_start_poi("POI1"), 60)
+        sim.world.battery.percentage = LOW_BATTERY
+        await _until(exe, lambda: bool(raised), 60)
+        await exe.clock.sleep_until(raised[0] + ACK_AFTER_S)
+        answer = await exe.staff.submit(Command.ACK_ALERT, "battery_low")
+        assert answer.ok, answer.text
+
+
+def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Run and record one tour (in a worker process); what happened, in brief."""
+    import tempfile
+
+    from frog_bt.config import load_site
+    from frog_bt.live.recording import Recorder
+    from frog_bt.model.events import Ticked
+    from frog_bt.rehearsal import Rehearsal
+    from frog_bt.runtime.observer import attach_all, listen
+
+    path = Path(directory) / tour.file
+    path.parent.mkdir(parents=True, exist_ok=True)
+    scenario = _scenario(tour, FAST if fast is None else fast)
+    paths = [path]
+
     async def run() -> tuple[int, str]:
+        site = load_site()
         recorder = Recorder(path)
         try:
-            async with Rehearsal(
-                scenario, site=load_site(), prepare=lambda exe: attach_all(exe, [recorder])
-            ) as r:
+            # a --once executive exits when the robot asks for help: this one waits for
+            # the person's answer and stops at the tick the tour ends
+            once = tour.kind != "dock_help"
+
+            def prepare(exe: Any) -> None:
+                attach_all(exe, [recorder])
+                if not once:
+                    listen(
+                        exe,
+                        lambda _e: exe.outcome.tours >= 1 and exe.stop("tour ended docked", 0),
+                        Ticked,
+                    )
+
+            async with Rehearsal(scenario, site=site, prepare=prepare, once=once) as r:
+                if tour.kind in HELP_KINDS:
+                    await _help(tour, r)
                 outcome = await r.finish(120.0)
         finally:
             recorder.close()
         return outcome.code, outcome.reason
 
+    async def resumed() -> tuple[int, str]:
+        """The executive stops during POI3's content; a new one resumes from the checkpoint."""
+        site = load_site()
+        with tempfile.TemporaryDirectory() as tmp:
+            checkpoint = Path(tmp) / "checkpoint.json"
+            first = Recorder(path)
+            run = Rehearsal(
+                scenario,
+                site=site,
+                prepare=lambda exe: attach_all(exe, [first]),
+                checkpoint=checkpoint,
+                once=False,
+            )
+            try:
+                async with run:
+                    sim, listen = run.sim, run.listen
+                    await sim.wait_for(_start_poi("POI3"), 60)
+                    run.own_sim = False  # the simulator (the robot, the visitor) goes on
+            finally:
+                first.close()
+            second_path = path.with_name(path.stem + "-resumed.mcap")
+            paths.append(second_path)
+            second = Recorder(second_path)
+            again = Rehearsal(
+                None,
+                sim=sim,
+                listen=listen,
+                site=site,
+                prepare=lambda exe: attach_all(exe, [second]),
+                checkpoint=checkpoint,
+            )
+            try:
+                async with again:
+                    outcome = await again.finish(120.0)
+            finally:
+                second.close()
+                await sim.stop()
+        return outcome.code, outcome.reason
+
     t0 = time.monotonic()
-    code, reason = asyncio.run(run())
+    code, reason = asyncio.run(resumed() if tour.kind == "restart" else run())
     return {
         "file": tour.file,
+        "files": [str(p.relative_to(directory)) for p in paths],
         "code": code,
         "reason": reason,
         "wall_s": round(time.monotonic() - t0, 2),
-        "bytes": path.stat().st_size,
+        "bytes": sum(p.stat().st_size for p in paths),
     }
 
 
 def make(
-    out: Path, days: int, per_day: int, seed: int, jobs: int = 1, progress: bool = False
+    out: Path,
+    days: int,
+    per_day: int,
+    seed: int,
+    jobs: int = 1,
+    progress: bool = False,
+    *,
+    help_each: int = 0,
+    weights: dict[str, float] | None = None,
+    fast: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """Record the season into ``out`` and write ``out/corpus.json``; the manifest."""
+    """Record the season into ``out`` and write ``out/corpus.json``; the manifest.
+
+    ``help_each``: tours of each help kind (HELP_KINDS); ``weights``: the visitors'
+    kinds (default KINDS); ``fast``: the simulator's speed and timings (default FAST)."""
     import multiprocessing
 
     out.mkdir(parents=True, exist_ok=True)
-    tours = plan(days, per_day, seed)
+    tours = plan(days, per_day, seed, help_each, weights)
     context = multiprocessing.get_context("fork")
     t0 = time.monotonic()
     results = []
     with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
-        futures = [pool.submit(record, t, str(out)) for t in tours]
+        futures = [pool.submit(record, t, str(out), fast) for t in tours]
         for done, future in enumerate(futures, 1):
             results.append(future.result())
             if progress:
@@ -158,7 +338,14 @@ def make(
         "seed": seed,
         "days": days,
         "tours_per_day": per_day,
-        "weights": KINDS,
+        "weights": weights or KINDS,
+        "help": {
+            "each": help_each,
+            "kinds": list(HELP_KINDS) if help_each else [],
+            "help_after_s": HELP_AFTER_S,
+            "ack_after_s": ACK_AFTER_S,
+            "low_battery": LOW_BATTERY,
+        },
         "tours": [asdict(t) for t in tours],
         "runs": results,
         "wall_s": round(time.monotonic() - t0, 1),
@@ -173,9 +360,12 @@ def main() -> None:
     p.add_argument("--days", type=int, default=10)
     p.add_argument("--tours-per-day", type=int, default=20)
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--help-each", type=int, default=4, help="tours of each help kind (0: none)")
     p.add_argument("--jobs", type=int, default=2, help="tours recorded at once (processes)")
     a = p.parse_args()
-    manifest = make(a.out, a.days, a.tours_per_day, a.seed, a.jobs, progress=True)
+    manifest = make(
+        a.out, a.days, a.tours_per_day, a.seed, a.jobs, progress=True, help_each=a.help_each
+    )
     kinds: dict[str, int] = {}
     for t in manifest["tours"]:
         kinds[t["kind"]] = kinds.get(t["kind"], 0) + 1

@@ -54,4 +54,4 @@ def test_every_observer_attaches_to_a_live_executive_and_closes(tmp_path: Path) 
         "idle0001.mcap"
     ]
     assert (tmp_path / "in.rrd").stat().st_size > 0 and (tmp_path / "child.rrd").exists()
-    assert "success" in out.getvalue()  # the status line's last line: the tour's end
+    assert "tip TourStatus ended" in out.getvalue()  # the status line's last line: the end

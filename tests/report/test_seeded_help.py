@@ -1,0 +1,142 @@
+"""`frog-bt report` over a small seeded season with one tour of each help event
+(scripts/corpus_run.py: a dock answered ``done_by_hand``, an operator ``home`` and
+``skip``, a ``battery_low`` acknowledged after a known delay, a restart) held against
+its manifest: the interventions told apart, per 100 tours, the time to acknowledge, the
+funnel and the failure taxonomy with each cause counted once; and ``--compare`` of two
+tiny seasons that differ in one seeded rate."""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from frog_bt.cli import main
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+from corpus_run import HELP_KINDS, make
+
+# Tours in under a second of wall time (tests/recording/recorded_tour.py FAST_TOURS)
+FAST_TOURS: dict[str, Any] = {
+    "speed": 400.0,
+    "navigation": {"speed": 3.0, "approach_time": 1.0},
+    "docking": {"undock_time": 2.0, "dock_time": 3.0},
+    "content": {"default": 4, "introduction": 3},
+    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0},
+}
+SEED = 1  # 7 tours: one of each help kind, a visitor who wanders off, a bored one
+DOCK_ATTEMPTS = 3  # config/site.yaml docking.attempts: all fail, then the robot asks
+
+
+@pytest.fixture(scope="module")
+def season(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    out = tmp_path_factory.mktemp("helped")
+    manifest = make(out, days=1, per_day=7, seed=SEED, jobs=2, help_each=1, fast=FAST_TOURS)
+    for run, tour in zip(manifest["runs"], manifest["tours"], strict=True):
+        assert run["code"] == (1 if tour["kind"] == "home" else 0), run
+    return out, manifest
+
+
+def report(tmp_path: Path, *args: str) -> dict[str, Any]:
+    target = tmp_path / "out.json"
+    assert main(["report", *args, "--json", str(target), "--quiet"]) == 0
+    return json.loads(target.read_text())
+
+
+def test_the_help_events_are_those_seeded(season, tmp_path) -> None:
+    directory, manifest = season
+    kinds = [t["kind"] for t in manifest["tours"]]
+    count = Counter(kinds)
+    assert {k: count[k] for k in HELP_KINDS} == dict.fromkeys(HELP_KINDS, 1)
+    assert manifest["help"]["each"] == 1
+    n = len(kinds)
+    got = report(tmp_path, str(directory))
+    t, tours = got["totals"], got["tours"]
+    assert t["tours"] == n and t["resumed"] == count["restart"]
+    assert [r["ended"] for r in tours] == ["aborted" if k == "home" else "ended" for k in kinds]
+    assert t["completed"] == n - count["home"] - count["fault"]
+
+    # the interventions, told apart, and per 100 tours
+    rel = t["reliability"]
+    want = {
+        "help answered": count["dock_help"],
+        "home": count["home"],
+        "skip": count["skip"],
+        "alert acknowledged": count["ack_alert"],
+    }
+    assert rel["interventions"] == want
+    assert rel["interventions_per_100_tours"] == round(100 * sum(want.values()) / n, 1)
+    for r, kind in zip(tours, kinds, strict=True):
+        assert r["interventions"] == (
+            1 if kind in ("dock_help", "home", "skip", "ack_alert") else 0
+        )
+        ops = [c["command"] for c in r["operator"] if c["ok"]]
+        assert ops == {
+            "dock_help": ["done_by_hand"],
+            "home": ["home"],
+            "skip": ["skip"],
+            "ack_alert": ["ack_alert"],
+        }.get(kind, [])
+    # the time to acknowledge: the battery alerts, acknowledged the seeded delay after
+    # their raise (the executive applies an answer at its next tick)
+    ack = manifest["help"]["ack_after_s"]
+    assert rel["acknowledged"] == count["ack_alert"]
+    assert rel["time_to_acknowledge_s"]["median"] == pytest.approx(ack, abs=1.0)
+    (alert,) = next(r for r, k in zip(tours, kinds, strict=True) if k == "ack_alert")["alerts"]
+    assert alert["kind"] == "battery_low" and alert["acknowledged_s"] == pytest.approx(ack, abs=1.0)
+    # the help request and the fault alerts are the failures that needed a person
+    assert rel["failures_needing_a_person"] == count["dock_help"] + count["fault"]
+    assert 0.0 <= rel["autonomy"] < 1.0  # someone was needed in some hour
+
+    # the funnel: the wanderer's visitor reaches POI1 only, and the next one starts
+    # again; the visitor sent home at POI3 reaches no later stop
+    funnel = t["funnel"]
+    started = n + count["wander_off"]
+    assert funnel["started"] == funnel["POI1"] == started
+    assert funnel["POI2"] == funnel["POI3"] == n
+    assert funnel["POI4"] == funnel["POI5"] == n - count["home"] - count["fault"]
+    assert funnel["finished"] == n - count["home"] - count["fault"]
+
+    # the taxonomy, each cause once: the home's abort, the restart's unrecorded stop and
+    # the done_by_hand's help alert are not counted again
+    causes = {(c["cause"], c["detail"]): c["events"] for c in t["failure_causes"]}
+    expected = {
+        ("help needed", "docking_failed"): count["dock_help"],
+        ("dock retry", ""): (DOCK_ATTEMPTS - 1) * count["dock_help"],
+        ("operator", "home"): count["home"],
+        ("operator", "skip"): count["skip"],
+        ("alert", "battery_low"): count["ack_alert"],
+        ("restart", ""): count["restart"],
+        ("visitor lost", ""): count["wander_off"],
+        ("invitation declined", ""): count["declines"],
+        ("fault", "motors"): count["fault"],
+        ("navigation retry", ""): count["nav_failure"],
+    }
+    causes.pop(("approach rejected", ""), None)
+    assert causes == {k: v for k, v in expected.items() if v}
+    for r in tours:  # in a tour, no cause twice but the dock's retries
+        once = [(i["cause"], i["detail"]) for i in r["incidents"] if i["cause"] != "dock retry"]
+        assert len(once) == len(set(once)), r["incidents"]
+    # the resumed tour's files are one robot's, in a directory of their own
+    resumed = next(r for r, k in zip(tours, kinds, strict=True) if k == "restart")
+    assert resumed["resumed"] and resumed["restarts"] == 1 and len(resumed["files"]) == 2
+    assert resumed["stops_skipped"] == []
+
+
+def test_compare_tells_the_seeded_difference_from_the_same_rate(tmp_path) -> None:
+    """Two tiny seasons, one of engaged visitors and one of bored ones: part b differs
+    (its interval leaves 0 out), completion does not (its interval holds 0)."""
+    a, b = tmp_path / "a", tmp_path / "b"
+    make(a, days=1, per_day=3, seed=2, jobs=2, weights={"engaged": 1.0}, fast=FAST_TOURS)
+    make(b, days=1, per_day=3, seed=2, jobs=2, weights={"bored": 1.0}, fast=FAST_TOURS)
+    got = report(tmp_path, str(a), "--compare", str(b))["totals"]["compare"]["rates"]
+    part_b = got["part_b:POI2"]
+    assert (part_b["a"]["rate"], part_b["b"]["rate"], part_b["difference"]) == (1.0, 0.0, -1.0)
+    assert part_b["significant"] and part_b["high"] < 0
+    completion = got["completion"]
+    assert completion["difference"] == 0.0 and not completion["significant"]
+    assert completion["low"] < 0 < completion["high"]
