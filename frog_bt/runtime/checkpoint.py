@@ -82,15 +82,22 @@ def claim(path: Path, option: str = "--checkpoint") -> IO[str]:
 
 def save(path: Path, progress: Progress) -> None:
     """Write ``progress`` atomically; an empty progress removes the file."""
-    if not progress.done:
+    write_json(path, progress.to_json(time.time()) if progress.done else None)
+
+
+def write_json(path: Path, data: object | None) -> None:
+    """Write ``data`` as JSON to ``path`` atomically (a temporary file, fsync, rename): a
+    kill or a power cut leaves the old file or the new one, never half of one. None
+    removes the file."""
+    if data is None:
         with contextlib.suppress(FileNotFoundError):
             path.unlink()
         return
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".checkpoint-", dir=path.parent)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", dir=path.parent)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(progress.to_json(time.time()), f)
+            json.dump(data, f)
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)

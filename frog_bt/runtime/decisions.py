@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import contextlib
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from frog_bt.model.help import Help, HelpAbout
+from frog_bt.runtime.checkpoint import write_json
 
 __all__ = ["Decisions", "load", "path_for", "save"]
 
@@ -53,22 +52,7 @@ def path_for(checkpoint: Path) -> Path:
 
 def save(path: Path, decisions: Decisions) -> None:
     """Write ``decisions`` atomically; none at all removes the file."""
-    if decisions == NONE:
-        with contextlib.suppress(FileNotFoundError):
-            path.unlink()
-        return
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".staff-", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(decisions.to_json(), f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
+    write_json(path, decisions.to_json() if decisions != NONE else None)
 
 
 def load(path: Path) -> Decisions:
