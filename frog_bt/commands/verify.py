@@ -13,16 +13,20 @@ Examples:
 
   frog-bt verify                                 the packaged tour and site
   frog-bt verify trees/tour.yaml --format mermaid
+  frog-bt verify --coverage recordings/          and the share a season reached
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from frog_bt.commands.options import add_tree_argument, load_tree_argument
+from frog_bt.config import Site
+from frog_bt.engine.loaded import LoadedTree
 from frog_bt.errors import DefinitionError, TreeErrors, UsageError
-from frog_bt.verify.explore import TooBig
+from frog_bt.verify.explore import Graph, TooBig
 from frog_bt.verify.prove import prove
 from frog_bt.verify.report import broken_text, summary
 
@@ -33,6 +37,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--format",
         choices=("mermaid", "dot"),
         help="draw the tree with the nodes of each broken run marked",
+    )
+    p.add_argument(
+        "--coverage",
+        type=Path,
+        metavar="DIR",
+        help="recordings: the share of the explored states and transitions they reached",
     )
 
 
@@ -53,8 +63,43 @@ def run(args: argparse.Namespace) -> int:
     except TooBig as exc:
         print(f"frog-bt: the tree is too big to verify whole: {exc}", file=sys.stderr)
         return 2
+    if args.coverage is not None:
+        print(season_share(verdict.graph, args.coverage, site, tree))
     if verdict.ok:
         print(summary(verdict))
         return 0
     print(broken_text(verdict, args.format))
     return 1
+
+
+def season_share(graph: Graph, directory: Path, site: Site, tree: LoadedTree) -> str:
+    """Replay every recording under ``directory`` on ``tree`` and say which share of the
+    explored states and transitions it reached, each seen as which nodes run (a
+    recording keeps no memory positions or abstract keys)."""
+    from frog_bt.behaviours import load_tree
+    from frog_bt.offline.corpus import recordings
+    from frog_bt.offline.replay import Replay
+    from frog_bt.recordings.commands import ReplayError
+    from frog_bt.verify.coverage import Reached, explored_configurations
+
+    configs, moves = explored_configurations(graph)
+    reached = Reached()
+    files = 0
+    for path in recordings([directory]):
+        try:
+            replay = Replay(path, site, load_tree(tree.file, site))
+        except (ReplayError, OSError) as exc:
+            print(f"frog-bt: {path}: {exc}", file=sys.stderr)
+            continue
+        replay.observers.attach(replay, [reached])
+        replay.run()
+        files += 1
+    got = len(configs & reached.configs)
+    moved = len(moves & reached.moves)
+    outside = len(reached.configs - configs)
+    return (
+        f"coverage: {files} recordings reached {got} of {len(configs)} explored states "
+        f"({100 * got / max(1, len(configs)):.0f} %) and {moved} of {len(moves)} transitions "
+        f"({100 * moved / max(1, len(moves)):.0f} %), states seen as which nodes run"
+        + (f"; {outside} states outside the model" if outside else "")
+    )

@@ -17,7 +17,9 @@ from typing import Any
 
 from frog_bt.engine.loaded import LoadedTree
 from frog_bt.model.events import Event, Ticked
+from frog_bt.verify.explore import Graph
 from frog_bt.verify.model import Model, preorder
+from frog_bt.verify.tick import State
 
 RUNNING = "RUNNING"
 
@@ -126,3 +128,45 @@ def add(total: list[NodeCount], more: list[NodeCount]) -> None:
         into.runs += count.runs
         into.ticks += count.ticks
         into.outcomes.update(count.outcomes)
+
+
+Config = frozenset[int]  # the nodes running after a tick (preorder indices)
+
+
+def explored_configurations(graph: Graph) -> tuple[set[Config], set[tuple[Config, Config]]]:
+    """The explored states and transitions, each seen as which nodes run (what a
+    recording can show of a state: it keeps no memory positions or abstract keys)."""
+
+    def running(state: State) -> Config:
+        return frozenset(i for i, v in enumerate(state[0]) if v > 0)
+
+    configs = [running(s) for s in graph.states]
+    moves = {(configs[a], configs[b]) for a, b, _ in graph.each()}
+    return set(configs), moves
+
+
+class Reached:
+    """An observer of a replay: the configurations and moves between them that it ran."""
+
+    def __init__(self) -> None:
+        self.configs: set[Config] = set()
+        self.moves: set[tuple[Config, Config]] = set()
+        self.host: Any = None
+        self._nodes: list[Any] = []
+        self._last: Config | None = None
+
+    def attach(self, host: Any) -> None:
+        self.host = host
+        self._nodes = preorder(host.core.tree.root)
+
+    def on_event(self, event: Event) -> None:
+        if not isinstance(event, Ticked):
+            return
+        now = frozenset(i for i, n in enumerate(self._nodes) if n.status.name == RUNNING)
+        self.configs.add(now)
+        if self._last is not None and self._last != now:
+            self.moves.add((self._last, now))
+        self._last = now
+
+    def close(self) -> None:
+        pass

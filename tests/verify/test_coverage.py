@@ -43,3 +43,17 @@ def test_coverage_of_a_recorded_tour(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert doubled[-1].startswith("2 recordings: ")
     twice = {text.strip().split(":")[0]: text for text in doubled}
     assert "ran 2x: success 2" in twice["Docking 'Docking undock'"]
+
+
+def test_verify_says_which_share_of_the_explored_states_a_season_reached(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "season").mkdir()
+    recorded = record_tour(tmp_path / "season" / "tour.mcap")
+    assert recorded.outcome.code == 0
+    assert main(["verify", "--coverage", str(tmp_path / "season")]) == 0
+    out = capsys.readouterr().out
+    line = next(text for text in out.splitlines() if text.startswith("coverage: "))
+    got, explored = (int(n) for n in line.split("reached ")[1].split(" explored")[0].split(" of "))
+    assert 10 < got < explored  # one happy tour: many states, far from all
+    assert "transitions" in line and "states outside the model" not in line
