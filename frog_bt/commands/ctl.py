@@ -30,10 +30,12 @@ import urllib.request
 from pathlib import Path
 from typing import Any
 
+from frog_bt import __version__
 from frog_bt.commands.console_options import console_address
 from frog_bt.engine.operator import Command
 from frog_bt.errors import UsageError
 from frog_bt.i18n import N_, Msg, translator
+from frog_bt.live.console import CTL_AGENT
 
 DEFAULT_CONSOLE = "127.0.0.1:8080"
 ENV = "FROG_BT_CONSOLE"
@@ -126,7 +128,7 @@ def _run(args: argparse.Namespace) -> int:
     except UsageError as exc:
         where = "--console" if args.console is not None else ENV
         return _fail(f"{where} {given}: {exc.detail}, or a URL")
-    headers = {"Content-Type": "application/json"}
+    headers = {"Content-Type": "application/json", "User-Agent": f"{CTL_AGENT}/{__version__}"}
     if args.token_file is not None:
         try:
             headers["Authorization"] = "Bearer " + args.token_file.read_text("utf-8").strip()

@@ -14,7 +14,6 @@ from typing import Any
 from frog_bt.clock import Clock
 from frog_bt.engine.blackboard import Inputs
 from frog_bt.engine.journal import Journal
-from frog_bt.model import keys
 from frog_bt.model.key import Key
 
 __all__ = ["Standing"]
@@ -28,12 +27,3 @@ class Standing:
         self.paused_since: float | None = None  # the operator's pause, on the project clock
         self.journal = Journal(clock)
         self.inputs: Inputs | None = None  # the robot's latest inputs (the first core's)
-
-    @property
-    def in_service(self) -> bool:
-        """Tours may start (``service_off`` makes it false until ``service_on``)."""
-        return self.values.get(keys.IN_SERVICE) is not False
-
-    @property
-    def paused(self) -> bool:
-        return bool(self.values.get(keys.PAUSED))

@@ -22,14 +22,12 @@ class Tally:
     def __init__(self) -> None:
         self.by_kind: Counter[IncidentKind] = Counter()
         self.tour: list[Incident] = []  # since the latest tour started (kept after it ends)
-        self.tours = 0  # tours started
 
     def add(self, incident: Incident) -> None:
         self.by_kind[incident.kind] += 1
         self.tour.append(incident)
 
     def tour_started(self) -> None:
-        self.tours += 1
         self.tour = []
 
     def stops_left(self) -> list[str]:

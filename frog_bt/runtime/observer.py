@@ -13,7 +13,7 @@ None there). :class:`Observers` is the list a host keeps and tells.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 from frog_bt.model.events import Event
@@ -66,9 +66,6 @@ class Observers:
     def __bool__(self) -> bool:
         return bool(self._observers)
 
-    def __iter__(self) -> Iterator[Observer]:
-        return iter(list(self._observers))
-
     def attach(self, host: Host, observers: Iterable[Observer]) -> list[Observer]:
         """Attach each observer to ``host`` in order; the list of those attached."""
         attached = []
@@ -91,11 +88,6 @@ class Observers:
             call(event)
 
     __call__ = emit  # a core's ``emit``: false while nobody listens
-
-    def close(self) -> None:
-        """Close in the reverse order of attaching (the last attached may use the first)."""
-        for observer in reversed(self._observers):
-            observer.close()
 
 
 def attach_all(host: Host, observers: Iterable[Observer]) -> list[Observer]:

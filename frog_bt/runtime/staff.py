@@ -42,6 +42,7 @@ class Queued:
     command: Command
     alert_id: str
     answer: asyncio.Future[Answer]
+    by: str = ""  # who sent it: console, ctl, link (recorded with the answer)
 
 
 @dataclass
@@ -62,10 +63,11 @@ class Staff:
 
     # ------------------------------------------------------------ commands
 
-    async def submit(self, command: Command, alert_id: str = "") -> Answer:
-        """Queue ``command``; its answer once applied at the next tick (or refused)."""
+    async def submit(self, command: Command, alert_id: str = "", by: str = "") -> Answer:
+        """Queue ``command`` (sent ``by`` console, ctl or an acknowledgement link); its
+        answer once applied at the next tick (or refused)."""
         answer: asyncio.Future[Answer] = asyncio.get_running_loop().create_future()
-        queued = Queued(command, alert_id, answer)
+        queued = Queued(command, alert_id, answer, by)
         self._queue.append(queued)
         self.executive.wake()
         try:
@@ -106,10 +108,11 @@ class Staff:
                         answer.ok,
                         answer.text,
                         queued.alert_id,
+                        by=queued.by,
                     )
                 )
             else:
-                answer = core.command(queued.command)
+                answer = core.command(queued.command, by=queued.by)
             # a person steered the robot: always in the log (at INFO, the log's level)
             log.info(
                 "operator %s: %s%s", queued.command, "" if answer.ok else "refused: ", answer.text

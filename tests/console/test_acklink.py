@@ -16,6 +16,8 @@ from receivers import Receiver
 from frog_bt.behaviours import load_tree
 from frog_bt.config import load_site
 from frog_bt.live.console.acklink import Verdict, ack_link, link_key, signature, verify
+from frog_bt.model.events import OperatorDone
+from frog_bt.runtime.observer import listen
 
 KEY = link_key(TOKEN)
 CONSOLE = "http://127.0.0.1:8080"
@@ -62,6 +64,8 @@ def test_a_signed_link_acknowledges_exactly_its_alert_and_bad_ones_nothing(tmp_p
         fault = {"at": 0, "name": "motors", "level": 2, "message": "overheated", "duration": 10**6}
         async with console_tour({"faults": [fault]}, tree=tree, once=False) as (run, _people, url):
             run.sim.world.battery.percentage = 22.0
+            acks: list[tuple[str, bool, str]] = []
+            listen(run.executive, lambda e: acks.append((e.id, e.ok, e.by)), OperatorDone)
             book = run.executive.staff.book
             await run.executive_ticks_until(lambda: {"fault", "battery_low"} <= set(book.active))
             now = int(time.time())
@@ -87,6 +91,7 @@ def test_a_signed_link_acknowledges_exactly_its_alert_and_bad_ones_nothing(tmp_p
                     assert r.status == 405  # a HEAD acknowledges nothing
             shown = [a.id for a in book.shown()]
             run.executive.stop("test over")
+            assert ("fault", True, "link") in acks  # recorded as acknowledged by the link
             return out, shown, headers
 
     out, shown, headers = asyncio.run(main())

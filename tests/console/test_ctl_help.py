@@ -11,6 +11,8 @@ from console_tour import TOKEN, console_tour
 
 from frog_bt.cli import main
 from frog_bt.model import keys
+from frog_bt.model.events import OperatorDone
+from frog_bt.runtime.observer import listen
 
 
 def test_ctl_answers_a_robot_that_needs_help(
@@ -24,6 +26,8 @@ def test_ctl_answers_a_robot_that_needs_help(
         code = main(["ctl", *argv, "--token-file", str(token), "--timeout", "30"])
         return code, capsys.readouterr().out.strip()
 
+    senders: list[tuple[str, str]] = []
+
     async def run() -> list[tuple[int, str]]:
         out = []
         async with console_tour({"docking": {"dock_failures": 3}}, once=False) as (
@@ -32,6 +36,7 @@ def test_ctl_answers_a_robot_that_needs_help(
             url,
         ):
             exe = tour.executive
+            listen(exe, lambda e: senders.append((e.command, e.by)), OperatorDone)
             out.append(await asyncio.to_thread(ctl, "retry", "--console", url))  # no help yet
             await tour.executive_ticks_until(lambda: exe.core.board.get(keys.HELP) is not None, 120)
             out.append(await asyncio.to_thread(ctl, "retry", "--console", url))
@@ -42,3 +47,4 @@ def test_ctl_answers_a_robot_that_needs_help(
     before, retried = asyncio.run(run())
     assert before == (1, "refused: ahora el robot no necesita ayuda")  # the site speaks Spanish
     assert retried[0] == 0 and retried[1].startswith("done: lo vuelve a intentar")
+    assert senders == [("retry", "ctl"), ("retry", "ctl")]  # recorded as sent by ctl

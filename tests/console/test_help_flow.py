@@ -12,6 +12,8 @@ from console_tour import command, console_tour
 from receivers import Receiver
 
 from frog_bt.config import load_site
+from frog_bt.model.events import OperatorDone
+from frog_bt.runtime.observer import listen
 
 
 def test_a_failed_dock_is_shown_escalated_and_answered_from_the_api() -> None:
@@ -25,6 +27,8 @@ def test_a_failed_dock_is_shown_escalated_and_answered_from_the_api() -> None:
             scenario = {"docking": {"dock_failures": 3}}
             async with console_tour(scenario, site=site, once=False) as (run, _people, url):
                 exe = run.executive
+                senders: list[tuple[str, bool, str]] = []
+                listen(exe, lambda e: senders.append((e.command, e.ok, e.by)), OperatorDone)
                 book = exe.staff.book
                 await run.executive_ticks_until(lambda: "docking_failed" in book.active, 120)
                 async with aiohttp.ClientSession() as s:
@@ -46,6 +50,7 @@ def test_a_failed_dock_is_shown_escalated_and_answered_from_the_api() -> None:
                 )
                 exe.stop("test over")
                 return {
+                    "senders": senders,
                     "state": state,
                     "refused": refused,
                     "done": done,
@@ -54,6 +59,7 @@ def test_a_failed_dock_is_shown_escalated_and_answered_from_the_api() -> None:
                 }
 
     out = asyncio.run(main())
+    assert out["senders"] == [("done_by_hand", False, "console"), ("done_by_hand", True, "console")]
     help_ = out["state"]["help"]
     assert help_["what"] == (  # in the site's language (config/site.yaml: es)
         "El robot no ha conseguido acoplarse a su cargador tras varios intentos."

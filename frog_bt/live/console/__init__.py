@@ -8,3 +8,5 @@ the day, :mod:`frog_bt.runtime.alerts` decides when the robot asks for help and
 :mod:`.webhooks` tells people's phones. Operator commands reach the tree through
 :mod:`frog_bt.runtime.staff` and :mod:`frog_bt.engine.operator`. Docs: docs/CONSOLE.md.
 """
+
+CTL_AGENT = "frog-bt-ctl"  # the User-Agent of frog-bt ctl: its commands are recorded "by ctl"

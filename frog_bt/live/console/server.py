@@ -59,6 +59,7 @@ from aiohttp import web
 
 from frog_bt.engine.operator import Command
 from frog_bt.i18n import LANGUAGES, Msg, catalog, language, say
+from frog_bt.live.console import CTL_AGENT
 from frog_bt.live.console.acklink import Verdict, link_key, verify
 from frog_bt.live.console.bearer import Failures, Tickets, bearer, matches
 from frog_bt.live.console.day import Day
@@ -401,8 +402,9 @@ async def post_command(request: web.Request) -> web.Response:
         return refuse(400, 'ack_alert needs the alert\'s "id"')
     if not request.app[ACCESS].limit.take():
         return refuse(429, "too many commands: wait a second")
+    sender = "ctl" if request.headers.get("User-Agent", "").startswith(CTL_AGENT) else "console"
     answer = await request.app[EXECUTIVE].staff.submit(
-        command, alert_id if isinstance(alert_id, str) else ""
+        command, alert_id if isinstance(alert_id, str) else "", by=sender
     )
     request.app[PAGES].changed.set()
     words = say(by_name(answer.words, request.app[EXECUTIVE].site), asked_language(request))
@@ -465,7 +467,7 @@ async def get_ack(request: web.Request) -> web.Response:
         )
     if not access.limit.take():
         return plain_page(429, "Too many requests", "Wait a second, then open the link again.")
-    answer = await request.app[EXECUTIVE].staff.submit(Command.ACK_ALERT, alert_id)
+    answer = await request.app[EXECUTIVE].staff.submit(Command.ACK_ALERT, alert_id, by="link")
     request.app[PAGES].changed.set()
     if not answer.ok:
         return plain_page(409, "Nothing acknowledged", f"Not done: {answer.text}.")
