@@ -85,6 +85,11 @@ ACK_AFTER_S = 90.0  # simulated seconds from the battery_low alert's raise to it
 LOW_BATTERY = 24.0  # percent: below the alert (25), above the abort (20)
 FAST: dict[str, Any] = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
 FIRST_DAY = "2026-06-01"
+MORNING_MIN = 9 * 60  # the morning's tours from 09:00 (local minutes) ...
+AFTERNOON_MIN = 14 * 60 + 30  # ... the afternoon's from 14:30
+HALF_DAY_MIN = 3.5 * 60  # each for 3.5 hours
+LONGEST_TOUR_MIN = 18.0  # a seeded tour's longest run (a wanderer's: 17 simulated minutes)
+MOST_PER_DAY = int(2 * HALF_DAY_MIN // LONGEST_TOUR_MIN)
 TZ = "+02:00"  # the site's summer time (Europe/Madrid)
 
 
@@ -109,21 +114,26 @@ def plan(
     ``help_each`` tours of each help kind in place of tours drawn at random (a second
     generator, so that the others are those ``help_each=0`` draws)."""
     weights = weights or KINDS
+    if per_day > MOST_PER_DAY:
+        raise ValueError(
+            f"{per_day} tours a day: at most {MOST_PER_DAY} fit one robot's 7 hours one "
+            "after another"
+        )
     rng = random.Random(seed)
     out: list[Seeded] = []
     first = datetime.fromisoformat(f"{FIRST_DAY}T00:00:00{TZ}")
+    slot = 2 * HALF_DAY_MIN / per_day
     number = 0
     for d in range(days):
         day = first + timedelta(days=d)
-        starts = sorted(
-            day
-            + timedelta(
-                minutes=rng.choice(
-                    (rng.uniform(9 * 60, 12.5 * 60), rng.uniform(14.5 * 60, 18 * 60))
-                )
-            )
-            for _ in range(per_day)
-        )
+        starts = []
+        for i in range(per_day):
+            # one robot's day: its tours one after another, each at a random moment of
+            # its slot early enough to end inside it (a robot's tours cannot overlap)
+            minute = i * slot + rng.uniform(0.0, max(0.0, slot - LONGEST_TOUR_MIN))
+            if minute >= HALF_DAY_MIN:
+                minute += AFTERNOON_MIN - MORNING_MIN - HALF_DAY_MIN
+            starts.append(day + timedelta(minutes=MORNING_MIN + minute))
         for start in starts:
             number += 1
             kind = rng.choices(list(weights), weights=list(weights.values()))[0]
@@ -171,8 +181,9 @@ async def _until(executive: Any, ok: Any, limit: float = 600.0) -> None:
         await executive.clock.sleep(1.0)
 
 
-async def _help(tour: Seeded, r: Any) -> None:
-    """What the person does in a help tour (while the executive runs it)."""
+async def _help(tour: Seeded, r: Any, acted: list[float]) -> None:
+    """What the person does in a help tour (while the executive runs it); the executive
+    clock's time of each answer it accepted goes in ``acted``."""
     from frog_bt.engine.operator import Command
     from frog_bt.model.events import AlertChanged
     from frog_bt.runtime.observer import listen
@@ -186,6 +197,7 @@ async def _help(tour: Seeded, r: Any) -> None:
         for _ in range(30):  # until the executive has seen /docking/state say docked
             await exe.clock.sleep(1.0)
             if (await exe.staff.submit(Command.DONE_BY_HAND)).ok:
+                acted.append(exe.clock.now())
                 return
         raise RuntimeError("done_by_hand was never accepted")
     if tour.kind in ("home", "skip"):
@@ -193,6 +205,7 @@ async def _help(tour: Seeded, r: Any) -> None:
         command = Command.HOME if tour.kind == "home" else Command.SKIP
         answer = await exe.staff.submit(command)
         assert answer.ok, answer.text
+        acted.append(exe.clock.now())
     elif tour.kind == "ack_alert":
         raised: list[float] = []
         listen(
@@ -210,6 +223,7 @@ async def _help(tour: Seeded, r: Any) -> None:
         await exe.clock.sleep_until(raised[0] + ACK_AFTER_S)
         answer = await exe.staff.submit(Command.ACK_ALERT, "battery_low")
         assert answer.ok, answer.text
+        acted.append(exe.clock.now())
 
 
 def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -218,7 +232,7 @@ def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> 
 
     from frog_bt.config import load_site
     from frog_bt.live.recording import Recorder
-    from frog_bt.model.events import Ticked
+    from frog_bt.model.events import AlertChanged, Ticked
     from frog_bt.rehearsal import Rehearsal
     from frog_bt.runtime.observer import attach_all, listen
 
@@ -226,6 +240,17 @@ def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> 
     path.parent.mkdir(parents=True, exist_ok=True)
     scenario = _scenario(tour, FAST if fast is None else fast)
     paths = [path]
+    acted: list[float] = []  # when a person's answer was accepted (executive clock)
+    alerts: list[dict[str, Any]] = []  # the alert changes the executives made, as heard
+
+    def hear(exe: Any) -> None:
+        listen(
+            exe,
+            lambda e: alerts.append(
+                {"t": e.t, "id": e.alert.id, "state": e.alert.state, "severity": e.alert.severity}
+            ),
+            AlertChanged,
+        )
 
     async def run() -> tuple[int, str]:
         site = load_site()
@@ -237,6 +262,7 @@ def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> 
 
             def prepare(exe: Any) -> None:
                 attach_all(exe, [recorder])
+                hear(exe)
                 if not once:
                     listen(
                         exe,
@@ -246,7 +272,7 @@ def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> 
 
             async with Rehearsal(scenario, site=site, prepare=prepare, once=once) as r:
                 if tour.kind in HELP_KINDS:
-                    await _help(tour, r)
+                    await _help(tour, r, acted)
                 outcome = await r.finish(120.0)
         finally:
             recorder.close()
@@ -261,7 +287,7 @@ def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> 
             run = Rehearsal(
                 scenario,
                 site=site,
-                prepare=lambda exe: attach_all(exe, [first]),
+                prepare=lambda exe: (attach_all(exe, [first]), hear(exe)),
                 checkpoint=checkpoint,
                 once=False,
             )
@@ -280,7 +306,7 @@ def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> 
                 sim=sim,
                 listen=listen,
                 site=site,
-                prepare=lambda exe: attach_all(exe, [second]),
+                prepare=lambda exe: (attach_all(exe, [second]), hear(exe)),
                 checkpoint=checkpoint,
             )
             try:
@@ -300,7 +326,41 @@ def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> 
         "reason": reason,
         "wall_s": round(time.monotonic() - t0, 2),
         "bytes": sum(p.stat().st_size for p in paths),
+        "spans": [_span(p) for p in paths],
+        "needed": _needed(acted, alerts),
     }
+
+
+def _span(path: Path) -> list[float]:
+    """The file's first and last message times (seconds), from its MCAP summary."""
+    from mcap.reader import make_reader
+
+    with path.open("rb") as f:
+        summary = make_reader(f).get_summary()
+    assert summary is not None and summary.statistics is not None, path
+    stats = summary.statistics
+    return [stats.message_start_time / 1e9, stats.message_end_time / 1e9]
+
+
+def _needed(acted: list[float], alerts: list[dict[str, Any]]) -> list[list[float]]:
+    """When a person was needed, as heard while the tour ran: each accepted answer (a
+    moment), and each ERROR alert from its raise to its clearing (to its acknowledgement
+    when it was never cleared, to its raise when neither)."""
+    out = [[t, t] for t in acted]
+    open_: dict[str, list[float]] = {}  # id -> [raised, acknowledged or raised]
+    for change in alerts:
+        if change["severity"] != "ERROR":
+            continue
+        span = open_.get(change["id"])
+        if change["state"] == "raised" and span is None:
+            open_[change["id"]] = [change["t"], change["t"]]
+        elif change["state"] == "acknowledged" and span is not None and span[1] == span[0]:
+            span[1] = change["t"]
+        elif change["state"] == "cleared" and span is not None:
+            out.append([span[0], change["t"]])
+            del open_[change["id"]]
+    out += list(open_.values())
+    return sorted(out)
 
 
 def make(
@@ -363,6 +423,10 @@ def main() -> None:
     p.add_argument("--help-each", type=int, default=4, help="tours of each help kind (0: none)")
     p.add_argument("--jobs", type=int, default=2, help="tours recorded at once (processes)")
     a = p.parse_args()
+    if a.tours_per_day > MOST_PER_DAY:
+        p.error(
+            f"--tours-per-day: at most {MOST_PER_DAY} tours fit one robot's day one after another"
+        )
     manifest = make(
         a.out, a.days, a.tours_per_day, a.seed, a.jobs, progress=True, help_each=a.help_each
     )

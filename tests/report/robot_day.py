@@ -185,6 +185,9 @@ async def _tour(directory: Path, kind: str) -> Seen:
     return _seen(kind, outcome.code, outcome.reason, list(run.sim.log))
 
 
+RESTART_INTO_POI2_S = 2.0  # simulated seconds of POI2's part a (4 s) before the stop
+
+
 async def _resumed(directory: Path, checkpoint: Path) -> Seen:
     """A tour whose executive stops during POI2's content (its files closed as SIGTERM
     closes them) and a new executive that resumes it from the checkpoint."""
@@ -202,6 +205,7 @@ async def _resumed(directory: Path, checkpoint: Path) -> Seen:
         async with run:
             sim, listen = run.sim, run.listen
             await sim.wait_for(_is("start_poi", poi="POI2", part="a"), 60)
+            await run.executive.clock.sleep(RESTART_INTO_POI2_S)
             run.own_sim = False  # the simulator (the robot, the visitor) goes on
     finally:
         first.close()

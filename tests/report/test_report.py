@@ -28,7 +28,7 @@ from frog_bt.runtime.observer import attach_all
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 from corpus_run import make
 
-SEED = 6  # one day: engaged, declines, wander_off, fault, wander_off, bored; 4 afternoon
+SEED = 2  # one day: declines, engaged, declines, fault, wander_off, bored; 3 afternoon
 
 
 @pytest.fixture(scope="module")

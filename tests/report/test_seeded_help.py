@@ -18,6 +18,7 @@ import pytest
 from frog_bt.cli import main
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+from check_report import autonomy
 from corpus_run import HELP_KINDS, make
 
 # Tours in under a second of wall time (tests/recording/recorded_tour.py FAST_TOURS)
@@ -28,7 +29,7 @@ FAST_TOURS: dict[str, Any] = {
     "content": {"default": 4, "introduction": 3},
     "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0},
 }
-SEED = 1  # 7 tours: one of each help kind, a visitor who wanders off, a bored one
+SEED = 1  # 7 tours: one of each help kind, a bored visitor, a navigation failure
 DOCK_ATTEMPTS = 3  # config/site.yaml docking.attempts: all fail, then the robot asks
 
 
@@ -90,7 +91,16 @@ def test_the_help_events_are_those_seeded(season, tmp_path) -> None:
     assert alert["kind"] == "battery_low" and alert["acknowledged_s"] == pytest.approx(ack, abs=1.0)
     # the help request and the fault alerts are the failures that needed a person
     assert rel["failures_needing_a_person"] == count["dock_help"] + count["fault"]
-    assert 0.0 <= rel["autonomy"] < 1.0  # someone was needed in some hour
+    # autonomy: the time in service in hours when no one was needed, against the spans
+    # and the moments the corpus heard as it recorded (each answer, each ERROR alert)
+    assert all(
+        run["needed"]
+        for run, k in zip(manifest["runs"], kinds, strict=True)
+        if k in ("dock_help", "home", "skip", "ack_alert")
+    )
+    heard = autonomy(manifest)
+    assert heard is not None and 0.0 < heard < 1.0
+    assert rel["autonomy"] == pytest.approx(heard, abs=0.002)
 
     # the funnel: the wanderer's visitor reaches POI1 only, and the next one starts
     # again; the visitor sent home at POI3 reaches no later stop

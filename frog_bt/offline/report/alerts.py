@@ -9,19 +9,30 @@ the ``ack_alert`` operator command that did it (``by``: console, ctl, link).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from frog_bt.engine.operator import Command
-from frog_bt.offline.report.facts import AlertChange, OperatorCall
+from frog_bt.offline.report.facts import AlertChange, FileFacts, OperatorCall
 from frog_bt.runtime.alerts import KINDS
+from frog_bt.runtime.staff import REMEMBER_ACKS
 
 ACK_WINDOW = 2.0  # seconds: an ack_alert command and the acknowledgement it caused
+OUTLIVED = REMEMBER_ACKS  # seconds from a run's end in which a raise anew continues an episode
 
 
 def needs_help(kind: str) -> bool:
     """The robot holds and asks a person (its answers include ``done_by_hand``)."""
     spec = KINDS.get(kind)
     return spec is not None and Command.DONE_BY_HAND.value in spec.answers
+
+
+class Restart(NamedTuple):
+    """An executive started (``started``) after a recording that ended at ``previous_end``."""
+
+    previous_end: float
+    started: float
 
 
 @dataclass
@@ -37,6 +48,7 @@ class Episode:
     acknowledged_by: str = ""
     cleared: float | None = None
     repeats: int = 0  # told again unacknowledged (escalation)
+    last: float = 0.0  # its latest change
 
     @property
     def help(self) -> bool:
@@ -48,14 +60,45 @@ class Episode:
         return None if self.acknowledged is None else self.acknowledged - self.raised
 
 
-def episodes(changes: list[AlertChange], calls: list[OperatorCall]) -> list[Episode]:
+def runs_of(files: list[FileFacts]) -> list[Restart]:
+    """One robot's executive starts, each with the end of the recording before it."""
+    out = []
+    for t in sorted(t for f in files for t in f.restarts):
+        before = [f.end for f in files if f.end <= t]
+        out.append(Restart(max(before) if before else t, t))
+    return out
+
+
+def _run_ended(runs: list[Restart], episode: Episode, t: float) -> bool:
+    """Whether a raise anew at ``t`` of an alert still open in ``episode`` is a new
+    episode. A new executive knows no alert: one its predecessor left up ended with that
+    run, unseen, unless the condition outlived the restart: raised again within
+    :data:`OUTLIVED` seconds of the end of the run before."""
+    started = [r for r in runs if episode.last < r.started <= t]
+    return bool(started) and t - started[-1].previous_end > OUTLIVED
+
+
+def episodes(
+    changes: list[AlertChange], calls: list[OperatorCall], runs: Sequence[Restart] = ()
+) -> list[Episode]:
     """The episodes of one robot's alert changes (any order), in order of their raise. A
-    change of an alert whose raise is not in the corpus opens an episode there."""
+    change of an alert whose raise is not in the corpus opens an episode there. ``runs``:
+    the robot's executive starts (:func:`runs_of`), to tell an alert raised again by a
+    later run from the one an earlier run left up."""
     open_: dict[str, Episode] = {}
     out: list[Episode] = []
+    starts = sorted(runs, key=lambda r: r.started)
     acks = sorted((c for c in calls if c.command == Command.ACK_ALERT and c.ok), key=lambda c: c.t)
     for change in sorted(changes, key=lambda c: c.t):
         episode = open_.get(change.id)
+        if (
+            episode is not None
+            and change.state == "raised"
+            and change.repeat == 0
+            and _run_ended(starts, episode, change.t)
+        ):
+            del open_[change.id]
+            episode = None
         if episode is None:
             if change.state == "cleared":
                 continue  # cleared, its raise not in the corpus: nothing to count
@@ -64,6 +107,7 @@ def episodes(changes: list[AlertChange], calls: list[OperatorCall]) -> list[Epis
             out.append(episode)
         elif change.state == "raised":
             episode.repeats += change.repeat > 0
+        episode.last = change.t
         if change.state == "acknowledged" and episode.acknowledged is None:
             episode.acknowledged = change.t
             episode.acknowledged_by = next(

@@ -24,7 +24,7 @@ import numpy as np
 
 from frog_bt.clock import SITE_TZ
 from frog_bt.engine.operator import Command
-from frog_bt.offline.report.alerts import Episode, episodes
+from frog_bt.offline.report.alerts import Episode, episodes, runs_of
 from frog_bt.offline.report.facts import HOUR, FileFacts
 from frog_bt.offline.report.rows import Intervention, Row, by_robot, intervention
 
@@ -147,7 +147,7 @@ def reliability(files: list[FileFacts], rows: list[Row]) -> dict[str, Any]:
             if what is not None:
                 kinds.append((c.t, what.value))
                 needed.add((robot, int(c.t // HOUR)))
-        for e in episodes([a for f in group for a in f.alerts], calls):
+        for e in episodes([a for f in group for a in f.alerts], calls, runs_of(group)):
             if e.to_acknowledge is not None:
                 acks.append((e.raised, e.to_acknowledge))
             if e.severity == "ERROR":

@@ -30,7 +30,7 @@ from typing import Any
 from frog_bt.clock import SITE_TZ
 from frog_bt.config import Site
 from frog_bt.engine.operator import Command
-from frog_bt.offline.report.alerts import Episode, episodes
+from frog_bt.offline.report.alerts import Episode, episodes, runs_of
 from frog_bt.offline.report.causes import Cause, Incident
 from frog_bt.offline.report.facts import FileFacts, OperatorCall, Piece, StopFacts, stop_of
 
@@ -470,7 +470,11 @@ def rows(files: list[FileFacts], site: Site) -> list[Row]:
             k = _during(own, c.t)
             if k is not None:
                 calls.setdefault(k, []).append(c)
-        for e in episodes([a for f in group for a in f.alerts], robot_calls):
+        for e in episodes(
+            [a for f in group for a in f.alerts],
+            robot_calls,
+            runs_of(group),
+        ):
             k = _during(own, e.raised)
             if k is not None:
                 alerts.setdefault(k, []).append(e)
