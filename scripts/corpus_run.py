@@ -3,9 +3,11 @@
 Each tour is a whole run of the real executive against the built-in simulator on sim
 time (fast content, 400x), recorded to one MCAP file named by its local start time,
 ``YYYYMMDD-HHMMSS-tourNNNN.mcap``. From ``--seed``, per day (from 2026-06-01):
-``--tours-per-day`` tours, each in the morning (09:00-12:30) or the afternoon
-(14:30-18:00, where POI1 and POI2 play their afternoon variants), each with one kind
-of visitor, drawn with these weights:
+``--tours-per-day`` tours of one robot, one after another: the day's seven hours
+(09:00-12:30, 14:30-18:00, where POI1 and POI2 play their afternoon variants) cut in
+equal slots, each tour at a random moment of its slot early enough to end inside it
+(a robot's tours cannot overlap; at most ``MOST_PER_DAY`` fit), each with one kind of
+visitor, drawn with these weights:
 
 ==============  ======  =====================================================
 kind            weight  what happens
@@ -34,17 +36,19 @@ help kind        what happens
                  20 %); a person acknowledges ``battery_low`` ``ACK_AFTER_S`` after its raise
 ``restart``      the executive stops during POI3's content; a new one resumes the tour from
                  its checkpoint. Its two files go in a directory of their own
-                 (``resumed-NNNN/``): the season's tours overlap in time, a robot's could
-                 not, and the report joins a resumed tour's pieces within one robot's
-                 directory
+                 (``resumed-NNNN/``): the checkpoint's robot, whose day is that tour (the
+                 report joins a resumed tour's pieces within one robot's directory)
 ===============  ===========================================================================
 
 Operator commands go through the executive's staff (``by``: console), as the console
 sends them.
 
 ``corpus.json`` beside the files lists every tour as seeded (file, day, local start,
-kind), the seed, the weights and the help events, so that a test can hold the report's
-figures against them.
+kind), the seed, the weights and the help events, and per tour (``runs``) what the
+corpus heard as it recorded: each file's first and last message (``spans``) and when a
+person was needed (``needed``: each answer the executive accepted, each ERROR alert
+from its raise to its clearing), so that a test can hold the report's figures against
+them (scripts/check_report.py).
 
     scripts/corpus --out season/ --days 10 --tours-per-day 20 --help-each 4 --jobs 2
 """
