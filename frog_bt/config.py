@@ -8,6 +8,7 @@ an error names the file, the path inside it and what was expected::
 
 from __future__ import annotations
 
+import hashlib
 import math
 from datetime import time as dtime
 from pathlib import Path
@@ -443,6 +444,12 @@ def _unknown(name: str, known: list[str]) -> str:
     return f"unknown POI {name!r} (" + (
         f"known: {', '.join(known)})" if known else "no POIs are defined)"
     )
+
+
+def fingerprint(site: Site) -> str:
+    """The configuration as validated, hashed (sha256, 12 hex): defaults filled in, the
+    file's comments and spacing not counted. Recordings carry it (provenance)."""
+    return hashlib.sha256(site.model_dump_json().encode()).hexdigest()[:12]
 
 
 def load_site(path: str | Path | None = None) -> Site:

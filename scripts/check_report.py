@@ -266,6 +266,7 @@ def main() -> int:
         [r["interventions"] for r in parquet],
         [int(r["interventions"]) for r in rows],
     )
+    check("robot-days (one robot, every day of the season)", rel["robot_days"], manifest["days"])
     check("resumed tours (the restarts)", t["resumed"], kinds.count("restart"))
     check("CSV: resumed", [r["resumed"] == "True" for r in rows], [k == "restart" for k in kinds])
     check("Parquet: resumed", [r["resumed"] for r in parquet], [k == "restart" for k in kinds])

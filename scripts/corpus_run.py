@@ -35,9 +35,7 @@ help kind        what happens
 ``ack_alert``    the battery drops to 24 % at POI1 (the alert is below 25 %, the abort below
                  20 %); a person acknowledges ``battery_low`` ``ACK_AFTER_S`` after its raise
 ``restart``      the executive stops during POI3's content; a new one resumes the tour from
-                 its checkpoint. Its two files go in a directory of their own
-                 (``resumed-NNNN/``): the checkpoint's robot, whose day is that tour (the
-                 report joins a resumed tour's pieces within one robot's directory)
+                 its checkpoint: two files, the second ``...-resumed.mcap``
 ===============  ===========================================================================
 
 Operator commands go through the executive's staff (``by``: console), as the console
@@ -152,11 +150,7 @@ def plan(
         chosen = random.Random(f"help:{seed}").sample(range(len(out)), len(HELP_KINDS) * help_each)
         for i, number in enumerate(chosen):
             kind = HELP_KINDS[i % len(HELP_KINDS)]
-            tour = out[number]
-            file = tour.file
-            if kind == "restart":
-                file = f"resumed-{tour.number:04d}/{file}"
-            out[number] = replace(tour, kind=kind, file=file)
+            out[number] = replace(out[number], kind=kind)
     return out
 
 

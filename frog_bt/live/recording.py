@@ -14,7 +14,9 @@
 * ``/frog_bt/blame``: after each command, the tree node that sent it and the
   blackboard values it read (``{"channel", "node", "reads"}``), for replay's
   divergence report;
-* ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``).
+* ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``);
+* metadata ``frog_bt_site``: ``config_sha256``, the site configuration that ran
+  (:func:`frog_bt.config.fingerprint`), in every file.
   Live ticks coalesce bursts of inputs and fall wherever the event loop gets to
   them, so replay ticks exactly where the live executive did
   (:mod:`frog_bt.offline.replay`).
@@ -52,6 +54,7 @@ import msgspec
 from mcap.writer import CompressionType, Writer
 
 from frog_bt import __version__
+from frog_bt.config import fingerprint
 from frog_bt.errors import DecodeError
 from frog_bt.model import channels
 from frog_bt.model.channels import (
@@ -63,6 +66,7 @@ from frog_bt.model.channels import (
     OPERATOR,
     OWN_TYPES,
     PRIMER,
+    SITE_METADATA,
     TICK,
     TREE,
     from_ns,
@@ -157,6 +161,7 @@ class Recorder:
         self._ready: Callable[[], bool] = lambda: True
         self._clock_topic: str | None = None
         self._tree: bytes | None = None
+        self._site: dict[str, str] = {}  # SITE_METADATA, for the next file too
         # What a new file starts with (rotation): the latest message of each input kept
         # as latest, the last /clock, recent datagrams in and the seqs sent out.
         self._latest_topics: frozenset[str] = frozenset()
@@ -224,6 +229,8 @@ class Recorder:
             self.channel(channel, OWN_TYPES[channel])
         clock = host.clock
         self._ready = lambda: bool(clock.ready)
+        self._site = {"config_sha256": fingerprint(site)}
+        self._writer.add_metadata(SITE_METADATA, self._site)
         self._tree = self._tree_message(host)
         if self._tree is not None:
             self._write(TREE, None, self._tree)
@@ -446,6 +453,8 @@ class Recorder:
             log.error("recording to %s stopped: %s", path, exc)
             self.closed = True
             return
+        if self._site:
+            self._writer.add_metadata(SITE_METADATA, self._site)
         if self._tree is not None:
             self._write(TREE, None, self._tree)
         if self._clock_raw is not None and self._clock_topic is not None:

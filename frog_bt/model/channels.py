@@ -36,6 +36,7 @@ TICK = "/frog_bt/tick"
 BLAME = "/frog_bt/blame"  # the tree node that sent each command, right after it
 TREE = "/frog_bt/tree"  # the tree that ran, as BehaviorTree.CPP v4 XML, once at the start
 PRIMER = "/frog_bt/primer"  # what a rotated file carries from before it
+SITE_METADATA = "frog_bt_site"  # MCAP metadata in every file: config_sha256, the site config
 OPERATOR = "/frog_bt/operator"  # each operator command and its answer
 ALERT = "/frog_bt/alert"  # each alert's changes
 

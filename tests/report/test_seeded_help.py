@@ -11,12 +11,16 @@ import json
 import subprocess
 import sys
 from collections import Counter
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
 import pytest
 
+from frog_bt import __version__
 from frog_bt.cli import main
+from frog_bt.clock import SITE_TZ
+from frog_bt.config import fingerprint, load_site
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 from check_report import autonomy
@@ -132,7 +136,8 @@ def test_the_help_events_are_those_seeded(season, tmp_path) -> None:
     for r in tours:  # in a tour, no cause twice but the dock's retries
         once = [(i["cause"], i["detail"]) for i in r["incidents"] if i["cause"] != "dock retry"]
         assert len(once) == len(set(once)), r["incidents"]
-    # the resumed tour's files are one robot's, in a directory of their own
+    # the resumed tour: its two files, joined; the day is one robot's
+    assert rel["robot_days"] == 1
     resumed = next(r for r, k in zip(tours, kinds, strict=True) if k == "restart")
     assert resumed["resumed"] and resumed["restarts"] == 1 and len(resumed["files"]) == 2
     assert resumed["stops_skipped"] == []
@@ -167,3 +172,38 @@ def test_check_report_holds_the_season(season) -> None:
     assert done.returncode == 0, done.stdout + done.stderr
     assert "FAIL" not in done.stdout and "7 tours: all checks hold" in done.stdout
     assert "ok   autonomy" in done.stdout  # the manifest has what autonomy is held to
+
+
+def test_provenance_names_what_wrote_and_ran_every_file(season, tmp_path) -> None:
+    """The date range (local), the version, the tree and the site configuration that ran
+    (hashed at start, in every file) and the files skipped, each with its reason."""
+    directory, manifest = season
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"not a recording")
+    got = report(tmp_path, str(directory), str(junk))["totals"]["provenance"]
+    files = sum(len(run["files"]) for run in manifest["runs"])
+    starts = [s for run in manifest["runs"] for s, _ in run["spans"]]
+    ends = [e for run in manifest["runs"] for _, e in run["spans"]]
+    local = lambda t: datetime.fromtimestamp(t, SITE_TZ).isoformat("T", "seconds")  # noqa: E731
+    assert (got["files"], got["first"], got["last"]) == (
+        files,
+        local(min(starts)),
+        local(max(ends)),
+    )
+    assert got["versions"] == {f"frog-bt {__version__}": files}
+    ((tree, n),) = got["trees"].items()
+    assert len(tree) == 12 and n == files
+    assert got["configs"] == {fingerprint(load_site()): files}
+    (skipped,) = got["skipped"]
+    assert skipped.startswith(str(junk)) and len(skipped) > len(str(junk)) + 5  # and why
+
+
+def test_the_configuration_hash_is_of_what_was_validated(tmp_path) -> None:
+    """Comments and spacing do not change it; a value does."""
+    text = (Path(__file__).resolve().parents[2] / "config" / "site.yaml").read_text()
+    same, other = tmp_path / "same.yaml", tmp_path / "other.yaml"
+    same.write_text("# a comment\n\n" + text)
+    other.write_text(text.replace("language: es", "language: en"))
+    assert "language: es" in text
+    assert fingerprint(load_site(same)) == fingerprint(load_site())
+    assert fingerprint(load_site(other)) != fingerprint(load_site())

@@ -42,7 +42,16 @@ import numpy as np
 from frog_bt.config import Site
 from frog_bt.engine.operator import Command as OperatorCommand
 from frog_bt.maths.engagement import decide
-from frog_bt.model.channels import ALERT, FRONTEND_IN, FRONTEND_OUT, OPERATOR, PRIMER, TREE, from_ns
+from frog_bt.model.channels import (
+    ALERT,
+    FRONTEND_IN,
+    FRONTEND_OUT,
+    OPERATOR,
+    PRIMER,
+    SITE_METADATA,
+    TREE,
+    from_ns,
+)
 from frog_bt.model.channels import Alert as AlertMessage
 from frog_bt.model.channels import Operator as OperatorMessage
 from frog_bt.model.channels import Tree as TreeMessage
@@ -190,6 +199,7 @@ class FileFacts:
     metres: dict[int, float] = field(default_factory=dict)  # clock hour -> metres driven
     library: str = ""  # what wrote it (frog-bt and its version)
     tree: str = ""  # sha256 (12 hex) of the tree that ran, from /frog_bt/tree
+    config: str = ""  # sha256 (12 hex) of the site configuration, from its metadata
     error: str = ""  # unreadable: why (the file is reported and skipped)
     recovered: str = ""  # a file cut short: what was read of it
     start: float = 0.0  # first message, seconds
@@ -529,6 +539,7 @@ def read_file(path: str, site: Site) -> FileFacts:
             metres=pieces.metres,
             library=_library(Path(path)),
             tree=pieces.tree,
+            config=recording.metadata.get(SITE_METADATA, {}).get("config_sha256", ""),
             recovered=recording.recovered,
             start=start or 0.0,
             bad=tally.count,

@@ -175,17 +175,25 @@ def causes(t: dict[str, Any]) -> str:
     return _grid(["cause", "detail", "events", "tours"], rows or [["none", "", "", ""]], "causes")
 
 
+def _when(iso: str | None) -> str:
+    """``2026-06-01T09:06:26+02:00`` as a reader writes it: ``2026-06-01 09:06:26``."""
+    return "\u2013" if not iso else iso[:19].replace("T", " ")
+
+
 def provenance(p: dict[str, Any]) -> str:
     lines = [
         ("Recordings", f"{p['files']} files read, {len(p['skipped'])} skipped"),
-        ("From", p["first"] or "\u2013"),
-        ("To", p["last"] or "\u2013"),
+        ("From (local time)", _when(p["first"])),
+        ("To (local time)", _when(p["last"])),
         ("Written by", ", ".join(f"{k} ({n} files)" for k, n in p["versions"].items()) or "\u2013"),
         (
             "Trees (sha256)",
             ", ".join(f"{k} ({n} files)" for k, n in p["trees"].items()) or "\u2013",
         ),
-        ("Configuration", p["config"]),
+        (
+            "Site configurations (sha256)",
+            ", ".join(f"{k} ({n} files)" for k, n in p["configs"].items()) or "\u2013",
+        ),
     ]
     skipped = "".join(f"<li>{e(s)}</li>" for s in p["skipped"])
     return _table(lines, "provenance") + (f'<ul class="skip">{skipped}</ul>' if skipped else "")
@@ -230,6 +238,7 @@ def _tour(r: Row, order: list[str]) -> str:
         incidents[str(i)] = incidents.get(str(i), 0) + 1
     said = ", ".join(k if n == 1 else f"{k} \u00d7{n}" for k, n in incidents.items())
     reached = len({p for p in r.stops_visited if p in order})
+    skipped = ", ".join(f"{s.poi} ({s.why})" for s in r.stops_skipped)
     cells = [
         (str(r.tour), str(r.tour)),
         (r.day.isoformat(), r.day.isoformat()),
@@ -242,7 +251,7 @@ def _tour(r: Row, order: list[str]) -> str:
             " ".join(v.poi for v in r.engagement if v.decision == "b") or "\u2013",
             str(sum(v.decision == "b" for v in r.engagement)),
         ),
-        (", ".join(f"{s.poi} ({s.why})" for s in r.stops_skipped), ""),
+        (skipped, skipped),
         (ending, r.ended),
         (said, said),
     ]
@@ -342,7 +351,7 @@ h1 { font-size: 1.6em; } h2 { font-size: 1.2em; margin-top: 1.8em; }
 table { border-collapse: collapse; } td, th { padding: .2em .6em; text-align: left;
         border-bottom: 1px solid #dde3ea; vertical-align: top; }
 .kv th { font-weight: 600; white-space: nowrap; }
-.grid th { background: #eef2f6; }
+.grid th { background: #eef2f6; } .grid td:first-child, #funnel td { white-space: nowrap; }
 .cols { display: flex; flex-wrap: wrap; gap: 0 2.5em; } .cols > div { flex: 1 1 30em; }
 .figs { display: flex; flex-wrap: wrap; gap: 1em; }
 figure { margin: 0; } figcaption { font-weight: 600; } img { max-width: 100%; }
@@ -359,7 +368,23 @@ figure { margin: 0; } figcaption { font-weight: 600; } img { max-width: 100%; }
 .skip { color: #8a4b00; }
 """
 
-WIDTHS = ["3.2em", "8em", "5em", "4.2em", "5.6em", "6.2em", "5.6em", "7.5em", "", "11em", ""]
+# Each column as wide as its header with the sort arrow (" ▲") and its usual cells
+# ("2026-06-01", "6 of 6", "POI3 (operator)", "aborted: operator"); Incidents, the widest
+# and what a reader looks for, takes the rest. Longer cells end in "…" (their title has
+# them whole) and the tour's details have everything.
+WIDTHS = [
+    "3.2em",
+    "7.2em",
+    "5.3em",
+    "4.5em",
+    "6.4em",
+    "6.8em",
+    "5.7em",
+    "7.5em",
+    "9.2em",
+    "10.2em",
+    "",
+]
 
 
 def page(

@@ -1,6 +1,7 @@
 """Where the figures come from: the recordings' date range, the frog-bt versions that
 wrote them (the MCAP header's ``library``), the trees that ran (a hash of
-``/frog_bt/tree``), and the files skipped and why."""
+``/frog_bt/tree``), the site configurations (their hash, recorded at start: metadata
+``frog_bt_site``), and the files skipped and why."""
 
 from __future__ import annotations
 
@@ -28,6 +29,6 @@ def provenance(facts: list[FileFacts], skipped: list[str]) -> dict[str, Any]:
         "last": local(last),
         "versions": dict(Counter(f.library or NOT_RECORDED for f in read).most_common()),
         "trees": dict(Counter(f.tree or NOT_RECORDED for f in read).most_common()),
-        "config": "not recorded (recordings carry the tree, not the site configuration)",
+        "configs": dict(Counter(f.config or NOT_RECORDED for f in read).most_common()),
         "skipped": skipped,
     }
