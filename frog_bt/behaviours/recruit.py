@@ -99,10 +99,12 @@ class SeekVisitor(Leaf):
 class ApproachVisitor(GoalLeaf):
     """Approach ``/visitor`` with ``/ApproachPeopleFar``, never faster than the site allows.
 
-    Reads ``/visitor``, ``/now``, ``/goal`` (its result), ``/approach_failed``; writes
-    ``/approach_failed``.
+    Reads ``/visitor``, ``/now``, ``/goal`` (its result), ``/approach_failed``, ``/paused``
+    and ``/pose``; writes ``/approach_failed``.
     The command goes out once ``recruit.approach_interval`` seconds have passed
-    since the previous approach (RUNNING until then). SUCCESS on
+    since the previous approach, and not while the operator's pause lasts (RUNNING
+    until then; a pause while it is out stops the robot where it is, and the approach
+    goes out again after ``resume``). SUCCESS on
     ``/FROG_response`` 2; FAILURE on 3 or 4, or after ``timeout`` (default: site
     ``timeouts.approach``), recording the person in ``/approach_failed`` so that
     the next search passes them over for ``recruit.retry_after`` seconds.
@@ -113,8 +115,9 @@ class ApproachVisitor(GoalLeaf):
 
     params: Params
     reads = (keys.VISITOR, keys.NOW, keys.GOAL)
-    optional_reads = (keys.APPROACH_FAILED,)
+    optional_reads = (keys.APPROACH_FAILED, keys.PAUSED, keys.POSE)
     writes = (keys.APPROACH_FAILED,)
+    waits_while_paused = True
 
     def default_timeout(self) -> float:
         return self.ctx.site.timeouts.approach
@@ -156,12 +159,17 @@ class ApproachVisitor(GoalLeaf):
 class StartIntroduction(Leaf):
     """Send ``start_introduction``; ``icl`` is true while the face stream runs.
 
-    Reads ``/icl`` (optional: False without a FaceStream scope). SUCCESS.
+    Reads ``/icl`` (optional: False without a FaceStream scope) and ``/paused``
+    (optional). SUCCESS once sent; RUNNING while the operator's pause lasts (no new
+    content until ``resume``).
     """
 
-    optional_reads = (keys.ICL,)
+    optional_reads = (keys.ICL, keys.PAUSED)
 
     def update(self) -> Status:
+        if self.get(keys.PAUSED):
+            self.feedback_message = "paused: the introduction waits"
+            return RUNNING
         self.ctx.send(StartIntroductionCommand(bool(self.get(keys.ICL))))
         return SUCCESS
 
@@ -171,12 +179,17 @@ class AskTour(Leaf):
     """Ask the visitor to join (``ask_tour``), worded by their engagement.
 
     Reads ``/engaged`` (optional): the decision over the introduction's face
-    samples, None (sent as null) without face data. SUCCESS.
+    samples, None (sent as null) without face data; ``/paused`` (optional). SUCCESS
+    once sent; RUNNING while the operator's pause lasts (no new content until
+    ``resume``).
     """
 
-    optional_reads = (keys.ENGAGED,)
+    optional_reads = (keys.ENGAGED, keys.PAUSED)
 
     def update(self) -> Status:
+        if self.get(keys.PAUSED):
+            self.feedback_message = "paused: the question waits"
+            return RUNNING
         self.ctx.send(AskTourCommand(self.get(keys.ENGAGED)))
         return SUCCESS
 

@@ -132,10 +132,20 @@ def goal(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
         out = 1
         if n.abstraction.role is Role.DRIVE:
             t.event(Event.DRIVE, n)
+        elif n.abstraction.role is Role.APPROACH:
+            t.event(Event.APPROACH, n)
             if t.world[HOME] and n.params.get("poi") == n.dock:
                 t.world[HOMING] = True
     chosen = t.choose(n, "outcome", options(n.abstraction, count, starting))
     return STATUS[chosen], (_next(n.abstraction, count, starting) << 1) | out
+
+
+def speak(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+    """StartIntroduction, AskTour: said at once, unless paused (then held until resume)."""
+    if _held(t, n):
+        return RUNNING, 0
+    t.event(Event.SPEAK, n)
+    return SUCCESS, 0
 
 
 def content(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
@@ -267,13 +277,13 @@ TABLE: dict[str, Abstraction] = {
     "WaitFrontendIdle": Abstraction((R, S), W, None, Role.IDLE),
     "AskForHelp": Abstraction(rule=ask_for_help, role=Role.HELP, bound=None),
     "Navigate": Abstraction((R, S, F), role=Role.DRIVE, rule=goal, first=(R,)),
-    "ApproachVisitor": Abstraction((R, S, F), rule=goal, first=(R,)),
+    "ApproachVisitor": Abstraction((R, S, F), role=Role.APPROACH, rule=goal, first=(R,)),
     "Docking": Abstraction((R, S, F), rule=docking, first=(R,)),
     "SkipStop": Abstraction(rule=skip_stop),
     "Skipped": Abstraction(rule=skipped),
     "SeekVisitor": Abstraction((R, S), W, None),
-    "StartIntroduction": Abstraction(role=Role.SPEAK),
-    "AskTour": Abstraction(role=Role.SPEAK),
+    "StartIntroduction": Abstraction(role=Role.SPEAK, rule=speak),
+    "AskTour": Abstraction(role=Role.SPEAK, rule=speak),
     "WaitEvent": Abstraction((R, S), W, rule=wait_event),
     "WaitAnswer": Abstraction((R, S, F), W, first=(R,)),
     "DecideEngagement": Abstraction(),

@@ -28,6 +28,8 @@ from frog_bt.verify.world import (
     Role,
 )
 
+PAUSE_HOLDS = (Event.DRIVE, Event.APPROACH, Event.CONTENT, Event.SPEAK)  # what a pause holds
+
 MEANING = {
     "ends-well": "every run ends docked and idle, or holds and asks a person for help: no "
     "trap, no loop the robot repeats on its own",
@@ -35,7 +37,8 @@ MEANING = {
     "sequence (or asks for help) within a bounded number of ticks",
     "service-off-obeyed": "between service_off and service_on no new tour starts: no `tour "
     "started`, no undock outside a tour already under way",
-    "pause-obeyed": "while paused, no new drive to a stop and no new stop content",
+    "pause-obeyed": "while paused, no new goal (a drive to a stop, an approach), no new "
+    "content and nothing new said to the visitor (CONTRACT §7)",
     "no-content-while-driving": "no content plays and the visitor is not addressed while a "
     "drive is under way",
     "bounded-retries": "each retry loop ends: no retry repeats for ever on the robot's own "
@@ -91,7 +94,7 @@ class Safety:
                     node,
                     f"{kind.value} while out of service",
                 )
-            if kind in (Event.DRIVE, Event.CONTENT) and world[PAUSED]:
+            if kind in PAUSE_HOLDS and world[PAUSED]:
                 self._hit("pause-obeyed", src, step, dst, node, f"{kind.value} while paused")
             if kind is Event.CONTENT and world[HOME]:
                 self._hit("home-obeyed", src, step, dst, node, "content started after home")

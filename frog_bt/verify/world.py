@@ -41,6 +41,7 @@ class Role(enum.Enum):
 
     NONE = "none"
     DRIVE = "drive"  # sends the robot across the floor to a POI (a pause holds it)
+    APPROACH = "approach"  # drives the robot up to a visitor (a pause holds it)
     CONTENT = "content"  # plays a stop's content (a pause holds its start)
     SPEAK = "speak"  # says something to the visitor at once (introduction, question)
     DOCK = "dock"
@@ -53,6 +54,7 @@ class Event(enum.Enum):
     """What happened in a tick that a property watches."""
 
     DRIVE = "drive goal sent"
+    APPROACH = "approach sent"
     CONTENT = "content started"
     SPEAK = "visitor addressed"
     UNDOCK = "undock sent"

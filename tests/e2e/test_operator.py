@@ -189,3 +189,53 @@ def test_service_off_finishes_the_tour_then_starts_none_until_service_on() -> No
     assert not in_service
     assert not [c for c in quiet if c.startswith(("tour started", "/docking/dock undock"))]
     assert restarted == ["tour started"]
+
+
+async def _pause_while_recruiting() -> tuple[list[str], list[str], list[str], int]:
+    """Pause while the robot seeks at POI0 (a visitor then appears, facing it), resume;
+    pause again as the introduction plays (its content_done comes while paused),
+    resume."""
+    from frog_bt.sim.people import PRESENT
+    from frog_bt.tree.leaf import RUNNING
+
+    hidden = {
+        "id": 7,
+        "position": [103.0, 36.0],
+        "facing": True,
+        "answer": "positive",
+        "faces": "engaged",
+        "follow": True,
+        "after_tour": "return",
+        "appear_at": "never",
+    }
+    async with Running({"visitors": [hidden]}, once=True) as run:
+        core, clock = run.executive.core, run.sim.clock
+        bound = clock.now() + 600.0
+        while not any(n.status is RUNNING for n in core.seekers):
+            assert clock.now() < bound, "the robot never sought a visitor"
+            await clock.sleep_until(clock.now() + 0.5)
+        assert core.command(Command.PAUSE).ok
+        paused_at = clock.now()
+        run.sim.world.crowd.visitors[7].state = PRESENT  # someone faces the robot now
+        await clock.sleep_until(paused_at + 60.0)
+        seeking = commands_after(run, paused_at)
+        resumed_at = clock.now()
+        assert core.command(Command.RESUME).ok
+        await run.sim.wait_for(is_("start_introduction"), 120)
+        assert core.command(Command.PAUSE).ok
+        paused_at = clock.now()
+        await clock.sleep_until(paused_at + 60.0)  # the introduction (3 s) ends meanwhile
+        introducing = commands_after(run, paused_at)
+        assert core.command(Command.RESUME).ok
+        outcome = await run.finish()
+        return seeking, commands_after(run, resumed_at), introducing, outcome.code
+
+
+def test_pause_holds_the_approach_and_the_question_to_the_visitor() -> None:
+    """CONTRACT §7: no new goal and no new content until resume, when recruiting too."""
+    seeking, after, introducing, code = asyncio.run(_pause_while_recruiting())
+    assert not [c for c in seeking if c.startswith(("/Approach", "start_introduction"))]
+    assert after[0].startswith("/ApproachPeopleFar")  # resumed: the visitor is approached
+    assert not [c for c in introducing if c.startswith(("ask_tour", "/GotoWayPoint POI1"))]
+    assert [c for c in after if c.startswith("ask_tour")]  # asked once resumed
+    assert code == 0

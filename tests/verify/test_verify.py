@@ -9,9 +9,11 @@ import pytest
 
 from frog_bt.behaviours import FACTORY
 from frog_bt.behaviours.navigation import Navigate
+from frog_bt.behaviours.recruit import ApproachVisitor, AskTour
 from frog_bt.behaviours.registry import DECORATOR_TYPES, LEAF_TYPES
 from frog_bt.cli import main
 from frog_bt.model import keys
+from frog_bt.model.frontend import AskTour as AskTourCommand
 from frog_bt.tree.factory import NodeFactory
 from frog_bt.tree.leaf import RUNNING, SUCCESS, Leaf, Status
 from frog_bt.verify.abstraction import Abstraction
@@ -145,6 +147,48 @@ def test_the_pause_guard_after_the_drive_breaks_pause_obeyed(tmp_path: Path) -> 
     assert "[drive goal sent: NavigateNoPause" in text[-1]
     assert run.note == "drive goal sent while paused"
     assert FACTORY.leaves["Navigate"] is Navigate  # the tour's factory is untouched
+
+
+class AskTourNoPause(AskTour):
+    """AskTour as it was: it asked the visitor whether paused or not (the mutation)."""
+
+    optional_reads = (keys.ENGAGED,)
+
+    def update(self) -> Status:
+        self.ctx.send(AskTourCommand(self.get(keys.ENGAGED)))
+        return SUCCESS
+
+
+class ApproachNoPause(ApproachVisitor):
+    """ApproachVisitor as it was: the approach went out while paused (the mutation)."""
+
+    optional_reads = (keys.APPROACH_FAILED,)
+    waits_while_paused = False
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "cls", "note"),
+    [
+        ("{type: AskTour}", "{type: AskTourNoPause}", AskTour, "visitor addressed while paused"),
+        (
+            "{type: ApproachVisitor}",
+            "{type: ApproachNoPause}",
+            ApproachVisitor,
+            "approach sent while paused",
+        ),
+    ],
+)
+def test_a_recruiting_leaf_that_ignores_the_pause_breaks_pause_obeyed(
+    tmp_path: Path, old: str, new: str, cls: type, note: str
+) -> None:
+    """CONTRACT §7: no new goal and no new content until resume, the approach and the
+    question to the visitor too."""
+    factory = NodeFactory([*LEAF_TYPES, AskTourNoPause, ApproachNoPause], DECORATOR_TYPES)
+    v = verdict(copy(tmp_path, {"recruit.yaml": [(old, new)]}), factory)
+    run = run_of(v, "pause-obeyed")
+    assert any("operator: pause" in t for t in lines(v, run))
+    assert run.note == note
+    assert FACTORY.leaves[cls.__name__] is cls  # the tour's factory is untouched
 
 
 def test_the_dock_failure_branch_made_to_loop_breaks_ends_well(tmp_path: Path) -> None:
