@@ -421,6 +421,11 @@ def main() -> None:
     p.add_argument("--help-each", type=int, default=4, help="tours of each help kind (0: none)")
     p.add_argument("--jobs", type=int, default=2, help="tours recorded at once (processes)")
     a = p.parse_args()
+    if a.help_each * len(HELP_KINDS) > a.days * a.tours_per_day:
+        p.error(
+            f"--help-each {a.help_each}: {a.help_each * len(HELP_KINDS)} help tours "
+            f"({len(HELP_KINDS)} kinds) do not fit a season of {a.days * a.tours_per_day} tours"
+        )
     if a.tours_per_day > MOST_PER_DAY:
         p.error(
             f"--tours-per-day: at most {MOST_PER_DAY} tours fit one robot's day one after another"
