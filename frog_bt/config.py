@@ -48,6 +48,9 @@ class Poi(_Model):
     z: Finite
     w: Finite
     name: str = ""
+    # the name in a language staff may read (es: Patio de la Montería), used when it is
+    # the site's `language`; `name` otherwise
+    names: dict[Literal["en", "es"], str] = {}
     note: str = ""
 
     @model_validator(mode="after")
@@ -362,12 +365,15 @@ class Site(_Model):
     topics: dict[Literal[tuple(INPUTS) + tuple(OUTPUTS)], str] = {}  # type: ignore[valid-type]
 
     def name(self, poi: str) -> str:
-        """A stop or waypoint by the name staff know it by (POI2 or POI2a: Hunting
-        Courtyard); the code itself when the site names neither."""
+        """A stop or waypoint by the name staff know it by, in the site's language (POI2
+        or POI2a: Patio de la Montería, or Hunting Courtyard); the code itself when the
+        site names neither."""
         found = self.pois.get(poi)
         if found is None and self.variants.get(poi):
             found = self.pois.get(self.variants[poi][0].waypoint)
-        return found.name if found is not None and found.name else poi
+        if found is None:
+            return poi
+        return found.names.get(self.language) or found.name or poi
 
     @model_validator(mode="after")
     def _cross_check(self) -> Site:

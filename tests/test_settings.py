@@ -10,7 +10,7 @@ import pytest
 
 from frog_bt.commands import run as run_command
 from frog_bt.commands.settings import fill
-from frog_bt.config import RunCfg
+from frog_bt.config import RunCfg, load_site
 from frog_bt.errors import UsageError
 
 
@@ -53,3 +53,18 @@ def test_the_command_line_wins_then_the_environment_then_the_site() -> None:
 def test_a_bad_flag_in_the_environment_names_the_variable() -> None:
     with pytest.raises(UsageError, match="FROG_BT_ONCE maybe: expected 1/true/yes/on"):
         fill(parse(), RunCfg(), {"FROG_BT_ONCE": "maybe"})
+
+
+def test_a_stop_is_named_in_the_sites_language() -> None:
+    """config/site.yaml: language es, each stop with its Spanish name; `name` (the
+    CONTRACT's POI table) otherwise, and the code when neither is given."""
+    site = load_site()
+    assert site.language == "es"
+    assert (site.name("POI2"), site.name("POI2b"), site.name("SHOP")) == (
+        "Patio de la Montería",
+        "Patio de la Montería",
+        "Tienda",
+    )
+    english = site.model_copy(update={"language": "en"})
+    assert (english.name("POI2"), english.name("SHOP")) == ("Hunting Courtyard", "Shop")
+    assert site.name("NOWHERE") == "NOWHERE"

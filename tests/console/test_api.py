@@ -79,7 +79,8 @@ def test_every_command_and_every_refusal() -> None:
     ]
     texts = [body.get("did") or body.get("reason") for _, body in answers]
     assert texts[0] == "not at a stop or driving to one: nothing to skip"
-    assert texts[5] == "skipping Almohad wall: on to the next stop"  # the stop as staff know it
+    # the stop as staff know it, in the site's language (config/site.yaml: es)
+    assert texts[5] == "skipping Muralla almohade: on to the next stop"
     assert texts[8] == "no alert 'nope' to acknowledge"
     assert texts[9] == "ending the tour: the robot goes home and docks"
 

@@ -57,9 +57,10 @@ def drive(url: str) -> tuple[list[str], str]:
         wait = WebDriverWait(driver, WAIT, poll_frequency=0.05)
         driver.get(url)
         stop = driver.find_element(By.ID, "stop")
-        wait.until(lambda d: stop.text == "Almohad wall")  # stops by their site names
+        # stops by the names staff know them by, in the site's language (es)
+        wait.until(lambda d: stop.text == "Muralla almohade")
         seen = [stop.text]
-        wait.until(lambda d: stop.text == "Hunting Courtyard")  # the stop changes in the page
+        wait.until(lambda d: stop.text == "Patio de la Montería")  # the stop changes
         seen.append(stop.text)
         home = driver.find_element(By.CSS_SELECTOR, "button[data-command=home]")
         home.click()  # one tap arms it, the second confirms
@@ -91,7 +92,7 @@ def test_send_home_from_the_console_in_chromium() -> None:
             )
 
     seen, answer, reason, outcome, docking = asyncio.run(main())
-    assert seen == ["Almohad wall", "Hunting Courtyard"]
+    assert seen == ["Muralla almohade", "Patio de la Montería"]
     # the page speaks the site's language (config/site.yaml: es)
     assert answer == "Hecho: termina la visita: el robot vuelve a la base y se pone a cargar"
     assert (reason, outcome, docking) == ("operator", "tour aborted: operator", "docked")

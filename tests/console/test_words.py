@@ -76,7 +76,7 @@ def test_translations_keep_their_fields() -> None:
 def test_a_sentence_in_both_languages() -> None:
     msg = Msg("Driving to {stop}", stop="Hunting Courtyard")
     assert str(msg) == "Driving to Hunting Courtyard"
-    assert msg.say(translator("es")) == "De camino a Hunting Courtyard"
+    assert msg.say(translator("es")) == "De camino a la parada Hunting Courtyard"
     assert msg.say(translator("es-ES")) == msg.say(translator("es"))
     assert msg.wire() == ["Driving to {stop}", {"stop": "Hunting Courtyard"}]
     assert i18n.catalog("en")["Send home"] == "Send home"
