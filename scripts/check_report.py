@@ -147,20 +147,20 @@ def main() -> int:
         import pyarrow.parquet as pq
 
         parquet = pq.read_table(out / "r.parquet").to_pylist()
-    failures = 0
+    failed = 0
 
     def check(what: str, got: object, want: object) -> None:
-        nonlocal failures
+        nonlocal failed
         ok = got == want
-        failures += not ok
+        failed += not ok
         shown = f"{len(got)} alike" if isinstance(got, list) and ok and len(got) > 12 else got
         print(f"{'ok  ' if ok else 'FAIL'} {what}: {shown}" + ("" if ok else f" (want {want})"))
 
     def near(what: str, got: float, p: float, trials: int) -> None:
-        nonlocal failures
+        nonlocal failed
         sigma = math.sqrt(p * (1 - p) / trials)
         ok = abs(got - p) <= 3 * sigma + 1e-9
-        failures += not ok
+        failed += not ok
         print(f"{'ok  ' if ok else 'FAIL'} {what}: {got:.3f}, seeded {p:.3f} (± {3 * sigma:.3f})")
 
     check("HTML: tours", t["tours"], n)
@@ -239,10 +239,20 @@ def main() -> int:
     )
     check("funnel: finished", t["funnel"]["finished"], ended)
     rel = t["reliability"]
+    # The known race again: a robot left docking away from its charger after a fault
+    # asks for help (docking_failed) after the tour; the corpus heard each ERROR raise
+    raced = sum(
+        max(0, len(run.get("needed", [[0, 0]])) - 1)
+        for run, k in zip(manifest["runs"], kinds, strict=True)
+        if k == "fault"
+    )
+    asked = kinds.count("fault") + kinds.count("dock_help") + raced
     check(
-        "failures that needed a person (the faults' and the docks' alerts)",
+        "failures that needed a person (the faults' and the docks' alerts"
+        + (f", {raced} help after a fault's race" if raced else "")
+        + ")",
         rel["failures_needing_a_person"],
-        kinds.count("fault") + kinds.count("dock_help"),
+        asked,
     )
     interventions = {
         "help answered": kinds.count("dock_help"),
@@ -265,6 +275,22 @@ def main() -> int:
         "Parquet: interventions per tour = CSV",
         [r["interventions"] for r in parquet],
         [int(r["interventions"]) for r in rows],
+    )
+    check(
+        "Parquet: each operator command accepted, sent by the console (as seeded)",
+        sorted({(c["command"], c["ok"], c["by"]) for r in parquet for c in r["operator"]}),
+        sorted(
+            {
+                (command, True, "console")
+                for kind, command in (
+                    ("dock_help", "done_by_hand"),
+                    ("home", "home"),
+                    ("skip", "skip"),
+                    ("ack_alert", "ack_alert"),
+                )
+                if kind in kinds
+            }
+        ),
     )
     check("robot-days (one robot, every day of the season)", rel["robot_days"], manifest["days"])
     check("resumed tours (the restarts)", t["resumed"], kinds.count("restart"))
@@ -296,7 +322,7 @@ def main() -> int:
     check(
         "HTML, as shown: failures that needed a person",
         shown.get("Failures that needed a person"),
-        str(kinds.count("fault") + kinds.count("dock_help")),
+        str(asked),
     )
     want = autonomy(manifest)
     if want is not None:
@@ -342,8 +368,8 @@ def main() -> int:
         1 - w["declines"] / asked,
         t["invitations"],
     )
-    print(f"{n} tours: {'all checks hold' if not failures else f'{failures} failed'}")
-    return 1 if failures else 0
+    print(f"{n} tours: {'all checks hold' if not failed else f'{failed} failed'}")
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

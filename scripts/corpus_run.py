@@ -183,7 +183,9 @@ async def _help(tour: Seeded, r: Any, acted: list[float]) -> None:
     """What the person does in a help tour (while the executive runs it); the executive
     clock's time of each answer it accepted goes in ``acted``."""
     from frog_bt.engine.operator import Command
+    from frog_bt.model import keys
     from frog_bt.model.events import AlertChanged
+    from frog_bt.model.outcomes import DockingState
     from frog_bt.runtime.observer import listen
 
     exe, sim = r.executive, r.sim
@@ -192,16 +194,21 @@ async def _help(tour: Seeded, r: Any, acted: list[float]) -> None:
         await exe.clock.sleep(HELP_AFTER_S)
         docking = sim.world.docking  # a person puts the robot on its charger
         docking.state, docking.docked = "docked", True
-        for _ in range(30):  # until the executive has seen /docking/state say docked
-            await exe.clock.sleep(1.0)
-            if (await exe.staff.submit(Command.DONE_BY_HAND)).ok:
-                acted.append(exe.clock.now())
-                return
-        raise RuntimeError("done_by_hand was never accepted")
+
+        # as a person would: answer once the console shows the robot docked
+        def docked() -> bool:
+            reading = exe.core.board.get(keys.DOCKING)
+            return reading is not None and reading.value == DockingState.DOCKED
+
+        await _until(exe, docked, 30)
+        answer = await exe.staff.submit(Command.DONE_BY_HAND, by="console")
+        assert answer.ok, answer.text
+        acted.append(exe.clock.now())
+        return
     if tour.kind in ("home", "skip"):
         await sim.wait_for(_start_poi("POI3"), 60)
         command = Command.HOME if tour.kind == "home" else Command.SKIP
-        answer = await exe.staff.submit(command)
+        answer = await exe.staff.submit(command, by="console")
         assert answer.ok, answer.text
         acted.append(exe.clock.now())
     elif tour.kind == "ack_alert":
@@ -219,7 +226,7 @@ async def _help(tour: Seeded, r: Any, acted: list[float]) -> None:
         sim.world.battery.percentage = LOW_BATTERY
         await _until(exe, lambda: bool(raised), 60)
         await exe.clock.sleep_until(raised[0] + ACK_AFTER_S)
-        answer = await exe.staff.submit(Command.ACK_ALERT, "battery_low")
+        answer = await exe.staff.submit(Command.ACK_ALERT, "battery_low", by="console")
         assert answer.ok, answer.text
         acted.append(exe.clock.now())
 
@@ -421,6 +428,14 @@ def main() -> None:
     p.add_argument("--help-each", type=int, default=4, help="tours of each help kind (0: none)")
     p.add_argument("--jobs", type=int, default=2, help="tours recorded at once (processes)")
     a = p.parse_args()
+    for option, value, least in (
+        ("--days", a.days, 1),
+        ("--tours-per-day", a.tours_per_day, 1),
+        ("--jobs", a.jobs, 1),
+        ("--help-each", a.help_each, 0),
+    ):
+        if value < least:
+            p.error(f"{option} {value}: expected {least} or more")
     if a.help_each * len(HELP_KINDS) > a.days * a.tours_per_day:
         p.error(
             f"--help-each {a.help_each}: {a.help_each * len(HELP_KINDS)} help tours "

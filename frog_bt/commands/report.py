@@ -142,17 +142,28 @@ def run(args: argparse.Namespace) -> int:
         print(f"frog-bt report: no such file or directory: {', '.join(missing)}", file=sys.stderr)
         return 2
     files = recordings(args.files)
-    if not files or (other and not recordings(other)):
-        print("frog-bt report: no recordings (*.mcap) found", file=sys.stderr)
+    for given, found in ((args.files, files), (other, recordings(other) if other else [1])):
+        if not found:
+            where = ", ".join(str(p) for p in given)
+            print(f"frog-bt report: no recordings (*.mcap) found in {where}", file=sys.stderr)
+            return 2
+    same = {p.resolve() for p in args.files} & {p.resolve() for p in other}
+    if same:
+        print(
+            f"frog-bt report: --compare {', '.join(map(str, sorted(same)))}: the same "
+            "recordings on both sides",
+            file=sys.stderr,
+        )
         return 2
     bar = None if args.quiet or not sys.stderr.isatty() else CountBar(sys.stderr, "report", "files")
     try:
         with executor(args.jobs, args.scheduler) as pool:
             _, rows, t, skipped = _season(args.files, site, pool, bar)
             if other:
-                _, _, t_b, _ = _season(other, site, pool, bar)
+                _, _, t_b, skipped_b = _season(other, site, pool, bar)
                 name = ", ".join(str(p) for p in args.files)
                 t["compare"] = compare(t, t_b, name, ", ".join(str(p) for p in other))
+                t["compare"]["skipped_b"] = skipped_b
     except ExecutorError as exc:
         print(f"frog-bt report: {exc}", file=sys.stderr)
         return 2
@@ -162,6 +173,12 @@ def run(args: argparse.Namespace) -> int:
         f"completed ({'-' if rate is None else f'{100 * rate:.1f} %'}), "
         f"{t['resumed']} resumed, {len(skipped)} skipped"
     )
+    if other:
+        c = t["compare"]
+        print(
+            f"frog-bt report: --compare: {c['tours'][1]} tours, {c['completed'][1]} completed, "
+            f"{len(c['skipped_b'])} skipped"
+        )
     try:
         if args.csv:
             outputs.write_csv(rows, args.csv)

@@ -209,6 +209,11 @@ def test_a_cut_file_is_read_to_the_cut_and_a_foreign_one_is_skipped(
     assert "cut short" in err
     assert got["totals"]["tours"] == 2 and got["totals"]["unreadable_files"] == 1
     assert [r["ended"] for r in got["tours"]] == ["ended", "cut"]
+    # the outputs keep both: the file skipped with why, the one read in part with how much
+    prov = got["totals"]["provenance"]
+    assert [s.split(": ", 1)[1] for s in prov["skipped"]] == ["not an MCAP file"]
+    ((cut,),) = [prov["cut_short"]]
+    assert cut.startswith(str(work / files[1].name) + ": cut short") and "recovered" in cut
 
 
 def test_the_pieces_of_a_tour_are_joined_into_one() -> None:

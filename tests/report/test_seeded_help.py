@@ -8,6 +8,7 @@ tiny seasons that differ in one seeded rate."""
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from collections import Counter
@@ -156,6 +157,30 @@ def test_compare_tells_the_seeded_difference_from_the_same_rate(tmp_path) -> Non
     completion = got["completion"]
     assert completion["difference"] == 0.0 and not completion["significant"]
     assert completion["low"] < 0 < completion["high"]
+    # the page shows it too: a table under the summary, a row per rate
+    html = tmp_path / "c.html"
+    assert main(["report", str(a), "--compare", str(b), "-o", str(html), "--quiet"]) == 0
+    table = html.read_text().split('id="compare">', 1)[1].split("</table>", 1)[0]
+    cells = {
+        row[0]: row
+        for row in (re.findall(r"<td>(.*?)</td>", r) for r in table.split("<tr>"))
+        if row
+    }
+    assert cells["part_b:POI2"][3] == "-100.0 points" and cells["part_b:POI2"][5] == "yes"
+    assert cells["completion"][3] == "+0.0 points" and cells["completion"][5] == "no"
+
+
+def test_compare_mistakes_are_named(tmp_path, capsys) -> None:
+    empty, some = tmp_path / "empty", tmp_path / "some"
+    empty.mkdir()
+    some.mkdir()
+    (some / "junk.mcap").write_bytes(b"not a recording")
+    assert main(["report", str(some), "--compare", str(empty), "--quiet"]) == 2
+    assert f"no recordings (*.mcap) found in {empty}" in capsys.readouterr().err
+    assert main(["report", str(empty), "--quiet"]) == 2
+    assert f"found in {empty}" in capsys.readouterr().err
+    assert main(["report", str(some), "--compare", str(some), "--quiet"]) == 2
+    assert "the same recordings on both sides" in capsys.readouterr().err
 
 
 def test_check_report_holds_the_season(season) -> None:

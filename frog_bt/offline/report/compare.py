@@ -19,4 +19,5 @@ def compare(a: dict[str, Any], b: dict[str, Any], a_name: str, b_name: str) -> d
             name: difference(rates_a[name], rates_b[name]) for name in rates_a if name in rates_b
         },
         "tours": [a["tours"], b["tours"]],
+        "completed": [a["completed"], b["completed"]],
     }

@@ -88,8 +88,15 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
         raise MissingExtra(f"the HTML report needs matplotlib: {EXTRA}") from exc
     out = []
 
+    from matplotlib.ticker import MaxNLocator
+
     def bar(
-        title: str, data: dict[Any, float], xlabel: str, ylabel: str, rotate: bool = False
+        title: str,
+        data: dict[Any, float],
+        xlabel: str,
+        ylabel: str,
+        rotate: bool = False,
+        counts: bool = False,
     ) -> None:
         fig, ax = plt.subplots(figsize=(5.2, 2.7))
         ax.bar([str(k) for k in data], list(data.values()), color="#3a6ea5")
@@ -97,6 +104,8 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
         ax.set_ylabel(ylabel)
         if rotate:
             ax.tick_params(axis="x", labelrotation=45)
+        if counts:  # whole tours, visitors: no 0.5 on the axis
+            ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(axis="y", alpha=0.3)
         out.append((title, _png(fig)))
         plt.close(fig)
@@ -106,16 +115,19 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
         ax.hist(values, bins=20, color="#3a6ea5")
         ax.set_xlabel(xlabel)
         ax.set_ylabel("tours")
+        ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(axis="y", alpha=0.3)
         out.append((title, _png(fig)))
         plt.close(fig)
 
-    bar("Tours per day", t["tours_per_day"], "day", "tours", rotate=True)
+    bar("Tours per day", t["tours_per_day"], "day", "tours", rotate=True, counts=True)
     bar(
         "Tours per hour of the day",
         {f"{h}:00": n for h, n in t["tours_per_hour"].items()},
         "hour (local time)",
         "tours",
+        rotate=True,
+        counts=True,
     )
     rates = {poi: 100 * r for poi, r in t["part_b_rate"].items() if r is not None}
     if rates:
@@ -134,7 +146,7 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
         out.append(("Time at each stop", _png(fig)))
         plt.close(fig)
     if t["funnel"]:
-        bar("Where visitors drop out", t["funnel"], "stop", "visitors", rotate=True)
+        bar("Where visitors drop out", t["funnel"], "stop", "visitors", rotate=True, counts=True)
     days = t["per_day"]
     if days:
         fig, ax = plt.subplots(figsize=(5.2, 2.7))
@@ -147,7 +159,8 @@ def plots(rows: list[Row], t: dict[str, Any]) -> list[tuple[str, str]]:
             ax.errorbar(xs, ys, yerr=[lo, hi], marker="o", capsize=3, label=name)
         ax.set_xticks(range(len(days)), list(days), rotation=45)
         ax.set_ylabel("% (95 % interval)")
-        ax.legend(loc="lower left")
+        ax.set_ylim(top=118)  # room above 100 % for the legend, clear of the bars
+        ax.legend(loc="upper center", ncols=2, frameon=False)
         ax.grid(axis="y", alpha=0.3)
         out.append(("Per day: completion and part b", _png(fig)))
         plt.close(fig)

@@ -32,6 +32,11 @@ def _or_dash(x: object) -> str:
     return DASH if x is None else str(x)
 
 
+def _n(count: int, thing: str) -> str:
+    """``1 alert``, ``2 alerts``."""
+    return f"{count} {thing}" if count == 1 else f"{count} {thing}s"
+
+
 def pct(x: float | None) -> str:
     return "\u2013" if x is None else f"{100 * x:.1f} %"
 
@@ -84,7 +89,10 @@ def reliability(rel: dict[str, Any]) -> str:
     iv = rel["interventions"]
     mtbf = rel["mean_hours_between_failures"]
     lines = [
-        ("Hours in service", f"{rel['hours_in_service']:g} h over {rel['robot_days']} robot-days"),
+        (
+            "Hours in service",
+            f"{rel['hours_in_service']:g} h over {_n(rel['robot_days'], 'robot-day')}",
+        ),
         ("Tours per hour in service", str(rel["tours_per_hour_in_service"] or "\u2013")),
         (
             "Interventions per 100 tours",
@@ -102,7 +110,7 @@ def reliability(rel: dict[str, Any]) -> str:
             "none acknowledged"
             if ack is None
             else f"median {ack['median']:g} s, 90th percentile {ack['p90']:g} s "
-            f"({rel['acknowledged']} alerts)",
+            f"({_n(rel['acknowledged'], 'alert')})",
         ),
         (
             "Distance per robot-day",
@@ -120,7 +128,7 @@ def reliability(rel: dict[str, Any]) -> str:
 
 
 def per_day(t: dict[str, Any], rel: dict[str, Any] | None) -> str:
-    head = ["day", "tours", "completion", "part b", "interventions"]
+    head = ["day", "tours", "completion", "part b (all stops' visits)", "interventions"]
     if rel is not None:
         head += ["hours in service", "autonomy", "km"]
     rows = []
@@ -162,10 +170,17 @@ def funnel(t: dict[str, Any]) -> str:
 
 def engagement(t: dict[str, Any]) -> str:
     rows = []
-    for by, label in (("by_stop", "stop"), ("by_hour", "hour"), ("by_variant", "variant")):
+    for by, label in (
+        ("by_stop", "stop"),
+        ("by_hour", "hour (all stops)"),
+        ("by_variant", "variant"),
+    ):
         for key, r in t["engagement"][by].items():
             rows.append([label, f"{key}:00" if by == "by_hour" else key, rate(r)])
-    return _grid(["by", "", "part b played (95 % interval)"], rows, "engagement")
+    return _grid(["by", "", "part b played (95 % interval)"], rows, "engagement") + (
+        "<p>Pooled figures count each visit (a visitor's stops are not independent "
+        "trials, so their intervals are narrower than they should be).</p>"
+    )
 
 
 def causes(t: dict[str, Any]) -> str:
@@ -182,7 +197,11 @@ def _when(iso: str | None) -> str:
 
 def provenance(p: dict[str, Any]) -> str:
     lines = [
-        ("Recordings", f"{p['files']} files read, {len(p['skipped'])} skipped"),
+        (
+            "Recordings",
+            f"{p['files']} files read ({len(p.get('cut_short', []))} of them cut short), "
+            f"{len(p['skipped'])} skipped",
+        ),
         ("From (local time)", _when(p["first"])),
         ("To (local time)", _when(p["last"])),
         ("Written by", ", ".join(f"{k} ({n} files)" for k, n in p["versions"].items()) or "\u2013"),
@@ -195,8 +214,11 @@ def provenance(p: dict[str, Any]) -> str:
             ", ".join(f"{k} ({n} files)" for k, n in p["configs"].items()) or "\u2013",
         ),
     ]
-    skipped = "".join(f"<li>{e(s)}</li>" for s in p["skipped"])
-    return _table(lines, "provenance") + (f'<ul class="skip">{skipped}</ul>' if skipped else "")
+    skipped = "".join(f"<li>skipped: {e(s)}</li>" for s in p["skipped"])
+    cut = "".join(f"<li>read in part: {e(s)}</li>" for s in p.get("cut_short", []))
+    return _table(lines, "provenance") + (
+        f'<ul class="skip">{skipped}{cut}</ul>' if skipped or cut else ""
+    )
 
 
 def compare(c: dict[str, Any]) -> str:
@@ -211,8 +233,13 @@ def compare(c: dict[str, Any]) -> str:
         ]
         for name, d in c["rates"].items()
     ]
-    return f"<p>{e(c['a'])} (A) beside {e(c['b'])} (B).</p>" + _grid(
-        ["rate", "A", "B", "B \u2212 A", "95 % interval", "differs"], rows, "compare"
+    skipped = "".join(f"<li>{e(s)}</li>" for s in c.get("skipped_b", []))
+    return (
+        f"<p>{e(c['a'])} (A) beside {e(c['b'])} (B). Each rate with its 95 % interval; "
+        "the difference with the interval of B \u2212 A (Newcombe's hybrid score): it "
+        "differs when that interval leaves 0 out.</p>"
+        + _grid(["rate", "A", "B", "B \u2212 A", "95 % interval", "differs"], rows, "compare")
+        + (f'<p>Skipped in B:</p><ul class="skip">{skipped}</ul>' if skipped else "")
     )
 
 
@@ -425,6 +452,7 @@ def page(
 <style>{STYLE}</style></head><body>
 <h1>{e(title)}</h1>
 <div class="cols">{"".join(f"<div>{s}</div>" for s in sections)}</div>
+{"<h2>Compared: A beside B</h2>" + compare(t["compare"]) if "compare" in t else ""}
 {extra}
 <h2>Per day</h2>{per_day(t, rel)}
 <div class="cols"><div><h2>Stop by stop: where visitors drop out</h2>{funnel(t)}

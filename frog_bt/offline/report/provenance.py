@@ -1,7 +1,8 @@
 """Where the figures come from: the recordings' date range, the frog-bt versions that
 wrote them (the MCAP header's ``library``), the trees that ran (a hash of
 ``/frog_bt/tree``), the site configurations (their hash, recorded at start: metadata
-``frog_bt_site``), and the files skipped and why."""
+``frog_bt_site``), the files skipped and why, and those read only in part (cut short:
+what was recovered)."""
 
 from __future__ import annotations
 
@@ -31,4 +32,5 @@ def provenance(facts: list[FileFacts], skipped: list[str]) -> dict[str, Any]:
         "trees": dict(Counter(f.tree or NOT_RECORDED for f in read).most_common()),
         "configs": dict(Counter(f.config or NOT_RECORDED for f in read).most_common()),
         "skipped": skipped,
+        "cut_short": [f"{f.file}: {f.recovered}" for f in read if f.recovered],
     }
