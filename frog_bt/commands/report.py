@@ -28,6 +28,7 @@ import argparse
 import importlib.util
 import json
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -81,12 +82,15 @@ def _season(
     from frog_bt.offline.report.corpus import read_corpus
     from frog_bt.offline.report.provenance import provenance
     from frog_bt.offline.report.reliability import reliability
+    from frog_bt.offline.report.rows import overlapping
     from frog_bt.offline.report.rows import rows as tour_rows
     from frog_bt.offline.report.totals import totals
 
     facts = read_corpus(recordings(paths), site, pool, bar)
     if bar is not None:
         bar.clear()
+    copies = overlapping([f for f in facts if not f.error])
+    facts = [replace(f, error=copies[f.file]) if f.file in copies else f for f in facts]
     skipped = [f"{f.file}: {f.error}" for f in facts if f.error]
     for line in skipped:
         print(f"frog-bt report: skipped {line}", file=sys.stderr)

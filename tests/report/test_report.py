@@ -429,3 +429,26 @@ def test_without_the_fleet_extra_scheduler_says_which(
         assert err == [
             f"frog-bt {command}: --scheduler needs dask.distributed: pip install 'frog-bt[fleet]'"
         ]
+
+
+def test_a_copy_beside_its_original_is_skipped_not_counted_twice(corpus, tmp_path) -> None:
+    """One robot's recordings cannot overlap in time: a (cut) copy of a file put beside
+    it is skipped and says why; the tour is counted once, as from the original alone."""
+    directory, _ = corpus
+    original = sorted(directory.glob("*.mcap"))[0]
+    alone, both = tmp_path / "alone", tmp_path / "both"
+    alone.mkdir()
+    both.mkdir()
+    shutil.copy(original, alone / original.name)
+    shutil.copy(original, both / original.name)
+    data = original.read_bytes()
+    (both / "copy.mcap").write_bytes(data[: len(data) // 2])
+    one = report(tmp_path, str(alone))
+    got = report(tmp_path, str(both))
+    (skipped,) = got["totals"]["provenance"]["skipped"]
+    assert skipped.startswith(str(both / "copy.mcap") + ": overlaps " + original.name)
+    assert got["totals"]["tours"] == 1
+    keep = ("approaches", "invitations", "visitors", "distance_m", "stops_visited", "ended")
+    assert [{k: r[k] for k in keep} for r in got["tours"]] == [
+        {k: r[k] for k in keep} for r in one["tours"]
+    ]

@@ -491,6 +491,29 @@ def by_robot(files: list[FileFacts]) -> dict[str, list[FileFacts]]:
     return robots
 
 
+OVERLAP_S = 1.0  # seconds two of one robot's files may share (a rotation's seam)
+
+
+def overlapping(files: list[FileFacts]) -> dict[str, str]:
+    """Files of one robot that overlap another of its files in time, which one robot's
+    recordings cannot (a copy, or a cut copy, put beside the original): file -> why.
+    Of two, the one that covers more time is read."""
+    out: dict[str, str] = {}
+    for group in by_robot(files).values():
+        kept: FileFacts | None = None
+        for f in sorted(group, key=lambda f: f.start):
+            if kept is None or f.start >= kept.end - OVERLAP_S:
+                kept = f if kept is None or f.end > kept.end else kept
+                continue
+            shorter, longer = sorted((kept, f), key=lambda g: g.end - g.start)
+            out[shorter.file] = (
+                f"overlaps {Path(longer.file).name} in time, which one robot's recordings "
+                "cannot: a copy? (the longer one is read)"
+            )
+            kept = longer
+    return out
+
+
 def _during(spans: list[tuple[float, float, int]], t: float) -> int | None:
     """The tour whose span holds ``t`` (the latest to start, when two overlap)."""
     for start, end, i in reversed(spans):
