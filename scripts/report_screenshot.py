@@ -14,43 +14,22 @@ The window is made as tall as the page before each shot, so the shot is the whol
 from __future__ import annotations
 
 import argparse
-import shutil
 import sys
 import tempfile
 from pathlib import Path
 
-from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import WebDriverWait
 
 from frog_bt.cli import main as frog_bt
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from console_screenshot import browser  # headless Chromium, as for the console
 from corpus_run import make
 
 WIDTHS = (1400, 1024)
 TALL = "return Math.max(document.body.scrollHeight, document.documentElement.scrollHeight)"
 DAYS, PER_DAY, SEED, HELP_EACH = 2, 10, 1, 1
-
-
-def browser() -> webdriver.Chrome:
-    options = webdriver.ChromeOptions()
-    options.binary_location = shutil.which("chromium") or "chromium"
-    for arg in (
-        "--headless=new",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-dev-shm-usage",
-        "--hide-scrollbars",
-        "--no-proxy-server",
-        "--force-device-scale-factor=1",
-        "--window-size=1400,900",
-    ):
-        options.add_argument(arg)
-    return webdriver.Chrome(
-        service=Service(shutil.which("chromedriver") or "chromedriver"), options=options
-    )
 
 
 def shoot(page: Path, out: Path) -> list[Path]:

@@ -146,7 +146,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"frog-bt report: no such file or directory: {', '.join(missing)}", file=sys.stderr)
         return 2
     files = recordings(args.files)
-    for given, found in ((args.files, files), (other, recordings(other) if other else [1])):
+    sides = [(args.files, files)] + ([(other, recordings(other))] if other else [])
+    for given, found in sides:
         if not found:
             where = ", ".join(str(p) for p in given)
             print(f"frog-bt report: no recordings (*.mcap) found in {where}", file=sys.stderr)
@@ -164,10 +165,9 @@ def run(args: argparse.Namespace) -> int:
         with executor(args.jobs, args.scheduler) as pool:
             _, rows, t, skipped = _season(args.files, site, pool, bar)
             if other:
-                _, _, t_b, skipped_b = _season(other, site, pool, bar)
+                _, _, t_b, _ = _season(other, site, pool, bar)
                 name = ", ".join(str(p) for p in args.files)
                 t["compare"] = compare(t, t_b, name, ", ".join(str(p) for p in other))
-                t["compare"]["skipped_b"] = skipped_b
     except ExecutorError as exc:
         print(f"frog-bt report: {exc}", file=sys.stderr)
         return 2

@@ -10,24 +10,14 @@ where ``.ci/run`` installs it and the test must run.
 from __future__ import annotations
 
 import asyncio
-import os
-import shutil
 
-import pytest
+import chromium
 from console_tour import TOKEN, console_tour
 from test_faults import is_
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-DRIVER = shutil.which("chromedriver")
-if not (CHROMIUM and DRIVER) and os.environ.get("CI") != "true":
-    pytest.skip(
-        "Debian's chromium and chromium-driver are not installed "
-        "(apt-get install chromium chromium-driver)",
-        allow_module_level=True,
-    )
+chromium.require()
 
 from selenium import webdriver  # noqa: E402 - only where a browser can run it
-from selenium.webdriver.chrome.service import Service  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.support import expected_conditions  # noqa: E402
 from selenium.webdriver.support.ui import WebDriverWait  # noqa: E402
@@ -36,18 +26,7 @@ WAIT = 60.0  # seconds any one thing may take to show in the page (a bound, not 
 
 
 def browser() -> webdriver.Chrome:
-    options = webdriver.ChromeOptions()
-    options.binary_location = CHROMIUM or "chromium"
-    for arg in (
-        "--headless=new",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-dev-shm-usage",
-        "--window-size=1280,1600",
-        "--no-proxy-server",
-    ):
-        options.add_argument(arg)
-    return webdriver.Chrome(service=Service(DRIVER or "chromedriver"), options=options)
+    return chromium.browser(1280, 1600)
 
 
 def drive(url: str) -> tuple[list[str], str]:

@@ -17,28 +17,19 @@ except in CI (``CI=true``).
 from __future__ import annotations
 
 import asyncio
-import os
-import shutil
 from collections.abc import Iterator
 from typing import Any
 
+import chromium
 import pytest
 from console_tour import TOKEN, console_tour
 from test_faults import is_
 
 from frog_bt.model import keys
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-DRIVER = shutil.which("chromedriver")
-if not (CHROMIUM and DRIVER) and os.environ.get("CI") != "true":
-    pytest.skip(
-        "Debian's chromium and chromium-driver are not installed "
-        "(apt-get install chromium chromium-driver)",
-        allow_module_level=True,
-    )
+chromium.require()
 
 from selenium import webdriver  # noqa: E402 - only where a browser can run it
-from selenium.webdriver.chrome.service import Service  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.remote.webelement import WebElement  # noqa: E402
 from selenium.webdriver.support import expected_conditions  # noqa: E402
@@ -51,18 +42,7 @@ FAST = 400.0  # the simulator's speed once the page has answered
 @pytest.fixture(scope="module")
 def driver() -> Iterator[webdriver.Chrome]:
     """One browser for the whole walk-through, at phone size."""
-    options = webdriver.ChromeOptions()
-    options.binary_location = CHROMIUM or "chromium"
-    for arg in (
-        "--headless=new",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-dev-shm-usage",
-        "--window-size=390,844",
-        "--no-proxy-server",
-    ):
-        options.add_argument(arg)
-    browser = webdriver.Chrome(service=Service(DRIVER or "chromedriver"), options=options)
+    browser = chromium.browser(390, 844)
     try:
         yield browser
     finally:

@@ -12,13 +12,21 @@ from tour import Running, describe, fast
 from frog_bt.config import load_site
 from frog_bt.rehearsal import Rehearsal
 from frog_bt.runtime.checkpoint import load as load_checkpoint
+from frog_bt.sim.traffic import Record
 
 
-def commands_after(run: Running, t: float) -> list[str]:
+def commands_after(run: Running, since: float | Record) -> list[str]:
+    """What the executive sent from time ``since`` on, or after the record ``since`` (one
+    awaited with ``wait_for``: what came after it, even in the same simulated instant)."""
+    received = run.sim.received()
+    if isinstance(since, Record):
+        received = received[next(i for i, r in enumerate(received) if r is since) + 1 :]
+    else:
+        received = [r for r in received if r.t >= since]
     return [
         describe(r, run.summary)
-        for r in run.sim.received()
-        if r.t >= t and r.channel not in ("ack", "engagement", "volume")
+        for r in received
+        if r.channel not in ("ack", "engagement", "volume")
     ]
 
 
@@ -32,11 +40,15 @@ def is_(channel: str, **fields: object):
 
 async def _battery_low_during_content() -> tuple[list[str], int, str, str]:
     async with Running({}, once=True) as run:
-        await run.sim.wait_for(is_("start_poi", poi="POI1", part="a"), 60)
+        started = await run.sim.wait_for(is_("start_poi", poi="POI1", part="a"), 60)
         run.sim.world.battery.percentage = 12.0  # the battery sags mid-content
-        t = run.sim.clock.now()
         outcome = await run.finish()
-        return commands_after(run, t), outcome.code, outcome.reason, run.sim.world.docking_state
+        return (
+            commands_after(run, started),
+            outcome.code,
+            outcome.reason,
+            run.sim.world.docking_state,
+        )
 
 
 def test_battery_low_mid_content_aborts_politely_and_docks():
@@ -171,11 +183,10 @@ async def _battery_low_after_resume(tmp_path) -> tuple[list[str], int, str]:
         await sim.wait_for(is_("start_poi", poi="POI2", part="a"), 60)
         first.own_sim = False
     async with Running({}, sim=sim, listen=listen, checkpoint=checkpoint, once=True) as second:
-        await sim.wait_for(is_("start_poi", poi="POI3", part="a"), 60)
+        started = await sim.wait_for(is_("start_poi", poi="POI3", part="a"), 60)
         sim.world.battery.percentage = 12.0
-        t = sim.clock.now()
         outcome = await second.finish()
-        after = commands_after(second, t)
+        after = commands_after(second, started)
     await sim.stop()
     return after, outcome.code, outcome.reason
 

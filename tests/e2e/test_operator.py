@@ -28,13 +28,12 @@ def sent_(channel: str, **fields: object):
 
 async def _home_mid_content() -> tuple[list[str], int, str, str, str]:
     async with Running({}, once=True) as run:
-        await run.sim.wait_for(is_("start_poi", poi="POI1", part="a"), 60)
-        t = run.sim.clock.now()
+        started = await run.sim.wait_for(is_("start_poi", poi="POI1", part="a"), 60)
         answer = run.executive.core.command(Command.HOME)
         again = run.executive.core.command(Command.HOME)
         outcome = await run.finish()
         return (
-            commands_after(run, t),
+            commands_after(run, started),
             outcome.code,
             outcome.reason,
             answer.text,

@@ -25,15 +25,10 @@ from frog_bt.rehearsal import Rehearsal
 from frog_bt.runtime.observer import attach_all, listen
 from frog_bt.sim import scenario_from
 from frog_bt.sim.traffic import Record
+from tests.recording.recorded_tour import FAST_TOURS
 
 # Tours in about 0.6 s of wall time: a fast robot, short content, quick answers.
-FAST: dict[str, Any] = {
-    "speed": 400.0,
-    "navigation": {"speed": 3.0, "approach_time": 1.0},
-    "docking": {"undock_time": 2.0, "dock_time": 3.0},
-    "content": {"default": 4, "introduction": 3},
-    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0},
-}
+FAST = FAST_TOURS
 
 # kind -> (scenario, overrides, local start); one day each, so that no two overlap
 KINDS: dict[str, tuple[str, dict[str, Any], str]] = {

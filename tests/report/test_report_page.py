@@ -9,29 +9,21 @@ CI (``CI=true``).
 
 from __future__ import annotations
 
-import os
 import re
-import shutil
 import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import chromium
 import pytest
 
 from frog_bt.cli import main
+from tests.recording.recorded_tour import FAST_TOURS
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-DRIVER = shutil.which("chromedriver")
-if not (CHROMIUM and DRIVER) and os.environ.get("CI") != "true":
-    pytest.skip(
-        "Debian's chromium and chromium-driver are not installed "
-        "(apt-get install chromium chromium-driver)",
-        allow_module_level=True,
-    )
+chromium.require()
 
 from selenium import webdriver  # noqa: E402 - only where a browser can run it
-from selenium.webdriver.chrome.service import Service  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.remote.webelement import WebElement  # noqa: E402
 from selenium.webdriver.support.ui import Select, WebDriverWait  # noqa: E402
@@ -39,14 +31,6 @@ from selenium.webdriver.support.ui import Select, WebDriverWait  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 from corpus_run import ACK_AFTER_S, make  # noqa: E402
 
-# Tours in under a second of wall time (as tests/report/test_seeded_help.py)
-FAST_TOURS: dict[str, Any] = {
-    "speed": 400.0,
-    "navigation": {"speed": 3.0, "approach_time": 1.0},
-    "docking": {"undock_time": 2.0, "dock_time": 3.0},
-    "content": {"default": 4, "introduction": 3},
-    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0},
-}
 WIDTHS = (1400, 1024)
 WAIT = 10.0  # seconds any one thing may take to show in the page (a bound, not a pace)
 ONE_LINE_PX = 40  # a tour's row is one line of the table's text (about 25 px)
@@ -68,20 +52,7 @@ def season(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, list[str]]:
 
 @pytest.fixture(scope="module")
 def driver() -> Iterator[webdriver.Chrome]:
-    options = webdriver.ChromeOptions()
-    options.binary_location = CHROMIUM or "chromium"
-    for arg in (
-        "--headless=new",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-dev-shm-usage",
-        "--hide-scrollbars",
-        "--force-device-scale-factor=1",
-        "--window-size=1400,900",
-        "--no-proxy-server",
-    ):
-        options.add_argument(arg)
-    browser = webdriver.Chrome(service=Service(DRIVER or "chromedriver"), options=options)
+    browser = chromium.browser(1400, 900, "--hide-scrollbars", "--force-device-scale-factor=1")
     try:
         yield browser
     finally:

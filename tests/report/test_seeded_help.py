@@ -22,19 +22,12 @@ from frog_bt import __version__
 from frog_bt.cli import main
 from frog_bt.clock import SITE_TZ
 from frog_bt.config import fingerprint, load_site
+from tests.recording.recorded_tour import FAST_TOURS  # tours in under a second
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 from check_report import autonomy
 from corpus_run import HELP_KINDS, make
 
-# Tours in under a second of wall time (tests/recording/recorded_tour.py FAST_TOURS)
-FAST_TOURS: dict[str, Any] = {
-    "speed": 400.0,
-    "navigation": {"speed": 3.0, "approach_time": 1.0},
-    "docking": {"undock_time": 2.0, "dock_time": 3.0},
-    "content": {"default": 4, "introduction": 3},
-    "frontend": {"idle_at": 1.0, "idle_after_tour": 1.0, "answer_delay": 1.0},
-}
 SEED = 1  # 7 tours: one of each help kind, a bored visitor, a navigation failure
 DOCK_ATTEMPTS = 3  # config/site.yaml docking.attempts: all fail, then the robot asks
 
@@ -157,9 +150,12 @@ def test_compare_tells_the_seeded_difference_from_the_same_rate(tmp_path) -> Non
     completion = got["completion"]
     assert completion["difference"] == 0.0 and not completion["significant"]
     assert completion["low"] < 0 < completion["high"]
-    # the page shows it too: a table under the summary, a row per rate
+    # the page shows it too: a table under the summary, a row per rate, and B's files
+    # that were skipped (here one that is not a recording), each with why
+    (b / "notes.mcap").write_text("not a recording")
     html = tmp_path / "c.html"
     assert main(["report", str(a), "--compare", str(b), "-o", str(html), "--quiet"]) == 0
+    assert f"<li>{b / 'notes.mcap'}: not an MCAP file</li>" in html.read_text()
     table = html.read_text().split('id="compare">', 1)[1].split("</table>", 1)[0]
     cells = {
         row[0]: row

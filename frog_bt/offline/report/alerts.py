@@ -9,6 +9,7 @@ the ``ack_alert`` operator command that did it (``by``: console, ctl, link).
 
 from __future__ import annotations
 
+import bisect
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -62,10 +63,11 @@ class Episode:
 
 def runs_of(files: list[FileFacts]) -> list[Restart]:
     """One robot's executive starts, each with the end of the recording before it."""
+    ends = sorted(f.end for f in files)
     out = []
     for t in sorted(t for f in files for t in f.restarts):
-        before = [f.end for f in files if f.end <= t]
-        out.append(Restart(max(before) if before else t, t))
+        before = bisect.bisect_right(ends, t)  # the files ended by then; the last is latest
+        out.append(Restart(ends[before - 1] if before else t, t))
     return out
 
 

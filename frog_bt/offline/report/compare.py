@@ -20,4 +20,5 @@ def compare(a: dict[str, Any], b: dict[str, Any], a_name: str, b_name: str) -> d
         },
         "tours": [a["tours"], b["tours"]],
         "completed": [a["completed"], b["completed"]],
+        "skipped_b": b["provenance"]["skipped"],
     }

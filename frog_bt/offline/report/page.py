@@ -199,7 +199,7 @@ def provenance(p: dict[str, Any]) -> str:
     lines = [
         (
             "Recordings",
-            f"{p['files']} files read ({len(p.get('cut_short', []))} of them cut short), "
+            f"{p['files']} files read ({len(p['cut_short'])} of them cut short), "
             f"{len(p['skipped'])} skipped",
         ),
         ("From (local time)", _when(p["first"])),
@@ -215,7 +215,7 @@ def provenance(p: dict[str, Any]) -> str:
         ),
     ]
     skipped = "".join(f"<li>skipped: {e(s)}</li>" for s in p["skipped"])
-    cut = "".join(f"<li>read in part: {e(s)}</li>" for s in p.get("cut_short", []))
+    cut = "".join(f"<li>read in part: {e(s)}</li>" for s in p["cut_short"])
     return _table(lines, "provenance") + (
         f'<ul class="skip">{skipped}{cut}</ul>' if skipped or cut else ""
     )
@@ -233,7 +233,7 @@ def compare(c: dict[str, Any]) -> str:
         ]
         for name, d in c["rates"].items()
     ]
-    skipped = "".join(f"<li>{e(s)}</li>" for s in c.get("skipped_b", []))
+    skipped = "".join(f"<li>{e(s)}</li>" for s in c["skipped_b"])
     return (
         f"<p>{e(c['a'])} (A) beside {e(c['b'])} (B). Each rate with its 95 % interval; "
         "the difference with the interval of B \u2212 A (Newcombe's hybrid score): it "
