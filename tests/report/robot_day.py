@@ -20,7 +20,7 @@ from typing import Any
 from frog_bt.config import load_site
 from frog_bt.engine.operator import Command
 from frog_bt.live.rotation import RecordingDir
-from frog_bt.model.events import FrontendIn
+from frog_bt.model.events import FrontendIn, FrontendOut, RobotInput
 from frog_bt.rehearsal import Rehearsal
 from frog_bt.runtime.observer import attach_all, listen
 from frog_bt.sim import scenario_from
@@ -73,10 +73,12 @@ class Seen:
     reason: str
     frontend: list[dict[str, Any]] = field(default_factory=list)  # commands, in order
     ros: list[tuple[str, Any]] = field(default_factory=list)  # (topic, msg), in order
-    tour: list[float] = field(default_factory=list)  # times of `tour` started, ended/aborted
     answers: list[str] = field(default_factory=list)  # user_positive / user_negative sent
-    docked: list[float] = field(default_factory=list)  # times /docking/state said docked
     path_m: float = 0.0  # the robot's path, from the poses the simulator published
+    # the executives' own clock (what a recording is stamped with): when each sent `tour`
+    # (its state) and heard /docking/state say docked
+    told: list[tuple[float, str]] = field(default_factory=list)
+    heard_docked: list[float] = field(default_factory=list)
 
     def of(self, type_: str) -> list[dict[str, Any]]:
         return [m for m in self.frontend if m["type"] == type_]
@@ -84,11 +86,27 @@ class Seen:
     @property
     def duration(self) -> float:
         """From `tour started` to `tour ended` (docked by then), or to docked again after
-        `tour aborted`."""
-        end = self.tour[-1]
-        if self.of("tour")[-1]["state"] == "aborted":
-            end = next(t for t in self.docked if t >= end)
-        return end - self.tour[0]
+        `tour aborted`, as the executives timed them: the simulator's clock runs ahead of
+        theirs by the link's latency, many simulated seconds a wall millisecond at 400x."""
+        (start, _), (end, state) = self.told[0], self.told[-1]
+        if state == "aborted":
+            end = next(t for t in self.heard_docked if t >= end)
+        return end - start
+
+
+def hear(exe: Any, seen: Seen) -> None:
+    """Keep in ``seen`` what ``exe`` sent of the tour and heard of docking, when."""
+
+    def out(e: FrontendOut) -> None:
+        if e.message.type == "tour":
+            seen.told.append((e.t, str(e.message.state)))
+
+    def docking(e: RobotInput) -> None:
+        if e.topic == "/docking/state" and str(e.value) == "docked":
+            seen.heard_docked.append(e.t)
+
+    listen(exe, out, FrontendOut)
+    listen(exe, docking, RobotInput)
 
 
 def _merge(a: dict[str, Any], b: dict[str, Any]) -> dict[str, Any]:
@@ -133,26 +151,18 @@ ACTIONS: dict[str, Callable[[Rehearsal], Awaitable[None]]] = {
 }
 
 
-def _seen(kind: str, code: int, reason: str, records: list[Record]) -> Seen:
-    """The simulator's log, for one tour. The simulated front end logs a command once,
-    however often it was sent."""
-    seen = Seen(kind, code, reason)
+def _seen(kind: str, code: int, reason: str, records: list[Record], seen: Seen) -> Seen:
+    """The simulator's log, for one tour, into ``seen``. The simulated front end logs a
+    command once, however often it was sent."""
+    seen.code, seen.reason = code, reason
     pose: tuple[float, float] | None = None
     for rec in records:
         if rec.direction == "in" and rec.side == "frontend" and rec.channel != "ack":
             seen.frontend.append({"type": rec.channel, **rec.payload})
-            if rec.channel == "tour":
-                seen.tour.append(rec.t)
         elif rec.direction == "in" and rec.side == "ros":
             seen.ros.append((rec.channel, rec.payload))
         elif rec.direction == "out" and rec.channel in ("user_positive", "user_negative"):
             seen.answers.append(rec.channel)
-        elif (
-            rec.direction == "out"
-            and rec.channel == "/docking/state"
-            and rec.payload["data"] == "docked"
-        ):
-            seen.docked.append(rec.t)
         elif rec.direction == "out" and rec.channel == "/FROG_pose":
             p = rec.payload["pose"]["position"]
             if pose is not None:
@@ -165,9 +175,12 @@ async def _tour(directory: Path, kind: str) -> Seen:
     name, overrides, start = KINDS[kind]
     data = _merge(_merge(FAST, overrides), {"start_time": start + "+02:00"})
     site = load_site()
+    seen = Seen(kind, 0, "")
     recordings = RecordingDir(directory, 10**12)
     run = Rehearsal(
-        scenario_from(name, data), site=site, prepare=lambda exe: attach_all(exe, [recordings])
+        scenario_from(name, data),
+        site=site,
+        prepare=lambda exe: (attach_all(exe, [recordings]), hear(exe, seen)),
     )
     try:
         async with run:
@@ -177,7 +190,7 @@ async def _tour(directory: Path, kind: str) -> Seen:
             outcome = await run.finish(60)
     finally:
         recordings.close()
-    return _seen(kind, outcome.code, outcome.reason, list(run.sim.log))
+    return _seen(kind, outcome.code, outcome.reason, list(run.sim.log), seen)
 
 
 RESTART_INTO_POI2_S = 2.0  # simulated seconds of POI2's part a (4 s) before the stop
@@ -188,11 +201,12 @@ async def _resumed(directory: Path, checkpoint: Path) -> Seen:
     closes them) and a new executive that resumes it from the checkpoint."""
     name, _, start = KINDS["resumed"]
     site = load_site()
+    seen = Seen("resumed", 0, "")
     first = RecordingDir(directory, 10**12)
     run = Rehearsal(
         scenario_from(name, _merge(FAST, {"start_time": start + "+02:00"})),
         site=site,
-        prepare=lambda exe: attach_all(exe, [first]),
+        prepare=lambda exe: (attach_all(exe, [first]), hear(exe, seen)),
         checkpoint=checkpoint,
         once=False,
     )
@@ -210,7 +224,7 @@ async def _resumed(directory: Path, checkpoint: Path) -> Seen:
         sim=sim,
         listen=listen,
         site=site,
-        prepare=lambda exe: attach_all(exe, [second]),
+        prepare=lambda exe: (attach_all(exe, [second]), hear(exe, seen)),
         checkpoint=checkpoint,
     )
     try:
@@ -219,7 +233,7 @@ async def _resumed(directory: Path, checkpoint: Path) -> Seen:
     finally:
         second.close()
         await sim.stop()
-    return _seen("resumed", outcome.code, outcome.reason, list(sim.log))
+    return _seen("resumed", outcome.code, outcome.reason, list(sim.log), seen)
 
 
 def record(directory: str, kind: str) -> Seen:
