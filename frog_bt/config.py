@@ -104,6 +104,9 @@ class Timeouts(_Model):
 
 class Navigation(_Model):
     attempts: int = Field(default=3, ge=1)
+    # metres: an "arrived" is believed only this near its goal (by /FROG_pose), and
+    # `dock` is sent only this near the dock's waypoint
+    tolerance: Positive = 2.0
 
 
 class DockingCfg(_Model):

@@ -69,6 +69,11 @@ class Bench:
     def pose(self, x: float, y: float) -> None:
         self.ros("pose", Pose(self.clock.now(), "map", x, y, 0.0, 1.0))
 
+    def at(self, waypoint: str) -> None:
+        """The robot's pose at ``waypoint`` (an arrival there is then believed)."""
+        poi = self.site.pois[waypoint]
+        self.pose(poi.x, poi.y)
+
     def persons(self, *persons: tuple[int, float, float, float]) -> None:
         self.ros(
             "persons",

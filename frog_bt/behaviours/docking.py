@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import logging
+import math
 from typing import Literal
 
 from pydantic import Field
@@ -15,6 +17,7 @@ from frog_bt.tree.leaf import RUNNING, SUCCESS, Status
 
 TARGET = {"dock": DockingState.DOCKED, "undock": DockingState.UNDOCKED}
 BUSY = {"dock": DockingState.DOCKING, "undock": DockingState.UNDOCKING}
+log = logging.getLogger(__name__)
 FAILED_GRACE = 2.0  # seconds after the command from which a "failed" is surely about it
 
 
@@ -22,8 +25,11 @@ FAILED_GRACE = 2.0  # seconds after the command from which a "failed" is surely 
 class Docking(GoalLeaf):
     """Dock or undock and wait for the robot to report it done.
 
-    Reads ``/docking`` and ``/now``. Sends ``/docking/dock`` ``action`` in
-    initialise (not when the robot already reports the target state). SUCCESS
+    Reads ``/docking``, ``/now`` and ``/pose`` (optional). Sends ``/docking/dock``
+    ``action`` in initialise (not when the robot already reports the target state);
+    ``dock`` only at the dock's waypoint (``/pose`` within ``navigation.tolerance`` of
+    site ``tour.dock``): asked anywhere else, or with no pose, it fails at once with
+    that reason and sends nothing, so that the tree drives home again. SUCCESS
     on ``docked`` / ``undocked`` received after the command; FAILURE on
     ``failed`` once the robot has shown it took this command (``docking`` /
     ``undocking`` seen, or :data:`FAILED_GRACE` seconds passed: a ``failed`` left
@@ -42,6 +48,7 @@ class Docking(GoalLeaf):
 
     params: Params
     reads = (keys.DOCKING, keys.NOW)
+    optional_reads = (keys.POSE,)
 
     def default_timeout(self) -> float:
         timeouts = self.ctx.site.timeouts
@@ -51,13 +58,31 @@ class Docking(GoalLeaf):
         state = self.get(keys.DOCKING)
         self.already = state is not None and state.value == TARGET[self.params.action]
         self.took = False
+        self.away = None if self.already or self.params.action != "dock" else self._away()
+
+    def _away(self) -> str | None:
+        """Why the robot is not at the dock's waypoint (None: it is)."""
+        site = self.ctx.site
+        dock = site.tour.dock
+        reading = self.get(keys.POSE)
+        if reading is None:
+            return f"no pose: the robot may not be at {dock}"
+        here, there = reading.value, site.pois[dock]
+        away = math.hypot(here.x - there.x, here.y - there.y)
+        tolerance = site.navigation.tolerance
+        return f"the robot is {away:.0f} m from {dock}" if away > tolerance else None
 
     def send(self) -> None:
-        if not self.already:
+        if self.away is not None:
+            log.warning("dock not sent: %s", self.away)
+            self.ctx.note(f"dock not sent: {self.away}")
+        elif not self.already:
             self.ctx.actions.dock(self.params.action)
             self.ctx.note(f"{self.params.action}")
 
     def poll(self) -> Status | Failure:
+        if self.away is not None:
+            return Failure.AWAY
         if self.already:
             return SUCCESS
         assert self.sent_at is not None
@@ -74,6 +99,9 @@ class Docking(GoalLeaf):
         return RUNNING
 
     def failed(self, why: Failure) -> None:
+        if why is Failure.AWAY:
+            self.feedback_message = f"not at the dock: {self.away}"
+            return  # noted as it was not sent; nothing failed at the dock
         action = self.params.action
         self.ctx.note(
             f"{action}: no {TARGET[action]} within {self.timeout:g} s"

@@ -51,6 +51,7 @@ class Failure(enum.Enum):
     REFUSED = "refused"  # the robot answered failure (/FROG_response 3 or 4, docking failed)
     REPLACED = "replaced"  # a newer goal replaced it: one is pending at a time (CONTRACT §1)
     TIMED_OUT = "timed out"
+    AWAY = "not at its place"  # asked where it cannot be done (dock away from the dock)
 
 
 class TimedParams(NodeParams, Protocol):

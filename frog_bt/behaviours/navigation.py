@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from pydantic import Field, ValidationInfo, field_validator
 
 from frog_bt.behaviours.goal_leaf import Failure, GoalLeaf
@@ -98,6 +100,32 @@ class Navigate(GoalLeaf):
     def progress(self) -> str:
         assert self.goal is not None and self.latest is not None
         return f"{self.goal.target}: {self.latest.state()}"
+
+
+@register
+class AtPoi(Leaf):
+    """Is the robot at ``poi`` (its time-of-day variant now)?
+
+    Reads ``/pose`` (optional). SUCCESS when the latest pose is within
+    ``navigation.tolerance`` metres of it; FAILURE otherwise, and with no pose (where
+    the robot is cannot be believed without one).
+    """
+
+    Params = PoiParams
+    params: PoiParams
+    optional_reads = (keys.POSE,)
+
+    def update(self) -> Status:
+        site = self.ctx.site
+        waypoint = site.waypoint_for(self.params.poi, self.ctx.clock.local_time().time())
+        reading = self.get(keys.POSE)
+        if reading is None:
+            self.feedback_message = "no pose yet"
+            return FAILURE
+        here, there = reading.value, site.pois[waypoint]
+        away = math.hypot(here.x - there.x, here.y - there.y)
+        self.feedback_message = f"{away:.1f} m from {waypoint}"
+        return SUCCESS if away <= site.navigation.tolerance else FAILURE
 
 
 @register

@@ -22,6 +22,7 @@ from frog_bt.model.outcomes import (
 )
 from frog_bt.model.progress import EMPTY, Progress
 from frog_bt.model.ros import Diagnostics
+from frog_bt.text import LINE, inert
 from frog_bt.tree.decorators import FrogDecorator
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
 
@@ -72,8 +73,8 @@ class MustAbort(Leaf):
             return FAILURE
         reason: AbortReason | None = None
         if diagnostics.faults:
-            reason = AbortReason(
-                AbortCause.FAULT, "electronics fault: " + "; ".join(diagnostics.faults)
+            reason = AbortReason(  # each fault is inert already; the whole is bounded too
+                AbortCause.FAULT, inert("electronics fault: " + "; ".join(diagnostics.faults), LINE)
             )
         elif diagnostics.battery is not None and diagnostics.battery < cfg.battery_low:
             reason = AbortReason(

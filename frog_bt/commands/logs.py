@@ -1,5 +1,9 @@
 """Logging for a terminal, a journal or a log shipper (``frog-bt run --log-format``).
 
+Every line is one record: a message's control characters are shown escaped
+(:class:`~frog_bt.text.InertFormatter`), so robot text never forges a line or moves a
+terminal's cursor.
+
 * ``text`` (default): ``LEVEL logger: message``; under systemd (``$JOURNAL_STREAM`` set)
   each line starts with its syslog priority (``<4>`` for a warning), so journald keeps
   the levels (``journalctl -p warning``).
@@ -14,6 +18,8 @@ import logging
 import os
 import sys
 
+from frog_bt.text import InertFormatter, escape
+
 PRIORITY = {
     logging.CRITICAL: 2,
     logging.ERROR: 3,
@@ -23,7 +29,7 @@ PRIORITY = {
 }  # syslog priorities, as sd-daemon(3) prefixes them
 
 
-class JournalFormatter(logging.Formatter):
+class JournalFormatter(InertFormatter):
     def format(self, record: logging.LogRecord) -> str:
         line = super().format(record)
         prefix = f"<{PRIORITY.get(record.levelno, 6)}>"
@@ -36,7 +42,7 @@ class JsonFormatter(logging.Formatter):
             "t": round(record.created, 3),
             "level": record.levelname,
             "logger": record.name,
-            "msg": record.getMessage(),
+            "msg": escape(record.getMessage()),
         }
         if record.exc_info:
             out["exc"] = self.formatException(record.exc_info)
@@ -51,7 +57,7 @@ def setup(verbose: bool = False, fmt: str = "text") -> None:
     elif os.environ.get("JOURNAL_STREAM"):
         handler.setFormatter(JournalFormatter(text))
     else:
-        handler.setFormatter(logging.Formatter(text))
+        handler.setFormatter(InertFormatter(text))
     root = logging.getLogger()
     for old in list(root.handlers):
         root.removeHandler(old)

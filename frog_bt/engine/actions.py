@@ -5,6 +5,10 @@ no goal id, so at most one of them is pending at a time: a new goal replaces
 the active one (CONTRACT §1), and a response that arrives while nothing is
 pending is stale and ignored.
 
+An answer is believed only when it fits what else the robot says (its pose, the order
+of its answers: :mod:`frog_bt.engine.belief`); one that does not is told to
+``on_doubt`` and never acted on.
+
 Results reach the tree as values, not by mutation: the pre-tick step applies the
 responses that arrived (:meth:`Actions.on_response`) and writes the newest goal's state
 to :data:`frog_bt.model.keys.GOAL`, so every tick sees one consistent state. A leaf
@@ -22,46 +26,65 @@ from dataclasses import replace
 
 from frog_bt.clock import Clock
 from frog_bt.config import Poi
+from frog_bt.engine.belief import Judgement, Verdict, World, judge
 from frog_bt.model.goals import Goal
 from frog_bt.model.ros import Pose
-from frog_bt.model.wire import Response
+from frog_bt.model.wire import ACTIVE, Response
 
 log = logging.getLogger(__name__)
 
 # (output role, value: the wire table encodes it, the goal it carries: goto and approach)
 Publish = Callable[[str, object, "Goal | None"], None]
+Doubt = Callable[[int, Goal, Judgement], None]  # an answer not believed: code, goal, why
 
 
 class Actions:
     """Publishes robot commands by role (``goto``, ``approach``, ``icl``, ``dock``) and
     tracks the one pending goal (a service: leaves learn results from the blackboard)."""
 
-    def __init__(self, publish: Publish, clock: Clock) -> None:
+    def __init__(
+        self,
+        publish: Publish,
+        clock: Clock,
+        poses: Callable[[], int] = lambda: 0,
+        on_doubt: Doubt | None = None,
+    ) -> None:
         self._publish = publish
         self._clock = clock
+        self._poses = poses  # /FROG_pose messages received so far
+        self.on_doubt = on_doubt
         self._ids = itertools.count(1)
         self.pending: Goal | None = None
         self.latest: Goal | None = None  # the newest goal sent, with its latest response
+        # the goal the pending one replaced while it was still open: its answer may come yet
+        self.before: Goal | None = None
         self.stale_responses = 0
+        self.doubted = 0  # answers not believed (stale by order, or not what the world shows)
         self.last_approach_at = -math.inf  # project-clock time of the last approach sent
 
     def goto(self, waypoint: str, poi: Poi) -> Goal:
         now = self._clock.now()
         pose = Pose(now, "map", poi.x, poi.y, poi.z, poi.w)
-        goal = self._replace(Goal(next(self._ids), "goto", waypoint, now, pose))
+        goal = self._replace(
+            Goal(next(self._ids), "goto", waypoint, now, pose, poses=self._poses())
+        )
         self._publish("goto", pose, goal)
         return goal
 
     def stop(self, here: Pose) -> Goal:
         """Stop driving now: a goal at the robot's own pose replaces the active one
         (CONTRACT §1: a new goal replaces the active one). The robot then stands."""
-        goal = self._replace(Goal(next(self._ids), "goto", "(stop here)", here.stamp, here))
+        goal = self._replace(
+            Goal(next(self._ids), "goto", "(stop here)", here.stamp, here, poses=self._poses())
+        )
         self._publish("goto", here, goal)
         return goal
 
     def approach(self, person_id: int) -> Goal:
         self.last_approach_at = now = self._clock.now()
-        goal = self._replace(Goal(next(self._ids), "approach", str(person_id), now, person_id))
+        goal = self._replace(
+            Goal(next(self._ids), "approach", str(person_id), now, person_id, poses=self._poses())
+        )
         self._publish("approach", person_id, goal)
         return goal
 
@@ -75,6 +98,9 @@ class Actions:
         return goal
 
     def _replace(self, goal: Goal) -> Goal:
+        latest = self.latest
+        # An open goal replaced (or cancelled and then replaced): its answer may still come
+        self.before = latest if latest is not None and not latest.done else None
         self.pending = self.latest = goal
         return goal
 
@@ -83,9 +109,11 @@ class Actions:
         if goal is not None and self.pending is not None and self.pending.id == goal.id:
             self.pending = None
 
-    def on_response(self, code: int, at: float) -> Goal | None:
+    def on_response(self, code: int, at: float, world: World | None = None) -> Goal | None:
         """Apply one ``/FROG_response`` code; the goal it answered, if any. A code the
-        contract does not know is counted as stale."""
+        contract does not know, or one that comes with nothing pending, is counted as
+        stale; with ``world`` (what else the robot said), one that does not fit the
+        pending goal is not believed (:func:`~frog_bt.engine.belief.judge`)."""
         goal = self.pending
         known = Response.of(code)
         if goal is None or known is None:
@@ -96,7 +124,19 @@ class Actions:
                 "nothing pending" if known is not None else "unknown code",
             )
             return None
-        goal = replace(goal, code=known, answered_at=at)
+        if world is not None:
+            judgement = judge(goal, code, world, self.before)
+            if judgement.verdict is not Verdict.BELIEVED:
+                self.doubted += 1
+                if judgement.verdict is Verdict.STALE:
+                    self.stale_responses += 1
+                    if self.before is not None and code != ACTIVE:
+                        self.before = None  # the one answer it was still owed has come
+                if self.on_doubt is not None:
+                    self.on_doubt(code, goal, judgement)
+                return None
+        goal = replace(goal, code=known, answered_at=at, acknowledged=True)
+        self.before = None  # the robot has answered this goal: an older answer is no more due
         self.pending = None if goal.done else goal
         if self.latest is not None and self.latest.id == goal.id:
             self.latest = goal

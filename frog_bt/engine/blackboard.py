@@ -16,6 +16,7 @@ from typing import Any, TypeVar
 
 from frog_bt.clock import Clock
 from frog_bt.engine.actions import Actions
+from frog_bt.engine.belief import World
 from frog_bt.model import keys
 from frog_bt.model.eventlog import EventLog
 from frog_bt.model.frontend import FrontendIdle, FrontendMessage
@@ -78,18 +79,22 @@ class Inputs:
             i.key: [] for i in table.values() if i.keep is not Keep.LATEST
         }
         self.events: list[tuple[FrontendMessage, float]] = []
+        self.poses = 0  # /FROG_pose messages received so far: the order of the robot's answers
 
     def add(self, inp: Input, value: Any, at: float) -> None:
-        """Cache one decoded message of ``inp``."""
+        """Cache one decoded message of ``inp``. A queued one (``/FROG_response``) keeps
+        how many poses had arrived before it (:mod:`frog_bt.engine.belief`: order)."""
         if inp.keep is Keep.LATEST:
             self.latest[inp.key] = Reading(value, at)
+            if inp.key is keys.POSE:
+                self.poses += 1
             return
         pending = self.pending[inp.key]
         if inp.keep is Keep.SAMPLES:
             assert inp.items is not None
             pending.extend((at, item) for item in inp.items(value))
         else:
-            pending.append((value, at))
+            pending.append((value, at, self.poses))
         if len(pending) > inp.limit:
             del pending[: len(pending) - inp.limit]  # a stalled tick must not grow memory
 
@@ -98,11 +103,20 @@ class Snapshot:
     """Writes the input keys once per tick (the pre-tick step): the clock, the latest
     inputs, the front end's events, and the newest goal with the responses applied."""
 
-    def __init__(self, board: Board, inputs: Inputs, clock: Clock, actions: Actions) -> None:
+    def __init__(
+        self,
+        board: Board,
+        inputs: Inputs,
+        clock: Clock,
+        actions: Actions,
+        believe: tuple[float, float] | None = None,
+    ) -> None:
         self.board = board
         self.inputs = inputs
         self.clock = clock
         self.actions = actions
+        # (navigation.tolerance, recruit.detection_max_age): judge the robot's answers
+        self.believe = believe
         events = board.get(keys.EVENTS)  # the executive's, kept across trees
         self.events = events if events is not None else EventLog()
         if not board.written(keys.FRONTEND_READY):
@@ -124,6 +138,17 @@ class Snapshot:
                     set_(keys.FRONTEND_READY, True)
             inp.events.clear()
         set_(keys.EVENTS, self.events)
-        for code, at in self.board.get(keys.RESPONSES) or ():
-            self.actions.on_response(code, at)
+        board, believe = self.board, self.believe
+        for code, at, poses in board.get(keys.RESPONSES) or ():
+            world = None
+            if believe is not None:
+                world = World(
+                    now=board.get(keys.NOW) or at,
+                    pose=board.get(keys.POSE),
+                    persons=board.get(keys.PERSONS),
+                    poses_at_answer=poses,
+                    tolerance=believe[0],
+                    detection_max_age=believe[1],
+                )
+            self.actions.on_response(code, at, world)
         set_(keys.GOAL, self.actions.latest)

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from frog_bt.clock import Clock
 from frog_bt.config import Site
 from frog_bt.engine.actions import Actions
+from frog_bt.engine.faults import Faults
 from frog_bt.engine.journal import Journal
 from frog_bt.model.frontend import FrontendMessage
 from frog_bt.model.outcomes import Incident, IncidentKind
@@ -28,6 +29,7 @@ class Context:
     actions: Actions
     send: Callable[[FrontendMessage], None]
     journal: Journal
+    faults: Faults | None = None  # where a node's failure of its own code is counted
 
     def note(
         self, text: str, incident: IncidentKind | None = None, subject: str = ""

@@ -22,6 +22,7 @@ from frog_bt.clock import Clock
 from frog_bt.config import Site
 from frog_bt.engine import observed
 from frog_bt.engine.actions import Actions
+from frog_bt.engine.belief import Judgement
 from frog_bt.engine.blackboard import Board, Inputs, Snapshot
 from frog_bt.engine.context import Context
 from frog_bt.engine.loaded import LoadedTree
@@ -31,7 +32,9 @@ from frog_bt.engine.standing import Standing
 from frog_bt.model import keys
 from frog_bt.model.events import (
     Blamed,
+    Doubted,
     Event,
+    Faulted,
     FrontendIn,
     FrontendOut,
     OperatorDone,
@@ -81,12 +84,23 @@ class Core:
         if standing.inputs is None:
             standing.inputs = Inputs(self.table)
         self.inputs = standing.inputs  # what the robot last said still holds after a reload
-        self.actions = Actions(self._publish, clock)
+        inputs = self.inputs
+        self.actions = Actions(
+            self._publish, clock, poses=lambda: inputs.poses, on_doubt=self._doubted
+        )
         self.board = Board(standing.values)  # this core's own; the lasting keys the executive's
         self.trace = Trace()
         self.journal = standing.journal
-        self.ctx = Context(clock, site, self.actions, self._send_message, self.journal)
-        self.snapshot = Snapshot(self.board, self.inputs, clock, self.actions)
+        self.faults = standing.faults
+        self.faults.emit = self._faulted
+        self.ctx = Context(clock, site, self.actions, self._send_message, self.journal, self.faults)
+        self.snapshot = Snapshot(
+            self.board,
+            self.inputs,
+            clock,
+            self.actions,
+            believe=(site.navigation.tolerance, site.recruit.detection_max_age),
+        )
         self.root = tree.root
         self.stops = [
             n for n in tree.root.iterate() if isinstance(n, Observed) and n.role is Role.STOP
@@ -148,6 +162,19 @@ class Core:
             now = self.clock.now()
             emit(RobotCommand(now, role, topic, value, msg, goal))
             emit(Blamed(now, topic, self.blamed, self.blamed_reads))
+
+    def _doubted(self, code: int, goal: Goal, judgement: Judgement) -> None:
+        """An answer not believed: one log line, a journal note, the observers told."""
+        log.warning("%s", judgement.why)
+        self.journal.note(judgement.why)
+        if self.emit:
+            self.emit(
+                Doubted(self.clock.now(), code, goal.target, judgement.why, judgement.answers)
+            )
+
+    def _faulted(self, event: Faulted) -> None:
+        if self.emit:
+            self.emit(event)
 
     def _send_message(self, message: FrontendMessage) -> None:
         self._note_sender()
@@ -217,9 +244,12 @@ class Core:
         self.setup()
         self.trace.decided.clear()
         self.pause_ran_out = self.operator.check_pause(self.clock.now())
-        self.snapshot.write()
         touched = self.touched
-        touched.extend(self.root.tick())  # stopped nodes are already in it
+        try:
+            self.snapshot.write()
+            touched.extend(self.root.tick())  # stopped nodes are already in it
+        except Exception as exc:  # a node's own failure is caught by the node (Declared.tick)
+            self.faults.failed("the tree", exc, f"tick {self.ticks + 1}")
         self.ticks += 1
         status = self.root.status
         if self.emit:

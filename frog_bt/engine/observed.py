@@ -28,6 +28,7 @@ from frog_bt.model.key import Scope
 
 if TYPE_CHECKING:
     from frog_bt.engine.blackboard import Board
+    from frog_bt.engine.faults import Faults
 
 Behaviour = py_trees.behaviour.Behaviour
 
@@ -62,6 +63,7 @@ class Observed:
     status: py_trees.common.Status  # the py_trees base's
     _trace: Trace | None = None
     _board: Board | None = None
+    _faults: Faults | None = None  # the executive's (from ctx): a terminate's failure counted
 
     def stop_poi(self) -> str:
         """A :attr:`Role.STOP` node's stop: the POI a skip would leave."""
@@ -70,6 +72,7 @@ class Observed:
     def setup(self, **kwargs: Any) -> None:
         self._trace = kwargs.get("trace")
         self._board = kwargs.get("board")
+        self._faults = getattr(kwargs.get("ctx"), "faults", None)
         super().setup(**kwargs)  # type: ignore[misc]
 
     def start_scope(self) -> None:
@@ -80,13 +83,19 @@ class Observed:
 
     def stop(self, new_status: py_trees.common.Status = py_trees.common.Status.INVALID) -> None:
         trace = self._trace
-        if trace is None:
-            super().stop(new_status)  # type: ignore[misc]
-        else:
+        if trace is not None:
             trace.acting.append(self)  # type: ignore[arg-type]
-            try:
-                super().stop(new_status)  # type: ignore[misc]
-            finally:
+        try:
+            super().stop(new_status)  # type: ignore[misc]
+        except Exception as exc:
+            faults = self._faults
+            if faults is None:
+                raise
+            faults.failed(getattr(self, "name", type(self).__name__), exc, "its terminate")
+            self.status = new_status  # stopped all the same
+            self.iterator = self.tick()  # type: ignore[attr-defined]
+        finally:
+            if trace is not None:
                 trace.acting.pop()
         log = self.stop_log
         if log is not None:

@@ -13,6 +13,7 @@ from typing import Any
 
 from frog_bt.clock import Clock
 from frog_bt.engine.blackboard import Inputs
+from frog_bt.engine.faults import Faults
 from frog_bt.engine.journal import Journal
 from frog_bt.model.key import Key
 
@@ -26,4 +27,5 @@ class Standing:
         self.values: dict[Key[Any], Any] = {}  # the lasting keys (Board routes them here)
         self.paused_since: float | None = None  # the operator's pause, on the project clock
         self.journal = Journal(clock)
+        self.faults = Faults(clock)  # the executive's own failures, caught and counted
         self.inputs: Inputs | None = None  # the robot's latest inputs (the first core's)

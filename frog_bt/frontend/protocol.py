@@ -32,15 +32,22 @@ from frog_bt.model.frontend import (
     decode_envelope,
     message_fields,
 )
+from frog_bt.text import fit
 
 MAX_DATAGRAM = 8192
 log = logging.getLogger(__name__)
 
 
 def encode_datagram(type_: str, seq: int, fields: dict[str, Any] | None = None) -> bytes:
-    data = encode({"type": type_, "seq": seq, **(fields or {})})
+    """One datagram, at most :data:`MAX_DATAGRAM` bytes: a field too long to fit (a fault's
+    message in a ``tour`` reason) is cut, marked, and logged; the message is never lost.
+    ValueError only for what cannot be JSON (NaN)."""
+    whole = {"type": type_, "seq": seq, **(fields or {})}
+    data = encode(whole)
     if len(data) > MAX_DATAGRAM:
-        raise ValueError(f"datagram of {len(data)} bytes exceeds {MAX_DATAGRAM}")
+        size = len(data)
+        _, data = fit(whole, encode, MAX_DATAGRAM)
+        log.warning("%s datagram of %d bytes cut to %d (a field too long)", type_, size, len(data))
     return data
 
 

@@ -18,6 +18,8 @@ event               when
 :class:`OperatorDone`   an operator command was applied or refused
 :class:`LinksChanged`   a link changed state
 :class:`AlertChanged`   an alert was raised, cleared or acknowledged
+:class:`Doubted`        a robot's answer was not believed (stale, or not what the world shows)
+:class:`Faulted`        the executive's own code failed at one place (caught, counted)
 ==================  =========================================================
 
 Times are project-clock seconds. Values are the wire Structs' values (what the leaves
@@ -40,7 +42,9 @@ __all__ = [
     "AlertChanged",
     "Blamed",
     "Datagram",
+    "Doubted",
     "Event",
+    "Faulted",
     "FrontendIn",
     "FrontendOut",
     "LinksChanged",
@@ -140,6 +144,30 @@ class AlertChanged(msgspec.Struct, frozen=True, tag=True):
     alert: Alert
 
 
+class Doubted(msgspec.Struct, frozen=True, tag=True):
+    """A ``/FROG_response`` the executive did not act on: ``code``, the goal pending when
+    it came (``goal``: its target, e.g. ``SHOP``), what it is taken to answer instead
+    (``answers``: an earlier goal's target, or ""), and ``why`` in domain terms
+    ("arrival at POI2 heard after the drive to SHOP: ignored")."""
+
+    t: float
+    code: int
+    goal: str
+    why: str
+    answers: str = ""
+
+
+class Faulted(msgspec.Struct, frozen=True, tag=True):
+    """The executive's own code failed at ``where`` (a node, an input, an observer) while
+    doing ``what``; the error (inert text) and how often that place has failed so far."""
+
+    t: float
+    where: str
+    what: str
+    error: str
+    count: int
+
+
 Event = (
     RobotInput
     | RobotCommand
@@ -151,4 +179,6 @@ Event = (
     | OperatorDone
     | LinksChanged
     | AlertChanged
+    | Doubted
+    | Faulted
 )

@@ -19,6 +19,7 @@ import msgspec
 from frog_bt.codec import convert, decoder
 from frog_bt.errors import DecodeError
 from frog_bt.model.outcomes import TourState
+from frog_bt.text import FIELD, inert
 
 Part = Literal["a", "b"]
 Level = Annotated[float, msgspec.Meta(ge=-1.0, le=1.0)]
@@ -181,7 +182,12 @@ class DatagramDecoder:
             return datagram.seq, None
         cls = self._plain[type(datagram)]
         seq: int = msgspec.structs.asdict(datagram)["seq"]  # the datagram class's own field
-        return seq, cls(*(getattr(datagram, f) for f in cls.__struct_fields__))
+        return seq, cls(*(_inert(getattr(datagram, f)) for f in cls.__struct_fields__))
+
+
+def _inert(value: Any) -> Any:
+    """A field of a front-end event as the tree may keep it: text bounded and inert."""
+    return inert(value, FIELD) if isinstance(value, str) else value
 
 
 def decode_message(

@@ -24,6 +24,8 @@ class Goal:
     value: Pose | int  # as published, for a re-send
     code: Response | None = None
     answered_at: float | None = None
+    poses: int = 0  # /FROG_pose messages received when it went out (believe: order)
+    acknowledged: bool = False  # the robot said ``active`` after it went out
 
     @property
     def done(self) -> bool:

@@ -24,6 +24,7 @@ import msgspec
 
 from frog_bt.codec import Finite, Int32, UInt32, convert, decoder, encode
 from frog_bt.errors import DecodeError
+from frog_bt.text import FIELD, LINE, inert
 
 V = TypeVar("V")
 
@@ -228,7 +229,7 @@ class StringMsg(msgspec.Struct, frozen=True):
     data: str
 
     def value(self) -> str:
-        return self.data
+        return inert(self.data, FIELD)  # robot text (a docking state): bounded and inert
 
     @classmethod
     def of(cls, value: str) -> StringMsg:
@@ -245,7 +246,8 @@ class DiagnosticArray(msgspec.Struct, frozen=True, kw_only=True):
         faults: list[str] = []
         for i, status in enumerate(self.status):
             if status.level >= 2:
-                faults.append(f"{status.name}: {status.message}" if status.message else status.name)
+                name = inert(status.name, FIELD)  # robot text: bounded and inert from here on
+                faults.append(f"{name}: {inert(status.message, LINE)}" if status.message else name)
             if status.name == "battery":
                 for j, kv in enumerate(status.values):
                     if kv.key == "percentage":

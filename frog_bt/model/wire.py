@@ -45,7 +45,7 @@ class Keep(enum.Enum):
 
     LATEST = "latest"  # the last message as a Reading(value, at), or None before any
     SAMPLES = "samples"  # the items of every message since the last tick: ((at, item), ...)
-    QUEUE = "queue"  # every message since the last tick, in order: ((value, at), ...)
+    QUEUE = "queue"  # every message since the last tick, in order: ((value, at, poses), ...)
 
 
 @dataclass(frozen=True, slots=True)
@@ -78,8 +78,8 @@ class Input(Topic):
 POSE = input_key("/pose", Reading[Pose], "the robot's pose in the map frame")
 RESPONSES = input_key(
     "/responses",
-    tuple[tuple[int, float], ...],
-    "/FROG_response codes received since the last tick: (code, t)",
+    tuple[tuple[int, float, int], ...],
+    "/FROG_response codes received since the last tick: (code, t, poses received before it)",
 )
 DOCKING = input_key(
     "/docking", Reading[str], "the docking state (a DockingState word: docked, undocking, ...)"

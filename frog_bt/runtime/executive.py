@@ -161,6 +161,12 @@ class Executive:
     # ------------------------------------------------------------ I/O callbacks (cache only)
 
     def _on_ros(self, topic: str, value: object, raw: Any) -> None:
+        try:
+            self._take_ros(topic, value, raw)
+        except Exception as exc:
+            self.core.faults.failed(f"input {topic}", exc, "its handling")
+
+    def _take_ros(self, topic: str, value: object, raw: Any) -> None:
         if topic == CLOCK.name and self.sim_time:
             if isinstance(value, float):
                 self.clock.set(value)  # type: ignore[attr-defined]
@@ -214,7 +220,10 @@ class Executive:
                 self.emit(LinksChanged(now, self.links))
 
     def _on_event(self, message: FrontendMessage) -> None:
-        self.core.on_event(message)
+        try:
+            self.core.on_event(message)
+        except Exception as exc:
+            self.core.faults.failed(f"front-end event {message.type}", exc, "its handling")
         self._wake.set()
 
     def _on_datagram(self, direction: str, data: bytes, t: float) -> None:
@@ -302,7 +311,10 @@ class Executive:
                     continue
                 self._wake.clear()
                 if not self._stopping.is_set():
-                    self.tick()
+                    try:
+                        self.tick()
+                    except Exception as exc:
+                        self.core.faults.failed("the executive", exc, "a tick")
         finally:
             periodic.cancel()
 

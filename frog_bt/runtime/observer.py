@@ -13,10 +13,14 @@ None there). :class:`Observers` is the list a host keeps and tells.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 from frog_bt.model.events import Event
+from frog_bt.text import LINE, escape
+
+log = logging.getLogger(__name__)
 
 if TYPE_CHECKING:
     from frog_bt.clock import Clock
@@ -62,6 +66,7 @@ class Observers:
     def __init__(self) -> None:
         self._observers: list[Observer] = []
         self._calls: list[Callable[[Event], None]] = []  # their on_event, bound once
+        self.failures: dict[tuple[str, str], int] = {}  # (observer, error) -> how many
 
     def __bool__(self) -> bool:
         return bool(self._observers)
@@ -83,9 +88,25 @@ class Observers:
             del self._observers[i], self._calls[i]
 
     def emit(self, event: Event) -> None:
-        """Tell every observer, in the order they attached."""
+        """Tell every observer, in the order they attached. An observer that fails is
+        counted and logged once (per observer and kind of error), never the tick's end."""
         for call in self._calls:
-            call(event)
+            try:
+                call(event)
+            except Exception as exc:
+                self.failed(call, exc, event)
+
+    def failed(self, call: Callable[[Event], None], exc: Exception, event: Event) -> None:
+        owner = type(getattr(call, "__self__", call)).__name__
+        key = (owner, type(exc).__name__)
+        self.failures[key] = self.failures.get(key, 0) + 1
+        if self.failures[key] == 1:
+            log.error(
+                "observer %s failed on %s: %s; going on (further ones are counted)",
+                owner,
+                type(event).__name__,
+                escape(f"{type(exc).__name__}: {exc}")[:LINE],
+            )
 
     __call__ = emit  # a core's ``emit``: false while nobody listens
 

@@ -11,6 +11,7 @@ connects. At run time ``setup`` hands the node the
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol, TypeVar
 
@@ -133,6 +134,16 @@ class Declared:
                 subject=missing.key.name,
             )
             self.stop(FAILURE)  # type: ignore[attr-defined]
+            yield self  # type: ignore[misc]
+        except Exception as exc:
+            faults = self._ctx.faults if self._ctx is not None else None
+            if faults is None:
+                raise
+            seen = faults.failed(self.name, exc, "its tick")
+            self.feedback_message = f"failed: {seen.error}"
+            with contextlib.suppress(Exception):  # its terminate is counted by Observed.stop
+                self.stop(FAILURE)  # type: ignore[attr-defined]
+            self.status = FAILURE  # the tick that failed counts as the node's failure
             yield self  # type: ignore[misc]
         finally:
             trace.acting.pop()

@@ -49,8 +49,17 @@ def test_already_undocked_sends_nothing(tmp_path):
     assert bench.take_published() == []
 
 
+DOCK = "root: {type: Docking, action: dock}"
+
+
+def at_shop(bench: Bench, metres: float = 0.0) -> None:
+    shop = bench.site.pois["SHOP"]
+    bench.pose(shop.x + metres, shop.y)
+
+
 def test_dock_gives_up_after_the_site_timeout_without_a_docked_state(tmp_path):
-    bench = Bench(write_tree(tmp_path, "root: {type: Docking, action: dock}"))
+    bench = Bench(write_tree(tmp_path, DOCK))
+    at_shop(bench)
     bench.ros("docking_state", "undocked")
     assert bench.tick() == RUNNING
     bench.ros("docking_state", "docking")
@@ -59,3 +68,29 @@ def test_dock_gives_up_after_the_site_timeout_without_a_docked_state(tmp_path):
     bench.advance(0.1)
     assert bench.tick() == FAILURE
     assert [i.text for i in bench.core.journal.incidents] == ["dock: no docked within 120 s"]
+
+
+def test_dock_is_sent_only_at_the_docks_waypoint(tmp_path):
+    bench = Bench(write_tree(tmp_path, DOCK))
+    at_shop(bench, metres=1.9)  # within navigation.tolerance (2 m)
+    bench.ros("docking_state", "undocked")
+    assert bench.tick() == RUNNING
+    assert bench.take_published() == [("/docking/dock", {"data": "dock"})]
+
+
+def test_dock_asked_away_from_the_dock_fails_at_once_and_sends_nothing(tmp_path):
+    bench = Bench(write_tree(tmp_path, DOCK))
+    poi2 = bench.site.pois["POI2b"]
+    bench.pose(poi2.x, poi2.y)  # 80 m from SHOP
+    bench.ros("docking_state", "undocked")
+    assert bench.tick() == FAILURE
+    assert bench.take_published() == []
+    assert bench.core.journal.notes[-1].text == "dock not sent: the robot is 80 m from SHOP"
+    assert bench.core.journal.incidents == []  # nothing failed at the dock
+
+
+def test_dock_with_no_pose_is_not_sent(tmp_path):
+    bench = Bench(write_tree(tmp_path, DOCK))
+    bench.ros("docking_state", "undocked")
+    assert bench.tick() == FAILURE
+    assert bench.take_published() == []

@@ -71,6 +71,7 @@ def sent(bench) -> list[str]:
 
 
 def test_sends_on_start_and_succeeds_on_response_2(bench):
+    bench.at("POI3")
     assert bench.tick() == RUNNING
     assert sent(bench) == ["/GotoWayPoint"]
     bench.ros("response", 1)
@@ -155,11 +156,13 @@ def test_the_operators_pause_holds_the_send_of_a_leaf_that_waits(bench):
     stop = bench.take_published()[-1]
     assert stop[0] == "/GotoWayPoint"
     assert stop[1]["pose"]["position"]["x"] == 100.0  # a goal where the robot is
-    bench.ros("response", 2)  # the robot stands: that answers the stop, not the leaf
+    bench.pose(100.0, 30.0)  # the robot stands where it stopped
+    bench.ros("response", 2)  # that answers the stop, not the leaf
     assert bench.tick() == RUNNING
     bench.core.board.set(keys.PAUSED, False)  # resume: the goal again
     assert bench.tick() == RUNNING
     assert bench.take_published()[-1][1]["pose"]["position"]["x"] != 100.0
+    bench.at("POI3")
     bench.ros("response", 2)
     assert bench.tick() == SUCCESS
 

@@ -56,6 +56,7 @@ def test_succeeds_on_response_2_only_after_active(tmp_path):
     bench.tick()
     bench.ros("response", 1)
     assert bench.tick() == RUNNING
+    bench.at("POI1a")
     bench.ros("response", 2)
     assert bench.tick() == SUCCESS
 

@@ -62,6 +62,7 @@ def test_content_plays_the_chosen_waypoint_and_waits_for_its_own_done(tmp_path):
         )
     )
     bench.tick()
+    bench.at("POI2a")
     bench.ros("response", 2)
     assert bench.tick() == RUNNING
     assert bench.take_sent() == [StartPoi("POI2", "POI2a", "a")]

@@ -25,6 +25,7 @@ from frog_bt.runtime.logctx import OwnedBy
 from frog_bt.runtime.phrase import doing as phrase_of
 from frog_bt.runtime.phrase import of
 from frog_bt.runtime.status import phase
+from frog_bt.text import InertFormatter
 
 if TYPE_CHECKING:
     from frog_bt.live.console.day import Day
@@ -46,7 +47,7 @@ class LogLines(logging.Handler):
         super().__init__(logging.INFO)
         self.lines: deque[str] = deque(maxlen=size)
         self.addFilter(OwnedBy(owner))
-        self.setFormatter(logging.Formatter("%(asctime)s %(message)s", "%H:%M:%S"))
+        self.setFormatter(InertFormatter("%(asctime)s %(message)s", "%H:%M:%S"))
 
     def emit(self, record: logging.LogRecord) -> None:
         try:  # staff read the message; a warning says so, the logger's name is for the team
