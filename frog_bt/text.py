@@ -24,10 +24,11 @@ import re
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["FIELD", "LINE", "InertFormatter", "escape", "fit", "inert", "is_inert"]
+__all__ = ["FIELD", "LINE", "MESSAGE", "InertFormatter", "escape", "fit", "inert", "is_inert"]
 
-FIELD = 200  # characters: a name, an id, a state word, a reason
-LINE = 1000  # characters: a fault message, a log line's worth of text
+FIELD = 200  # characters: a name, an id, a state word
+MESSAGE = 300  # characters: a fault's message, as a reason on a screen or in an alert
+LINE = 1000  # characters: a whole reason, a log line's worth of text
 
 # Characters shown escaped: C0 controls, DEL, C1 controls, line/paragraph separators,
 # and the format characters that reorder or hide text (bidi embeddings, overrides and

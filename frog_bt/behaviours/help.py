@@ -22,6 +22,7 @@ INCIDENT = {
     HelpAbout.DOCK: IncidentKind.DOCKING_FAILED,
     HelpAbout.HOME: IncidentKind.GAVE_UP,
     HelpAbout.FAULT: IncidentKind.GAVE_UP,
+    HelpAbout.CRASHED: IncidentKind.GAVE_UP,
 }
 
 
@@ -81,8 +82,9 @@ class AskForHelp(Leaf):
     def _ask(self, about: HelpAbout) -> None:
         now = self.need(keys.NOW)
         restored = self.get(keys.HELP_RESTORED)
-        since = restored.since if restored is not None and restored.about is about else now
-        self.asking = Help(about, since)
+        same = restored is not None and restored.about is about
+        since = restored.since if restored is not None and same else now
+        self.asking = Help(about, since, restored.detail if restored is not None and same else "")
         self.set(keys.HELP, self.asking)
         self.set(keys.HELP_ANSWER, None)
         actions = self.ctx.actions
@@ -90,8 +92,9 @@ class AskForHelp(Leaf):
         if actions.pending is not None and pose is not None:
             here = pose.value
             actions.stop(Pose(now, "map", here.x, here.y, here.qz, here.qw))
+        detail = f" ({self.asking.detail})" if self.asking.detail else ""
         incident = self.ctx.note(
-            f"needs help: {about.what}", incident=INCIDENT[about], subject=about.value
+            f"needs help: {about.what}{detail}", incident=INCIDENT[about], subject=about.value
         )
         self.set(keys.GAVE_UP, incident)
         self.set(keys.PROGRESS, EMPTY)  # a restart restores this request, not the tour

@@ -217,6 +217,7 @@ def report(result: Any, site: Any) -> dict[str, Any]:
             "what": what_differs(div.expected, div.got, site),
             "recorded": side(div.expected),
             "replayed": side(div.got),
+            "doubted": [{"side": side_, "why": why} for side_, why in div.doubts],
         }
     return out
 
@@ -304,6 +305,9 @@ def run_one(args: argparse.Namespace) -> int:
             )
             print(f"  {label + ':':9} {text}")
         print(f"  {'differs:':9} {differences(div.expected, div.got, site)}")
+        for side, why in div.doubts:  # a robot answer one side believed and the other not
+            where = "recording" if side == "recorded" else "replay"
+            print(f"  {'doubted:':9} {why} (in the {where} only)")
         for label, command in (("recorded", div.expected), ("replayed", div.got)):
             if command is not None:
                 print(f"  {label + ':':9} sent by {command.node or '? (no blame recorded)'}")

@@ -136,7 +136,8 @@ class Actions:
                     self.on_doubt(code, goal, judgement)
                 return None
         goal = replace(goal, code=known, answered_at=at, acknowledged=True)
-        self.before = None  # the robot has answered this goal: an older answer is no more due
+        if known.terminal:  # this goal's end: an older goal's answer is no more due
+            self.before = None
         self.pending = None if goal.done else goal
         if self.latest is not None and self.latest.id == goal.id:
             self.latest = goal

@@ -74,14 +74,19 @@ def describe_answer(code: int, goal: Goal | None) -> str:
     if goal is None:
         return f"/FROG_response {code}"
     if goal.kind == "approach":
-        word = {SUCCEEDED: "success", FAILED: "failure", ABORTED: "refusal", ACTIVE: "start"}
+        word: dict[int, str] = {
+            SUCCEEDED: "success",
+            FAILED: "failure",
+            ABORTED: "refusal",
+            ACTIVE: "start",
+        }
         return f"{word.get(code, str(code))} of the approach of visitor {goal.target}"
-    word = {
+    drive: dict[int, str] = {
         SUCCEEDED: "arrival at",
         FAILED: "failure of the drive to",
         ABORTED: "abort of the drive to",
     }
-    return f"{word.get(code, 'start of the drive to')} {goal.target}"
+    return f"{drive.get(code, 'start of the drive to')} {goal.target}"
 
 
 def distance(pose: Pose, goal: Goal) -> float:

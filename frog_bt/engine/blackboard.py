@@ -75,7 +75,7 @@ class Inputs:
         self.latest: dict[Key[Any], Reading[Any] | None] = {
             i.key: None for i in table.values() if i.keep is Keep.LATEST
         }
-        self.pending: dict[Key[Any], list[tuple[Any, Any]]] = {
+        self.pending: dict[Key[Any], list[tuple[Any, ...]]] = {
             i.key: [] for i in table.values() if i.keep is not Keep.LATEST
         }
         self.events: list[tuple[FrontendMessage, float]] = []

@@ -51,6 +51,7 @@ _STEP = {
     HelpAbout.DOCK: N_("dock"),
     HelpAbout.HOME: N_("home"),
     HelpAbout.FAULT: N_("fault"),
+    HelpAbout.CRASHED: N_("home"),
 }
 TREE_COMMANDS = frozenset(Command) - {Command.ACK_ALERT}
 SENT_HOME = AbortReason(AbortCause.OPERATOR, "operator")
@@ -185,7 +186,7 @@ class Operator:
     def _not_done(self, help_: Help) -> Msg | None:
         """Why ``done_by_hand`` cannot be true yet, from what the robot reports; None."""
         about = help_.about
-        if about in (HelpAbout.DOCK, HelpAbout.HOME, HelpAbout.UNDOCK):
+        if about in (HelpAbout.DOCK, HelpAbout.HOME, HelpAbout.UNDOCK, HelpAbout.CRASHED):
             want = DockingState.UNDOCKED if about is HelpAbout.UNDOCK else DockingState.DOCKED
             reading = self.board.get(keys.DOCKING)
             state = reading.value if reading is not None else "nothing"

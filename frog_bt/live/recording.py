@@ -61,6 +61,8 @@ from frog_bt.model.channels import (
     ALERT,
     BLAME,
     DATAGRAM_TYPE,
+    DOUBT,
+    FAULT,
     FRONTEND_IN,
     FRONTEND_OUT,
     OPERATOR,
@@ -77,7 +79,9 @@ from frog_bt.model.events import (
     AlertChanged,
     Blamed,
     Datagram,
+    Doubted,
     Event,
+    Faulted,
     OperatorDone,
     RobotCommand,
     RobotInput,
@@ -175,6 +179,8 @@ class Recorder:
             Blamed: self._blame,
             OperatorDone: self._operator,
             AlertChanged: self._alert,
+            Doubted: self._doubt,
+            Faulted: self._fault,
         }
         self._frontend_in: deque[bytes] = deque(maxlen=PRIMER_DATAGRAMS)
         self._frontend_out_seqs: deque[int] = deque(maxlen=PRIMER_SEQS)
@@ -225,7 +231,7 @@ class Recorder:
             self.channel(CLOCK.name, CLOCK.type)
         self.channel(FRONTEND_IN, DATAGRAM_TYPE)
         self.channel(FRONTEND_OUT, DATAGRAM_TYPE)
-        for channel in (TICK, BLAME, OPERATOR, ALERT):
+        for channel in (TICK, BLAME, OPERATOR, ALERT, DOUBT, FAULT):
             self.channel(channel, OWN_TYPES[channel])
         clock = host.clock
         self._ready = lambda: bool(clock.ready)
@@ -328,6 +334,16 @@ class Recorder:
     def _alert(self, event: AlertChanged) -> None:
         """An alert raised, cleared or acknowledged."""
         self._write(ALERT, event.t, channels.encode(event.alert))
+
+    def _doubt(self, event: Doubted) -> None:
+        """A robot answer not believed."""
+        doubt = channels.Doubt(event.code, event.goal, event.why, event.answers)
+        self._write(DOUBT, event.t, channels.encode(doubt))
+
+    def _fault(self, event: Faulted) -> None:
+        """A failure of the executive's own code, caught."""
+        fault = channels.Fault(event.where, event.what, event.error, event.count)
+        self._write(FAULT, event.t, channels.encode(fault))
 
     def _tick(self, event: Ticked) -> None:
         self._write(TICK, event.t, channels.encode(channels.Tick(event.tick, event.status)))

@@ -17,7 +17,15 @@ from frog_bt.engine.context import Incident
 from frog_bt.engine.tally import Tally
 from frog_bt.maths.engagement import Decision
 from frog_bt.model import keys
-from frog_bt.model.events import Event, FrontendIn, FrontendOut, RobotCommand, RobotInput, Ticked
+from frog_bt.model.events import (
+    Doubted,
+    Event,
+    FrontendIn,
+    FrontendOut,
+    RobotCommand,
+    RobotInput,
+    Ticked,
+)
 from frog_bt.model.frontend import FrontendMessage, StartPoi, Tour, UserPositive
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.model.ros import POSE
@@ -38,6 +46,7 @@ class TourSummary:
     decisions: list[tuple[str, Decision]] = field(default_factory=list)  # (about, decision)
     incidents: list[Incident] = field(default_factory=list)
     tours: list[str] = field(default_factory=list)  # "ended" / "aborted: reason", in order
+    doubted: list[str] = field(default_factory=list)  # robot answers not believed: why
     resumed: str | None = None
     _goal: str | None = None
     _last_decision: Any = None
@@ -60,6 +69,8 @@ class TourSummary:
             self._frontend_in(event.message)  # type: ignore[union-attr]
         elif kind is Ticked and self._host is not None:
             self._tick(self._host.core)
+        elif isinstance(event, Doubted):
+            self.doubted.append(event.why)
 
     def _ros_out(self, out: RobotCommand) -> None:
         if out.role == "goto" and out.goal is not None:
@@ -160,6 +171,10 @@ class TourSummary:
             out += [
                 f"{'':<10} {i.text}" for i in self.incidents[-MAX_LISTED:] if i.kind != "resumed"
             ]
+        if self.doubted:
+            n = len(self.doubted)
+            out.append(f"not believed: {n} robot answer{'s' if n > 1 else ''} (not acted on)")
+            out += [f"{'':<10} {why}" for why in self.doubted[-MAX_LISTED:]]
         out.append(f"outcome:   {self.verdict()}")
         return out
 

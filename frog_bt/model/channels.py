@@ -15,6 +15,8 @@ channel                schema name             one message per
 ``/frog_bt/primer``    ``frog_bt/Primer``      rotated file: what it carries from before
 ``/frog_bt/operator``  ``frog_bt/Operator``    operator command, with its answer
 ``/frog_bt/alert``     ``frog_bt/Alert``       alert raised, cleared or acknowledged
+``/frog_bt/doubt``     ``frog_bt/Doubt``       robot answer not believed (stale, or off)
+``/frog_bt/fault``     ``frog_bt/Fault``       failure of the executive's own code, caught
 =====================  ======================  ============================================
 """
 
@@ -39,6 +41,8 @@ PRIMER = "/frog_bt/primer"  # what a rotated file carries from before it
 SITE_METADATA = "frog_bt_site"  # MCAP metadata in every file: config_sha256, the site config
 OPERATOR = "/frog_bt/operator"  # each operator command and its answer
 ALERT = "/frog_bt/alert"  # each alert's changes
+DOUBT = "/frog_bt/doubt"  # each robot answer not believed, and why
+FAULT = "/frog_bt/fault"  # each failure of the executive's own code, caught and counted
 
 
 class Tick(msgspec.Struct, frozen=True):
@@ -106,6 +110,20 @@ class Alert(msgspec.Struct, frozen=True):
     waited: float = 0.0
 
 
+class Doubt(msgspec.Struct, frozen=True):
+    code: int  # the /FROG_response code
+    goal: str  # the goal pending when it came (its target)
+    why: str  # in domain terms: "arrival at POI2 heard after the drive to SHOP: ignored"
+    answers: str = ""  # the earlier goal it is taken to answer, if known
+
+
+class Fault(msgspec.Struct, frozen=True):
+    where: str  # the node, input or observer that failed
+    what: str  # what it was doing
+    error: str  # the error, inert text
+    count: int  # failures at that place so far
+
+
 TYPES: dict[str, tuple[str, type[msgspec.Struct]]] = {
     TICK: ("frog_bt/Tick", Tick),
     BLAME: ("frog_bt/Blame", Blame),
@@ -113,6 +131,8 @@ TYPES: dict[str, tuple[str, type[msgspec.Struct]]] = {
     PRIMER: ("frog_bt/Primer", Primer),
     OPERATOR: ("frog_bt/Operator", Operator),
     ALERT: ("frog_bt/Alert", Alert),
+    DOUBT: ("frog_bt/Doubt", Doubt),
+    FAULT: ("frog_bt/Fault", Fault),
 }
 
 _ENCODER = msgspec.json.Encoder()

@@ -22,6 +22,7 @@ class HelpAbout(enum.StrEnum):
     DOCK = "dock"  # docking failed after its attempts
     HOME = "home"  # the robot could not get home to its charger (navigation, docking)
     FAULT = "fault"  # an electronics fault persists with no tour running
+    CRASHED = "crashed"  # the executive stopped during a tour: not resumed, to not loop
 
     @property
     def what(self) -> str:
@@ -44,12 +45,16 @@ _WHAT = {
     HelpAbout.DOCK: N_("The robot could not dock after all its attempts."),
     HelpAbout.HOME: N_("The robot could not get back to its charger."),
     HelpAbout.FAULT: N_("The robot reports an electronics fault that does not go away."),
+    HelpAbout.CRASHED: N_(
+        "The executive stopped during a tour; it did not resume the tour, so as not to stop again."
+    ),
 }
 _BY_HAND = {
     HelpAbout.UNDOCK: N_("a person moved the robot off the charger (the robot reports undocked)"),
     HelpAbout.DOCK: N_("a person put the robot on its charger (the robot reports docked)"),
     HelpAbout.HOME: N_("a person put the robot on its charger (the robot reports docked)"),
     HelpAbout.FAULT: N_("a person fixed the fault (the robot no longer reports it)"),
+    HelpAbout.CRASHED: N_("a person put the robot on its charger (the robot reports docked)"),
 }
 
 
@@ -64,6 +69,7 @@ class Help:
 
     about: HelpAbout
     since: float
+    detail: str = ""  # what went wrong, as the executive knows it (crashed: why)
 
     @property
     def what(self) -> str:

@@ -55,6 +55,8 @@ class Resume:
     visitor: int | None
     order: tuple[str, ...] = ()
     written: float = 0.0  # wall time the checkpoint was written
+    resumed: int = 0  # starts that resumed it and then stopped before any progress
+    crashed: str = ""  # why the executive that ran it crashed (empty: it did not)
 
     def without(self, name: str) -> Resume:
         """This resume point once ``name`` has been skipped."""

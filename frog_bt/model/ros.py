@@ -24,7 +24,7 @@ import msgspec
 
 from frog_bt.codec import Finite, Int32, UInt32, convert, decoder, encode
 from frog_bt.errors import DecodeError
-from frog_bt.text import FIELD, LINE, inert
+from frog_bt.text import FIELD, MESSAGE, inert
 
 V = TypeVar("V")
 
@@ -247,7 +247,8 @@ class DiagnosticArray(msgspec.Struct, frozen=True, kw_only=True):
         for i, status in enumerate(self.status):
             if status.level >= 2:
                 name = inert(status.name, FIELD)  # robot text: bounded and inert from here on
-                faults.append(f"{name}: {inert(status.message, LINE)}" if status.message else name)
+                message = inert(status.message, MESSAGE)
+                faults.append(f"{name}: {message}" if message else name)
             if status.name == "battery":
                 for j, kv in enumerate(status.values):
                     if kv.key == "percentage":

@@ -43,12 +43,14 @@ from typing import TYPE_CHECKING, Any
 
 from frog_bt.clock import ManualClock
 from frog_bt.config import Site, parse_hostport
+from frog_bt.engine.belief import Judgement
 from frog_bt.engine.core import Core
 from frog_bt.engine.operator import Command as OperatorCommand
 from frog_bt.frontend.protocol import Endpoint
 from frog_bt.model import channels, keys
 from frog_bt.model.channels import BLAME, FRONTEND_IN, FRONTEND_OUT, OPERATOR, TICK, from_ns
 from frog_bt.model.frontend import EVENTS, FrontendMessage, message_fields
+from frog_bt.model.goals import Goal
 from frog_bt.model.wire import CLOCK, OUTPUTS
 from frog_bt.recordings.commands import (
     Command,
@@ -85,6 +87,9 @@ class Divergence:
     number: int
     expected: Command | None
     got: Command | None
+    # robot answers one side did not believe and the other did, since the last command
+    # both sent alike: ("recorded" | "replayed", why), in domain terms
+    doubts: list[tuple[str, str]] = field(default_factory=list)
 
     @property
     def t(self) -> float:
@@ -158,6 +163,11 @@ class Replay:
         self.on_command: list[Callable[[str, Command], None]] = []
         self.on_divergence: list[Callable[[Divergence], None]] = []
         self._seqs: set[int] = set()
+        # answers not believed, each side: (when, why); the replayed ones from the core
+        self.doubts: dict[str, list[tuple[float, str]]] = {"recorded": [], "replayed": []}
+        self._agreed_at = self.start  # when the last command both sides sent alike was sent
+        self._judge = self.core.actions.on_doubt
+        self.core.actions.on_doubt = self._replayed_doubt
         self._compared = 0
         self._next_tick = 0.0
         self.result = ReplayResult(
@@ -195,9 +205,32 @@ class Replay:
                 observe("recorded", expected)
                 observe("replayed", got)
             if (expected.channel, expected.payload) != (got.channel, got.payload):
-                self.result.divergence = Divergence(self._compared, expected, got)
+                self.result.divergence = Divergence(
+                    self._compared, expected, got, self._doubts_apart()
+                )
                 for seen in self.on_divergence:
                     seen(self.result.divergence)
+            else:
+                self._agreed_at = max(expected.t, got.t)
+
+    def _replayed_doubt(self, code: int, goal: Goal, judgement: Judgement) -> None:
+        self.doubts["replayed"].append((self.clock.now(), judgement.why))
+        if self._judge is not None:
+            self._judge(code, goal, judgement)
+
+    def _doubts_apart(self) -> list[tuple[str, str]]:
+        """The answers one side did not believe and the other did, since both last agreed:
+        what a divergence about a stale or doubted answer names."""
+        since = {
+            side: [why for t, why in seen if t >= self._agreed_at]
+            for side, seen in self.doubts.items()
+        }
+        return [
+            (side, why)
+            for side, other in (("recorded", "replayed"), ("replayed", "recorded"))
+            for why in since[side]
+            if why not in since[other]
+        ]
 
     # ------------------------------------------------------------ the run
 
@@ -222,7 +255,9 @@ class Replay:
                 if result.divergence is None and (self._expected or self._got):
                     expected = self._expected.popleft() if self._expected else None
                     got = self._got.popleft() if self._got else None
-                    result.divergence = Divergence(self._compared + 1, expected, got)
+                    result.divergence = Divergence(
+                        self._compared + 1, expected, got, self._doubts_apart()
+                    )
         result.ticks = self.core.ticks
         result.bad_count = self.reader.tally.count
         result.bad = self.reader.tally.lines(self.start)
@@ -261,6 +296,8 @@ class Replay:
             self._blame(message)
         elif isinstance(message, channels.Operator):
             self._operator(record.t, message)
+        elif isinstance(message, channels.Doubt):
+            self.doubts["recorded"].append((record.t, message.why))
 
     def _on_ros(self, record: RobotInput) -> None:
         self.result.inputs += 1

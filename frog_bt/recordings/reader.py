@@ -85,7 +85,15 @@ CLOCK_ROLE = "clock"  # the role of /clock among the inputs (sim time only)
 
 RosValue = Pose | Diagnostics | PersonDetections | FaceData | TrackedPeople | int | float | str
 """What a wire Struct's ``value()`` gives: what the leaves see."""
-OwnMessage = channels.Tick | channels.Blame | channels.Tree | channels.Operator | channels.Alert
+OwnMessage = (
+    channels.Tick
+    | channels.Blame
+    | channels.Tree
+    | channels.Operator
+    | channels.Alert
+    | channels.Doubt
+    | channels.Fault
+)
 
 # Errors a message can make decoding raise (DecodeError from the Structs; the others
 # from a value() that computes on what it decoded): a bad message, not a crash.

@@ -45,6 +45,8 @@ class Facts:
     help: Help | None = None  # the robot holds and asks a person (AskForHelp)
     stops_given_up: tuple[str, ...] = ()  # stops skipped this tour (navigation kept failing)
     pause_ran_out: bool = False  # this tour: a pause ended it
+    # failures of the executive's own code that keep coming: (where, how many, the error)
+    internal_errors: tuple[tuple[str, int, str], ...] = ()
 
 
 Severity = Literal["WARN", "ERROR"]
@@ -65,6 +67,8 @@ KINDS: dict[str, Kind] = {
     "undocking_failed": Kind("ERROR", _HELP),
     "gave_up": Kind("ERROR", _HELP),
     "fault_persists": Kind("ERROR", _HELP),
+    "executive_crashed": Kind("ERROR", _HELP),
+    "internal_error": Kind("ERROR", ("ack_alert",)),
     "fault": Kind("ERROR", ("service_off", "ack_alert")),
     "rosbridge_down": Kind("ERROR", ("ack_alert",)),
     "battery_low": Kind("WARN", ("home", "service_off", "ack_alert")),
@@ -138,7 +142,23 @@ def conditions(f: Facts, cfg: AlertsCfg, names: Callable[[str], str] = str) -> l
     """The conditions that hold now, in the order a person should read them (``names``:
     a stop's name as staff know it)."""
     out: list[Condition] = []
-    if f.help is not None:  # the robot holds and waits for a person's answer
+    if f.help is not None and f.help.about is HelpAbout.CRASHED:
+        out.append(
+            Condition(
+                "executive_crashed",
+                "",
+                Msg(
+                    "The executive stopped during a tour ({why}); it did not resume the tour, "
+                    "so as not to stop again.",
+                    why=f.help.detail or "?",
+                ),
+                Msg(
+                    "Bring the robot to its charger and press Done, or press Try again to "
+                    "send it home; tell the robot team."
+                ),
+            )
+        )
+    elif f.help is not None:  # the robot holds and waits for a person's answer
         out.append(_HELP_CONDITIONS[f.help.about])
     elif f.gave_up:  # a tree of its own gave up (GiveUp): the executive stops
         out.append(
@@ -218,6 +238,20 @@ def conditions(f: Facts, cfg: AlertsCfg, names: Callable[[str], str] = str) -> l
                     minutes=f"{(f.now - f.seeking_since) / 60:.0f}",
                 ),
                 Msg("Check that the robot stands where visitors pass and that its camera sees."),
+            )
+        )
+    for where, count, error in f.internal_errors:
+        out.append(
+            Condition(
+                "internal_error",
+                where,
+                Msg(
+                    "The executive's own code failed {count} times at {where}: {error}.",
+                    count=str(count),
+                    where=where,
+                    error=error,
+                ),
+                Msg("The tour goes on where it can; tell the robot team."),
             )
         )
     if f.pause_ran_out:

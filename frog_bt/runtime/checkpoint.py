@@ -9,6 +9,12 @@ and deletes it when a tour ends or is aborted.
 On start-up, :func:`load` gives a :class:`Resume`: the checkpoints a resumed
 tour skips, once each, and the visitor to restore.
 
+No crash loop: a checkpoint says how often it was resumed without progress since
+(:func:`mark_resumed`, reset by the next :func:`save`) and why the executive that ran it
+crashed, if it did (:func:`mark_crashed`). A restarted executive that would resume the
+same checkpoint into the same failure (:func:`crash_loop`) holds and asks a person
+instead.
+
 A checkpoint belongs to one executive. The default file is scoped by the site
 configuration and the listen address (:func:`default_path`), and
 :func:`claim` locks it for the executive's lifetime, so two executives on one
@@ -32,10 +38,27 @@ from typing import IO
 
 from frog_bt.errors import UsageError
 from frog_bt.model.progress import VERSION, Progress, Resume
+from frog_bt.text import LINE, inert
 
 STATE_DIR = Path(os.environ.get("XDG_STATE_HOME", Path.home() / ".local" / "state")) / "frog-bt"
 
-__all__ = ["VERSION", "Progress", "Resume", "claim", "default_path", "load", "save"]
+__all__ = [
+    "RESUMES_WITHOUT_PROGRESS",
+    "VERSION",
+    "Progress",
+    "Resume",
+    "claim",
+    "crash_loop",
+    "default_path",
+    "load",
+    "mark_crashed",
+    "mark_resumed",
+    "save",
+]
+
+# Starts that resumed a checkpoint and stopped again before any progress (a kill, an
+# out-of-memory, a watchdog): the next one does not resume it but holds and asks.
+RESUMES_WITHOUT_PROGRESS = 2
 
 
 def default_path(config: Path, listen: tuple[str, int], state_dir: Path = STATE_DIR) -> Path:
@@ -125,4 +148,38 @@ def load(path: Path, max_age: float = math.inf) -> Resume | None:
         return None
     if visitor is not None and (isinstance(visitor, bool) or not isinstance(visitor, int)):
         visitor = None
-    return Resume(frozenset(done), visitor, tuple(done), float(written))
+    resumed = data.get("resumed", 0)
+    resumed = resumed if isinstance(resumed, int) and not isinstance(resumed, bool) else 0
+    crashed = data.get("crashed", "")
+    crashed = inert(crashed, LINE) if isinstance(crashed, str) else "crashed"
+    return Resume(frozenset(done), visitor, tuple(done), float(written), resumed, crashed)
+
+
+def _update(path: Path, **fields: object) -> None:
+    """Add ``fields`` to the checkpoint in ``path`` (atomically); nothing without one."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return
+    if isinstance(data, dict):
+        write_json(path, {**data, **fields})
+
+
+def mark_resumed(path: Path, resume: Resume) -> None:
+    """This start resumes ``resume``: counted in the file until the tour makes progress
+    (:func:`save` writes a checkpoint without the count)."""
+    _update(path, resumed=resume.resumed + 1)
+
+
+def mark_crashed(path: Path, why: str) -> None:
+    """The executive running the tour of ``path`` crashed: say why, for the next start."""
+    _update(path, crashed=inert(why, LINE))
+
+
+def crash_loop(resume: Resume) -> str | None:
+    """Why resuming ``resume`` would run into the same failure again, or None."""
+    if resume.crashed:
+        return f"it crashed on this tour: {resume.crashed}"
+    if resume.resumed >= RESUMES_WITHOUT_PROGRESS:
+        return f"it stopped {resume.resumed + 1} times on this tour without going on"
+    return None

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from frog_bt.model.help import Help, HelpAbout
 from frog_bt.runtime.checkpoint import write_json
+from frog_bt.text import LINE, inert
 
 __all__ = ["Decisions", "load", "path_for", "save"]
 
@@ -34,7 +35,11 @@ class Decisions:
             "in_service": self.in_service,
             "paused": self.paused,
             "help": (
-                {"about": self.help.about.value, "since": self.help.since}
+                {
+                    "about": self.help.about.value,
+                    "since": self.help.since,
+                    "detail": self.help.detail,
+                }
                 if self.help is not None
                 else None
             ),
@@ -67,7 +72,12 @@ def load(path: Path) -> Decisions:
     raw = data.get("help")
     if isinstance(raw, dict):
         with contextlib.suppress(ValueError, TypeError):
-            help_ = Help(HelpAbout(raw.get("about", "")), float(raw.get("since", 0.0)))
+            detail = raw.get("detail", "")
+            help_ = Help(
+                HelpAbout(raw.get("about", "")),
+                float(raw.get("since", 0.0)),
+                inert(detail, LINE) if isinstance(detail, str) else "",
+            )
     acked = data.get("acknowledged")
     return Decisions(
         in_service=data.get("in_service") is not False,

@@ -30,6 +30,7 @@ from frog_bt.model import keys
 from frog_bt.model.channels import Alert
 from frog_bt.model.events import AlertChanged, Datagram, Event, LinksChanged
 from frog_bt.model.frontend import EVENTS, FrontendMessage
+from frog_bt.model.help import Help, HelpAbout
 from frog_bt.model.links import Links, states
 from frog_bt.model.outcomes import DockingState, IncidentKind, TourState
 from frog_bt.model.progress import EMPTY, Progress
@@ -37,6 +38,7 @@ from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime import decisions, logctx
+from frog_bt.runtime.checkpoint import crash_loop, mark_crashed, mark_resumed
 from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
 from frog_bt.runtime.notify import Notifier
@@ -101,8 +103,9 @@ class Executive:
         self.checkpoint = checkpoint
         self._saved: Progress = EMPTY
         self._decided = decisions.NONE  # what staff decided, as last saved
+        self._crash_loop: Help | None = None  # a tour not resumed, to not fail the same way
         if checkpoint is not None and not fresh:
-            self.core.board.set(keys.RESUME, load_checkpoint(checkpoint, site.checkpoint.max_age))
+            self._resume_or_hold(checkpoint, site.checkpoint.max_age)
         self._wake = asyncio.Event()
         self._stopping = asyncio.Event()
         self._pending_at_loss: object = None
@@ -117,8 +120,28 @@ class Executive:
         if checkpoint is not None and not fresh:
             self._decided = decisions.load(decisions.path_for(checkpoint))
             self._restore(self._decided)
+        if self._crash_loop is not None:  # it holds and asks, whatever staff decided before
+            self.core.board.set(keys.HELP_RESTORED, self._crash_loop)
         self.staff.book.listeners.append(self._on_alert)
         self.notifier = Notifier.from_env()  # systemd: READY, STATUS, watchdog pings
+
+    def _resume_or_hold(self, checkpoint: Path, max_age: float) -> None:
+        """Resume the tour of ``checkpoint`` (marking the file: resumed once more), unless
+        that would run into the same failure again (:func:`crash_loop`): then the robot
+        holds where it is and asks a person (``help`` crashed, with the reason); the
+        checkpoint is set aside, so that a further start does not try it either."""
+        resume = load_checkpoint(checkpoint, max_age)
+        if resume is None:
+            return
+        why = crash_loop(resume)
+        if why is None:
+            mark_resumed(checkpoint, resume)
+            self.core.board.set(keys.RESUME, resume)
+            return
+        log.error("not resuming the tour of %s: %s; holding for a person", checkpoint, why)
+        with contextlib.suppress(OSError):
+            checkpoint.replace(checkpoint.with_name(checkpoint.name + ".crashed"))
+        self._crash_loop = Help(HelpAbout.CRASHED, resume.written, why)
 
     def _restore(self, decided: decisions.Decisions) -> None:
         """What staff decided before a restart holds again: out of service, a pause (its
@@ -253,6 +276,12 @@ class Executive:
             if await self._until_stopped(self._ready_or_alive()):
                 self.core.setup()
                 await self._loop()
+        except (asyncio.CancelledError, KeyboardInterrupt):
+            raise
+        except BaseException as exc:  # a crash: the next start must not loop into it
+            if self.checkpoint is not None:
+                mark_crashed(self.checkpoint, f"{type(exc).__name__}: {exc}")
+            raise
         finally:
             self.notifier.stopping()
             await self._shutdown()

@@ -195,4 +195,7 @@ class Staff:
             help=board.get(keys.HELP),
             stops_given_up=tuple(core.journal.tally.stops_given_up()),  # until the next tour
             pause_ran_out=self._pause_ran_out,
+            internal_errors=tuple(
+                (seen.where, seen.count, seen.error) for seen in core.faults.repeated(now)
+            ),
         )

@@ -8,7 +8,7 @@ fault is a status at level 2 (ERROR) or 3 (STALE) from its ``at`` time on, for
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 
 from frog_bt.model.ros import DiagnosticStatus, KeyValue
 from frog_bt.sim.scenario import BatterySpec, FaultSpec
@@ -31,11 +31,15 @@ class Battery:
         )
 
 
-def active_faults(faults: Iterable[FaultSpec], elapsed: float) -> list[DiagnosticStatus]:
-    """Statuses of the faults active ``elapsed`` seconds after the scenario start."""
+def active_faults(
+    faults: Iterable[FaultSpec], elapsed: float, arrivals: Mapping[str, float] | None = None
+) -> list[DiagnosticStatus]:
+    """Statuses of the faults active ``elapsed`` seconds after the scenario start;
+    ``arrivals``: when the robot first arrived at each scenario POI (``on_arrival``)."""
     t = elapsed + 1e-9  # a step time of 2.9999999 is 3
-    return [
-        DiagnosticStatus(f.level, f.name, f.message, "frog")
-        for f in faults
-        if f.at <= t and (f.duration is None or t < f.at + f.duration)
-    ]
+    out = []
+    for f in faults:
+        start = f.at if f.at is not None else (arrivals or {}).get(f.on_arrival or "")
+        if start is not None and start <= t and (f.duration is None or t < start + f.duration):
+            out.append(DiagnosticStatus(f.level, f.name, f.text, "frog"))
+    return out

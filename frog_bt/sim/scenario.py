@@ -95,10 +95,21 @@ class NavFailure(_Model):
         return self
 
 
+class LateAnswer(_Model):
+    """Hold back the robot's ``/FROG_response`` to goals at ``poi`` (every goal: none) by
+    ``delay`` seconds; a newer goal meanwhile does not cancel it, so it arrives after that
+    goal went out (a stale answer). ``duplicate``: the final answer is sent twice."""
+
+    poi: str | None = None
+    delay: NonNegative = 2.0
+    duplicate: bool = False
+
+
 class NavigationSpec(_Model):
     speed: Positive = 0.6  # m/s, straight line
     approach_time: NonNegative = 3.0  # seconds an /ApproachPeopleFar takes
     failures: list[NavFailure] = []
+    late: list[LateAnswer] = []  # answers held back (out of order with newer goals)
 
 
 class DockingSpec(_Model):
@@ -116,13 +127,31 @@ class BatterySpec(_Model):
 
 
 class FaultSpec(_Model):
-    """A ``/diagnostic`` status at level 2 (ERROR) or 3 (STALE) from ``at`` on."""
+    """A ``/diagnostic`` status at level 2 (ERROR) or 3 (STALE) from ``at`` on, or from
+    the robot's arrival at ``on_arrival`` (a POI, or any of its variants). ``pad_to``:
+    the message repeated up to that many characters (a driver's stack trace)."""
 
-    at: NonNegative
+    at: NonNegative | None = None
+    on_arrival: str | None = None
     name: str
     level: Literal[2, 3] = 2
     message: str = ""
+    pad_to: Annotated[int, Field(ge=0, le=1_000_000)] = 0
     duration: Positive | None = None  # seconds; none: the fault stays
+
+    @model_validator(mode="after")
+    def _one_start(self) -> FaultSpec:
+        if (self.at is None) == (self.on_arrival is None):
+            raise ValueError("expected exactly one of at: SECONDS or on_arrival: POI")
+        return self
+
+    @property
+    def text(self) -> str:
+        """The message as the robot publishes it (padded to ``pad_to``)."""
+        message = self.message
+        if self.pad_to and message:
+            message = (message * (self.pad_to // len(message) + 1))[: self.pad_to]
+        return message
 
 
 class WanderSpec(_Model):

@@ -89,6 +89,16 @@ def check_pois(scenario: Scenario, pois: Mapping[str, PoiPose]) -> None:
         if f.poi is not None
     ]
     refs += [
+        (("navigation", "late", i, "poi"), late.poi)
+        for i, late in enumerate(scenario.navigation.late)
+        if late.poi is not None
+    ]
+    refs += [
+        (("faults", i, "on_arrival"), f.on_arrival)
+        for i, f in enumerate(scenario.faults)
+        if f.on_arrival is not None
+    ]
+    refs += [
         (("visitors", i, "wander_off", "heading_to"), v.wander_off.heading_to)
         for i, v in enumerate(scenario.visitors)
         if v.wander_off is not None and v.wander_off.heading_to is not None
@@ -123,6 +133,8 @@ class World:
         self.crowd = Crowd(scenario.visitors, scenario.seed, scenario.detection_range)
         self.faces_on = False
         self.approach: Approach | None = None
+        self.arrivals: dict[str, float] = {}  # scenario POI -> first arrival (on_arrival faults)
+        self.late: list[tuple[float, Out]] = []  # answers held back: (due, what)
         self.malformed = 0
         self._rates = {
             POSE: Rate(0.1),
@@ -195,7 +207,18 @@ class World:
         self.navigator.new_goal(goal.x, goal.y, goal.qz, goal.qw, pois)
         log.info("goal to (%.2f, %.2f) %s", goal.x, goal.y, ",".join(sorted(pois)))
         self.crowd.heading_to(pois, self.pose)
-        return [self._response(ACTIVE)]
+        return self._answer(ACTIVE, pois)
+
+    def _answer(self, code: int, pois: frozenset[str]) -> list[Out]:
+        """A goal's answer now, or held back by a ``navigation.late`` rule (a newer goal
+        does not cancel it: it may arrive after that goal went out)."""
+        for rule in self.scenario.navigation.late:
+            if rule.poi is None or poi_matches(rule.poi, pois):
+                copies = 2 if rule.duplicate and code != ACTIVE else 1
+                due = self.elapsed + rule.delay
+                self.late.extend((due, self._response(code)) for _ in range(copies))
+                return []
+        return [self._response(code)]
 
     def _on_approach(self, msg: Any) -> list[Out]:
         vid = ros.INT32.convert(msg)
@@ -249,9 +272,16 @@ class World:
         out: list[Out] = []
         before = (self.pose.x, self.pose.y)
         if not self.docking.docked:
+            goal = self.navigator.active
             code = self.navigator.step(self.pose, dt)
-            if code is not None:
-                out.append(self._response(code))
+            if code is not None and goal is not None:
+                if code == SUCCEEDED:
+                    self._arrived(goal.pois)
+                out += self._answer(code, goal.pois)
+        if self.late:
+            due = [o for t, o in self.late if t <= self.elapsed + 1e-9]
+            self.late = [(t, o) for t, o in self.late if t > self.elapsed + 1e-9]
+            out += due
         out += self._step_approach(dt)
         state = self.docking.step(dt)
         if state is not None:
@@ -264,6 +294,15 @@ class World:
         self.crowd.step(self.elapsed, dt, self.pose, moved)
         out += self._publications()
         return out
+
+    def _arrived(self, pois: frozenset[str]) -> None:
+        """Note the first arrival at each scenario POI a fault waits for; its fault is
+        published at once (not at the next 1 Hz report)."""
+        for fault in self.scenario.faults:
+            name = fault.on_arrival
+            if name is not None and name not in self.arrivals and poi_matches(name, pois):
+                self.arrivals[name] = self.elapsed
+                self._rates[DIAGNOSTIC].next = self.elapsed  # due now
 
     def _step_approach(self, dt: float) -> list[Out]:
         approach = self.approach
@@ -290,7 +329,8 @@ class World:
         if self.faces_on and rates[FACES].due(elapsed):
             out.append((FACES, msgs.face_data(now, self.crowd.faces())))
         if rates[DIAGNOSTIC].due(elapsed):
-            statuses = [self.battery.status(), *active_faults(self.scenario.faults, elapsed)]
+            faults = active_faults(self.scenario.faults, elapsed, self.arrivals)
+            statuses = [self.battery.status(), *faults]
             out.append((DIAGNOSTIC, msgs.diagnostic_array(now, statuses)))
         if rates[DOCKING_STATE].due(elapsed):
             out.append((DOCKING_STATE, ros.STRING.encode(self.docking.state)))

@@ -143,7 +143,8 @@ class Declared:
             self.feedback_message = f"failed: {seen.error}"
             with contextlib.suppress(Exception):  # its terminate is counted by Observed.stop
                 self.stop(FAILURE)  # type: ignore[attr-defined]
-            self.status = FAILURE  # the tick that failed counts as the node's failure
+            # the tick that failed counts as the node's failure (py_trees' own attribute)
+            setattr(self, "status", FAILURE)  # noqa: B010
             yield self  # type: ignore[misc]
         finally:
             trace.acting.pop()
