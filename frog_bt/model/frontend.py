@@ -182,7 +182,10 @@ class DatagramDecoder:
             return datagram.seq, None
         cls = self._plain[type(datagram)]
         seq: int = msgspec.structs.asdict(datagram)["seq"]  # the datagram class's own field
-        return seq, cls(*(_inert(getattr(datagram, f)) for f in cls.__struct_fields__))
+        values = (getattr(datagram, f) for f in cls.__struct_fields__)
+        if cls.type in EVENTS:  # the front end's text, as the executive keeps it
+            return seq, cls(*map(_inert, values))
+        return seq, cls(*values)
 
 
 def _inert(value: Any) -> Any:
