@@ -36,6 +36,7 @@ from frog_bt.engine.operator import Command
 from frog_bt.errors import UsageError
 from frog_bt.i18n import N_, Msg, translator
 from frog_bt.live.console import CTL_AGENT
+from frog_bt.text import escape
 
 DEFAULT_CONSOLE = "127.0.0.1:8080"
 ENV = "FROG_BT_CONSOLE"
@@ -91,7 +92,7 @@ def _reason(body: bytes, default: str) -> str:
 
 
 def _fail(text: str) -> int:
-    print(f"frog-bt ctl: {text}", file=sys.stderr)
+    print(f"frog-bt ctl: {escape(text)}", file=sys.stderr)
     return 2
 
 
@@ -117,7 +118,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _say(text: str) -> None:
-    print(text)
+    """Print ``text``, its lines as we made them, any other control character (robot
+    text in a state or an answer) escaped."""
+    print("\n".join(escape(line) for line in text.split("\n")))
     sys.stdout.flush()  # a closed pipe shows here, where it is caught
 
 
