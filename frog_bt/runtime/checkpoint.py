@@ -7,7 +7,8 @@ atomically (write a temporary file, fsync, rename) whenever progress changes,
 and deletes it when a tour ends or is aborted.
 
 On start-up, :func:`load` gives a :class:`Resume`: the checkpoints a resumed
-tour skips, once each, and the visitor to restore.
+tour skips, once each, the visitor to restore, and the run id of the executive that
+wrote it, which the resumed executive's recordings keep (:mod:`frog_bt.model.run`).
 
 A checkpoint belongs to one executive. The default file is scoped by the site
 configuration and the listen address (:func:`default_path`), and
@@ -32,6 +33,7 @@ from typing import IO
 
 from frog_bt.errors import UsageError
 from frog_bt.model.progress import VERSION, Progress, Resume
+from frog_bt.model.run import valid_id
 
 STATE_DIR = Path(os.environ.get("XDG_STATE_HOME", Path.home() / ".local" / "state")) / "frog-bt"
 
@@ -80,9 +82,10 @@ def claim(path: Path, option: str = "--checkpoint") -> IO[str]:
     return handle
 
 
-def save(path: Path, progress: Progress) -> None:
-    """Write ``progress`` atomically; an empty progress removes the file."""
-    write_json(path, progress.to_json(time.time()) if progress.done else None)
+def save(path: Path, progress: Progress, run: str = "") -> None:
+    """Write ``progress`` of run ``run`` (its id) atomically; an empty progress removes
+    the file."""
+    write_json(path, {**progress.to_json(time.time()), "run": run} if progress.done else None)
 
 
 def write_json(path: Path, data: object | None) -> None:
@@ -125,4 +128,4 @@ def load(path: Path, max_age: float = math.inf) -> Resume | None:
         return None
     if visitor is not None and (isinstance(visitor, bool) or not isinstance(visitor, int)):
         visitor = None
-    return Resume(frozenset(done), visitor, tuple(done), float(written))
+    return Resume(frozenset(done), visitor, tuple(done), float(written), valid_id(data.get("run")))

@@ -33,6 +33,7 @@ from frog_bt.model.frontend import EVENTS, FrontendMessage
 from frog_bt.model.links import Links, states
 from frog_bt.model.outcomes import DockingState, IncidentKind, TourState
 from frog_bt.model.progress import EMPTY, Progress
+from frog_bt.model.run import RunId
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.rosbridge.link import LinkState
@@ -102,7 +103,10 @@ class Executive:
         self._saved: Progress = EMPTY
         self._decided = decisions.NONE  # what staff decided, as last saved
         if checkpoint is not None and not fresh:
-            self.core.board.set(keys.RESUME, load_checkpoint(checkpoint, site.checkpoint.max_age))
+            resume = load_checkpoint(checkpoint, site.checkpoint.max_age)
+            self.core.board.set(keys.RESUME, resume)
+            if resume is not None and resume.run:  # the run goes on: its recordings say so
+                self.standing.run = RunId.resuming(resume.run)
         self._wake = asyncio.Event()
         self._stopping = asyncio.Event()
         self._pending_at_loss: object = None
@@ -361,7 +365,7 @@ class Executive:
         if self.checkpoint is not None and progress != self._saved:
             self._saved = progress
             try:
-                save_checkpoint(self.checkpoint, progress)
+                save_checkpoint(self.checkpoint, progress, self.standing.run.id)
             except OSError as exc:  # a full disk must not stop the tour; warn once a minute
                 self._checkpoint_warnings.warn(
                     "checkpoint",
