@@ -7,7 +7,8 @@ file and line. Then, when it is fast enough (a bounded number of states), it pro
 the tree as `frog-bt verify` does and lists each property that does not hold
 (`--no-verify` skips that), each at the node it concerns, `FILE:LINE:COLUMN: PATH:
 PROPERTY: what`, with its shortest run on the lines after. Exit 0 when both are valid
-and every property holds, 2 otherwise. No robot, no network: fast enough for an editor's save hook.
+and every property holds, 2 otherwise. No robot, no network: fast enough for an
+editor's save hook.
 
 Examples:
 
