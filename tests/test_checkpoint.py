@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import time
+import uuid
 
 import pytest
 
@@ -21,6 +22,21 @@ def test_progress_round_trips_and_an_empty_one_removes_the_file(tmp_path):
     assert [p.name for p in path.parent.iterdir()] == ["checkpoint.json"]  # no temp file left
     save(path, Progress())
     assert not path.exists()
+
+
+def test_the_checkpoint_keeps_the_run_id_of_the_executive_that_wrote_it(tmp_path):
+    """A resumed executive's recordings keep the run id: the checkpoint carries it; one
+    written before run ids (or with something else there) resumes with none."""
+    path = tmp_path / "checkpoint.json"
+    run = str(uuid.uuid4())
+    save(path, Progress().complete("start"), run)
+    resume = load(path)
+    assert resume is not None and resume.run == run
+    for foreign in ({}, {"run": "not a uuid\x1b[2J"}, {"run": 7}):
+        data = {"version": 1, "done": ["start"], "visitor": None, "written": time.time()}
+        path.write_text(json.dumps({**data, **foreign}))
+        resume = load(path)
+        assert resume is not None and resume.run == ""
 
 
 def test_running_a_checkpoint_again_drops_it_and_everything_after():

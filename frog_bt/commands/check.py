@@ -5,8 +5,10 @@ foreach, parameters, the order-aware data-flow check) and reports every error
 found, one line each: `FILE:LINE:COLUMN: PATH: what was expected`, sorted by
 file and line. Then, when it is fast enough (a bounded number of states), it proves
 the tree as `frog-bt verify` does and lists each property that does not hold
-(`--no-verify` skips that). Exit 0 when both are valid and every property holds, 2
-otherwise. No robot, no network: fast enough for an editor's save hook.
+(`--no-verify` skips that), each at the node it concerns, `FILE:LINE:COLUMN: PATH:
+PROPERTY: what`, with its shortest run on the lines after. Exit 0 when both are valid
+and every property holds, 2 otherwise. No robot, no network: fast enough for an
+editor's save hook.
 
 Examples:
 
@@ -52,6 +54,7 @@ def run(args: argparse.Namespace) -> int:
         from frog_bt.verify.explore import TooBig
         from frog_bt.verify.model import compile_tree
         from frog_bt.verify.prove import prove
+        from frog_bt.verify.report import finding
 
         try:
             props = designer.read_properties(tree.file) if tree.file.endswith("yaml") else []
@@ -68,11 +71,7 @@ def run(args: argparse.Namespace) -> int:
             proved = "; not proved (too many states: run frog-bt verify)"
         else:
             for broken in verdict.broken:
-                print(
-                    f"{tree.file}: property {broken.name} does not hold: {broken.run.note} "
-                    "(frog-bt verify shows the run)",
-                    file=sys.stderr,
-                )
+                print("\n".join(finding(verdict.model, broken)), file=sys.stderr)
             if verdict.broken:
                 return 2
             proved = f"; {len(verdict.checked)} properties hold"

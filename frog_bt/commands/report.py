@@ -82,15 +82,15 @@ def _season(
     from frog_bt.offline.report.corpus import read_corpus
     from frog_bt.offline.report.provenance import provenance
     from frog_bt.offline.report.reliability import reliability
-    from frog_bt.offline.report.rows import overlapping
     from frog_bt.offline.report.rows import rows as tour_rows
+    from frog_bt.offline.report.runs import copies, suspicious
     from frog_bt.offline.report.totals import totals
 
     facts = read_corpus(recordings(paths), site, pool, bar)
     if bar is not None:
         bar.clear()
-    copies = overlapping([f for f in facts if not f.error])
-    facts = [replace(f, error=copies[f.file]) if f.file in copies else f for f in facts]
+    copy = copies([f for f in facts if not f.error])
+    facts = [replace(f, error=copy[f.file]) if f.file in copy else f for f in facts]
     skipped = [f"{f.file}: {f.error}" for f in facts if f.error]
     for line in skipped:
         print(f"frog-bt report: skipped {line}", file=sys.stderr)
@@ -104,12 +104,15 @@ def _season(
                 file=sys.stderr,
             )
     read = [f for f in facts if not f.error]
+    doubtful = suspicious(read)
+    for line in doubtful:
+        print(f"frog-bt report: suspicious: {line}", file=sys.stderr)
     rows = tour_rows(read, site)
     face_stops = [s.poi for s in site.tour.stops if s.face_stream]
     order = [s.poi for s in site.tour.stops if s.content]
     t = totals(rows, face_stops, unreadable=len(skipped), order=order)
     t["reliability"] = reliability(read, rows)
-    t["provenance"] = provenance(facts, skipped)
+    t["provenance"] = provenance(facts, skipped, doubtful)
     return facts, rows, t, skipped
 
 

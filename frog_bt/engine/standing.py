@@ -4,7 +4,8 @@ A reload (``--watch``) builds a new :class:`~frog_bt.engine.core.Core` for the n
 each core gets the executive's one :class:`Standing` injected, so nothing people decided
 is lost with the old tree: in service or not, a pause and its timer, the resume point,
 the front end's events and readiness, the tours' state, the decision journal with its
-incidents and their tally, and the robot's latest inputs.
+incidents and their tally, the robot's latest inputs, and the run's id (what its
+recordings carry, :mod:`frog_bt.model.run`).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from frog_bt.engine.blackboard import Inputs
 from frog_bt.engine.faults import Faults
 from frog_bt.engine.journal import Journal
 from frog_bt.model.key import Key
+from frog_bt.model.run import RunId
 
 __all__ = ["Standing"]
 
@@ -29,3 +31,4 @@ class Standing:
         self.journal = Journal(clock)
         self.faults = Faults(clock)  # the executive's own failures, caught and counted
         self.inputs: Inputs | None = None  # the robot's latest inputs (the first core's)
+        self.run = RunId.new()  # a resumed executive's: the run its checkpoint names

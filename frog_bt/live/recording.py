@@ -16,7 +16,11 @@
   divergence report;
 * ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``);
 * metadata ``frog_bt_site``: ``config_sha256``, the site configuration that ran
-  (:func:`frog_bt.config.fingerprint`), in every file.
+  (:func:`frog_bt.config.fingerprint`), in every file;
+* metadata ``frog_bt_run``: ``id``, the run's UUID (drawn when the executive started
+  afresh, kept by one that resumed the run from its checkpoint), ``robot``, the robot's
+  configured name (``alerts.robot``), and, in a resumed run's files, ``resumes``: the run
+  it carries on (:mod:`frog_bt.model.run`), in every file.
   Live ticks coalesce bursts of inputs and fall wherever the event loop gets to
   them, so replay ticks exactly where the live executive did
   (:mod:`frog_bt.offline.replay`).
@@ -87,6 +91,7 @@ from frog_bt.model.events import (
     RobotInput,
     Ticked,
 )
+from frog_bt.model.run import RUN_METADATA
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS, Keep
 
 if TYPE_CHECKING:
@@ -166,6 +171,7 @@ class Recorder:
         self._clock_topic: str | None = None
         self._tree: bytes | None = None
         self._site: dict[str, str] = {}  # SITE_METADATA, for the next file too
+        self._run: dict[str, str] = {}  # RUN_METADATA, for the next file too
         # What a new file starts with (rotation): the latest message of each input kept
         # as latest, the last /clock, recent datagrams in and the seqs sent out.
         self._latest_topics: frozenset[str] = frozenset()
@@ -237,6 +243,8 @@ class Recorder:
         self._ready = lambda: bool(clock.ready)
         self._site = {"config_sha256": fingerprint(site)}
         self._writer.add_metadata(SITE_METADATA, self._site)
+        self._run = host.core.standing.run.metadata(site.alerts.robot)
+        self._writer.add_metadata(RUN_METADATA, self._run)
         self._tree = self._tree_message(host)
         if self._tree is not None:
             self._write(TREE, None, self._tree)
@@ -471,6 +479,8 @@ class Recorder:
             return
         if self._site:
             self._writer.add_metadata(SITE_METADATA, self._site)
+        if self._run:
+            self._writer.add_metadata(RUN_METADATA, self._run)
         if self._tree is not None:
             self._write(TREE, None, self._tree)
         if self._clock_raw is not None and self._clock_topic is not None:

@@ -7,8 +7,9 @@ checkpoint file whenever a tick leaves a new value there
 (:mod:`frog_bt.runtime.checkpoint`). Starting a checkpoint again drops it and everything
 after it (a lost visitor: recruit again, then every stop again).
 
-:class:`Resume` is what a restarted executive skips (each name once) and the visitor it
-restores (:data:`frog_bt.model.keys.RESUME`).
+:class:`Resume` is what a restarted executive skips (each name once), the visitor it
+restores (:data:`frog_bt.model.keys.RESUME`) and the run it carries on
+(:mod:`frog_bt.model.run`).
 """
 
 from __future__ import annotations
@@ -55,6 +56,7 @@ class Resume:
     visitor: int | None
     order: tuple[str, ...] = ()
     written: float = 0.0  # wall time the checkpoint was written
+    run: str = ""  # the run id of the executive that wrote it ("": not recorded)
     resumed: int = 0  # starts that resumed it and then stopped before any progress
     crashed: str = ""  # why the executive that ran it crashed (empty: it did not)
 

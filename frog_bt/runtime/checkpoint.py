@@ -7,7 +7,8 @@ atomically (write a temporary file, fsync, rename) whenever progress changes,
 and deletes it when a tour ends or is aborted.
 
 On start-up, :func:`load` gives a :class:`Resume`: the checkpoints a resumed
-tour skips, once each, and the visitor to restore.
+tour skips, once each, the visitor to restore, and the run id of the executive that
+wrote it, which the resumed executive's recordings keep (:mod:`frog_bt.model.run`).
 
 No crash loop: a checkpoint says how often it was resumed without progress since
 (:func:`mark_resumed`, reset by the next :func:`save`) and why the executive that ran it
@@ -38,6 +39,7 @@ from typing import IO
 
 from frog_bt.errors import UsageError
 from frog_bt.model.progress import VERSION, Progress, Resume
+from frog_bt.model.run import valid_id
 from frog_bt.text import LINE, inert
 
 STATE_DIR = Path(os.environ.get("XDG_STATE_HOME", Path.home() / ".local" / "state")) / "frog-bt"
@@ -103,9 +105,10 @@ def claim(path: Path, option: str = "--checkpoint") -> IO[str]:
     return handle
 
 
-def save(path: Path, progress: Progress) -> None:
-    """Write ``progress`` atomically; an empty progress removes the file."""
-    write_json(path, progress.to_json(time.time()) if progress.done else None)
+def save(path: Path, progress: Progress, run: str = "") -> None:
+    """Write ``progress`` of run ``run`` (its id) atomically; an empty progress removes
+    the file."""
+    write_json(path, {**progress.to_json(time.time()), "run": run} if progress.done else None)
 
 
 def write_json(path: Path, data: object | None) -> None:
@@ -152,7 +155,15 @@ def load(path: Path, max_age: float = math.inf) -> Resume | None:
     resumed = resumed if isinstance(resumed, int) and not isinstance(resumed, bool) else 0
     crashed = data.get("crashed", "")
     crashed = inert(crashed, LINE) if isinstance(crashed, str) else "crashed"
-    return Resume(frozenset(done), visitor, tuple(done), float(written), resumed, crashed)
+    return Resume(
+        frozenset(done),
+        visitor,
+        tuple(done),
+        float(written),
+        valid_id(data.get("run")),
+        resumed,
+        crashed,
+    )
 
 
 def _update(path: Path, **fields: object) -> None:

@@ -34,6 +34,7 @@ from frog_bt.model.help import Help, HelpAbout
 from frog_bt.model.links import Links, states
 from frog_bt.model.outcomes import DockingState, IncidentKind, TourState
 from frog_bt.model.progress import EMPTY, Progress
+from frog_bt.model.run import RunId
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.rosbridge.link import LinkState
@@ -137,6 +138,8 @@ class Executive:
         if why is None:
             mark_resumed(checkpoint, resume)
             self.core.board.set(keys.RESUME, resume)
+            if resume.run:  # the run goes on: its recordings say so
+                self.standing.run = RunId.resuming(resume.run)
             return
         log.error("not resuming the tour of %s: %s; holding for a person", checkpoint, why)
         with contextlib.suppress(OSError):
@@ -402,7 +405,7 @@ class Executive:
         if self.checkpoint is not None and progress != self._saved:
             self._saved = progress
             try:
-                save_checkpoint(self.checkpoint, progress)
+                save_checkpoint(self.checkpoint, progress, self.standing.run.id)
             except OSError as exc:  # a full disk must not stop the tour; warn once a minute
                 self._checkpoint_warnings.warn(
                     "checkpoint",

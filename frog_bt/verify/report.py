@@ -1,12 +1,17 @@
-"""What verify says: a summary line, or per broken property its shortest run as numbered
-ticks, and the tree drawn with the nodes of the run marked (Mermaid or Graphviz dot)."""
+"""What verify says: a summary line, or per broken property one line at the node it
+concerns (``file:line:column: path: property: what``, the file the node was written in,
+an included one when it was) with its shortest run as numbered ticks on the lines after,
+and the tree drawn with the nodes of the run marked (Mermaid or Graphviz dot)."""
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 
+from frog_bt.engine.loaded import Where
+from frog_bt.errors import format_path
 from frog_bt.verify.graph import Run
 from frog_bt.verify.model import Model
+from frog_bt.verify.properties import Broken
 from frog_bt.verify.prove import Verdict
 from frog_bt.verify.tick import Step
 from frog_bt.verify.world import By, Event
@@ -60,12 +65,33 @@ def run_lines(model: Model, run: Run) -> list[str]:
     return out
 
 
+def where(model: Model, broken: Broken) -> Where:
+    """Where the node a broken property concerns was written (the first in the tree when
+    it concerns several; the root when none)."""
+    tree = model.tree
+    first = min(broken.run.nodes, default=None)
+    behaviour = tree.root if first is None else model.nodes[first].behaviour
+    return tree.where.get(id(behaviour)) or tree.where.get(id(tree.root)) or Where(tree.file, ())
+
+
+def finding(model: Model, broken: Broken) -> list[str]:
+    """``file:line:column: path: property: what``, then the property's meaning and its
+    shortest run, indented."""
+    at = where(model, broken)
+    place = f"{at.file}:{at.line[0]}:{at.line[1]}" if at.line else at.file
+    what = broken.run.note or broken.meaning
+    return [
+        f"{place}: {format_path(at.path)}: {broken.name}: {what}",
+        f"  {broken.name}: {broken.meaning}",
+        f"  the shortest run ({len(broken.run.ticks)} ticks):",
+        *run_lines(model, broken.run),
+    ]
+
+
 def broken_text(verdict: Verdict, fmt: str | None = None) -> str:
     lines = []
     for b in verdict.broken:
-        lines.append(f"broken: {b.name}: {b.meaning}")
-        lines.append(f"  the shortest run ({len(b.run.ticks)} ticks):")
-        lines += run_lines(verdict.model, b.run)
+        lines += finding(verdict.model, b)
         if fmt:
             lines.append(draw(verdict.model, run_nodes(b.run), b.run.nodes, fmt))
     held = len(verdict.checked) - len({b.name for b in verdict.broken})

@@ -32,6 +32,7 @@ from frog_bt.model.channels import (
 )
 from frog_bt.model.events import Datagram, RobotInput
 from frog_bt.model.links import Links, LinkStatus
+from frog_bt.model.run import RunId
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rehearsal import free_udp_port
 from frog_bt.runtime.observer import Observers, attach_all
@@ -145,7 +146,7 @@ def fake_executive() -> Any:
         sim_time=True,
         clock=SimClock(),
         observers=Observers(),
-        core=SimpleNamespace(tree=None),
+        core=SimpleNamespace(tree=None, standing=SimpleNamespace(run=RunId.new())),
         links=links,
     )
 

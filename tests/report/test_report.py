@@ -20,13 +20,16 @@ from frog_bt.cli import main
 from frog_bt.config import load_site
 from frog_bt.model import channels
 from frog_bt.model.frontend import AskTour, FinishPoi, StartPoi, Tour, UserPositive
+from frog_bt.model.run import RUN_METADATA
 from frog_bt.offline.report.facts import FileFacts, Piece, StopFacts, _Pieces
 from frog_bt.offline.report.rows import Played, StopTime, join, rows
+from frog_bt.recordings.mcapfile import open_recording
 from frog_bt.recordings.reader import FrontendIn, FrontendOut, Primed
 from frog_bt.runtime.observer import attach_all
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 from corpus_run import make
+from relabel import relabel
 
 SEED = 2  # one day: declines, engaged, declines, fault, wander_off, bored; 3 afternoon
 
@@ -416,6 +419,10 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
     (row,) = got["tours"]
     assert row["resumed"] and row["ended"] == "ended" and len(row["files"]) >= 3
     assert row["stops_visited"] == ["POI1", "POI2", "POI3", "POI4", "POI5", "END"]  # POI2 once
+    # one run: the resumed executive's files keep the run id and name the run they resume
+    runs = [open_recording(p).metadata[RUN_METADATA] for p in sorted(day.glob("*.mcap"))]
+    assert len({r["id"] for r in runs}) == 1 and {r["robot"] for r in runs} == {"frog"}
+    assert "resumes" not in runs[0] and runs[-1]["resumes"] == runs[-1]["id"]
 
 
 def test_without_the_fleet_extra_scheduler_says_which(
@@ -432,8 +439,9 @@ def test_without_the_fleet_extra_scheduler_says_which(
 
 
 def test_a_copy_beside_its_original_is_skipped_not_counted_twice(corpus, tmp_path) -> None:
-    """One robot's recordings cannot overlap in time: a (cut) copy of a file put beside
-    it is skipped and says why; the tour is counted once, as from the original alone."""
+    """A file copied whole and a copy cut short put beside the original are the same run
+    (their run id) overlapping in time: both are skipped and say why; the tour is counted
+    once, as from the original alone."""
     directory, _ = corpus
     original = sorted(directory.glob("*.mcap"))[0]
     alone, both = tmp_path / "alone", tmp_path / "both"
@@ -441,14 +449,39 @@ def test_a_copy_beside_its_original_is_skipped_not_counted_twice(corpus, tmp_pat
     both.mkdir()
     shutil.copy(original, alone / original.name)
     shutil.copy(original, both / original.name)
+    shutil.copy(original, both / "whole.mcap")
     data = original.read_bytes()
     (both / "copy.mcap").write_bytes(data[: len(data) // 2])
     one = report(tmp_path, str(alone))
     got = report(tmp_path, str(both))
-    (skipped,) = got["totals"]["provenance"]["skipped"]
-    assert skipped.startswith(str(both / "copy.mcap") + ": overlaps " + original.name)
-    assert got["totals"]["tours"] == 1
+    copy, whole = sorted(got["totals"]["provenance"]["skipped"])
+    same = f": the same run as {original.name} (run "
+    assert copy.startswith(f"{both / 'copy.mcap'}{same}") and whole.startswith(
+        f"{both / 'whole.mcap'}{same}"
+    )
+    assert whole.endswith("and overlaps it in time: a copy (the longer one is read)")
+    assert got["totals"]["tours"] == 1 and got["totals"]["provenance"]["runs"] == 1
+    assert got["totals"]["provenance"]["suspicious"] == []
     keep = ("approaches", "invitations", "visitors", "distance_m", "stops_visited", "ended")
     assert [{k: r[k] for k in keep} for r in got["tours"]] == [
         {k: r[k] for k in keep} for r in one["tours"]
     ]
+
+
+def test_files_recorded_before_run_ids_keep_the_copy_rule_by_time(corpus, tmp_path) -> None:
+    """Without run ids (files from before them), one directory is one robot's and a file
+    overlapping another in time is taken for a copy, as before, and says so."""
+    directory, _ = corpus
+    original = sorted(directory.glob("*.mcap"))[0]
+    old = tmp_path / "old"
+    old.mkdir()
+    relabel(original, old / original.name, lambda _run: None)
+    data = (old / original.name).read_bytes()
+    (old / "copy.mcap").write_bytes(data[: len(data) // 2])
+    got = report(tmp_path, str(old))
+    prov = got["totals"]["provenance"]
+    assert prov["skipped"] == [
+        f"{old / 'copy.mcap'}: overlaps {original.name} in time, which one robot's recordings "
+        "cannot: a copy? (no run id, recorded before run ids: the longer one is read)"
+    ]
+    assert (prov["runs"], prov["without_run_id"], got["totals"]["tours"]) == (0, 1, 1)

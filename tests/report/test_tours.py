@@ -8,6 +8,7 @@ from __future__ import annotations
 import csv
 import json
 import shutil
+import uuid
 from collections import Counter
 from datetime import datetime
 from html.parser import HTMLParser
@@ -16,6 +17,7 @@ from typing import Any
 
 import pytest
 from mcap.writer import Writer
+from relabel import relabel
 from robot_day import KINDS, RESTART_INTO_POI2_S, Seen
 
 from frog_bt.cli import main
@@ -379,13 +381,26 @@ def test_cut_and_foreign_files_are_said_and_the_rest_is_read(robot_day, tmp_path
 
 
 def test_two_robots_tours_at_the_same_time_stay_apart(robot_day, tmp_path) -> None:
+    """One robot's resumed tour, and the same recordings as another robot's run (another
+    run id, another name): two tours, each joined from its own run's files."""
     directory, _ = robot_day
     day = day_of("resumed").replace("-", "")
+    other: dict[str, str] = {}  # frog1's run id -> frog2's
+
+    def frog2(run: dict[str, str]) -> dict[str, str]:
+        new = other.setdefault(run["id"], str(uuid.uuid4()))
+        return {**run, "id": new, "robot": "frog2"} | ({"resumes": new} if "resumes" in run else {})
+
     for robot in ("frog1", "frog2"):
         (tmp_path / robot).mkdir()
         for path in directory.glob(f"{day}-*.mcap"):
-            shutil.copy(path, tmp_path / robot / path.name)
+            if robot == "frog1":
+                shutil.copy(path, tmp_path / robot / path.name)
+            else:
+                relabel(path, tmp_path / robot / path.name, frog2)
     got = report(tmp_path, str(tmp_path / "frog1"), str(tmp_path / "frog2"))
+    assert got["totals"]["provenance"]["skipped"] == []
+    assert got["totals"]["provenance"]["suspicious"] == []
     assert [(r["robot"], r["resumed"], r["stops_visited"]) for r in got["tours"]] == [
         ("frog1", True, STOPS),
         ("frog2", True, STOPS),

@@ -3,6 +3,7 @@ mutations of the shipped tree each break their property, with the shortest run."
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -17,7 +18,9 @@ from frog_bt.model.frontend import AskTour as AskTourCommand
 from frog_bt.tree.factory import NodeFactory
 from frog_bt.tree.leaf import RUNNING, SUCCESS, Leaf, Status
 from frog_bt.verify.abstraction import Abstraction
-from frog_bt.verify.properties import BUILT_IN
+from frog_bt.verify.graph import Run
+from frog_bt.verify.properties import BUILT_IN, Broken
+from frog_bt.verify.report import finding
 from frog_bt.verify.world import By, Role
 from tests.verify.mutate import copy, lines, run_of, verdict
 
@@ -62,7 +65,8 @@ def test_the_old_service_off_bug_is_found(
     ]
     assert main(["verify", str(tour), "--format", "mermaid"]) == 1
     out = capsys.readouterr().out
-    assert "broken: service-off-obeyed" in out and "  2. operator: service_off" in out
+    assert f"{tour}:" in out and ": service-off-obeyed: " in out
+    assert "  2. operator: service_off" in out
     assert "flowchart TD" in out and " broke" in out
 
 
@@ -227,6 +231,36 @@ def test_a_deleted_engagement_decision_is_a_dead_read(tmp_path: Path) -> None:
     assert any(r.note == "AskTour reads /engaged, which no run writes before it" for r in runs)
 
 
+def test_a_broken_property_is_reported_at_its_node_in_the_included_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check`` and ``verify`` alike: one ``file:line:column: path: property: what`` line
+    at the node (in recruit.yaml, which tour.yaml includes), its shortest run after it."""
+    decide = "            - {type: DecideEngagement, about: introduction}\n"
+    tour = copy(tmp_path, {"recruit.yaml": [(decide, "")]})
+    recruit = tour.with_name("recruit.yaml")
+    (line,) = [n for n, text in enumerate(recruit.read_text().splitlines(), 1) if "AskTour" in text]
+    column = recruit.read_text().splitlines()[line - 1].index("{type: AskTour}") + 1
+    located = (
+        f"{recruit}:{line}:{column}: root.child.children[2].child.children[2]: "
+        "no-dead-reads: AskTour reads /engaged, which no run writes before it"
+    )
+    assert main(["check", str(tour)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == located
+    assert [e for e in err if not e.startswith("  ")] == [located]  # the run: indented
+    assert "    5. [visitor addressed: AskTour]" in err
+    assert main(["verify", str(tour)]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == located
+    assert out[2:4] == [
+        "  the shortest run (5 ticks):",
+        "    1. WaitFrontendIdle 'Wait for the front end' success; "
+        "[tour started: TourStatus 'TourStatus started']; "
+        "[undock sent: Docking 'Docking undock']",
+    ]
+
+
 def test_designer_properties(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     props = """
 properties:
@@ -242,3 +276,13 @@ properties:
     tour.write_text(tour.read_text() + "  - {never: [No such node, Undock], together: true}\n")
     assert main(["check", str(tour)]) == 2
     assert "no node named 'No such node' in the tree" in capsys.readouterr().err
+
+
+def test_a_finding_about_no_node_is_at_the_root_of_the_tree_file() -> None:
+    """A property broken by the tree as a whole (a loop with no node to blame) points at
+    the root of the tour file."""
+    v = verdict(None)
+    broken = Broken("ends-well", "every tour ends well", Run([], note="loops"))
+    first, meaning, *_ = finding(v.model, broken)
+    assert re.fullmatch(r".*/tour\.yaml:\d+:\d+: root: ends-well: loops", first), first
+    assert meaning == "  ends-well: every tour ends well"

@@ -67,6 +67,7 @@ from frog_bt.model.frontend import (
 )
 from frog_bt.model.outcomes import DiagnosticLevel, DockCommand, DockingState, FaceStream, TourState
 from frog_bt.model.ros import Diagnostics, FaceData, Pose
+from frog_bt.model.run import read_metadata
 from frog_bt.model.wire import SUCCEEDED, Response
 from frog_bt.recordings.mcapfile import RecordingError, open_recording
 from frog_bt.recordings.reader import (
@@ -200,6 +201,8 @@ class FileFacts:
     library: str = ""  # what wrote it (frog-bt and its version)
     tree: str = ""  # sha256 (12 hex) of the tree that ran, from /frog_bt/tree
     config: str = ""  # sha256 (12 hex) of the site configuration, from its metadata
+    run: str = ""  # the run's UUID, from its metadata ("": recorded before run ids)
+    robot_name: str = ""  # the robot's configured name, from the same metadata
     error: str = ""  # unreadable: why (the file is reported and skipped)
     recovered: str = ""  # a file cut short: what was read of it
     start: float = 0.0  # first message, seconds
@@ -529,6 +532,7 @@ def read_file(path: str, site: Site) -> FileFacts:
         kind = recording.metadata.get("frog_bt", {}).get("kind")
         restarts = [start] if start is not None and kind != "tour" and not pieces.primed else []
         tally = reader.tally
+        run = read_metadata(recording.metadata)
         return FileFacts(
             path,
             pieces.finish(),
@@ -540,6 +544,8 @@ def read_file(path: str, site: Site) -> FileFacts:
             library=_library(Path(path)),
             tree=pieces.tree,
             config=recording.metadata.get(SITE_METADATA, {}).get("config_sha256", ""),
+            run=run.id,
+            robot_name=run.robot,
             recovered=recording.recovered,
             start=start or 0.0,
             bad=tally.count,

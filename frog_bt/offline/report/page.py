@@ -202,6 +202,16 @@ def provenance(p: dict[str, Any]) -> str:
             f"{p['files']} files read ({len(p['cut_short'])} of them cut short), "
             f"{len(p['skipped'])} skipped",
         ),
+        (
+            "Runs",
+            f"{p['runs']} runs"
+            + (
+                f"; {p['without_run_id']} files recorded before run ids "
+                "(a copy among them is found by its time alone)"
+                if p["without_run_id"]
+                else ""
+            ),
+        ),
         ("From (local time)", _when(p["first"])),
         ("To (local time)", _when(p["last"])),
         ("Written by", ", ".join(f"{k} ({n} files)" for k, n in p["versions"].items()) or "\u2013"),
@@ -215,10 +225,10 @@ def provenance(p: dict[str, Any]) -> str:
         ),
     ]
     skipped = "".join(f"<li>skipped: {e(s)}</li>" for s in p["skipped"])
+    doubtful = "".join(f"<li>suspicious: {e(s)}</li>" for s in p["suspicious"])
     cut = "".join(f"<li>read in part: {e(s)}</li>" for s in p["cut_short"])
-    return _table(lines, "provenance") + (
-        f'<ul class="skip">{skipped}{cut}</ul>' if skipped or cut else ""
-    )
+    listed = skipped + doubtful + cut
+    return _table(lines, "provenance") + (f'<ul class="skip">{listed}</ul>' if listed else "")
 
 
 def compare(c: dict[str, Any]) -> str:

@@ -1,8 +1,10 @@
 """Tours from the pieces of many files, and one flat row per tour.
 
-Pieces are joined within one directory (one robot's ``--record DIR``; a fleet's
-recordings go in one directory per robot, so that two robots' tours, which overlap in
-time, are never taken for one), in time order:
+Pieces are joined within one run (the files one executive wrote, those it rotated into
+and those of an executive that resumed it: they share the run id,
+:mod:`frog_bt.offline.report.runs`), so that two runs' tours, which may overlap in time,
+are never taken for one; files recorded before run ids are joined within one directory
+(one robot's ``--record DIR``). In time order:
 
 * a piece that opens with its file (no ``tour started`` of its own) continues the tour
   before it when that tour has not ended: the tour file after a rotation, or the file
@@ -33,6 +35,7 @@ from frog_bt.engine.operator import Command
 from frog_bt.offline.report.alerts import Episode, episodes, runs_of
 from frog_bt.offline.report.causes import Cause, Incident
 from frog_bt.offline.report.facts import FileFacts, OperatorCall, Piece, StopFacts, stop_of
+from frog_bt.offline.report.runs import lanes
 
 NAV_FAILED = "navigation failed"
 OPERATOR_SKIP = "operator"
@@ -61,7 +64,8 @@ INTERVENING = {
 class Tour:
     robot: str  # the directory its recordings are in
     pieces: list[Piece]
-    restarts: list[float] = field(default_factory=list)  # of its robot, in order
+    restarts: list[float] = field(default_factory=list)  # of its lane, in order
+    lane: str = ""  # the files it was joined from: a run's, or a directory's (lane_of)
 
     @property
     def first(self) -> Piece:
@@ -90,12 +94,12 @@ class Tour:
 
 def join(files: list[FileFacts]) -> list[Tour]:
     """The tours of the corpus, in order of their first event."""
-    robots = by_robot(files)
-    tours = [t for robot, group in robots.items() for t in _join(robot, group)]
-    return sorted(tours, key=lambda t: (t.first.t0, t.robot))
+    tours = [t for lane, group in lanes(files).items() for t in _join(lane, group)]
+    return sorted(tours, key=lambda t: (t.first.t0, t.robot, t.lane))
 
 
-def _join(robot: str, files: list[FileFacts]) -> list[Tour]:
+def _join(lane: str, files: list[FileFacts]) -> list[Tour]:
+    robot = str(Path(files[0].file).parent)
     restarts = sorted(r for f in files for r in f.restarts)
     pieces = sorted((p for f in files for p in f.pieces), key=lambda p: (p.t0, p.file))
     tours: list[Tour] = []
@@ -112,7 +116,7 @@ def _join(robot: str, files: list[FileFacts]) -> list[Tour]:
             ):
                 prev.pieces.append(piece)  # `tour started` resent after a file's rotation
             else:
-                tours.append(Tour(robot, [piece], restarts))
+                tours.append(Tour(robot, [piece], restarts, lane))
         elif open_ and prev is not None:
             if (
                 piece.ended
@@ -124,7 +128,7 @@ def _join(robot: str, files: list[FileFacts]) -> list[Tour]:
                 piece = replace(piece, ended="", reason="", end_seq=0)
             prev.pieces.append(piece)  # rotated, or carried on by a restarted executive
         elif piece.stops or piece.invitations:
-            tours.append(Tour(robot, [piece], restarts))  # its beginning is not in the corpus
+            tours.append(Tour(robot, [piece], restarts, lane))  # its start is not in the corpus
         # else: the tail of a tour whose start is not in the corpus, with nothing in it
     return tours
 
@@ -456,15 +460,14 @@ def incidents(
 def rows(files: list[FileFacts], site: Site) -> list[Row]:
     """One row per tour of the corpus, numbered from 1 in order of their start."""
     out = []
-    robots = by_robot(files)
     tours = join(files)
     spans: dict[str, list[tuple[float, float, int]]] = {}
     for i, t in enumerate(tours):
-        spans.setdefault(t.robot, []).append((t.start, t.last.t1, i))
+        spans.setdefault(t.lane, []).append((t.start, t.last.t1, i))
     calls: dict[int, list[OperatorCall]] = {}
     alerts: dict[int, list[Episode]] = {}
-    for robot, group in robots.items():
-        own = spans.get(robot, [])
+    for lane, group in lanes(files).items():
+        own = spans.get(lane, [])
         robot_calls = [c for f in group for c in f.operator]
         for c in sorted(robot_calls, key=lambda c: c.t):
             k = _during(own, c.t)
@@ -484,34 +487,11 @@ def rows(files: list[FileFacts], site: Site) -> list[Row]:
 
 
 def by_robot(files: list[FileFacts]) -> dict[str, list[FileFacts]]:
-    """The files of each robot (its directory)."""
+    """The files of each robot (its directory: field reliability's robot-days)."""
     robots: dict[str, list[FileFacts]] = {}
     for f in files:
         robots.setdefault(str(Path(f.file).parent), []).append(f)
     return robots
-
-
-OVERLAP_S = 1.0  # seconds two of one robot's files may share (a rotation's seam)
-
-
-def overlapping(files: list[FileFacts]) -> dict[str, str]:
-    """Files of one robot that overlap another of its files in time, which one robot's
-    recordings cannot (a copy, or a cut copy, put beside the original): file -> why.
-    Of two, the one that covers more time is read."""
-    out: dict[str, str] = {}
-    for group in by_robot(files).values():
-        kept: FileFacts | None = None
-        for f in sorted(group, key=lambda f: f.start):
-            if kept is None or f.start >= kept.end - OVERLAP_S:
-                kept = f if kept is None or f.end > kept.end else kept
-                continue
-            shorter, longer = sorted((kept, f), key=lambda g: g.end - g.start)
-            out[shorter.file] = (
-                f"overlaps {Path(longer.file).name} in time, which one robot's recordings "
-                "cannot: a copy? (the longer one is read)"
-            )
-            kept = longer
-    return out
 
 
 def _during(spans: list[tuple[float, float, int]], t: float) -> int | None:
