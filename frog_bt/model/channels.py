@@ -15,6 +15,9 @@ channel                schema name             one message per
 ``/frog_bt/primer``    ``frog_bt/Primer``      rotated file: what it carries from before
 ``/frog_bt/operator``  ``frog_bt/Operator``    operator command, with its answer
 ``/frog_bt/alert``     ``frog_bt/Alert``       alert raised, cleared or acknowledged
+``/frog_bt/links``     ``frog_bt/Links``       change of a link's state (the alerts read them)
+``/frog_bt/restored``  ``frog_bt/Restored``    file of a started executive: what it took up
+                                               from before it (checkpoint, staff's decisions)
 =====================  ======================  ============================================
 """
 
@@ -27,6 +30,7 @@ import msgspec
 
 from frog_bt.codec import decoder
 from frog_bt.model.frontend import COMMANDS, EVENTS
+from frog_bt.model.links import LinkStatus
 from frog_bt.model.ros import ROS_TYPES
 
 FRONTEND_IN = "/frontend/in"
@@ -39,6 +43,8 @@ PRIMER = "/frog_bt/primer"  # what a rotated file carries from before it
 SITE_METADATA = "frog_bt_site"  # MCAP metadata in every file: config_sha256, the site config
 OPERATOR = "/frog_bt/operator"  # each operator command and its answer
 ALERT = "/frog_bt/alert"  # each alert's changes
+LINKS = "/frog_bt/links"  # the links' states, at each change
+RESTORED = "/frog_bt/restored"  # what a started executive took up from before it
 
 
 class Tick(msgspec.Struct, frozen=True):
@@ -106,6 +112,36 @@ class Alert(msgspec.Struct, frozen=True):
     waited: float = 0.0
 
 
+class Links(msgspec.Struct, frozen=True):
+    """The links' states after one of them changed (the alerts ``rosbridge_down`` and
+    ``frontend_silent`` read them; replay takes them from here)."""
+
+    rosbridge: LinkStatus
+    frontend: LinkStatus
+    clock: LinkStatus
+
+
+class RestoredHelp(msgspec.Struct, frozen=True):
+    about: str  # a HelpAbout value: undock, dock, home, fault
+    since: float
+
+
+class Restored(msgspec.Struct, frozen=True):
+    """What an executive took up at start-up from the one before it (a restart): the
+    resume point of its checkpoint (``done``: the checkpoints done, in order; empty: none;
+    ``visitor``; ``written``: wall time) and what staff had decided (out of service, a
+    pause, the help the robot waited for, the alerts acknowledged). Replay starts from
+    the same."""
+
+    done: list[str] = []
+    visitor: int | None = None
+    written: float = 0.0
+    in_service: bool = True
+    paused: bool = False
+    help: RestoredHelp | None = None
+    acknowledged: list[str] = []
+
+
 TYPES: dict[str, tuple[str, type[msgspec.Struct]]] = {
     TICK: ("frog_bt/Tick", Tick),
     BLAME: ("frog_bt/Blame", Blame),
@@ -113,6 +149,8 @@ TYPES: dict[str, tuple[str, type[msgspec.Struct]]] = {
     PRIMER: ("frog_bt/Primer", Primer),
     OPERATOR: ("frog_bt/Operator", Operator),
     ALERT: ("frog_bt/Alert", Alert),
+    LINKS: ("frog_bt/Links", Links),
+    RESTORED: ("frog_bt/Restored", Restored),
 }
 
 _ENCODER = msgspec.json.Encoder()

@@ -253,6 +253,7 @@ class AlertBook:
     active: dict[str, Alert] = field(default_factory=dict)  # id -> raised, not cleared
     unacknowledged: dict[str, Alert] = field(default_factory=dict)  # id -> latest state
     told_at: dict[str, float] = field(default_factory=dict)  # id -> last told (raised)
+    logged: bool = True  # each change in the log (a replay's book is quiet)
 
     def update(self, facts: Facts) -> list[Alert]:
         """Compare the conditions now with the alerts up, and escalate what waits too
@@ -321,6 +322,12 @@ class AlertBook:
             self.unacknowledged.pop(alert.id, None)
         else:
             self.unacknowledged[alert.id] = alert
+        if self.logged:
+            self._log(alert)
+        for listener in self.listeners:
+            listener(now, alert)
+
+    def _log(self, alert: Alert) -> None:
         level = logging.WARNING if alert.state == "raised" else logging.INFO
         if alert.repeat:
             log.log(
@@ -335,5 +342,3 @@ class AlertBook:
             )
         else:
             log.log(level, "alert %s %s: %s", alert.id, alert.state, alert.text)
-        for listener in self.listeners:
-            listener(now, alert)

@@ -101,8 +101,10 @@ class Executive:
         self.checkpoint = checkpoint
         self._saved: Progress = EMPTY
         self._decided = decisions.NONE  # what staff decided, as last saved
+        resume = None
         if checkpoint is not None and not fresh:
-            self.core.board.set(keys.RESUME, load_checkpoint(checkpoint, site.checkpoint.max_age))
+            resume = load_checkpoint(checkpoint, site.checkpoint.max_age)
+            self.core.board.set(keys.RESUME, resume)
         self._wake = asyncio.Event()
         self._stopping = asyncio.Event()
         self._pending_at_loss: object = None
@@ -116,20 +118,13 @@ class Executive:
         self.staff = Staff(self)  # operator commands and alerts
         if checkpoint is not None and not fresh:
             self._decided = decisions.load(decisions.path_for(checkpoint))
-            self._restore(self._decided)
+            self.staff.restore(self._decided)
+            if self._decided != decisions.NONE:
+                log.info("restored what staff decided: %s", self._decided.to_json())
+        # what this executive took up from before it: recorded, so that replay does too
+        self.restored = decisions.restored(resume, self._decided)
         self.staff.book.listeners.append(self._on_alert)
         self.notifier = Notifier.from_env()  # systemd: READY, STATUS, watchdog pings
-
-    def _restore(self, decided: decisions.Decisions) -> None:
-        """What staff decided before a restart holds again: out of service, a pause (its
-        bound counts from now), the help the robot waits for, the alerts acknowledged."""
-        board = self.core.board
-        board.set(keys.IN_SERVICE, decided.in_service)
-        board.set(keys.PAUSED, decided.paused)
-        board.set(keys.HELP_RESTORED, decided.help)
-        self.staff.remembered_acks = set(decided.acknowledged)
-        if decided != decisions.NONE:
-            log.info("restored what staff decided: %s", decided.to_json())
 
     def decided(self) -> decisions.Decisions:
         """What staff decided now (saved beside the checkpoint whenever it changes)."""
