@@ -443,8 +443,9 @@ class Recorder:
         self._queue.clear()
         self.close()
 
-    def primer(self, frontend_ready: bool) -> bytes:
-        """A :data:`PRIMER` message: what the executive carries from before now."""
+    def primer(self, frontend_ready: bool, staff: channels.Carried | None = None) -> bytes:
+        """A :data:`PRIMER` message: what the executive carries from before now
+        (``staff``: beside the tree, the staff's decisions and the alert book)."""
         return channels.encode(
             channels.Primer(
                 inputs=[
@@ -454,6 +455,7 @@ class Recorder:
                 frontend_ready=frontend_ready,
                 frontend_in=[d.decode("utf-8", "replace") for d in self._frontend_in],
                 frontend_out_seqs=list(self._frontend_out_seqs),
+                staff=staff,
             )
         )
 

@@ -75,6 +75,7 @@ class Primer(msgspec.Struct, frozen=True):
     frontend_ready: bool = False
     frontend_in: list[str] = []  # recent datagrams in: their resends stay duplicates
     frontend_out_seqs: list[int] = []  # recent seqs out: resends are not new commands
+    staff: Carried | None = None  # beside the tree: the staff's decisions, the alert book
 
 
 class Operator(msgspec.Struct, frozen=True):
@@ -110,6 +111,30 @@ class Alert(msgspec.Struct, frozen=True):
     todo: str = ""
     repeat: int = 0
     waited: float = 0.0
+
+
+class CarriedIncident(msgspec.Struct, frozen=True):
+    at: float
+    kind: str  # an IncidentKind value
+    text: str
+    subject: str = ""
+
+
+class Carried(msgspec.Struct, frozen=True):
+    """What the executive carries beside the tree into a rotated file (in its primer):
+    the staff's standing decisions and the alert book (``active``: the alerts raised and
+    not cleared, as last told; ``shown``: those not yet acknowledged, raised or cleared;
+    ``told_at``: when each active one was last told, for its escalation), and what the
+    alert conditions read of the latest tour (its incidents: the stops given up; whether
+    a pause ended it)."""
+
+    in_service: bool = True
+    paused: bool = False
+    active: list[Alert] = []
+    shown: list[Alert] = []
+    told_at: dict[str, float] = {}
+    tour_incidents: list[CarriedIncident] = []
+    pause_ran_out: bool = False
 
 
 class Links(msgspec.Struct, frozen=True):

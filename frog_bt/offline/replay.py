@@ -178,7 +178,15 @@ class Replay:
         self.period = 1.0 / site.executive.tick_hz
         self.clock = ManualClock(None)
         self.observers = Observers()  # attach with attach_all(replay, [...]) before run()
-        self.core = Core(site, tree, self.clock, self._publish, self._send, emit=self.observers)
+        self.core = Core(
+            site,
+            tree,
+            self.clock,
+            self._publish,
+            self._send,
+            emit=self.observers,
+            after_tick=self._after_tick,  # the alerts checked, as the executive does
+        )
         # beside the tree, as the executive: the staff and its alert book, on the recorded
         # links' states (None until the recording tells them)
         self.recorded_links: Links | None = None
@@ -359,6 +367,8 @@ class Replay:
         for raw in primer.frontend_in:  # seen live: their resends are duplicates
             self.endpoint.receive(raw.encode(), self._peer, self.clock.now())
         self._seqs.update(primer.frontend_out_seqs)
+        if primer.staff is not None:  # beside the tree: decisions, the alert book
+            self.staff.take_up(primer.staff)
 
     def _blame(self, blame: channels.Blame) -> None:
         """A recorded ``/frog_bt/blame``: the node that sent the command just recorded."""
@@ -471,7 +481,9 @@ class Replay:
     def _tick(self) -> None:
         if self.result.divergence is None:
             self.core.tick()
-            self.staff.after_tick()  # the alert conditions, as the executive checks them
+
+    def _after_tick(self) -> None:
+        self.staff.after_tick()
 
 
 def _datagram_in(record: Record) -> bytes | None:

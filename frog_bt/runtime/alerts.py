@@ -313,6 +313,17 @@ class AlertBook:
         self._tell(now, ack)
         return ack
 
+    def carried(self) -> tuple[list[Alert], list[Alert], dict[str, float]]:
+        """The book now (active, not yet acknowledged, when each was last told), to be
+        taken up by another book (a replay of a rotated file: :meth:`take_up`)."""
+        return list(self.active.values()), list(self.unacknowledged.values()), dict(self.told_at)
+
+    def take_up(self, active: list[Alert], shown: list[Alert], told_at: dict[str, float]) -> None:
+        """Hold what another book held (:meth:`carried`); nothing is told."""
+        self.active = {a.id: a for a in active}
+        self.unacknowledged = {a.id: a for a in shown}
+        self.told_at = dict(told_at)
+
     def shown(self) -> list[Alert]:
         """What the console's banner shows: every alert not yet acknowledged."""
         return sorted(self.unacknowledged.values(), key=lambda a: a.since)

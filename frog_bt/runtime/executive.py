@@ -147,7 +147,12 @@ class Executive:
             self.link.send,
             emit=self.observers,
             standing=self.standing,
+            after_tick=self._after_tick,
         )
+
+    def _after_tick(self) -> None:
+        """Inside each tick, before the observers hear it: the alerts checked."""
+        self.staff.after_tick()
 
     def emit(self, event: Event) -> None:
         """Tell every observer."""
@@ -350,8 +355,7 @@ class Executive:
             self._peer_restarts = restarts
             self.core.ctx.note("front end restarted", incident=IncidentKind.FRONTEND_RESTARTED)
         self.staff.before_tick()
-        status = self.core.tick()
-        self.staff.after_tick()
+        status = self.core.tick()  # the staff check the alerts at its end (_after_tick)
         progress = self.core.board.get(keys.PROGRESS) or EMPTY
         if self.checkpoint is not None and progress != self._saved:
             self._saved = progress

@@ -8,8 +8,10 @@ recorded with their answer. A command the executive cannot apply within ``APPLY_
 seconds (the tree does not tick while rosbridge is unreachable) is refused and changes
 nothing.
 
-After each tick (:meth:`Staff.after_tick`) the alert conditions are checked against what
-the executive knows now (:class:`~frog_bt.runtime.alerts.Facts`).
+At the end of each tick (:meth:`Staff.after_tick`, the core's ``after_tick``: before the
+observers hear the tick, so that a recording keeps a tick's alert changes with it) the
+alert conditions are checked against what the executive knows now
+(:class:`~frog_bt.runtime.alerts.Facts`).
 
 The host is the online executive or a replay (:mod:`frog_bt.offline.replay`), which
 holds a :class:`Staff` of its own and calls :meth:`Staff.apply`, :meth:`Staff.after_tick`,
@@ -20,6 +22,7 @@ executive did: the same alert book, the same answers.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
@@ -29,9 +32,10 @@ from py_trees.common import Status
 from frog_bt.engine.operator import Answer, Command
 from frog_bt.i18n import Msg
 from frog_bt.model import keys
+from frog_bt.model.channels import Carried, CarriedIncident
 from frog_bt.model.events import Event, OperatorDone
 from frog_bt.model.links import LinkStatus
-from frog_bt.model.outcomes import TourState
+from frog_bt.model.outcomes import Incident, IncidentKind, TourState
 from frog_bt.runtime.alerts import AlertBook, Facts
 
 if TYPE_CHECKING:
@@ -153,6 +157,36 @@ class Staff:
         board.set(keys.PAUSED, decided.paused)
         board.set(keys.HELP_RESTORED, decided.help)
         self.remembered_acks = set(decided.acknowledged)
+
+    def carried(self) -> Carried:
+        """What the executive carries beside the tree into a rotated recording file."""
+        board = self.executive.core.board
+        active, shown, told_at = self.book.carried()
+        return Carried(
+            in_service=board.get(keys.IN_SERVICE) is not False,
+            paused=bool(board.get(keys.PAUSED)),
+            active=active,
+            shown=shown,
+            told_at=told_at,
+            tour_incidents=[
+                CarriedIncident(i.at, i.kind.value, i.text, i.subject)
+                for i in self.executive.core.journal.tally.tour
+            ],
+            pause_ran_out=self._pause_ran_out,
+        )
+
+    def take_up(self, carried: Carried) -> None:
+        """Hold what a rotated file's primer says the executive carried (replay)."""
+        board = self.executive.core.board
+        board.set(keys.IN_SERVICE, carried.in_service)
+        board.set(keys.PAUSED, carried.paused)
+        self.book.take_up(carried.active, carried.shown, carried.told_at)
+        tour = []
+        for i in carried.tour_incidents:
+            with contextlib.suppress(ValueError):  # a kind this version does not know
+                tour.append(Incident(i.at, IncidentKind(i.kind), i.text, i.subject))
+        self.executive.core.journal.tally.take_up(tour)
+        self._pause_ran_out = carried.pause_ran_out
 
     # ------------------------------------------------------------ links and alerts
 

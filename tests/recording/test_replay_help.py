@@ -349,3 +349,60 @@ def test_a_kill_while_help_is_pending_and_the_resumed_executive_replay_identical
     result = replay(second)
     assert result.identical, (result.divergence, result.divergence and result.divergence.story)
     assert result.operator_commands == 1 and result.alerts >= 3
+
+
+# ------------------------------------------------------------------ a day, one file per tour
+
+
+def test_a_day_of_files_carries_the_alert_book_across_rotation(tmp_path: Path) -> None:
+    """``--record DIR``: a stop given up raises its alert in the first tour's file; a
+    person acknowledges it in the idle file after it, where the alert book is carried
+    in the primer; the next tour clears it. Every file replays "identical" on its own."""
+    from recorded_tour import FAST_TOURS
+
+    from frog_bt.live.rotation import RecordingDir
+    from frog_bt.model.events import Ticked
+    from frog_bt.runtime.observer import listen
+    from frog_bt.sim import scenario_from
+
+    alert = "stop_given_up:POI2"
+    day = RecordingDir(tmp_path, 10**9)
+    data = {
+        **FAST_TOURS,
+        "frontend": {**FAST_TOURS["frontend"], "idle_after_tour": 30.0},
+        "navigation": {
+            **FAST_TOURS["navigation"],
+            "failures": [{"poi": "POI2", "times": 1000, "result": "aborted", "after": 1}],
+        },
+    }
+
+    async def run() -> None:
+        two = asyncio.Event()
+
+        def prepare(exe: Executive) -> None:
+            attach_all(exe, [day])
+            listen(exe, lambda _e: exe.outcome.tours >= 2 and two.set(), Ticked)
+
+        rehearsal = Rehearsal(
+            scenario_from("default", data), site=SITE, prepare=prepare, once=False
+        )
+        async with rehearsal:
+            exe = rehearsal.executive
+            await after_ticks(
+                exe, lambda: exe.outcome.tours >= 1 and alert in exe.staff.book.active
+            )
+            await _answer(exe, Command.ACK_ALERT, True, alert)
+            await after_ticks(exe, lambda: alert not in exe.staff.book.active)  # next tour
+            await asyncio.wait_for(two.wait(), 60)
+
+    try:
+        asyncio.run(run())
+    finally:
+        day.close()
+    kinds = [p.name[16:20] for p in day.files]
+    assert kinds[:4] == ["idle", "tour", "idle", "tour"], kinds
+    acked = [p for p in day.files if _messages(p, "/frog_bt/operator")]
+    assert [p.name[16:20] for p in acked] == ["idle"]  # the ack is in an idle file
+    for path in day.files:
+        result = replay(path)
+        assert result.identical, (path.name, result.divergence, result.divergence.story)
