@@ -2,8 +2,9 @@
 (scripts/corpus_run.py: a dock answered ``done_by_hand``, an operator ``home`` and
 ``skip``, a ``battery_low`` acknowledged after a known delay, a restart) held against
 its manifest: the interventions told apart, per 100 tours, the time to acknowledge, the
-funnel and the failure taxonomy with each cause counted once; and ``--compare`` of two
-tiny seasons that differ in one seeded rate."""
+funnel and the failure taxonomy with each cause counted once; ``replay`` of the season
+finds no divergence; and ``--compare`` of two tiny seasons that differ in one seeded
+rate."""
 
 from __future__ import annotations
 
