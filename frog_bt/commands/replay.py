@@ -194,6 +194,7 @@ def report(result: Any, site: Any) -> dict[str, Any]:
         "exact_ticks": result.exact,
         "recovered": result.recovered,
         "operator_commands": result.operator_commands,
+        "alerts": result.alerts,
         "bad_messages": result.bad_count,
         "bad": result.bad,
     }
@@ -214,6 +215,7 @@ def report(result: Any, site: Any) -> dict[str, Any]:
             "number": div.number,
             "at": div.t - result.start,
             "differs": differences(div.expected, div.got, site),
+            "story": div.story,
             "what": what_differs(div.expected, div.got, site),
             "recorded": side(div.expected),
             "replayed": side(div.got),
@@ -278,6 +280,8 @@ def run_one(args: argparse.Namespace) -> int:
     commands = f"{result.ros_commands} ROS and {result.frontend_commands} front-end commands"
     if result.operator_commands:
         commands += f", {result.operator_commands} operator commands"
+    if result.alerts:
+        commands += f", {result.alerts} alert changes"
     if args.format == "json":
         print(json.dumps(report(result, site), indent=1))
         return 0 if result.divergence is None else 1
@@ -305,6 +309,8 @@ def run_one(args: argparse.Namespace) -> int:
             )
             print(f"  {label + ':':9} {text}")
         print(f"  {'differs:':9} {differences(div.expected, div.got, site)}")
+        if div.story:  # an alert or an operator's answer, in domain terms
+            print(f"  {'':9} {div.story}")
         for side, why in div.doubts:  # a robot answer one side believed and the other not
             where = "recording" if side == "recorded" else "replay"
             print(f"  {'doubted:':9} {why} (in the {where} only)")

@@ -66,6 +66,7 @@ class Core:
         send: Callable[[FrontendMessage], None],
         emit: Emit | None = None,
         standing: Standing | None = None,
+        after_tick: Callable[[], None] | None = None,
     ) -> None:
         self.site = site
         self.tree = tree
@@ -75,6 +76,9 @@ class Core:
         # The host's observers: a callable that is false while nobody listens (no event is
         # built then: a replay without observers pays nothing for them), or None.
         self.emit = emit
+        # The host's own step after each tick, before the observers hear it (the executive
+        # checks its alerts there: a tick's alert changes are recorded with the tick)
+        self.after_tick = after_tick
         # The executive's state, kept across trees (a reload hands the next core the same)
         standing = self.standing = standing if standing is not None else Standing(clock)
         self.blamed = "-"  # the node that sent the latest command (see who())
@@ -239,8 +243,9 @@ class Core:
 
     def tick(self) -> Status:
         """The pre-tick step (snapshot the inputs, apply the responses), one tick of the
-        root, then :class:`~frog_bt.model.events.Ticked` to the observers (they may read this
-        core's tree, board and journal as the tick left them); the root's status."""
+        root, the host's ``after_tick``, then :class:`~frog_bt.model.events.Ticked` to the
+        observers (they may read this core's tree, board and journal as the tick left
+        them); the root's status."""
         self.setup()
         self.trace.decided.clear()
         self.pause_ran_out = self.operator.check_pause(self.clock.now())
@@ -252,6 +257,8 @@ class Core:
             self.faults.failed("the tree", exc, f"tick {self.ticks + 1}")
         self.ticks += 1
         status = self.root.status
+        if self.after_tick is not None:
+            self.after_tick()
         if self.emit:
             self.emit(Ticked(self.clock.now(), self.ticks, status.name))  # type: ignore[arg-type]
         touched.clear()

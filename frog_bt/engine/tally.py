@@ -27,6 +27,11 @@ class Tally:
         self.by_kind[incident.kind] += 1
         self.tour.append(incident)
 
+    def take_up(self, tour: list[Incident]) -> None:
+        """The latest tour's incidents, as another tally held them (a replay of a rotated
+        recording file)."""
+        self.tour = list(tour)
+
     def tour_started(self) -> None:
         self.tour = []
 

@@ -15,6 +15,11 @@
   blackboard values it read (``{"channel", "node", "reads"}``), for replay's
   divergence report;
 * ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``);
+* ``/frog_bt/operator``, ``/frog_bt/alert``, ``/frog_bt/links``: each operator command
+  with its answer, each alert change, each change of the links' states; and once, when
+  the executive took something up from before it (a restart), ``/frog_bt/restored``
+  (:mod:`frog_bt.model.channels`): replay rebuilds the alert book and the staff's
+  decisions from them;
 * metadata ``frog_bt_site``: ``config_sha256``, the site configuration that ran
   (:func:`frog_bt.config.fingerprint`), in every file;
 * metadata ``frog_bt_run``: ``id``, the run's UUID (drawn when the executive started
@@ -69,9 +74,11 @@ from frog_bt.model.channels import (
     FAULT,
     FRONTEND_IN,
     FRONTEND_OUT,
+    LINKS,
     OPERATOR,
     OWN_TYPES,
     PRIMER,
+    RESTORED,
     SITE_METADATA,
     TICK,
     TREE,
@@ -86,6 +93,7 @@ from frog_bt.model.events import (
     Doubted,
     Event,
     Faulted,
+    LinksChanged,
     OperatorDone,
     RobotCommand,
     RobotInput,
@@ -187,6 +195,7 @@ class Recorder:
             AlertChanged: self._alert,
             Doubted: self._doubt,
             Faulted: self._fault,
+            LinksChanged: self._links,
         }
         self._frontend_in: deque[bytes] = deque(maxlen=PRIMER_DATAGRAMS)
         self._frontend_out_seqs: deque[int] = deque(maxlen=PRIMER_SEQS)
@@ -237,7 +246,7 @@ class Recorder:
             self.channel(CLOCK.name, CLOCK.type)
         self.channel(FRONTEND_IN, DATAGRAM_TYPE)
         self.channel(FRONTEND_OUT, DATAGRAM_TYPE)
-        for channel in (TICK, BLAME, OPERATOR, ALERT, DOUBT, FAULT):
+        for channel in (TICK, BLAME, OPERATOR, ALERT, LINKS, DOUBT, FAULT):
             self.channel(channel, OWN_TYPES[channel])
         clock = host.clock
         self._ready = lambda: bool(clock.ready)
@@ -248,6 +257,10 @@ class Recorder:
         self._tree = self._tree_message(host)
         if self._tree is not None:
             self._write(TREE, None, self._tree)
+        restored = getattr(host, "restored", None)  # the executive's, after a restart
+        if isinstance(restored, channels.Restored):
+            self.channel(RESTORED, OWN_TYPES[RESTORED])
+            self._write(RESTORED, None, channels.encode(restored))
 
     def on_event(self, event: Event) -> None:
         """Each event its channel (tick path: a list append, see :meth:`_write`)."""
@@ -342,6 +355,12 @@ class Recorder:
     def _alert(self, event: AlertChanged) -> None:
         """An alert raised, cleared or acknowledged."""
         self._write(ALERT, event.t, channels.encode(event.alert))
+
+    def _links(self, event: LinksChanged) -> None:
+        """The links' states, after one changed (before the clock has a time: held)."""
+        links = event.links
+        message = channels.Links(links.rosbridge, links.frontend, links.clock)
+        self._write(LINKS, event.t if self._ready() else None, channels.encode(message))
 
     def _doubt(self, event: Doubted) -> None:
         """A robot answer not believed."""
@@ -448,8 +467,9 @@ class Recorder:
         self._queue.clear()
         self.close()
 
-    def primer(self, frontend_ready: bool) -> bytes:
-        """A :data:`PRIMER` message: what the executive carries from before now."""
+    def primer(self, frontend_ready: bool, staff: channels.Carried | None = None) -> bytes:
+        """A :data:`PRIMER` message: what the executive carries from before now
+        (``staff``: beside the tree, the staff's decisions and the alert book)."""
         return channels.encode(
             channels.Primer(
                 inputs=[
@@ -459,6 +479,7 @@ class Recorder:
                 frontend_ready=frontend_ready,
                 frontend_in=[d.decode("utf-8", "replace") for d in self._frontend_in],
                 frontend_out_seqs=list(self._frontend_out_seqs),
+                staff=staff,
             )
         )
 

@@ -13,7 +13,8 @@ it to a new file at two points, always between ticks:
   reads is written first in a run (``frog-bt check``), so the file needs only
   what the executive carries across runs: it starts with a ``/frog_bt/primer``
   (the latest message of every input, whether the front end said idle, the
-  recent datagrams) and replays on its own.
+  recent datagrams, and beside the tree the staff's decisions and the alert book)
+  and replays on its own.
 
 Files are named by their start time (site local time) and tour number,
 ``20260601-103012-tour0003.mcap``; numbers go on from the highest in DIR, so a
@@ -45,6 +46,7 @@ from frog_bt.model import keys
 from frog_bt.model.events import Event, Ticked
 from frog_bt.model.outcomes import TourState
 from frog_bt.runtime.observer import Host
+from frog_bt.runtime.staff import Staff
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
@@ -127,7 +129,11 @@ class RecordingDir:
             if self.kind == "tour":
                 self.number += 1
             assert self.recorder is not None
-            primer = self.recorder.primer(bool(core.board.get(keys.FRONTEND_READY)))
+            staff = getattr(self._host, "staff", None)  # the executive's (a host may have none)
+            primer = self.recorder.primer(
+                bool(core.board.get(keys.FRONTEND_READY)),
+                staff.carried() if isinstance(staff, Staff) else None,
+            )
             self._rotate("idle", {"kind": "idle", "tour": str(self.number)}, primer)
 
     def _rename_first(self) -> None:

@@ -17,6 +17,9 @@ channel                schema name             one message per
 ``/frog_bt/alert``     ``frog_bt/Alert``       alert raised, cleared or acknowledged
 ``/frog_bt/doubt``     ``frog_bt/Doubt``       robot answer not believed (stale, or off)
 ``/frog_bt/fault``     ``frog_bt/Fault``       failure of the executive's own code, caught
+``/frog_bt/links``     ``frog_bt/Links``       change of a link's state (the alerts read them)
+``/frog_bt/restored``  ``frog_bt/Restored``    file of a started executive: what it took up
+                                               from before it (checkpoint, staff's decisions)
 =====================  ======================  ============================================
 """
 
@@ -29,6 +32,7 @@ import msgspec
 
 from frog_bt.codec import decoder
 from frog_bt.model.frontend import COMMANDS, EVENTS
+from frog_bt.model.links import LinkStatus
 from frog_bt.model.ros import ROS_TYPES
 
 FRONTEND_IN = "/frontend/in"
@@ -43,6 +47,8 @@ OPERATOR = "/frog_bt/operator"  # each operator command and its answer
 ALERT = "/frog_bt/alert"  # each alert's changes
 DOUBT = "/frog_bt/doubt"  # each robot answer not believed, and why
 FAULT = "/frog_bt/fault"  # each failure of the executive's own code, caught and counted
+LINKS = "/frog_bt/links"  # the links' states, at each change
+RESTORED = "/frog_bt/restored"  # what a started executive took up from before it
 
 
 class Tick(msgspec.Struct, frozen=True):
@@ -73,6 +79,7 @@ class Primer(msgspec.Struct, frozen=True):
     frontend_ready: bool = False
     frontend_in: list[str] = []  # recent datagrams in: their resends stay duplicates
     frontend_out_seqs: list[int] = []  # recent seqs out: resends are not new commands
+    staff: Carried | None = None  # beside the tree: the staff's decisions, the alert book
 
 
 class Operator(msgspec.Struct, frozen=True):
@@ -110,6 +117,61 @@ class Alert(msgspec.Struct, frozen=True):
     waited: float = 0.0
 
 
+class CarriedIncident(msgspec.Struct, frozen=True):
+    at: float
+    kind: str  # an IncidentKind value
+    text: str
+    subject: str = ""
+
+
+class Carried(msgspec.Struct, frozen=True):
+    """What the executive carries beside the tree into a rotated file (in its primer):
+    the staff's standing decisions and the alert book (``active``: the alerts raised and
+    not cleared, as last told; ``shown``: those not yet acknowledged, raised or cleared;
+    ``told_at``: when each active one was last told, for its escalation), and what the
+    alert conditions read of the latest tour (its incidents: the stops given up; whether
+    a pause ended it)."""
+
+    in_service: bool = True
+    paused: bool = False
+    active: list[Alert] = []
+    shown: list[Alert] = []
+    told_at: dict[str, float] = {}
+    tour_incidents: list[CarriedIncident] = []
+    pause_ran_out: bool = False
+
+
+class Links(msgspec.Struct, frozen=True):
+    """The links' states after one of them changed (the alerts ``rosbridge_down`` and
+    ``frontend_silent`` read them; replay takes them from here)."""
+
+    rosbridge: LinkStatus
+    frontend: LinkStatus
+    clock: LinkStatus
+
+
+class RestoredHelp(msgspec.Struct, frozen=True):
+    about: str  # a HelpAbout value: undock, dock, home, fault, crashed
+    since: float
+    detail: str = ""  # crashed: why
+
+
+class Restored(msgspec.Struct, frozen=True):
+    """What an executive took up at start-up from the one before it (a restart): the
+    resume point of its checkpoint (``done``: the checkpoints done, in order; empty: none;
+    ``visitor``; ``written``: wall time) and what staff had decided (out of service, a
+    pause, the help the robot waited for, the alerts acknowledged). Replay starts from
+    the same."""
+
+    done: list[str] = []
+    visitor: int | None = None
+    written: float = 0.0
+    in_service: bool = True
+    paused: bool = False
+    help: RestoredHelp | None = None
+    acknowledged: list[str] = []
+
+
 class Doubt(msgspec.Struct, frozen=True):
     code: int  # the /FROG_response code
     goal: str  # the goal pending when it came (its target)
@@ -133,6 +195,8 @@ TYPES: dict[str, tuple[str, type[msgspec.Struct]]] = {
     ALERT: ("frog_bt/Alert", Alert),
     DOUBT: ("frog_bt/Doubt", Doubt),
     FAULT: ("frog_bt/Fault", Fault),
+    LINKS: ("frog_bt/Links", Links),
+    RESTORED: ("frog_bt/Restored", Restored),
 }
 
 _ENCODER = msgspec.json.Encoder()

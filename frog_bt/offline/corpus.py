@@ -85,7 +85,7 @@ def replay_file(path: str, tree: str | None, site: Site) -> TourRow:
     bad, bad_first = result.bad_count, result.bad[0] if result.bad else ""
     if div is None:
         return TourRow(path, "identical", recovered=recovered, bad=bad, bad_first=bad_first)
-    diff = differences(div.expected, div.got, site)
+    diff = div.story or differences(div.expected, div.got, site)  # an alert: its story
     recorded = div.expected.node if div.expected else ""
     replayed = div.got.node if div.got else ""
     node = (replayed or recorded or "?").split(" (")[0]

@@ -24,12 +24,24 @@ live rules instead (periodic ticks at ``executive.tick_hz`` on the clock, and a
 tick after each input that calls for one and after each front-end event), which
 is close but not guaranteed identical.
 
+What the executive held beside the tree is rebuilt with the executive's own code: a
+:class:`~frog_bt.runtime.staff.Staff` with its alert book. Each recorded operator command
+(``/frog_bt/operator``: from the console, ``frog-bt ctl`` or an acknowledgement link) is
+applied again through :meth:`Staff.apply <frog_bt.runtime.staff.Staff.apply>` before the
+same tick (``ack_alert`` to the alert book, the others to the tree); after each tick the
+alert conditions are checked as live; the links' states come from ``/frog_bt/links`` and
+what a restarted executive took up from before it (its checkpoint's resume point, the
+staff's decisions, the help it waited for) from ``/frog_bt/restored``.
+
 The commands the replayed tree sends are compared, in order, with the recorded
-ones: ROS outputs (``header.stamp`` left out) and new front-end commands
-(``/frontend/out`` without acks and resends; ``seq`` left out). The first
-difference is a :class:`Divergence`. With a changed tree or configuration this
-answers "what would the robot have done": until the first divergence the
-recorded inputs are exactly what the new tree would have seen.
+ones: ROS outputs (``header.stamp`` left out), new front-end commands
+(``/frontend/out`` without acks and resends; ``seq`` left out), the answer to each
+operator command and each alert raised, told again, cleared or acknowledged (its id,
+state and repeat; its words are the site's, not compared). The first difference is a
+:class:`Divergence`, with a sentence in domain terms when it is about an alert or a
+command's answer. With a changed tree or configuration this answers "what would the
+robot have done": until the first divergence the recorded inputs are exactly what the
+new tree would have seen.
 """
 
 from __future__ import annotations
@@ -37,9 +49,9 @@ from __future__ import annotations
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from frog_bt.clock import ManualClock
 from frog_bt.config import Site, parse_hostport
@@ -48,10 +60,22 @@ from frog_bt.engine.core import Core
 from frog_bt.engine.operator import Command as OperatorCommand
 from frog_bt.frontend.protocol import Endpoint
 from frog_bt.model import channels, keys
-from frog_bt.model.channels import BLAME, FRONTEND_IN, FRONTEND_OUT, OPERATOR, TICK, from_ns
+from frog_bt.model.channels import (
+    ALERT,
+    BLAME,
+    FRONTEND_IN,
+    FRONTEND_OUT,
+    LINKS,
+    OPERATOR,
+    TICK,
+    from_ns,
+)
+from frog_bt.model.events import AlertChanged
 from frog_bt.model.frontend import EVENTS, FrontendMessage, message_fields
 from frog_bt.model.goals import Goal
+from frog_bt.model.links import Links
 from frog_bt.model.wire import CLOCK, OUTPUTS
+from frog_bt.offline.beside import STAFF, Beside, Said, alert_command
 from frog_bt.recordings.commands import (
     Command,
     ReplayError,
@@ -73,20 +97,25 @@ from frog_bt.recordings.reader import (
     RobotCommand,
     RobotInput,
 )
+from frog_bt.runtime import decisions
 from frog_bt.runtime.observer import Observers
+from frog_bt.runtime.staff import Staff
 from frog_bt.tree.loader import LoadedTree
 
-if TYPE_CHECKING:
-    from frog_bt.model.links import Links
+# alerts about the links: without /frog_bt/links (older recordings) replay cannot tell them
+LINK_ALERTS = frozenset({"rosbridge_down", "frontend_silent"})
 
 
 @dataclass(frozen=True, slots=True)
 class Divergence:
-    """The first command that differs: its number (from 1), the recorded one, the replayed one."""
+    """The first command that differs: its number (from 1), the recorded one, the replayed
+    one; ``story``: what happened on each side in domain terms, when it is about an alert
+    or the answer to an operator command (empty otherwise)."""
 
     number: int
     expected: Command | None
     got: Command | None
+    story: str = ""
     # robot answers one side did not believe and the other did, since the last command
     # both sent alike: ("recorded" | "replayed", why), in domain terms
     doubts: list[tuple[str, str]] = field(default_factory=list)
@@ -113,6 +142,7 @@ class ReplayResult:
     bad: list[str] = field(default_factory=list)  # messages that did not decode: where, why
     bad_count: int = 0  # all of them (``bad`` keeps the first few)
     operator_commands: int = 0  # recorded operator commands, applied again
+    alerts: int = 0  # recorded alert changes, compared
 
     @property
     def identical(self) -> bool:
@@ -153,7 +183,24 @@ class Replay:
         self.period = 1.0 / site.executive.tick_hz
         self.clock = ManualClock(None)
         self.observers = Observers()  # attach with attach_all(replay, [...]) before run()
-        self.core = Core(site, tree, self.clock, self._publish, self._send, emit=self.observers)
+        self.core = Core(
+            site,
+            tree,
+            self.clock,
+            self._publish,
+            self._send,
+            emit=self.observers,
+            after_tick=self._after_tick,  # the alerts checked, as the executive does
+        )
+        # beside the tree, as the executive: the staff and its alert book, on the recorded
+        # links' states (None until the recording tells them)
+        self.recorded_links: Links | None = None
+        self.staff = Staff(Beside(self))
+        self.staff.book.listeners.append(self._on_alert)
+        self.staff.book.logged = False  # the live log said it; a replay's output is its report
+        self._alerts_compared = ALERT in self.types  # (older recordings have none)
+        self._links_known = LINKS in self.types
+        self.said = Said()  # each alert's latest change on each side, for the story
         self.reader = Reader(site)  # the one decoder; its tally counts the bad messages
         self.endpoint = Endpoint(self._peer, EVENTS)  # the same dedup as the live link
         self._expected: deque[Command] = deque()
@@ -205,13 +252,16 @@ class Replay:
                 observe("recorded", expected)
                 observe("replayed", got)
             if (expected.channel, expected.payload) != (got.channel, got.payload):
-                self.result.divergence = Divergence(
-                    self._compared, expected, got, self._doubts_apart()
-                )
-                for seen in self.on_divergence:
-                    seen(self.result.divergence)
+                self._diverged(Divergence(self._compared, expected, got))
             else:
                 self._agreed_at = max(expected.t, got.t)
+
+    def _diverged(self, divergence: Divergence) -> None:
+        story = self.said.story(divergence.expected, divergence.got)
+        divergence = replace(divergence, story=story, doubts=self._doubts_apart())
+        self.result.divergence = divergence
+        for seen in self.on_divergence:
+            seen(divergence)
 
     def _replayed_doubt(self, code: int, goal: Goal, judgement: Judgement) -> None:
         self.doubts["replayed"].append((self.clock.now(), judgement.why))
@@ -255,9 +305,7 @@ class Replay:
                 if result.divergence is None and (self._expected or self._got):
                     expected = self._expected.popleft() if self._expected else None
                     got = self._got.popleft() if self._got else None
-                    result.divergence = Divergence(
-                        self._compared + 1, expected, got, self._doubts_apart()
-                    )
+                    self._diverged(Divergence(self._compared + 1, expected, got))
         result.ticks = self.core.ticks
         result.bad_count = self.reader.tally.count
         result.bad = self.reader.tally.lines(self.start)
@@ -298,6 +346,12 @@ class Replay:
             self._operator(record.t, message)
         elif isinstance(message, channels.Doubt):
             self.doubts["recorded"].append((record.t, message.why))
+        elif isinstance(message, channels.Alert):
+            self._expect_alert(record.t, message)
+        elif isinstance(message, channels.Links):
+            self._links(message)
+        elif isinstance(message, channels.Restored):
+            self._restored(message)
 
     def _on_ros(self, record: RobotInput) -> None:
         self.result.inputs += 1
@@ -347,6 +401,8 @@ class Replay:
         for raw in primer.frontend_in:  # seen live: their resends are duplicates
             self.endpoint.receive(raw.encode(), self._peer, self.clock.now())
         self._seqs.update(primer.frontend_out_seqs)
+        if primer.staff is not None:  # beside the tree: decisions, the alert book
+            self.staff.take_up(primer.staff)
 
     def _blame(self, blame: channels.Blame) -> None:
         """A recorded ``/frog_bt/blame``: the node that sent the command just recorded."""
@@ -360,27 +416,68 @@ class Replay:
             last.reads = dict(blame.reads)
 
     def _operator(self, t: float, recorded: channels.Operator) -> None:
-        """A recorded operator command: applied again here, between the same two ticks; a
-        different answer is a divergence like a different command."""
+        """A recorded operator command: applied again here, between the same two ticks, as
+        the executive applied it (``ack_alert`` to the alert book, the others to the
+        tree); a different answer is a divergence like a different command."""
         try:
             command = OperatorCommand(recorded.command)
         except ValueError:
             self._bad(OPERATOR, t, f"unknown command {recorded.command!r}")
             return
         self.result.operator_commands += 1
-        answer = self.core.command(command)
+        answer = self.staff.apply(command, recorded.id, recorded.by)
+        about = {"id": recorded.id} if recorded.id else {}
         self._last_expected = Command(
-            t, OPERATOR, {"command": recorded.command, "ok": recorded.ok, "did": recorded.text}
+            t,
+            OPERATOR,
+            {"command": recorded.command, **about, "ok": recorded.ok, "did": recorded.text},
+            node=STAFF,
         )
         self._expected.append(self._last_expected)
         self._got.append(
             Command(
                 self.clock.now(),
                 OPERATOR,
-                {"command": command.value, "ok": answer.ok, "did": answer.text},
+                {"command": command.value, **about, "ok": answer.ok, "did": answer.text},
+                node=STAFF,
             )
         )
         self._compare()
+
+    # ------------------------------------------------------------ beside the tree
+
+    def _compared_alert(self, kind: str) -> bool:
+        return self._alerts_compared and (self._links_known or kind not in LINK_ALERTS)
+
+    def _expect_alert(self, t: float, alert: channels.Alert) -> None:
+        """A recorded alert change: compared with the replayed alert book's, in order."""
+        self.said.recorded(t, alert)
+        if self._compared_alert(alert.kind):
+            self.result.alerts += 1
+            self._expected.append(alert_command(t, alert))
+            self._compare()
+
+    def _on_alert(self, t: float, alert: channels.Alert) -> None:
+        """A change of the replayed alert book: to the observers, and compared."""
+        self.said.replayed(t, alert)
+        if self.observers:
+            self.observers.emit(AlertChanged(t, alert))
+        if self._compared_alert(alert.kind):
+            self._got.append(alert_command(t, alert))
+            self._compare()
+
+    def _links(self, recorded: channels.Links) -> None:
+        """A recorded change of the links' states, noted as the executive noted it."""
+        self.recorded_links = Links(recorded.rosbridge, recorded.frontend, recorded.clock)
+        if self.clock.ready:
+            self.staff.links_changed(self.clock.now())
+
+    def _restored(self, recorded: channels.Restored) -> None:
+        """What the recorded executive took up at start-up (a restart): its checkpoint's
+        resume point and the staff's decisions, taken up here before the first tick."""
+        resume, decided = decisions.taken_up(recorded)
+        self.core.board.set(keys.RESUME, resume)
+        self.staff.restore(decided)
 
     # ------------------------------------------------------------ time and ticks
 
@@ -418,6 +515,9 @@ class Replay:
     def _tick(self) -> None:
         if self.result.divergence is None:
             self.core.tick()
+
+    def _after_tick(self) -> None:
+        self.staff.after_tick()
 
 
 def _datagram_in(record: Record) -> bytes | None:

@@ -18,7 +18,8 @@ record                      channel, and what decodes it
 :class:`FrontendAck`        an ack on either (``/frontend/in``: the front end acked a
                             command; ``/frontend/out``: the executive acked an event)
 :class:`Own`                ``/frog_bt/tick``, ``blame``, ``tree``, ``operator``,
-                            ``alert``: their Structs of :mod:`frog_bt.model.channels`
+                            ``alert``, ``links``, ``restored``: their Structs of
+                            :mod:`frog_bt.model.channels`
 :class:`Primed`             ``/frog_bt/primer``: its Struct, and its inputs decoded as
                             :class:`RobotInput` (at the time each was received)
 :class:`Bad`                any of those that does not decode: channel and reason
@@ -93,6 +94,8 @@ OwnMessage = (
     | channels.Alert
     | channels.Doubt
     | channels.Fault
+    | channels.Links
+    | channels.Restored
 )
 
 # Errors a message can make decoding raise (DecodeError from the Structs; the others

@@ -287,6 +287,7 @@ class AlertBook:
     active: dict[str, Alert] = field(default_factory=dict)  # id -> raised, not cleared
     unacknowledged: dict[str, Alert] = field(default_factory=dict)  # id -> latest state
     told_at: dict[str, float] = field(default_factory=dict)  # id -> last told (raised)
+    logged: bool = True  # each change in the log (a replay's book is quiet)
 
     def update(self, facts: Facts) -> list[Alert]:
         """Compare the conditions now with the alerts up, and escalate what waits too
@@ -346,6 +347,17 @@ class AlertBook:
         self._tell(now, ack)
         return ack
 
+    def carried(self) -> tuple[list[Alert], list[Alert], dict[str, float]]:
+        """The book now (active, not yet acknowledged, when each was last told), to be
+        taken up by another book (a replay of a rotated file: :meth:`take_up`)."""
+        return list(self.active.values()), list(self.unacknowledged.values()), dict(self.told_at)
+
+    def take_up(self, active: list[Alert], shown: list[Alert], told_at: dict[str, float]) -> None:
+        """Hold what another book held (:meth:`carried`); nothing is told."""
+        self.active = {a.id: a for a in active}
+        self.unacknowledged = {a.id: a for a in shown}
+        self.told_at = dict(told_at)
+
     def shown(self) -> list[Alert]:
         """What the console's banner shows: every alert not yet acknowledged."""
         return sorted(self.unacknowledged.values(), key=lambda a: a.since)
@@ -355,6 +367,12 @@ class AlertBook:
             self.unacknowledged.pop(alert.id, None)
         else:
             self.unacknowledged[alert.id] = alert
+        if self.logged:
+            self._log(alert)
+        for listener in self.listeners:
+            listener(now, alert)
+
+    def _log(self, alert: Alert) -> None:
         level = logging.WARNING if alert.state == "raised" else logging.INFO
         if alert.repeat:
             log.log(
@@ -369,5 +387,3 @@ class AlertBook:
             )
         else:
             log.log(level, "alert %s %s: %s", alert.id, alert.state, alert.text)
-        for listener in self.listeners:
-            listener(now, alert)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -33,7 +33,7 @@ from frog_bt.model.frontend import EVENTS, FrontendMessage
 from frog_bt.model.help import Help, HelpAbout
 from frog_bt.model.links import Links, states
 from frog_bt.model.outcomes import DockingState, IncidentKind, TourState
-from frog_bt.model.progress import EMPTY, Progress
+from frog_bt.model.progress import EMPTY, Progress, Resume
 from frog_bt.model.run import RunId
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rosbridge.client import RosbridgeClient
@@ -105,8 +105,9 @@ class Executive:
         self._saved: Progress = EMPTY
         self._decided = decisions.NONE  # what staff decided, as last saved
         self._crash_loop: Help | None = None  # a tour not resumed, to not fail the same way
+        resume = None
         if checkpoint is not None and not fresh:
-            self._resume_or_hold(checkpoint, site.checkpoint.max_age)
+            resume = self._resume_or_hold(checkpoint, site.checkpoint.max_age)
         self._wake = asyncio.Event()
         self._stopping = asyncio.Event()
         self._pending_at_loss: object = None
@@ -120,42 +121,37 @@ class Executive:
         self.staff = Staff(self)  # operator commands and alerts
         if checkpoint is not None and not fresh:
             self._decided = decisions.load(decisions.path_for(checkpoint))
-            self._restore(self._decided)
-        if self._crash_loop is not None:  # it holds and asks, whatever staff decided before
-            self.core.board.set(keys.HELP_RESTORED, self._crash_loop)
+            if self._crash_loop is not None:  # it holds and asks, whatever staff decided
+                self._decided = replace(self._decided, help=self._crash_loop)
+            self.staff.restore(self._decided)
+            if self._decided != decisions.NONE:
+                log.info("restored what staff decided: %s", self._decided.to_json())
+        # what this executive took up from before it: recorded, so that replay does too
+        self.restored = decisions.restored(resume, self._decided)
         self.staff.book.listeners.append(self._on_alert)
         self.notifier = Notifier.from_env()  # systemd: READY, STATUS, watchdog pings
 
-    def _resume_or_hold(self, checkpoint: Path, max_age: float) -> None:
-        """Resume the tour of ``checkpoint`` (marking the file: resumed once more), unless
-        that would run into the same failure again (:func:`crash_loop`): then the robot
-        holds where it is and asks a person (``help`` crashed, with the reason); the
-        checkpoint is set aside, so that a further start does not try it either."""
+    def _resume_or_hold(self, checkpoint: Path, max_age: float) -> Resume | None:
+        """The resume point of ``checkpoint``, on the board (the file marked: resumed once
+        more), unless resuming it would run into the same failure again
+        (:func:`crash_loop`): then None, and the robot holds where it is and asks a person
+        (``help`` crashed, with the reason); the checkpoint is set aside, so that a further
+        start does not try it either."""
         resume = load_checkpoint(checkpoint, max_age)
         if resume is None:
-            return
+            return None
         why = crash_loop(resume)
         if why is None:
             mark_resumed(checkpoint, resume)
             self.core.board.set(keys.RESUME, resume)
             if resume.run:  # the run goes on: its recordings say so
                 self.standing.run = RunId.resuming(resume.run)
-            return
+            return resume
         log.error("not resuming the tour of %s: %s; holding for a person", checkpoint, why)
         with contextlib.suppress(OSError):
             checkpoint.replace(checkpoint.with_name(checkpoint.name + ".crashed"))
         self._crash_loop = Help(HelpAbout.CRASHED, resume.written, why)
-
-    def _restore(self, decided: decisions.Decisions) -> None:
-        """What staff decided before a restart holds again: out of service, a pause (its
-        bound counts from now), the help the robot waits for, the alerts acknowledged."""
-        board = self.core.board
-        board.set(keys.IN_SERVICE, decided.in_service)
-        board.set(keys.PAUSED, decided.paused)
-        board.set(keys.HELP_RESTORED, decided.help)
-        self.staff.remembered_acks = set(decided.acknowledged)
-        if decided != decisions.NONE:
-            log.info("restored what staff decided: %s", decided.to_json())
+        return None
 
     def decided(self) -> decisions.Decisions:
         """What staff decided now (saved beside the checkpoint whenever it changes)."""
@@ -178,7 +174,12 @@ class Executive:
             self.link.send,
             emit=self.observers,
             standing=self.standing,
+            after_tick=self._after_tick,
         )
+
+    def _after_tick(self) -> None:
+        """Inside each tick, before the observers hear it: the alerts checked."""
+        self.staff.after_tick()
 
     def emit(self, event: Event) -> None:
         """Tell every observer."""
@@ -399,8 +400,7 @@ class Executive:
             self._peer_restarts = restarts
             self.core.ctx.note("front end restarted", incident=IncidentKind.FRONTEND_RESTARTED)
         self.staff.before_tick()
-        status = self.core.tick()
-        self.staff.after_tick()
+        status = self.core.tick()  # the staff check the alerts at its end (_after_tick)
         progress = self.core.board.get(keys.PROGRESS) or EMPTY
         if self.checkpoint is not None and progress != self._saved:
             self._saved = progress

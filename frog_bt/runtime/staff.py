@@ -1,34 +1,49 @@
 """The executive's side of the people around the robot: operator commands and alerts.
 
-Commands from the console or ``frog-bt ctl`` are queued (:meth:`Staff.submit`, from any
-task) and applied at the next tick boundary (:meth:`Staff.before_tick`): tree commands
-through :meth:`~frog_bt.engine.core.Core.command` (recorded, replayed), ``ack_alert`` to
-the alert book. A command the executive cannot apply within ``APPLY_WITHIN`` seconds
-(the tree does not tick while rosbridge is unreachable) is refused and changes nothing.
+Commands from the console, ``frog-bt ctl`` or an acknowledgement link are queued
+(:meth:`Staff.submit`, from any task) and applied at the next tick boundary
+(:meth:`Staff.before_tick`, each through :meth:`Staff.apply`): tree commands through
+:meth:`~frog_bt.engine.core.Core.command`, ``ack_alert`` to the alert book; both are
+recorded with their answer. A command the executive cannot apply within ``APPLY_WITHIN``
+seconds (the tree does not tick while rosbridge is unreachable) is refused and changes
+nothing.
 
-After each tick (:meth:`Staff.after_tick`) the alert conditions are checked against what
-the executive knows now (:class:`~frog_bt.runtime.alerts.Facts`).
+At the end of each tick (:meth:`Staff.after_tick`, the core's ``after_tick``: before the
+observers hear the tick, so that a recording keeps a tick's alert changes with it) the
+alert conditions are checked against what the executive knows now
+(:class:`~frog_bt.runtime.alerts.Facts`).
+
+The host is the online executive or a replay (:mod:`frog_bt.offline.replay`), which
+holds a :class:`Staff` of its own and calls :meth:`Staff.apply`, :meth:`Staff.after_tick`,
+:meth:`Staff.links_changed` and :meth:`Staff.restore` where the recording says the
+executive did: the same alert book, the same answers.
 """
 
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 from py_trees.common import Status
 
 from frog_bt.engine.operator import Answer, Command
 from frog_bt.i18n import Msg
 from frog_bt.model import keys
-from frog_bt.model.events import OperatorDone
+from frog_bt.model.channels import Carried, CarriedIncident
+from frog_bt.model.events import Event, OperatorDone
 from frog_bt.model.links import LinkStatus
-from frog_bt.model.outcomes import TourState
+from frog_bt.model.outcomes import Incident, IncidentKind, TourState
 from frog_bt.runtime.alerts import AlertBook, Facts
 
 if TYPE_CHECKING:
-    from frog_bt.runtime.executive import Executive
+    from frog_bt.clock import Clock
+    from frog_bt.config import Site
+    from frog_bt.engine.core import Core
+    from frog_bt.model.links import Links
+    from frog_bt.runtime.decisions import Decisions
 
 log = logging.getLogger(__name__)
 if log.level == logging.NOTSET:  # a person steered the robot: at INFO, always in the log
@@ -45,9 +60,25 @@ class Queued:
     by: str = ""  # who sent it: console, ctl, link (recorded with the answer)
 
 
+class StaffHost(Protocol):
+    """What :class:`Staff` works on: the executive, or a replay of one."""
+
+    @property
+    def site(self) -> Site: ...
+    @property
+    def clock(self) -> Clock: ...
+    @property
+    def core(self) -> Core: ...  # the core running now (a reload replaces it)
+    @property
+    def links(self) -> Links | None: ...  # each link's state as last checked (None: unknown)
+
+    def emit(self, event: Event) -> None: ...
+    def wake(self) -> None: ...
+
+
 @dataclass
 class Staff:
-    executive: Executive
+    executive: StaffHost
     book: AlertBook = field(init=False)
     link_since: dict[str, tuple[LinkStatus, float]] = field(default_factory=dict)
     _queue: list[Queued] = field(default_factory=list)
@@ -87,47 +118,85 @@ class Staff:
     def before_tick(self) -> None:
         """Apply what was queued, in order, between two ticks."""
         queue, self._queue = self._queue, []
-        core = self.executive.core
         for queued in queue:
-            if queued.command is Command.ACK_ALERT:
-                now = core.clock.now()
-                ack = self.book.acknowledge(queued.alert_id, now)
-                answer = (
-                    Answer(True, Msg("alert {id} acknowledged", id=ack.id))
-                    if ack is not None
-                    else Answer(
-                        False, Msg("no alert {id} to acknowledge", id=repr(queued.alert_id))
-                    )
-                )
-                core.journal.note(f"operator: ack_alert {queued.alert_id}: {answer.text}")
-                self.executive.emit(
-                    OperatorDone(
-                        now,
-                        core.ticks + 1,
-                        queued.command.value,
-                        answer.ok,
-                        answer.text,
-                        queued.alert_id,
-                        by=queued.by,
-                    )
-                )
-            else:
-                answer = core.command(queued.command, by=queued.by)
-            # a person steered the robot: always in the log (at INFO, the log's level)
-            log.info(
-                "operator %s: %s%s", queued.command, "" if answer.ok else "refused: ", answer.text
-            )
+            answer = self.apply(queued.command, queued.alert_id, queued.by)
             if not queued.answer.done():
                 queued.answer.set_result(answer)
+
+    def apply(self, command: Command, alert_id: str = "", by: str = "") -> Answer:
+        """Apply one command now, between two ticks: ``ack_alert`` to the alert book,
+        any other to the tree (:meth:`~frog_bt.engine.core.Core.command`); its answer,
+        also told to the host's observers (the recording) and logged."""
+        core = self.executive.core
+        if command is Command.ACK_ALERT:
+            now = core.clock.now()
+            ack = self.book.acknowledge(alert_id, now)
+            answer = (
+                Answer(True, Msg("alert {id} acknowledged", id=ack.id))
+                if ack is not None
+                else Answer(False, Msg("no alert {id} to acknowledge", id=repr(alert_id)))
+            )
+            core.journal.note(f"operator: ack_alert {alert_id}: {answer.text}")
+            self.executive.emit(
+                OperatorDone(
+                    now, core.ticks + 1, command.value, answer.ok, answer.text, alert_id, by=by
+                )
+            )
+        else:
+            answer = core.command(command, by=by)
+        # a person steered the robot: always in the log (at INFO, the log's level)
+        log.info("operator %s: %s%s", command, "" if answer.ok else "refused: ", answer.text)
+        return answer
+
+    def restore(self, decided: Decisions) -> None:
+        """What staff decided before a restart holds again: out of service, a pause (its
+        bound counts from the first tick), the help the robot waits for, the alerts
+        acknowledged (acknowledged again when they come back, :data:`REMEMBER_ACKS`)."""
+        board = self.executive.core.board
+        board.set(keys.IN_SERVICE, decided.in_service)
+        board.set(keys.PAUSED, decided.paused)
+        board.set(keys.HELP_RESTORED, decided.help)
+        self.remembered_acks = set(decided.acknowledged)
+
+    def carried(self) -> Carried:
+        """What the executive carries beside the tree into a rotated recording file."""
+        board = self.executive.core.board
+        active, shown, told_at = self.book.carried()
+        return Carried(
+            in_service=board.get(keys.IN_SERVICE) is not False,
+            paused=bool(board.get(keys.PAUSED)),
+            active=active,
+            shown=shown,
+            told_at=told_at,
+            tour_incidents=[
+                CarriedIncident(i.at, i.kind.value, i.text, i.subject)
+                for i in self.executive.core.journal.tally.tour
+            ],
+            pause_ran_out=self._pause_ran_out,
+        )
+
+    def take_up(self, carried: Carried) -> None:
+        """Hold what a rotated file's primer says the executive carried (replay)."""
+        board = self.executive.core.board
+        board.set(keys.IN_SERVICE, carried.in_service)
+        board.set(keys.PAUSED, carried.paused)
+        self.book.take_up(carried.active, carried.shown, carried.told_at)
+        tour = []
+        for i in carried.tour_incidents:
+            with contextlib.suppress(ValueError):  # a kind this version does not know
+                tour.append(Incident(i.at, IncidentKind(i.kind), i.text, i.subject))
+        self.executive.core.journal.tally.take_up(tour)
+        self._pause_ran_out = carried.pause_ran_out
 
     # ------------------------------------------------------------ links and alerts
 
     def links_changed(self, now: float) -> None:
         """Note when each link entered its state (the console shows for how long); on the
         project clock, so not before it has a time."""
-        if not self.executive.clock.ready:
+        links = self.executive.links
+        if not self.executive.clock.ready or links is None:
             return
-        for name, state in self.executive.links.items():
+        for name, state in links.items():
             seen = self.link_since.get(name)
             if seen is None or seen[0] is not state:
                 self.link_since[name] = (state, now)

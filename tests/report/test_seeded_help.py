@@ -2,8 +2,9 @@
 (scripts/corpus_run.py: a dock answered ``done_by_hand``, an operator ``home`` and
 ``skip``, a ``battery_low`` acknowledged after a known delay, a restart) held against
 its manifest: the interventions told apart, per 100 tours, the time to acknowledge, the
-funnel and the failure taxonomy with each cause counted once; and ``--compare`` of two
-tiny seasons that differ in one seeded rate."""
+funnel and the failure taxonomy with each cause counted once; ``replay`` of the season
+finds no divergence; and ``--compare`` of two tiny seasons that differ in one seeded
+rate."""
 
 from __future__ import annotations
 
@@ -228,3 +229,16 @@ def test_the_configuration_hash_is_of_what_was_validated(tmp_path) -> None:
     assert "language: es" in text
     assert fingerprint(load_site(same)) == fingerprint(load_site())
     assert fingerprint(load_site(other)) != fingerprint(load_site())
+
+
+def test_replay_of_the_season_reports_no_divergence(season, tmp_path) -> None:
+    """Every tour of the season (a dock answered by hand, a home, a skip, an acknowledged
+    alert, a restart and its resumed file) replays "identical": the staff's answers and
+    the alert book are replayed with the tree, and the resumed executive starts from what
+    it took up."""
+    directory, manifest = season
+    target = tmp_path / "replay.json"
+    assert main(["replay", str(directory), "--quiet", "--jobs", "1", "--report", str(target)]) == 0
+    rows = json.loads(target.read_text())["tours"]
+    files = sum(len(run["files"]) for run in manifest["runs"])
+    assert len(rows) == files and [r["status"] for r in rows] == ["identical"] * files
