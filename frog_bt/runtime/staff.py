@@ -43,6 +43,7 @@ class Queued:
     alert_id: str
     answer: asyncio.Future[Answer]
     by: str = ""  # who sent it: console, ctl, link (recorded with the answer)
+    occurrence: str | None = None  # ack_alert from a link: only this raise of the alert
 
 
 @dataclass
@@ -63,11 +64,14 @@ class Staff:
 
     # ------------------------------------------------------------ commands
 
-    async def submit(self, command: Command, alert_id: str = "", by: str = "") -> Answer:
+    async def submit(
+        self, command: Command, alert_id: str = "", by: str = "", occurrence: str | None = None
+    ) -> Answer:
         """Queue ``command`` (sent ``by`` console, ctl or an acknowledgement link); its
-        answer once applied at the next tick (or refused)."""
+        answer once applied at the next tick (or refused). ``occurrence``: ``ack_alert``
+        acknowledges only that raise of the alert (an acknowledgement link's)."""
         answer: asyncio.Future[Answer] = asyncio.get_running_loop().create_future()
-        queued = Queued(command, alert_id, answer, by)
+        queued = Queued(command, alert_id, answer, by, occurrence)
         self._queue.append(queued)
         self.executive.wake()
         try:
@@ -91,14 +95,7 @@ class Staff:
         for queued in queue:
             if queued.command is Command.ACK_ALERT:
                 now = core.clock.now()
-                ack = self.book.acknowledge(queued.alert_id, now)
-                answer = (
-                    Answer(True, Msg("alert {id} acknowledged", id=ack.id))
-                    if ack is not None
-                    else Answer(
-                        False, Msg("no alert {id} to acknowledge", id=repr(queued.alert_id))
-                    )
-                )
+                answer = self._acknowledge(queued, now)
                 core.journal.note(f"operator: ack_alert {queued.alert_id}: {answer.text}")
                 self.executive.emit(
                     OperatorDone(
@@ -119,6 +116,17 @@ class Staff:
             )
             if not queued.answer.done():
                 queued.answer.set_result(answer)
+
+    def _acknowledge(self, queued: Queued, now: float) -> Answer:
+        seen = self.book.unacknowledged.get(queued.alert_id)
+        if seen is not None and queued.occurrence not in (None, seen.occurrence):
+            return Answer(
+                False, Msg("alert {id} was raised again since that link", id=queued.alert_id)
+            )
+        ack = self.book.acknowledge(queued.alert_id, now)
+        if ack is None:
+            return Answer(False, Msg("no alert {id} to acknowledge", id=repr(queued.alert_id)))
+        return Answer(True, Msg("alert {id} acknowledged", id=ack.id))
 
     # ------------------------------------------------------------ links and alerts
 
