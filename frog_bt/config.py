@@ -285,7 +285,7 @@ class AlertsCfg(_Model):
 
 
 class ConsoleCfg(_Model):
-    commands_per_second: Positive = 2.0  # more from one client: 429 (at least 5 at once)
+    commands_per_second: Positive = 2.0  # more from one client: 429 (10 at once)
     max_body: Annotated[int, Field(ge=64, le=1_000_000)] = 4096  # bytes of a request body
     push_every: Positive = 0.3  # seconds between pushed states (at once on a new phase)
     # reverse proxies (addresses or networks) whose X-Forwarded-For names the client
