@@ -6,12 +6,16 @@ DIR/config/site.yaml, copied from the packaged ones. Then:
 
   frog-bt check/render/run/demo --tree DIR/trees/tour.yaml --config DIR/config/site.yaml
 
-Existing files are left alone unless --force. With --service, also DIR/frog-bt.service:
-a systemd unit (Type=notify, a watchdog, Restart=always) that runs the executive with
-that folder's files as an ordinary user, and DIR/state/ and DIR/recordings/ for it to
-write. Run as root, it creates that user when there is none (``useradd --system``;
-where it cannot, it prints the one command that does) and gives it those two folders;
-it prints how to install the unit (docs/DEPLOY.md).
+Existing files are left alone unless --force; the site configuration is written 0600
+(webhook credentials go there). With --service, also DIR/frog-bt.service: a systemd unit
+(Type=notify, a watchdog, Restart=always, sandboxed as systemd recommends for a network
+daemon) that runs the executive with that folder's files as an ordinary user, its
+console on loopback with DIR/console-token (a random token, 0600, handed over with
+LoadCredential=), and DIR/state/ and DIR/recordings/ for it to write. It says in one
+line when that user cannot read or run the unit's program. Run as root, it creates
+that user when there is none (``useradd --system``; where it cannot, it prints the one
+command that does) and gives it those two folders and the site configuration; it prints
+how to install the unit (docs/DEPLOY.md).
 """
 
 from __future__ import annotations
