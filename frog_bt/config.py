@@ -9,6 +9,7 @@ an error names the file, the path inside it and what was expected::
 from __future__ import annotations
 
 import hashlib
+import ipaddress
 import math
 from datetime import time as dtime
 from pathlib import Path
@@ -287,9 +288,24 @@ class AlertsCfg(_Model):
 
 
 class ConsoleCfg(_Model):
-    commands_per_second: Positive = 2.0  # more from all clients together: 429
+    commands_per_second: Positive = 2.0  # more from one client: 429 (10 at once)
     max_body: Annotated[int, Field(ge=64, le=1_000_000)] = 4096  # bytes of a request body
     push_every: Positive = 0.3  # seconds between pushed states (at once on a new phase)
+    # reverse proxies (addresses or networks) whose X-Forwarded-For names the client
+    trusted_proxies: list[str] = []
+
+    @field_validator("trusted_proxies")
+    @classmethod
+    def _networks(cls, values: list[str]) -> list[str]:
+        out = []
+        for value in values:
+            try:
+                out.append(str(ipaddress.ip_network(value.strip(), strict=False)))
+            except ValueError:
+                raise ValueError(
+                    f"expected IP addresses or networks (127.0.0.1, 10.0.0.0/8), got {value!r}"
+                ) from None
+        return out
 
 
 class Recording(_Model):

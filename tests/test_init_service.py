@@ -57,10 +57,12 @@ def test_what_would_be_done_for_a_user_that_does_not_exist(site: Path) -> None:
         f"useradd --system --user-group --no-create-home --home-dir {folder} "
         f"--shell {shutil.which('nologin') or '/usr/sbin/nologin'} frog",
         f"chown -R frog: {folder / 'state'} {folder / 'recordings'}",
+        f"chown frog: {folder / 'config' / 'site.yaml'}",  # 0600: the service reads it
     ]
     as_root = service_user(site, "frog", euid=0, exists=lambda name: True)
     assert as_root.root and as_root.commands() == [
-        f"chown -R frog: {folder / 'state'} {folder / 'recordings'}"
+        f"chown -R frog: {folder / 'state'} {folder / 'recordings'}",
+        f"chown frog: {folder / 'config' / 'site.yaml'}",
     ]
 
 
@@ -104,3 +106,87 @@ def test_as_root_the_user_is_created_and_can_write_its_folders(
         assert reads.returncode == 0
     finally:
         subprocess.run(["userdel", name], capture_output=True, timeout=30, check=False)
+
+
+def test_the_unit_is_sandboxed_and_scored(site: Path) -> None:
+    """The hardening systemd recommends for a network daemon, the token as a credential,
+    and the score docs/DEPLOY.md gives (``systemd-analyze security``, where installed)."""
+    user = "daemon" if _exists("daemon") else pwd.getpwuid(os.geteuid()).pw_name
+    assert main(["init", str(site), "--service", "--user", user]) == 0
+    unit = (site / "frog-bt.service").read_text()
+    folder = site.resolve()
+    for line in (
+        "NoNewPrivileges=yes",
+        "ProtectSystem=strict",
+        f"ReadWritePaths={folder}/state {folder}/recordings",
+        "PrivateTmp=yes",
+        "RestrictAddressFamilies=AF_INET AF_INET6 AF_UNIX",
+        "CapabilityBoundingSet=",
+        "SystemCallFilter=@system-service",
+        f"LoadCredential=console-token:{folder}/console-token",
+    ):
+        assert f"\n{line}\n" in unit, line
+    assert "\nProtectHome=yes\n" in unit  # the site folder is not under /home
+    assert "--console 127.0.0.1:8080 --console-token-file %d/console-token" in unit
+    analyze = shutil.which("systemd-analyze")
+    if analyze is None:
+        pytest.skip("systemd-analyze is not installed (systemd)")
+    scored = subprocess.run(
+        [analyze, "security", "--offline=yes", str(site / "frog-bt.service")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    if user == "root":
+        pytest.skip("scored as root: the score counts the user")
+    last = scored.stdout.strip().splitlines()[-1]
+    assert "Overall exposure level for frog-bt.service: 1.2 OK" in last, scored.stdout[-500:]
+
+
+def test_secrets_are_written_for_their_owner_only(site: Path) -> None:
+    me = pwd.getpwuid(os.geteuid()).pw_name
+    assert main(["init", str(site), "--service", "--user", me]) == 0
+    token = site / "console-token"
+    assert token.stat().st_mode & 0o777 == 0o600 and len(token.read_text().strip()) >= 32
+    assert (site / "config" / "site.yaml").stat().st_mode & 0o777 == 0o600
+    before = token.read_text()
+    assert main(["init", str(site), "--service", "--user", me, "--force"]) == 0
+    assert token.read_text() == before  # a token there is kept
+
+
+def test_a_program_the_service_user_cannot_run_is_said_in_one_line(
+    site: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from frog_bt.commands.init import cannot_run
+
+    home = site.parent / "root-home"
+    venv = home / "venv" / "bin"
+    venv.mkdir(parents=True)
+    exe = venv / "frog-bt"
+    exe.write_text(f"#!{venv / 'python'}\n")
+    exe.chmod(0o755)
+    (venv / "python").write_text("")
+    (venv / "python").chmod(0o755)
+    home.chmod(0o700)  # as /root
+    stranger = 65534  # nobody
+    assert cannot_run(exe, stranger, stranger) == f"{home} is closed to it"
+    home.chmod(0o755)
+    assert cannot_run(exe, stranger, stranger) is None
+    (venv / "python").chmod(0o700)
+    assert cannot_run(exe, stranger, stranger) == f"it cannot run {venv / 'python'}"
+    if ROOT:  # the line init prints, for a user that exists
+        home.chmod(0o700)
+        from frog_bt.commands import init
+
+        line = init._cannot_run_as("nobody", exe)
+        assert line is not None and "\n" not in line
+        assert line.startswith(f"the service user nobody cannot run {exe} ({home} is closed")
+
+
+def _exists(name: str) -> bool:
+    try:
+        pwd.getpwnam(name)
+    except KeyError:
+        return False
+    return True

@@ -20,7 +20,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
+from frog_bt import resources
+from frog_bt.commands.exposed import exposed
 from frog_bt.commands.options import add_tree_argument, load_tree_argument
 from frog_bt.config import DEFAULT_CONFIG
 from frog_bt.errors import DefinitionError, TreeErrors, UsageError
@@ -47,6 +50,9 @@ def run(args: argparse.Namespace) -> int:
     except DefinitionError as exc:
         print(exc, file=sys.stderr)
         return 2
+    config = Path(args.config) if args.config else resources.site_dir() / resources.SITE_FILE
+    for line in exposed(config, site):
+        print(f"frog-bt: warning: {line}", file=sys.stderr)
     nodes = sum(1 for _ in tree.nodes())
     proved = ""
     if not args.no_verify:

@@ -14,19 +14,28 @@ state as the console gives it.
 Exit 0 when the command was applied (``status``: the state was read), 1 when the tour
 refused it (the reason is printed), 2 for a usage error, when the console cannot be
 reached (within ``--timeout`` seconds) or when its answer is not a clear yes: only
-``{"ok": true}`` counts as done. Redirects are never followed (the token would go with
-the request to wherever the redirect points). Output into a closed pipe (``| head -1``)
-ends quietly.
+``{"ok": true}`` counts as done. With a token, the answer must be the console's own: it
+carries the console's identity (``X-Frog-Console``, derived from the token, as
+``/api/state`` shows it) and the proof, over this request's nonce and the answer's body,
+that the console holding the token wrote it (``X-Frog-Proof``). Redirects are never
+followed (the token would go with the request to wherever the redirect points), no proxy
+is ever used (``http_proxy`` and its kin are ignored), and the token does not go over
+plain http to a host that is not loopback unless ``--insecure`` (with a warning). Output
+into a closed pipe (``| head -1``) ends quietly.
 """
 
 from __future__ import annotations
 
 import argparse
+import hmac
 import json
 import os
+import secrets
 import sys
 import urllib.error
+import urllib.parse
 import urllib.request
+from email.message import Message
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +45,8 @@ from frog_bt.engine.operator import Command
 from frog_bt.errors import UsageError
 from frog_bt.i18n import N_, Msg, translator
 from frog_bt.live.console import CTL_AGENT
+from frog_bt.live.console.acklink import answer_proof, console_id
+from frog_bt.live.console.origins import is_loopback
 from frog_bt.text import escape
 
 DEFAULT_CONSOLE = "127.0.0.1:8080"
@@ -70,6 +81,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--timeout", type=float, default=10.0, help="seconds to wait for the answer (default: 10)"
     )
+    p.add_argument(
+        "--insecure",
+        action="store_true",
+        help="send the token over plain http to a host that is not loopback (in clear: "
+        "anyone on the way reads it; prefer https:// through a TLS proxy)",
+    )
 
 
 class NoRedirects(urllib.request.HTTPRedirectHandler):
@@ -79,7 +96,9 @@ class NoRedirects(urllib.request.HTTPRedirectHandler):
         return None
 
 
-OPENER = urllib.request.build_opener(NoRedirects)
+# no proxy, whatever http_proxy and its kin say: the token goes to the console named and
+# nowhere else, and only the console's own answer counts
+OPENER = urllib.request.build_opener(urllib.request.ProxyHandler({}), NoRedirects)
 
 
 def _reason(body: bytes, default: str) -> str:
@@ -108,6 +127,52 @@ def console_url(text: str | None) -> str:
     return f"http://[{host}]:{port}" if ":" in host else f"http://{host}:{port}"
 
 
+def _in_clear(base: str, insecure: bool) -> str | None:
+    """Why the token may not go to ``base``: plain http to a host that is not loopback,
+    unless ``--insecure`` (then a warning names it); None when it may."""
+    url = urllib.parse.urlsplit(base)
+    if url.scheme != "http" or is_loopback(url.hostname or ""):
+        return None
+    if not insecure:
+        return (
+            f"{base} is plain http to a host that is not loopback: the token would travel "
+            "in clear; use https:// (a TLS proxy in front, docs/CONSOLE.md) or give --insecure"
+        )
+    print(
+        "frog-bt ctl: warning: --insecure: the token goes in clear over plain http to "
+        f"{url.hostname}",
+        file=sys.stderr,
+    )
+    return None
+
+
+def _stranger(
+    token: str | None, sent: dict[str, str], headers: Message | None, body: bytes, base: str
+) -> str | None:
+    """Why an answer is not the console's own (None when it is, or when there is no token
+    to know it by): it must carry the console's identity (``X-Frog-Console``, derived from
+    the token) and the proof that this body answers this request (``X-Frog-Proof``)."""
+    if token is None:
+        return None
+    expected = console_id(token)
+    got = headers.get("X-Frog-Console", "") if headers is not None else ""
+    proof = headers.get("X-Frog-Proof", "") if headers is not None else ""
+    if not hmac.compare_digest(got.encode(), expected.encode()):
+        return (
+            f"the answer from {base} is not from the console that holds this token "
+            f"(console id {got[:32] or 'missing'}, expected {expected}): "
+            "nothing is known to be done"
+        )
+    if not hmac.compare_digest(
+        proof.encode(), answer_proof(token, sent["X-Frog-Nonce"], body).encode()
+    ):
+        return (
+            f"the answer from {base} carries no valid proof of the console: "
+            "nothing is known to be done"
+        )
+    return None
+
+
 def run(args: argparse.Namespace) -> int:
     try:
         return _run(args)
@@ -132,14 +197,20 @@ def _run(args: argparse.Namespace) -> int:
         where = "--console" if args.console is not None else ENV
         return _fail(f"{where} {given}: {exc.detail}, or a URL")
     headers = {"Content-Type": "application/json", "User-Agent": f"{CTL_AGENT}/{__version__}"}
+    token: str | None = None
     if args.token_file is not None:
         try:
-            headers["Authorization"] = "Bearer " + args.token_file.read_text("utf-8").strip()
+            token = args.token_file.read_text("utf-8").strip()
         except (OSError, UnicodeDecodeError) as exc:
             return _fail(
                 f"--token-file {args.token_file}: cannot read it: "
                 f"{getattr(exc, 'strerror', None) or exc}"
             )
+        problem = _in_clear(base, args.insecure)
+        if problem:
+            return _fail(problem)
+        headers["Authorization"] = f"Bearer {token}"
+        headers["X-Frog-Nonce"] = secrets.token_urlsafe(24)
     if args.command == "ack_alert" and not args.id:
         return _fail("ack_alert needs the alert's id (frog-bt ctl status lists them)")
     if args.command == "status":
@@ -152,18 +223,26 @@ def _run(args: argparse.Namespace) -> int:
     try:
         with OPENER.open(request, timeout=args.timeout) as response:
             raw = response.read(1_000_000)
+            answered = response.headers
     except urllib.error.HTTPError as exc:
         if 300 <= exc.code < 400:
             where = exc.headers.get("Location", "?") if exc.headers else "?"
             return _fail(f"{exc.code}: the console redirects to {where[:200]}: not followed")
-        reason = _reason(exc.read(4096), str(exc.reason))
+        said = exc.read(4096)
+        reason = _reason(said, str(exc.reason))
         if exc.code == 409:
+            stranger = _stranger(token, headers, exc.headers, said, base)
+            if stranger:
+                return _fail(stranger)
             _say(f"refused: {reason}")
             return 1
         return _fail(f"{exc.code}: {reason}")
     except (urllib.error.URLError, OSError, ValueError) as exc:
         why = exc.reason if isinstance(exc, urllib.error.URLError) else exc
         return _fail(f"cannot reach the console at {base}: {why}")
+    stranger = _stranger(token, headers, answered, raw, base)
+    if stranger:
+        return _fail(stranger)
     try:
         answer = json.loads(raw)
     except (ValueError, RecursionError):

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import logging
 import os
 import signal
 import sys
@@ -27,7 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from frog_bt import __version__
+from frog_bt import __version__, resources
 from frog_bt.behaviours import load_tree
 from frog_bt.clock import SimClock, WallClock
 from frog_bt.commands import logs
@@ -37,6 +38,7 @@ from frog_bt.commands.console_options import (
     console_settings,
     start_people,
 )
+from frog_bt.commands.exposed import exposed
 from frog_bt.commands.options import add_tree_and_config, read_secret, rerun_spec, writable_file
 from frog_bt.commands.settings import fill, tree_and_config
 from frog_bt.config import DEFAULT_CONFIG, Site, check_ws_url, load_site, parse_hostport
@@ -245,6 +247,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"frog-bt: {line}", file=sys.stderr)
         return 2
     print("\n".join(banner(args, settings)), flush=True)
+    config = Path(args.config) if args.config else resources.site_dir() / resources.SITE_FILE
+    for line in exposed(config, site):
+        logging.getLogger("frog_bt").warning("%s", line)
     try:
         return asyncio.run(_main(args, site, tree, settings, console))
     except AddressError as exc:  # the listen port is taken, the front end's host unknown

@@ -112,6 +112,7 @@ FLUSH_EVERY = 1.0  # wall seconds between chunk flushes: a kill loses at most th
 PRIMER_DATAGRAMS = 16  # recent datagrams in, so that their resends stay duplicates
 PRIMER_SEQS = 64  # recent seqs out, so that resends of earlier commands are not new ones
 HELD_LIMIT = 10_000  # messages held before the first /clock
+RECORDING_MODE = 0o640  # rw owner, r group, nothing for others
 
 
 def _dumps(msg: Any) -> bytes:
@@ -206,7 +207,10 @@ class Recorder:
 
     def _open(self, path: Path, metadata: dict[str, str] | None) -> None:
         self.path = path
-        stream: IO[bytes] = open(path, "wb")  # noqa: SIM115 - closed by _finish
+        # owner and group only: a recording holds what the robot saw of its visitors
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, RECORDING_MODE)
+        stream: IO[bytes] = os.fdopen(fd, "wb")  # closed by _finish
+        os.fchmod(fd, RECORDING_MODE)  # also when the file was there before
         self._stream = stream
         compression = CompressionType.NONE
         try:

@@ -116,6 +116,12 @@ class Alert(msgspec.Struct, frozen=True):
     repeat: int = 0
     waited: float = 0.0
 
+    @property
+    def occurrence(self) -> str:
+        """Which raise of this alert: its raise time as text (the same through escalation,
+        clearing and acknowledgement; a later raise of the same alert has another)."""
+        return f"{self.since:.6f}"
+
 
 class CarriedIncident(msgspec.Struct, frozen=True):
     at: float

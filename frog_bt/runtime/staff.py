@@ -58,6 +58,7 @@ class Queued:
     alert_id: str
     answer: asyncio.Future[Answer]
     by: str = ""  # who sent it: console, ctl, link (recorded with the answer)
+    occurrence: str | None = None  # ack_alert from a link: only this raise of the alert
 
 
 class StaffHost(Protocol):
@@ -94,11 +95,14 @@ class Staff:
 
     # ------------------------------------------------------------ commands
 
-    async def submit(self, command: Command, alert_id: str = "", by: str = "") -> Answer:
+    async def submit(
+        self, command: Command, alert_id: str = "", by: str = "", occurrence: str | None = None
+    ) -> Answer:
         """Queue ``command`` (sent ``by`` console, ctl or an acknowledgement link); its
-        answer once applied at the next tick (or refused)."""
+        answer once applied at the next tick (or refused). ``occurrence``: ``ack_alert``
+        acknowledges only that raise of the alert (an acknowledgement link's)."""
         answer: asyncio.Future[Answer] = asyncio.get_running_loop().create_future()
-        queued = Queued(command, alert_id, answer, by)
+        queued = Queued(command, alert_id, answer, by, occurrence)
         self._queue.append(queued)
         self.executive.wake()
         try:
@@ -119,23 +123,21 @@ class Staff:
         """Apply what was queued, in order, between two ticks."""
         queue, self._queue = self._queue, []
         for queued in queue:
-            answer = self.apply(queued.command, queued.alert_id, queued.by)
+            answer = self.apply(queued.command, queued.alert_id, queued.by, queued.occurrence)
             if not queued.answer.done():
                 queued.answer.set_result(answer)
 
-    def apply(self, command: Command, alert_id: str = "", by: str = "") -> Answer:
+    def apply(
+        self, command: Command, alert_id: str = "", by: str = "", occurrence: str | None = None
+    ) -> Answer:
         """Apply one command now, between two ticks: ``ack_alert`` to the alert book,
         any other to the tree (:meth:`~frog_bt.engine.core.Core.command`); its answer,
-        also told to the host's observers (the recording) and logged."""
+        also told to the host's observers (the recording) and logged. ``occurrence``: the
+        raise an acknowledgement link was made for (None: any, as from the console)."""
         core = self.executive.core
         if command is Command.ACK_ALERT:
             now = core.clock.now()
-            ack = self.book.acknowledge(alert_id, now)
-            answer = (
-                Answer(True, Msg("alert {id} acknowledged", id=ack.id))
-                if ack is not None
-                else Answer(False, Msg("no alert {id} to acknowledge", id=repr(alert_id)))
-            )
+            answer = self._acknowledge(alert_id, occurrence, now)
             core.journal.note(f"operator: ack_alert {alert_id}: {answer.text}")
             self.executive.emit(
                 OperatorDone(
@@ -147,6 +149,15 @@ class Staff:
         # a person steered the robot: always in the log (at INFO, the log's level)
         log.info("operator %s: %s%s", command, "" if answer.ok else "refused: ", answer.text)
         return answer
+
+    def _acknowledge(self, alert_id: str, occurrence: str | None, now: float) -> Answer:
+        seen = self.book.unacknowledged.get(alert_id)
+        if seen is not None and occurrence not in (None, seen.occurrence):
+            return Answer(False, Msg("alert {id} was raised again since that link", id=alert_id))
+        ack = self.book.acknowledge(alert_id, now)
+        if ack is None:
+            return Answer(False, Msg("no alert {id} to acknowledge", id=repr(alert_id)))
+        return Answer(True, Msg("alert {id} acknowledged", id=ack.id))
 
     def restore(self, decided: Decisions) -> None:
         """What staff decided before a restart holds again: out of service, a pause (its

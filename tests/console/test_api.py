@@ -15,7 +15,8 @@ from test_faults import is_
 
 from frog_bt.commands.console_options import console_settings
 from frog_bt.errors import UsageError
-from frog_bt.live.console.server import ACCESS, RateLimit
+from frog_bt.live.console.server import ACCESS
+from frog_bt.live.console.throttle import COMMAND_BURST, Rates
 from frog_bt.model import keys
 
 
@@ -43,7 +44,7 @@ def test_every_command_and_every_refusal() -> None:
     async def main() -> list[tuple[int, dict[str, object]]]:
         async with console_tour(once=False) as (run, people, url):
             assert people.console is not None
-            people.console.app[ACCESS].limit = RateLimit(1000.0)  # not about the rate
+            people.console.app[ACCESS].rates = Rates(1000.0)  # not about the rate
             out = []
             async with aiohttp.ClientSession() as s:
                 await run.sim.wait_for(is_("tour", state="started"), 60)
@@ -89,8 +90,8 @@ def test_auth_bad_input_size_and_rate_are_refused_with_one_line_and_change_nothi
     async def main() -> list[tuple[int, str]]:
         async with console_tour() as (run, people, url):
             assert people.console is not None
-            # two commands a second, and time stands still
-            people.console.app[ACCESS].limit = RateLimit(2.0, clock=lambda: 0.0)
+            # two commands a second (a burst at once), and time stands still
+            people.console.app[ACCESS].rates = Rates(2.0, clock=lambda: 0.0)
             await run.sim.wait_for(is_("start_poi", poi="POI1", part="a"), 60)
             out = []
             async with aiohttp.ClientSession() as s:
@@ -114,7 +115,7 @@ def test_auth_bad_input_size_and_rate_are_refused_with_one_line_and_change_nothi
                 )
                 statuses = [
                     (await command(s, url, {"command": c}))[0]
-                    for c in ("pause", "resume", "pause", "resume")
+                    for c in ("pause", "resume") * (COMMAND_BURST // 2 + 1)
                 ]
             assert run.executive.core.board.get(keys.HOME) is None  # nobody sent it home
             out.append((statuses.count(429), str(statuses)))
@@ -125,7 +126,8 @@ def test_auth_bad_input_size_and_rate_are_refused_with_one_line_and_change_nothi
     assert out[0][1] == "a valid token is needed (Authorization: Bearer TOKEN)"
     assert out[5][1].startswith("unknown command 'dance' (known: home, skip, pause")
     assert out[7][1] == "request body over 4096 bytes"
-    assert out[8] == (2, "[200, 200, 429, 429]")  # two a second, and no time passed
+    # a burst at once (an even number: pause, resume, ...), then two a second, no time passed
+    assert out[8] == (2, str([200] * COMMAND_BURST + [429] * 2))
 
 
 def test_without_a_token_file_commands_are_off_and_off_loopback_it_does_not_start(

@@ -24,6 +24,7 @@ def test_the_routes_are_the_contracts_and_declared_once() -> None:
         ("GET", "/api/words"),
         ("GET", "/console.js"),
         ("GET", "/favicon.ico"),
+        ("POST", "/ack/{alert_id}"),
         ("POST", "/api/command"),
         ("POST", "/api/ticket"),
     ]

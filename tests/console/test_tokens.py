@@ -15,8 +15,9 @@ from test_faults import is_
 
 from frog_bt.commands.console_options import console_settings
 from frog_bt.errors import UsageError
-from frog_bt.live.console.bearer import FAIL_BURST, FAIL_EVERY, Failures, Tickets, bearer
+from frog_bt.live.console.bearer import Tickets, bearer
 from frog_bt.live.console.server import ACCESS
+from frog_bt.live.console.throttle import FAIL_BURST, FAIL_EVERY, TOTAL_BURST, Failures
 
 
 class Hand:
@@ -35,28 +36,31 @@ def test_only_bearer_and_any_bytes() -> None:
     assert bearer("Bearer \udcff\udcfe") == b"\xff\xfe"  # aiohttp's undecodable bytes
 
 
-def test_failures_are_throttled_per_address_and_logged_once_a_minute(
+def test_failures_are_throttled_per_client_and_in_total_and_every_one_logged(
     caplog: pytest.LogCaptureFixture,
 ) -> None:
     clock = Hand()
     failures = Failures(clock)
-    caplog.set_level(logging.WARNING, "frog_bt.live.console.bearer")
-    for _ in range(FAIL_BURST):
-        assert failures.allowed("10.0.0.5")
-        failures.failed("10.0.0.5")
-    assert not failures.allowed("10.0.0.5") and failures.allowed("10.0.0.6")
+    caplog.set_level(logging.WARNING, "frog_bt.live.console.throttle")
+    assert [failures.failed("10.0.0.5") for _ in range(FAIL_BURST + 3)] == [False] * (
+        FAIL_BURST
+    ) + [True] * 3
+    assert not failures.failed("10.0.0.6")  # another client: its own budget
     clock.t += FAIL_EVERY
-    assert failures.allowed("10.0.0.5")  # one more try after a while
-    failures.failed("10.0.0.5")
+    assert not failures.failed("10.0.0.5")  # one more try after a while
     clock.t += 30.0
     failures.flush()
     clock.t += 30.0
     failures.flush()
     failures.flush()
     assert [r.getMessage() for r in caplog.records] == [
-        "console: 1 failed token attempt (from 10.0.0.5)",
-        "console: 10 failed token attempts (from 10.0.0.5)",
+        "console: 1 failed token attempt, 0 of them answered 429 (from 10.0.0.5 1)",
+        "console: 14 failed token attempts, 3 of them answered 429 (from 10.0.0.5 13, 10.0.0.6 1)",
     ]
+    assert failures.counted == 15
+    # many clients at once: the total budget answers 429 too, each client fresh
+    spread = [failures.failed(f"10.1.{i // 256}.{i % 256}") for i in range(TOTAL_BURST + 20)]
+    assert spread.count(True) >= 20 - 1
 
 
 def test_tickets_are_used_once_and_expire() -> None:

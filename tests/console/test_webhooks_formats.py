@@ -115,7 +115,9 @@ def check_link(url: str, alert_id: str) -> None:
     assert unquote(parts.path) == f"/ack/{alert_id}" and TOKEN not in url
     query = dict(p.split("=") for p in parts.query.split("&"))
     assert int(query["exp"]) == WALL + 86400  # alerts.ack_link_ttl, on the wall clock
-    assert verify(link_key(TOKEN), alert_id, query["exp"], query["sig"], WALL) is Verdict.VALID
+    at = unquote(query["at"])  # the raise it acknowledges: the alert's raise time
+    key = link_key(TOKEN)
+    assert verify(key, "frog", alert_id, at, query["exp"], query["sig"], WALL) is Verdict.VALID
 
 
 def test_generic_json_raised_escalated_twice_then_resolved() -> None:

@@ -1,5 +1,6 @@
 """The console's door: at most so many connections at once, a plain 503 beyond, and one
-log line (not a traceback per attempt) when the process runs out of file descriptors.
+log line (not a traceback per attempt) when the process runs out of file descriptors;
+aiohttp's own error answers made the console's (:class:`SafeErrors`).
 
 :class:`GatedSite` is an aiohttp site (``web.BaseSite``, as ``TCPSite``) whose server
 hands each connection to :class:`Gate` first: under the cap, the connection goes on to
@@ -22,18 +23,34 @@ import logging
 import resource
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from aiohttp import web
 
+from frog_bt.warning_limit import WarningLimiter
+
 log = logging.getLogger(__name__)
 MAX_CONNECTIONS = 512  # connections at once (also at most half the descriptors)
+# what every answer carries, the ones aiohttp and the gate write themselves too
+BARE_HEADERS = {
+    "Content-Security-Policy": "default-src 'none'; frame-ancestors 'none'",
+    "X-Content-Type-Options": "nosniff",
+    "X-Frame-Options": "DENY",
+    "Referrer-Policy": "no-referrer",
+    "Cache-Control": "no-store",
+}
 PLAIN_503 = (
     b"HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain\r\n"
-    b"Content-Length: 30\r\nConnection: close\r\n\r\n"
-    b"the console is busy: try again"
+    + b"".join(f"{k}: {v}\r\n".encode() for k, v in BARE_HEADERS.items())
+    + b"Content-Length: 30\r\nConnection: close\r\n\r\n"
+    + b"the console is busy: try again"
 )
+ERRORS = {  # what aiohttp's own error answers say: fixed words, never the request's bytes
+    400: "the request could not be read (malformed, or a header too long)",
+    500: "the console failed to answer: see its log",
+    504: "the console took too long to answer",
+}
 OUT_OF_FILES = {errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM}
 
 
@@ -46,11 +63,57 @@ def connection_cap(limit: int = MAX_CONNECTIONS) -> int:
 
 @dataclass
 class Door:
-    """How many connections are open, and how many may be."""
+    """How many connections are open, how many may be, how many were turned away, and how
+    many requests aiohttp's HTTP layer answered with an error."""
 
     cap: int
     open: int = 0
     refused: int = 0
+    errors: int = 0  # answered by aiohttp's HTTP layer (:class:`SafeErrors`)
+    warnings: WarningLimiter = field(default_factory=lambda: WarningLimiter(60.0, logger=log))
+
+
+class SafeErrors(web.RequestHandler):
+    """aiohttp's protocol, with its own error answers made the console's. aiohttp answers
+    a request it cannot parse (a header over 8,190 bytes, a duplicate ``Host``, a bad
+    byte), a handler that raised or timed out, before and outside the application: no
+    middleware and no ``on_response_prepare`` runs, and its text repeats what it could
+    not parse. Here :meth:`handle_error` answers fixed words (:data:`ERRORS`) as the
+    console's JSON refusal with :data:`BARE_HEADERS`, counts it in its :class:`Door`, and
+    logs one line a minute with no byte of the request. ``__slots__ = ()``: the same
+    layout as aiohttp's class, so :class:`Gate` turns the protocol ``runner.server()``
+    makes into this one (pinned by ``tests/console/test_raw_errors.py``)."""
+
+    __slots__ = ()
+
+    def handle_error(
+        self,
+        request: web.BaseRequest,
+        status: int = 500,
+        exc: BaseException | None = None,
+        message: str | None = None,
+    ) -> web.StreamResponse:
+        transport = request.transport
+        gate = transport.get_protocol() if transport is not None else None
+        if isinstance(gate, Gate):  # this console's door counts them
+            door = gate.door
+            door.errors += 1
+            door.warnings.warn(
+                str(status),
+                f"console: {door.errors} request{'s' if door.errors != 1 else ''} answered "
+                f"{status} by the HTTP layer so far (the last: "
+                f"{type(exc).__name__ if exc else 'no exception'})",
+            )
+        if status >= 500 and exc is not None:
+            log.error("console: a request failed", exc_info=exc)
+        if request.writer.output_size > 0:  # as aiohttp: a half-sent answer cannot change
+            raise ConnectionError("an answer was partly sent already")
+        text = ERRORS.get(status, "the request could not be handled")
+        response = web.json_response(
+            {"ok": False, "reason": text}, status=status, headers=BARE_HEADERS
+        )
+        response.force_close()
+        return response
 
 
 class Gate(asyncio.Protocol):
@@ -70,6 +133,8 @@ class Gate(asyncio.Protocol):
             return
         self.door.open += 1
         self.inner = self.make_inner()
+        if type(self.inner) is web.RequestHandler:
+            self.inner.__class__ = SafeErrors  # the console's answers to aiohttp's errors
         self.inner.connection_made(transport)
 
     def data_received(self, data: bytes) -> None:

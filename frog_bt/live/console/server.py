@@ -13,22 +13,26 @@
   seconds, and within 50 ms of a new phase or a command (:mod:`~.stream`);
 * ``POST /api/ticket`` — with the token: a one-use ticket for ``/api/stream?ticket=``, so
   that off loopback the token never travels in a URL (:mod:`~.bearer`);
-* ``GET /ack/{alert_id}?exp=&sig=`` — a notification's signed link acknowledges its alert
-  (:func:`get_ack`), answering a plain page;
+* ``GET /ack/{alert_id}?at=&exp=&sig=`` — a notification's signed link: a plain page in
+  the site's language saying what it would acknowledge, with one button; ``POST`` (the
+  button) acknowledges that raise of that alert, once (:mod:`~.ackpage`);
 * ``POST /api/command`` — ``{"command": C}`` (``"id"`` with ``ack_alert``), with
   ``Authorization: Bearer TOKEN``: 200 ``{"ok": true, "did"}`` once applied at the next
   tick, 409 ``{"ok": false, "reason"}`` when the tour cannot do it now, 400 malformed or
-  unknown, 401 no or wrong token, 413 too large, 429 too many commands a second.
+  unknown, 401 no or wrong token, 413 too large, 429 too many commands a second from
+  one client.
 
 Every request passes :func:`guard` first: a ``Host`` or ``Origin`` that is not the
 console's gets 403 (:mod:`~.origins`); then the token, where one is needed (only the
-``Bearer`` scheme; failed attempts throttled per address, 429, and logged once a minute);
-then the body's size. Every refusal is one line of JSON ``{"ok": false, "reason": ...}``
-and changes nothing; every answer carries a strict Content-Security-Policy
-(:data:`SECURITY_HEADERS`). The token is compared in constant time and never logged or
-recorded. Reads need no token when the console listens on loopback and the request names
-a loopback host and came through no proxy; elsewhere they need it too (and the console
-does not start off loopback without a token file).
+``Bearer`` scheme; failed attempts counted per client and in total, logged once a minute,
+and over their budget answered 429 — the right token is never refused for anyone's
+failures: :mod:`~.throttle`); then the body's size. Every refusal is one line of JSON
+``{"ok": false, "reason": ...}`` and changes nothing; every answer carries a strict
+Content-Security-Policy (:data:`SECURITY_HEADERS`; aiohttp's own errors too: :mod:`~.gate`),
+the console's identity and, to ``ctl``, the proof of it. The token is compared in
+constant time and never logged or recorded. Reads need no token when the console listens
+on loopback and the request names a loopback host and came through no proxy; elsewhere
+they need it too (and the console does not start off loopback without a token file).
 
 What one console keeps lives in its application, under typed keys: :data:`EXECUTIVE`,
 :data:`ACCESS` (who may do what), :data:`SHOWN` (the day, the log lines, the stop clock,
@@ -44,12 +48,10 @@ import asyncio
 import base64
 import contextlib
 import hashlib
-import html
 import json
 import logging
 import re
 import socket
-import time
 from collections.abc import AsyncIterator, Awaitable, Callable
 from dataclasses import dataclass, field
 from importlib import resources
@@ -60,13 +62,15 @@ from aiohttp import web
 from frog_bt.engine.operator import Command
 from frog_bt.i18n import LANGUAGES, Msg, catalog, language, say
 from frog_bt.live.console import CTL_AGENT
-from frog_bt.live.console.acklink import Verdict, link_key, verify
-from frog_bt.live.console.bearer import Failures, Tickets, bearer, matches
+from frog_bt.live.console.acklink import answer_proof, console_id, link_key
+from frog_bt.live.console.ackpage import ACK_DESK, AckDesk, get_ack, post_ack
+from frog_bt.live.console.bearer import Tickets, bearer, matches
 from frog_bt.live.console.day import Day
 from frog_bt.live.console.gate import Door, GatedSite, OutOfFiles, connection_cap
 from frog_bt.live.console.origins import Origins, is_loopback, split_host
 from frog_bt.live.console.state import LogLines, StopClock, site_map, state, tree
 from frog_bt.live.console.stream import CLOSE_TIMEOUT, Pages, close_all, serve
+from frog_bt.live.console.throttle import Failures, Network, Rates, client_of, networks
 from frog_bt.runtime.status import phase
 
 if TYPE_CHECKING:
@@ -82,29 +86,11 @@ Handler = Callable[[web.Request], Awaitable[web.StreamResponse]]
 PHASE_POLL = 0.05  # wall seconds between looks at the phase (a new one is pushed at once)
 HEADER_TIMEOUT = 10.0  # seconds a connection may take to send a whole request header
 PROXIED = ("Forwarded", "X-Forwarded-For", "X-Real-IP")  # a request that came via a proxy
+MAX_NONCE = 64  # characters of X-Frog-Nonce answered with a proof
 
 
 def refuse(status: int, reason: str) -> web.Response:
     return web.json_response({"ok": False, "reason": reason}, status=status)
-
-
-class RateLimit:
-    """At most ``rate`` commands a second (a token bucket of one second's worth)."""
-
-    def __init__(self, rate: float, clock: Callable[[], float] = time.monotonic) -> None:
-        self.rate = rate
-        self.clock = clock
-        self.tokens = rate
-        self.at = clock()
-
-    def take(self) -> bool:
-        now = self.clock()
-        self.tokens = min(self.rate, self.tokens + (now - self.at) * self.rate)
-        self.at = now
-        if self.tokens >= 1.0:
-            self.tokens -= 1.0
-            return True
-        return False
 
 
 # ---------------------------------------------------------------- one console's state
@@ -113,16 +99,24 @@ class RateLimit:
 @dataclass
 class Access:
     """Who may do what: the staff token (None: commands are off), whether the console
-    listens on loopback, the console's own origins, the largest body, the command rate,
-    the failed attempts and the stream tickets."""
+    listens on loopback, the console's own origins, the largest body, the command rate
+    per client, the failed attempts, the stream tickets and the proxies whose
+    ``X-Forwarded-For`` names the client."""
 
     token: str | None
     loopback: bool
     max_body: int
-    limit: RateLimit
+    rates: Rates
     origins: Origins
     failures: Failures = field(default_factory=Failures)
     tickets: Tickets = field(default_factory=Tickets)
+    proxies: tuple[Network, ...] = ()
+
+    def client(self, request: web.Request) -> str:
+        """The client ``request`` stands for (:func:`~.throttle.client_of`)."""
+        return client_of(
+            request.remote, request.headers.getall("X-Forwarded-For", []), self.proxies
+        )
 
 
 @dataclass
@@ -188,17 +182,31 @@ SECURITY_HEADERS = {
 
 async def secure_headers(request: web.Request, response: web.StreamResponse) -> None:
     """Every answer: the page's policy (or, for JSON and plain pages, one that allows
-    nothing), no sniffing, no framing, no referrer."""
+    nothing), no sniffing, no framing, no referrer; with a token, the console's identity
+    (``X-Frog-Console``) and, when the request sent an ``X-Frog-Nonce``, the proof that this
+    body is this console's answer to it (``X-Frog-Proof``: what ``ctl`` checks)."""
     response.headers.setdefault("Content-Security-Policy", request.app[ASSETS].policy)
     for name, value in SECURITY_HEADERS.items():
         response.headers.setdefault(name, value)
     if request.path.startswith("/api"):
         response.headers.setdefault("Cache-Control", "no-store")
+    token = request.app[ACCESS].token
+    if token is None:
+        return
+    response.headers["X-Frog-Console"] = console_id(token)
+    nonce = request.headers.get("X-Frog-Nonce", "")
+    body = response.body if isinstance(response, web.Response) else None
+    if nonce and len(nonce) <= MAX_NONCE and nonce.isascii() and isinstance(body, bytes):
+        response.headers["X-Frog-Proof"] = answer_proof(token, nonce, body)
 
 
 def snapshot(app: web.Application) -> dict[str, Any]:
     shown = app[SHOWN]
-    return state(app[EXECUTIVE], shown.day, shown.logs, shown.stop_clock)
+    token = app[ACCESS].token
+    return {
+        **state(app[EXECUTIVE], shown.day, shown.logs, shown.stop_clock),
+        "console": console_id(token) if token is not None else None,
+    }
 
 
 # ---------------------------------------------------------------- guard
@@ -221,15 +229,14 @@ def reads_open(access: Access, request: web.Request) -> bool:
 
 
 def token_refusal(access: Access, request: web.Request) -> web.Response | None:
-    """None when the request may go on; else the 401 or 429 to answer."""
-    address = request.remote or "?"
-    if not access.failures.allowed(address):
-        return refuse(429, "too many failed attempts from this address: wait a minute")
+    """None when the request may go on (the right token is never refused here, whatever
+    anyone's failures); else the 401, or the 429 of a failure over its budget."""
     if matches(bearer(request.headers.get("Authorization")), access.token):
         return None
     if request.path == "/api/stream" and access.tickets.spend(request.query.get("ticket", "")):
         return None
-    access.failures.failed(address)
+    if access.failures.failed(access.client(request)):
+        return refuse(429, "too many failed attempts: wait a minute")
     return refuse(
         401,
         "a valid token is needed (Authorization: Bearer TOKEN)"
@@ -400,7 +407,8 @@ async def post_command(request: web.Request) -> web.Response:
     alert_id = body.get("id", "")
     if command is Command.ACK_ALERT and (not isinstance(alert_id, str) or not alert_id):
         return refuse(400, 'ack_alert needs the alert\'s "id"')
-    if not request.app[ACCESS].limit.take():
+    access = request.app[ACCESS]
+    if not access.rates.take(access.client(request)):
         return refuse(429, "too many commands: wait a second")
     sender = "ctl" if request.headers.get("User-Agent", "").startswith(CTL_AGENT) else "console"
     answer = await request.app[EXECUTIVE].staff.submit(
@@ -411,67 +419,6 @@ async def post_command(request: web.Request) -> web.Response:
     if not answer.ok:
         return refuse(409, words)
     return web.json_response({"ok": True, "did": words})
-
-
-# ---------------------------------------------------------------- acknowledgement links
-
-
-def plain_page(status: int, title: str, text: str) -> web.Response:
-    """A small page of text: no script, no style, nothing fetched, never cached."""
-    body = (
-        '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">'
-        '<meta name="viewport" content="width=device-width">'
-        f"<title>{html.escape(title)}</title></head>\n<body><h1>{html.escape(title)}</h1>"
-        f"\n<p>{html.escape(text)}</p></body></html>\n"
-    )
-    return web.Response(
-        status=status,
-        text=body,
-        content_type="text/html",
-        headers={
-            "Content-Security-Policy": "default-src 'none'; frame-ancestors 'none'",
-            "X-Content-Type-Options": "nosniff",
-            "Cache-Control": "no-store",
-            "Referrer-Policy": "no-referrer",
-        },
-    )
-
-
-async def get_ack(request: web.Request) -> web.Response:
-    """``GET /ack/{alert_id}?exp=&sig=``: a signed link from a notification
-    (:mod:`~frog_bt.live.console.acklink`) acknowledges exactly its alert, through the
-    staff queue like ``ack_alert``. An expired, tampered or other alert's link: 403, and
-    nothing is acknowledged. Expiry is on the wall clock (the phone is)."""
-    access = request.app[ACCESS]
-    alert_id = request.match_info["alert_id"]
-    verdict = (
-        verify(
-            link_key(access.token),
-            alert_id,
-            request.query.get("exp", ""),
-            request.query.get("sig", ""),
-            time.time(),
-        )
-        if access.token is not None
-        else Verdict.BAD
-    )
-    if verdict is Verdict.EXPIRED:
-        return plain_page(
-            403,
-            "Link expired",
-            "This link has expired: nothing was acknowledged. Open the console to see the alerts.",
-        )
-    if verdict is not Verdict.VALID:
-        return plain_page(
-            403, "Not a valid link", "This link is not valid: nothing was acknowledged."
-        )
-    if not access.limit.take():
-        return plain_page(429, "Too many requests", "Wait a second, then open the link again.")
-    answer = await request.app[EXECUTIVE].staff.submit(Command.ACK_ALERT, alert_id, by="link")
-    request.app[PAGES].changed.set()
-    if not answer.ok:
-        return plain_page(409, "Nothing acknowledged", f"Not done: {answer.text}.")
-    return plain_page(200, "Acknowledged", f"Done: {answer.text}. Thank you.")
 
 
 ROUTES = [
@@ -485,7 +432,8 @@ ROUTES = [
     web.get("/api/stream", get_stream),
     web.post("/api/ticket", post_ticket),
     web.post("/api/command", post_command),
-    web.get("/ack/{alert_id}", get_ack, allow_head=False),  # HEAD acknowledges nothing
+    web.get("/ack/{alert_id}", get_ack, allow_head=False),  # shows; HEAD not even that
+    web.post("/ack/{alert_id}", post_ack),  # the page's one button acknowledges
 ]
 
 
@@ -533,11 +481,21 @@ def make_app(
         token,
         loopback,
         cfg.max_body,
-        RateLimit(cfg.commands_per_second),
+        Rates(cfg.commands_per_second),
         origins or Origins("127.0.0.1", executive.site.alerts.console_url),
+        proxies=networks(cfg.trusted_proxies),
     )
     app[SHOWN] = Shown(Day(), LogLines(owner=executive), StopClock())
     app[PAGES] = Pages(cfg.push_every)
+    access = app[ACCESS]
+    app[ACK_DESK] = AckDesk(
+        executive,
+        link_key(token) if token is not None else None,
+        access.failures,
+        access.rates,
+        access.client,
+        app[PAGES].changed.set,
+    )
     app[ASSETS] = load_assets()
     app.add_routes(ROUTES)
     app.cleanup_ctx.extend([log_lines, pusher])

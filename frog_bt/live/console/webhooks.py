@@ -298,11 +298,14 @@ class Webhooks:
             d.put(out)
 
     def link(self, alert: Alert, at: float) -> str:
-        """The signed link acknowledging ``alert`` ("" without a console URL or a token,
-        or once it is acknowledged)."""
+        """The signed link acknowledging this raise of ``alert`` on this robot ("" without
+        a console URL or a token, or once it is acknowledged)."""
         if self._key is None or alert.state == "acknowledged":
             return ""
-        return ack_link(self.cfg.console_url, self._key, alert.id, int(at + self.cfg.ack_link_ttl))
+        exp = int(at + self.cfg.ack_link_ttl)
+        return ack_link(
+            self.cfg.console_url, self._key, self.robot, alert.id, alert.occurrence, exp
+        )
 
     @property
     def pending(self) -> int:
