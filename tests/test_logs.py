@@ -17,9 +17,9 @@ def test_journal_lines_carry_their_level_as_a_syslog_prefix() -> None:
     assert fmt.format(record(logging.WARNING, "alert battery_low raised")) == (
         "<4>WARNING frog_bt.alerts: alert battery_low raised"
     )
-    assert fmt.format(record(logging.ERROR, "a\nb")).splitlines() == [
-        "<3>ERROR frog_bt.alerts: a",
-        "<3>b",
+    # a newline in a message (robot text) never makes a line of its own: it is escaped
+    assert fmt.format(record(logging.ERROR, "a\nb\x1b[2J")).splitlines() == [
+        "<3>ERROR frog_bt.alerts: a\\nb\\x1b[2J"
     ]
 
 

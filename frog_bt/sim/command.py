@@ -36,7 +36,8 @@ time just runs slower.
 Scenarios: --scenario takes a built-in name (default, morning, afternoon,
 bored, no_visitor, declines, wander_off, nav_failure, undock_failure, fault,
 silent_frontend; and where the robot asks a person for help: dock_fails,
-undock_fails, home_fails, fault_persists) or the path of a YAML file. Every key is
+undock_fails, home_fails, fault_persists; and where the robot's word is not to be
+taken as it comes: late_arrival, long_fault, out_of_order) or the path of a YAML file. Every key is
 optional; `extends: NAME|FILE` starts from another scenario. Times called `at`
 are seconds of simulated time after the start.
 
@@ -53,9 +54,13 @@ are seconds of simulated time after the start.
       failures:                   # 3 failed / 4 aborted after `after` s of driving
         - {goal: 2, result: aborted, after: 5}      # the 2nd goal of the run
         - {poi: POI2, times: 1, result: failed}     # the first goal to POI2a/b
+      late:                       # answers held back: they come after a newer goal
+        - {poi: POI2, delay: 2, duplicate: false}   # no poi: every goal's answers
     docking: {undock_time: 5, dock_time: 10, undock_failures: 0, dock_failures: 0}
     battery: {start: 90, drain_per_hour: 5, charge_per_hour: 20}
     faults: [{at: 600, name: motors, level: 2, message: overheated, duration: 60}]
+                                  # or on_arrival: POI2 (from the first arrival there);
+                                  # pad_to: 9216 repeats the message to that length
     visitors:
       - id: 7
         position: [103, 36]       # map frame

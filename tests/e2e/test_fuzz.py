@@ -40,7 +40,7 @@ from frog_bt.model.outcomes import TourState
 from frog_bt.model.wire import INPUTS
 
 LONG = os.environ.get("FROG_BT_FUZZ") == "long"
-EXAMPLES = 200 if LONG else 3
+EXAMPLES = 150 if LONG else 3
 TOPICS = {role: inp.name for role, inp in INPUTS.items()}
 SHOP = (95.89384, 17.22943)
 
@@ -220,7 +220,7 @@ async def _tour_with(injections: list[tuple[str, Any]]) -> list[str]:
     return problems
 
 
-@pytest.mark.timeout(900 if LONG else 240)
+@pytest.mark.timeout(3600 if LONG else 240)
 @settings(
     max_examples=EXAMPLES,
     deadline=None,
