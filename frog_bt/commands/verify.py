@@ -5,9 +5,12 @@ for a bounded number of ticks), the guards' inputs (battery, faults, operator co
 the front end's and visitors' answers) are chosen anew at every tick, and every state the
 tree can reach is visited, breadth first. The built-in properties (ends-well,
 home-obeyed, service-off-obeyed, pause-obeyed, no-content-while-driving,
-bounded-retries, no-dead-reads) and the tree file's own `properties:` are checked.
-Exit 0 when all hold; 1 with the shortest run that breaks each one that does not;
-2 when the tree or the configuration is invalid.
+bounded-retries, no-dead-reads) and the tree file's own `properties:` are checked, and
+for each, how often its trigger was reached (states paused, out of service, ...).
+Exit 0 when all hold; 1 with the shortest run that breaks each one that does not, or
+when one holds vacuously (no run reaches its trigger); 2 when the tree or the
+configuration is invalid, a leaf type declares no world interface, or a property of
+the tree file names a node the tree does not have.
 
 Examples:
 
