@@ -329,6 +329,10 @@ def test_a_property_whose_trigger_no_run_reaches_is_vacuous(
     assert ": root: bounded-retries: vacuous: " in capsys.readouterr().err
 
 
+INDENT = " " * 24  # of the leaves of a stop's content, in visit_poi.yaml
+FINISH = f"{INDENT}- {{type: FinishPoi"
+
+
 class Chime(Leaf):
     """A leaf verify knows nothing about: no world interface declared."""
 
@@ -343,8 +347,8 @@ def test_a_leaf_type_without_a_world_interface_is_an_error(tmp_path: Path) -> No
         {
             "visit_poi.yaml": [
                 (
-                    "                        - {type: FinishPoi",
-                    "                        - {type: Chime}\n                        - {type: FinishPoi",
+                    f"{INDENT}- {{type: FinishPoi",
+                    f"{INDENT}- {{type: Chime}}\n{INDENT}- {{type: FinishPoi",
                 )
             ]
         },
