@@ -6,8 +6,9 @@ found, one line each: `FILE:LINE:COLUMN: PATH: what was expected`, sorted by
 file and line. Then, when it is fast enough (a bounded number of states), it proves
 the tree as `frog-bt verify` does and lists each property that does not hold
 (`--no-verify` skips that), each at the node it concerns, `FILE:LINE:COLUMN: PATH:
-PROPERTY: what`, with its shortest run on the lines after. Exit 0 when both are valid
-and every property holds, 2 otherwise. No robot, no network: fast enough for an
+PROPERTY: what`, with its shortest run on the lines after, and each that holds only
+vacuously (no run reaches its trigger). Exit 0 when both are valid and every property
+holds, 2 otherwise. No robot, no network: fast enough for an
 editor's save hook.
 
 Examples:
@@ -56,20 +57,16 @@ def run(args: argparse.Namespace) -> int:
     nodes = sum(1 for _ in tree.nodes())
     proved = ""
     if not args.no_verify:
-        from frog_bt.verify import designer
         from frog_bt.verify.explore import TooBig
-        from frog_bt.verify.model import compile_tree
         from frog_bt.verify.prove import prove
-        from frog_bt.verify.report import finding
+        from frog_bt.verify.report import finding, vacuous_finding
 
         try:
-            props = designer.read_properties(tree.file) if tree.file.endswith("yaml") else []
-            errors = designer.check_names(tree.file, props, compile_tree(tree, site))
-            if errors:
-                for error in errors:
-                    print(error, file=sys.stderr)
-                return 2
-            verdict = prove(tree, site, props, limit=VERIFY_STATES)
+            verdict = prove(tree, site, limit=VERIFY_STATES)
+        except TreeErrors as exc:
+            for error in exc.errors:
+                print(error, file=sys.stderr)
+            return 2
         except DefinitionError as exc:
             print(exc, file=sys.stderr)
             return 2
@@ -78,7 +75,9 @@ def run(args: argparse.Namespace) -> int:
         else:
             for broken in verdict.broken:
                 print("\n".join(finding(verdict.model, broken)), file=sys.stderr)
-            if verdict.broken:
+            for name in verdict.vacuous:
+                print(vacuous_finding(verdict, name), file=sys.stderr)
+            if not verdict.ok:
                 return 2
             proved = f"; {len(verdict.checked)} properties hold"
     print(f"ok: {tree.file} ({nodes} nodes), {args.config or DEFAULT_CONFIG}{proved}")

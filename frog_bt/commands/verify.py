@@ -5,15 +5,22 @@ for a bounded number of ticks), the guards' inputs (battery, faults, operator co
 the front end's and visitors' answers) are chosen anew at every tick, and every state the
 tree can reach is visited, breadth first. The built-in properties (ends-well,
 home-obeyed, service-off-obeyed, pause-obeyed, no-content-while-driving,
-bounded-retries, no-dead-reads) and the tree file's own `properties:` are checked.
-Exit 0 when all hold; 1 with the shortest run that breaks each one that does not;
-2 when the tree or the configuration is invalid.
+bounded-retries, no-dead-reads) and the tree file's own `properties:` are checked, and
+for each, how often its trigger was reached (states paused, out of service, ...).
+Exit 0 when all hold; 1 with the shortest run that breaks each one that does not, or
+when one holds vacuously (no run reaches its trigger); 2 when the tree or the
+configuration is invalid, a leaf type declares no world interface, or a property of
+the tree file names a node the tree does not have. `--conformance` replays recordings
+on the tree and checks that every step they took (which nodes run, tick by tick) is one
+the exploration has; the first step outside, per recording, is named with its tick and
+node, and the exit is 1.
 
 Examples:
 
   frog-bt verify                                 the packaged tour and site
   frog-bt verify trees/tour.yaml --format mermaid
   frog-bt verify --coverage recordings/          and the share a season reached
+  frog-bt verify --conformance recordings/       every recorded step one it explores
 """
 
 from __future__ import annotations
@@ -27,7 +34,7 @@ from frog_bt.config import Site
 from frog_bt.engine.loaded import LoadedTree
 from frog_bt.errors import DefinitionError, TreeErrors, UsageError
 from frog_bt.verify.explore import Graph, TooBig
-from frog_bt.verify.prove import prove
+from frog_bt.verify.prove import Verdict, prove
 from frog_bt.verify.report import broken_text, summary
 
 
@@ -37,6 +44,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--format",
         choices=("mermaid", "dot"),
         help="draw the tree with the nodes of each broken run marked",
+    )
+    p.add_argument(
+        "--conformance",
+        type=Path,
+        nargs="+",
+        metavar="FILE_OR_DIR",
+        help="recordings: replay each on the tree and check every step is one it explores",
     )
     p.add_argument(
         "--coverage",
@@ -65,11 +79,45 @@ def run(args: argparse.Namespace) -> int:
         return 2
     if args.coverage is not None:
         print(season_share(verdict.graph, args.coverage, site, tree))
+    conforms = True
+    if args.conformance:
+        conforms = conformance_lines(verdict, args.conformance, site, tree)
     if verdict.ok:
         print(summary(verdict))
-        return 0
+        return 0 if conforms else 1
     print(broken_text(verdict, args.format))
     return 1
+
+
+def conformance_lines(verdict: Verdict, paths: list[Path], site: Site, tree: LoadedTree) -> bool:
+    """Replay the recordings under ``paths`` on ``tree`` (freshly built for each) and
+    print each that took a step the exploration does not allow, then one summary line;
+    whether every recording conformed."""
+    from frog_bt.offline.conformance import conformance
+    from frog_bt.offline.corpus import recordings
+
+    def fresh() -> LoadedTree:
+        reload = getattr(tree.factory, "load", None)
+        if reload is not None:
+            return reload(tree.file, site)  # type: ignore[no-any-return]
+        from frog_bt.behaviours import load_tree
+
+        return load_tree(tree.file, site)
+
+    def unreadable(path: Path, why: str) -> None:
+        print(f"frog-bt: {path}: {why}", file=sys.stderr)
+
+    files, outside = conformance(
+        verdict.graph, verdict.model, site, fresh, recordings(paths), unreadable
+    )
+    for step in outside:
+        print(step.line())
+    print(
+        f"conformance: {files - len(outside)} of {files} recordings took only steps the "
+        "explorer allows"
+        + (f"; {len(outside)} left the model (the world model missed them)" if outside else "")
+    )
+    return not outside and files > 0
 
 
 def season_share(graph: Graph, directory: Path, site: Site, tree: LoadedTree) -> str:

@@ -257,6 +257,14 @@ def wait_event(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, in
     return STATUS[t.choose(n, "outcome", choices)], 0
 
 
+def at_poi(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+    """AtPoi: a robot on its charger is at the dock's waypoint; anywhere else, where it
+    is (by /pose) is the robot's: at the POI or not."""
+    if t.world[DOCKED] and n.params.get("poi") == n.dock:
+        return SUCCESS, 0
+    return STATUS[t.choose(n, "outcome", [(S, By.ROBOT), (F, By.ROBOT)])], 0
+
+
 def skip_stop(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
     t.world[SKIPPED] = n.params.get("poi")
     return SUCCESS, 0
@@ -279,6 +287,7 @@ TABLE: dict[str, Abstraction] = {
     "Navigate": Abstraction((R, S, F), role=Role.DRIVE, rule=goal, first=(R,)),
     "ApproachVisitor": Abstraction((R, S, F), role=Role.APPROACH, rule=goal, first=(R,)),
     "Docking": Abstraction((R, S, F), rule=docking, first=(R,)),
+    "AtPoi": Abstraction((S, F), rule=at_poi),
     "SkipStop": Abstraction(rule=skip_stop),
     "Skipped": Abstraction(rule=skipped),
     "SeekVisitor": Abstraction((R, S), W, None),

@@ -22,6 +22,7 @@ from frog_bt.errors import TreeError
 from frog_bt.verify.explore import Graph
 from frog_bt.verify.graph import Run, monitor
 from frog_bt.verify.model import Model
+from frog_bt.verify.properties import Trigger
 from frog_bt.yamlfile import load_yaml_marked, validate
 
 Name = Annotated[str, Field(min_length=1)]
@@ -107,6 +108,24 @@ def check(prop: Property, graph: Graph, model: Model) -> Run | None:
     if isinstance(prop, Reaches):
         return _reaches(prop, graph, model)
     return _between(prop, graph, model)
+
+
+def trigger(prop: Property, graph: Graph, model: Model) -> Trigger:
+    """How often ``prop``'s trigger was reached: the states in which the rarer of its two
+    nodes runs (together), or the ticks its first node starts (reaches, between)."""
+    if isinstance(prop, Together):
+        counts = []
+        for name in prop.never:
+            ids = _ids(model, name)
+            counts.append(
+                (sum(1 for nodes, _ in graph.states if any(nodes[i] > 0 for i in ids)), name)
+            )
+        count, name = min(counts)
+        return Trigger(count, f"states in which {name!r} runs")
+    first = prop.after if isinstance(prop, Reaches) else prop.between[0]
+    ids = _ids(model, first)
+    starts = sum(1 for _, _, step in graph.each() if _starts(step, ids) is not None)
+    return Trigger(starts, f"ticks in which {first!r} starts")
 
 
 def _ids(model: Model, name: str) -> set[int]:

@@ -18,6 +18,7 @@ import py_trees
 
 from frog_bt.config import Site
 from frog_bt.engine.loaded import LoadedTree
+from frog_bt.errors import TreeError
 from frog_bt.model import keys
 from frog_bt.model.key import Scope
 from frog_bt.tree.composites import Parallel, Selector, Sequence
@@ -89,8 +90,28 @@ class Model:
         return [n for n in self.nodes if n.name == name]
 
     def undeclared(self) -> list[str]:
-        """Leaf types with no abstraction (they run once, then succeed or fail)."""
+        """Leaf types with no declared world interface (no abstraction)."""
         return sorted({n.type_name for n in self.nodes if not n.declared})
+
+    def undeclared_errors(self) -> list[TreeError]:
+        """One error per leaf type with no declared world interface, at its first node:
+        verify cannot say what such a leaf may do, so it proves nothing about the tree."""
+        first: dict[str, CNode] = {}
+        for n in self.nodes:
+            if not n.declared:
+                first.setdefault(n.type_name, n)
+        errors = []
+        for type_name, n in first.items():
+            at = self.tree.where.get(id(n.behaviour))
+            errors.append(
+                TreeError(
+                    at.file if at else self.tree.file,
+                    at.path if at else (),
+                    f"leaf type {type_name} declares no world interface for verify "
+                    "(a `verify` Abstraction on its class)",
+                )
+            )
+        return errors
 
 
 def _kind(node: Behaviour) -> Kind:

@@ -255,3 +255,51 @@ def check_builtin(graph: Graph, model: Model, safety: Safety) -> dict[str, list[
                 runs[name].append(found)
     runs["no-dead-reads"] = no_dead_reads(graph, model)
     return {name: [Broken(name, MEANING[name], r) for r in rs] for name, rs in runs.items()}
+
+
+@dataclass(frozen=True, slots=True)
+class Trigger:
+    """How often a property's trigger was reached in the explored graph: ``count`` of
+    ``what`` (states that saw a pause, retries, ...). Never reached: the property holds
+    only because nothing ever asked it to, and verify says it is vacuous."""
+
+    count: int
+    what: str
+
+    @property
+    def vacuous(self) -> bool:
+        return self.count == 0
+
+
+def builtin_triggers(graph: Graph, model: Model) -> dict[str, Trigger]:
+    """Each built-in property's trigger, counted over the explored states and ticks."""
+    started = paused = home = out_of_service = driving = 0
+    drives = [n.index for n in model.nodes if n.role is Role.DRIVE]
+    for nodes, world in graph.states:
+        started += bool(world[STARTED])
+        paused += bool(world[PAUSED])
+        home += bool(world[HOME])
+        out_of_service += not world[IN_SERVICE]
+        driving += any(nodes[i] > 0 and (nodes[i] - 1) & 1 for i in drives)
+    retries = 0
+    ticked: set[int] = set()
+    for _, _, step in graph.each():
+        retries += sum(kind is Event.RETRY for kind, _, _ in step.events)
+        ticked.update(i for i, _ in step.ticked)
+    declared = by_name()
+    reads = sum(
+        1
+        for n in model.nodes
+        if n.index in ticked
+        for name in n.reads
+        if (key := declared.get(name)) is not None and key.source is Source.LEAF
+    )
+    return {
+        "ends-well": Trigger(started, "states with a tour under way"),
+        "home-obeyed": Trigger(home, "states after home"),
+        "service-off-obeyed": Trigger(out_of_service, "states out of service (service_off)"),
+        "pause-obeyed": Trigger(paused, "states paused"),
+        "no-content-while-driving": Trigger(driving, "states with a drive under way"),
+        "bounded-retries": Trigger(retries, "retries"),
+        "no-dead-reads": Trigger(reads, "reads of keys the tree writes, by nodes that run"),
+    }

@@ -1,4 +1,5 @@
-"""Prove a loaded tree: explore it, check every built-in property and the designer's."""
+"""Prove a loaded tree: explore it, check every built-in property and the designer's,
+and count how often each property's trigger was reached (never: vacuous)."""
 
 from __future__ import annotations
 
@@ -6,10 +7,18 @@ from dataclasses import dataclass, field
 
 from frog_bt.config import Site
 from frog_bt.engine.loaded import LoadedTree
+from frog_bt.errors import TreeErrors
 from frog_bt.verify import designer
 from frog_bt.verify.explore import MAX_STATES, Graph, explore
 from frog_bt.verify.model import Model, compile_tree
-from frog_bt.verify.properties import BUILT_IN, Broken, Safety, check_builtin
+from frog_bt.verify.properties import (
+    BUILT_IN,
+    Broken,
+    Safety,
+    Trigger,
+    builtin_triggers,
+    check_builtin,
+)
 
 
 @dataclass(slots=True)
@@ -18,10 +27,22 @@ class Verdict:
     graph: Graph
     checked: list[str]  # every property checked, by name or title
     broken: list[Broken] = field(default_factory=list)
+    triggers: dict[str, Trigger] = field(default_factory=dict)  # by name or title
+    nodes: dict[str, int] = field(default_factory=dict)  # a designer property: its node
+
+    @property
+    def vacuous(self) -> list[str]:
+        """The properties checked whose trigger no explored run reached."""
+        return [name for name in self.checked if self.triggers[name].vacuous]
+
+    @property
+    def held(self) -> int:
+        """Properties that hold, and not vacuously."""
+        return len(set(self.checked) - {b.name for b in self.broken} - set(self.vacuous))
 
     @property
     def ok(self) -> bool:
-        return not self.broken
+        return not self.broken and not self.vacuous
 
 
 def prove(
@@ -32,19 +53,28 @@ def prove(
     limit: int = MAX_STATES,
 ) -> Verdict:
     """Explore ``tree`` and check the built-in properties (``only`` those, if given) and
-    ``properties`` (default: the tree file's own). Raises TooBig past ``limit`` states."""
+    ``properties`` (default: the tree file's own). Raises TreeErrors, before exploring,
+    for a leaf type with no declared world interface and a property naming a node the
+    tree does not have; TooBig past ``limit`` states."""
     model = compile_tree(tree, site)
-    safety = Safety(model)
-    graph = explore(model, safety, limit)
     if properties is None:
         properties = designer.read_properties(tree.file) if tree.file.endswith("yaml") else []
+    errors = [*model.undeclared_errors(), *designer.check_names(tree.file, properties, model)]
+    if errors:
+        raise TreeErrors(errors)
+    safety = Safety(model)
+    graph = explore(model, safety, limit)
     broken_builtin = check_builtin(graph, model, safety)
     names = [n for n in BUILT_IN if not only or n in only]
     verdict = Verdict(model, graph, [*names, *(p.title() for p in properties)])
+    triggers = builtin_triggers(graph, model)
     for name in names:
         verdict.broken += broken_builtin[name]
+        verdict.triggers[name] = triggers[name]
     for prop in properties:
         run = designer.check(prop, graph, model)
         if run is not None:
             verdict.broken.append(Broken(prop.title(), "the tree file's own property", run))
+        verdict.triggers[prop.title()] = designer.trigger(prop, graph, model)
+        verdict.nodes[prop.title()] = min(n.index for n in model.named(prop.names()[0]))
     return verdict

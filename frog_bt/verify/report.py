@@ -18,11 +18,38 @@ from frog_bt.verify.world import By, Event
 
 
 def summary(verdict: Verdict) -> str:
+    """The summary line, then per property how often its trigger was reached."""
     g = verdict.graph
-    held = len(verdict.checked) - len({b.name for b in verdict.broken})
+    return "\n".join(
+        [
+            f"verified: {len(g.states)} states, {g.transitions} transitions, "
+            f"{verdict.held} properties hold ({g.seconds:.1f} s)",
+            *trigger_lines(verdict),
+        ]
+    )
+
+
+def trigger_lines(verdict: Verdict) -> list[str]:
+    """``  property: triggered by N what`` per property checked."""
+    return [
+        f"  {name}: triggered by {t.count} {t.what}"
+        for name in verdict.checked
+        if (t := verdict.triggers.get(name)) is not None
+    ]
+
+
+def vacuous_finding(verdict: Verdict, name: str) -> str:
+    """``file:line:column: path: property: vacuous: ...`` at the node a designer's
+    property names first, at the root of the tree file for a built-in one."""
+    tree = verdict.model.tree
+    index = verdict.nodes.get(name)
+    behaviour = tree.root if index is None else verdict.model.nodes[index].behaviour
+    at = tree.where.get(id(behaviour)) or tree.where.get(id(tree.root)) or Where(tree.file, ())
+    place = f"{at.file}:{at.line[0]}:{at.line[1]}" if at.line else at.file
+    trigger = verdict.triggers[name]
     return (
-        f"verified: {len(g.states)} states, {g.transitions} transitions, "
-        f"{held} properties hold ({g.seconds:.1f} s)"
+        f"{place}: {format_path(at.path)}: {name}: vacuous: no run reaches its trigger "
+        f"(0 {trigger.what}), so it holds without being tested"
     )
 
 
@@ -94,12 +121,14 @@ def broken_text(verdict: Verdict, fmt: str | None = None) -> str:
         lines += finding(verdict.model, b)
         if fmt:
             lines.append(draw(verdict.model, run_nodes(b.run), b.run.nodes, fmt))
-    held = len(verdict.checked) - len({b.name for b in verdict.broken})
+    lines += [vacuous_finding(verdict, name) for name in verdict.vacuous]
     g = verdict.graph
     lines.append(
-        f"{len({b.name for b in verdict.broken})} properties broken, {held} hold "
+        f"{len({b.name for b in verdict.broken})} properties broken, "
+        f"{len(verdict.vacuous)} vacuous, {verdict.held} hold "
         f"({len(g.states)} states, {g.transitions} transitions)"
     )
+    lines += trigger_lines(verdict)
     return "\n".join(lines)
 
 

@@ -8,7 +8,15 @@ from pathlib import Path
 
 import pytest
 
+from frog_bt.behaviours import visit
+from frog_bt.behaviours.registry import DECORATOR_TYPES, LEAF_TYPES
 from frog_bt.cli import main
+from frog_bt.config import load_site
+from frog_bt.offline.conformance import conformance
+from frog_bt.tree.factory import NodeFactory
+from frog_bt.verify.abstraction import Abstraction, S, content
+from frog_bt.verify.prove import prove
+from frog_bt.verify.world import Role
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "recording"))
 
@@ -57,3 +65,41 @@ def test_verify_says_which_share_of_the_explored_states_a_season_reached(
     got, explored = (int(n) for n in line.split("reached ")[1].split(" explored")[0].split(" of "))
     assert 10 < got < explored  # one happy tour: many states, far from all
     assert "transitions" in line and "states outside the model" not in line
+
+    # conformance: every step the recorded tour took is one the explorer allows...
+    assert main(["verify", "--conformance", str(tmp_path / "season")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "conformance: 1 of 1 recordings took only steps the explorer allows"
+    assert out[1].startswith("verified: ")
+
+    # ...and a recording the world model does not allow is named, with its tick and node:
+    # here the model says a stop's content ends in the tick it starts (it plays for
+    # seconds, over many ticks, on the robot)
+    factory = NodeFactory(
+        [*(c for c in LEAF_TYPES if c.__name__ != "PlayContent"), PlayContent], DECORATOR_TYPES
+    )
+    site = load_site(None)
+    tree = factory.load(None, site)
+    v = prove(tree, site)
+    files, outside = conformance(
+        v.graph,
+        v.model,
+        site,
+        lambda: factory.load(None, site),
+        [recorded.path],
+        lambda path, why: pytest.fail(why),
+    )
+    assert files == 1
+    (step,) = outside
+    assert step.recording == recorded.path and step.tick > 1
+    assert step.node == "PlayContent 'PlayContent POI1 a'" and step.what == "running"
+    assert step.line() == (
+        f"{recorded.path}: tick {step.tick}: PlayContent 'PlayContent POI1 a' running: "
+        "a step the explored model does not allow"
+    )
+
+
+class PlayContent(visit.PlayContent):
+    """PlayContent as a wrong world model sees it: over in the tick it starts."""
+
+    verify = Abstraction((S,), role=Role.CONTENT, rule=content)

@@ -13,6 +13,7 @@ from frog_bt.behaviours.navigation import Navigate
 from frog_bt.behaviours.recruit import ApproachVisitor, AskTour
 from frog_bt.behaviours.registry import DECORATOR_TYPES, LEAF_TYPES
 from frog_bt.cli import main
+from frog_bt.errors import TreeErrors
 from frog_bt.model import keys
 from frog_bt.model.frontend import AskTour as AskTourCommand
 from frog_bt.tree.factory import NodeFactory
@@ -33,6 +34,11 @@ def test_the_shipped_tree_holds_every_property(capsys: pytest.CaptureFixture[str
     assert main(["verify"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("verified: ") and "7 properties hold" in out
+    # each property's trigger was reached, and how often is said
+    counts = dict(re.findall(r"^  ([a-z-]+): triggered by (\d+) ", out, re.MULTILINE))
+    assert set(counts) == set(BUILT_IN) and all(int(n) > 0 for n in counts.values())
+    assert int(counts["pause-obeyed"]) == v.triggers["pause-obeyed"].count
+    assert "states out of service (service_off)" in out
 
 
 OLD_READY = """                    - type: Sequence
@@ -276,6 +282,85 @@ properties:
     tour.write_text(tour.read_text() + "  - {never: [No such node, Undock], together: true}\n")
     assert main(["check", str(tour)]) == 2
     assert "no node named 'No such node' in the tree" in capsys.readouterr().err
+    # verify as check: exit 2, one line per unknown name, at the property
+    assert main(["verify", str(tour)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1, err
+    assert re.fullmatch(
+        rf"{re.escape(str(tour))}:\d+:\d+: properties\[3\]: no node named 'No such node' in "
+        "the tree",
+        err[0],
+    )
+
+
+def test_a_property_whose_trigger_no_run_reaches_is_vacuous(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A designer's property about a node that never starts, and the built-ins of a tree
+    with no tour: each is named vacuous, and verify exits 1."""
+    tour = copy(tmp_path, {})
+    # ClearAbort ends in the tick it starts: no state has it running
+    tour.write_text(
+        tour.read_text()
+        + "properties:\n  - {never: [ClearAbort, Docking undock], together: true}\n"
+    )
+    v = verdict(tour)
+    title = "never 'ClearAbort' and 'Docking undock' together"
+    assert v.vacuous == [title] and not v.broken and not v.ok
+    assert main(["verify", str(tour)]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert re.fullmatch(
+        rf".*/tour\.yaml:\d+:\d+: root\..*: {re.escape(title)}: vacuous: no run reaches its "
+        r"trigger \(0 states in which 'ClearAbort' runs\), .*",
+        out[0],
+    ), out[0]
+    assert out[1] == "0 properties broken, 1 vacuous, 7 hold (" + out[1].split("(")[1]
+
+    idle = tmp_path / "idle.yaml"
+    idle.write_text(
+        "root:\n  type: Sequence\n  memory: false\n  children:\n"
+        "    - {type: WaitInService}\n    - {type: WaitFrontendIdle}\n"
+    )
+    assert main(["verify", str(idle)]) == 1
+    out = capsys.readouterr().out
+    assert f"{idle}:2:3: root: pause-obeyed: vacuous: no run reaches its trigger (0 states " in out
+    assert "  service-off-obeyed: triggered by 1 states out of service" in out
+    assert main(["check", str(idle)]) == 2
+    assert ": root: bounded-retries: vacuous: " in capsys.readouterr().err
+
+
+INDENT = " " * 24  # of the leaves of a stop's content, in visit_poi.yaml
+FINISH = f"{INDENT}- {{type: FinishPoi"
+
+
+class Chime(Leaf):
+    """A leaf verify knows nothing about: no world interface declared."""
+
+    def update(self) -> Status:
+        return SUCCESS
+
+
+def test_a_leaf_type_without_a_world_interface_is_an_error(tmp_path: Path) -> None:
+    factory = NodeFactory([*LEAF_TYPES, Chime], DECORATOR_TYPES)
+    tour = copy(
+        tmp_path,
+        {
+            "visit_poi.yaml": [
+                (
+                    f"{INDENT}- {{type: FinishPoi",
+                    f"{INDENT}- {{type: Chime}}\n{INDENT}- {{type: FinishPoi",
+                )
+            ]
+        },
+    )
+    with pytest.raises(TreeErrors) as raised:
+        verdict(tour, factory)
+    (error,) = raised.value.errors  # one line for the type, though every stop has one
+    assert re.fullmatch(
+        r".*/visit_poi\.yaml:\d+:\d+: root\..*: leaf type Chime declares no world interface "
+        r"for verify \(a `verify` Abstraction on its class\)",
+        str(error),
+    ), str(error)
 
 
 def test_a_finding_about_no_node_is_at_the_root_of_the_tree_file() -> None:
