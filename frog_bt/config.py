@@ -16,7 +16,14 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 from urllib.parse import urlsplit
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    field_validator,
+    model_validator,
+)
 
 from frog_bt import resources
 from frog_bt.errors import ConfigError, UsageError
@@ -28,6 +35,7 @@ from frog_bt.model.wire import (
     INPUTS,
     OUTPUTS,
 )
+from frog_bt.text import inert, is_inert
 from frog_bt.yamlfile import PathError, load_yaml, validate
 
 DEFAULT_CONFIG = resources.site_dir() / resources.SITE_FILE
@@ -35,6 +43,20 @@ DEFAULT_CONFIG = resources.site_dir() / resources.SITE_FILE
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+
+def _plain_text(value: str) -> str:
+    if len(value) > 200 or not is_inert(value):
+        raise ValueError(
+            "expected a line of plain text of at most 200 characters, without control "
+            f"characters, got {inert(value, 40)!r}"
+        )
+    return value
+
+
+# Words staff or visitors read (a stop's name, a zone, a spot): a line of plain text, no
+# control or format characters (frog_bt.text), at most 200 characters
+Text = Annotated[str, AfterValidator(_plain_text)]
 
 WAYPOINT_TOLERANCE = 1e-3  # metres and quaternion units: a goal names a POI within it
 
@@ -48,11 +70,11 @@ class Poi(_Model):
     y: Finite
     z: Finite
     w: Finite
-    name: str = ""
+    name: Text = ""
     # the name in a language staff may read (es: Patio de la Montería), used when it is
     # the site's `language`; `name` otherwise
-    names: dict[Literal["en", "es"], str] = {}
-    note: str = ""
+    names: dict[Literal["en", "es"], Text] = {}
+    note: Text = ""
 
     @model_validator(mode="after")
     def _unit_quaternion(self) -> Poi:
@@ -166,7 +188,7 @@ class ZoneShape(_Model):
 
 
 class VolumeZone(ZoneShape):
-    name: str
+    name: Text
     percent: int = Field(ge=0, le=100)
 
 
@@ -177,7 +199,7 @@ class Volume(_Model):
 
 
 class SpecialSpot(ZoneShape):
-    spot: str
+    spot: Text
 
 
 class Zones(_Model):

@@ -73,3 +73,20 @@ def test_a_log_line_is_one_line_whatever_it_quotes():
         logger.removeHandler(handler)
     lines = stream.getvalue().splitlines()
     assert len(lines) == 1 and "\x1b" not in lines[0] and "\\nWARNING" in lines[0]
+
+
+def test_words_staff_read_in_the_site_config_are_plain_text(tmp_path):
+    import pytest
+
+    from frog_bt.config import load_site
+    from frog_bt.errors import ConfigError
+    from frog_bt.resources import site_dir
+
+    text = (site_dir() / "site.yaml").read_text()
+    bad = tmp_path / "site.yaml"
+    bad.write_text(text.replace("names: {es: Tienda}", 'names: {es: "Tienda\\e]0;x\\a"}'))
+    with pytest.raises(ConfigError) as caught:
+        load_site(bad)
+    message = str(caught.value)
+    assert "pois.SHOP.names.es: expected a line of plain text" in message
+    assert is_inert(message)
