@@ -130,6 +130,8 @@ class Navigation(_Model):
     # metres: an "arrived" is believed only this near its goal (by /FROG_pose), and
     # `dock` is sent only this near the dock's waypoint
     tolerance: Positive = 2.0
+    # seconds: an arrival heard before a pose shows it is believed if one does this soon
+    pose_grace: NonNegative = 2.0
 
 
 class DockingCfg(_Model):

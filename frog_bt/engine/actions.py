@@ -26,10 +26,10 @@ from dataclasses import replace
 
 from frog_bt.clock import Clock
 from frog_bt.config import Poi
-from frog_bt.engine.belief import Judgement, Verdict, World, judge
+from frog_bt.engine.belief import Judgement, Verdict, World, distance, judge
 from frog_bt.model.goals import Goal
 from frog_bt.model.ros import Pose
-from frog_bt.model.wire import ACTIVE, Response
+from frog_bt.model.wire import ACTIVE, SUCCEEDED, Response
 
 log = logging.getLogger(__name__)
 
@@ -60,6 +60,8 @@ class Actions:
         self.before: Goal | None = None
         self.stale_responses = 0
         self.doubted = 0  # answers not believed (stale by order, or not what the world shows)
+        # an arrival heard before a pose that shows it: (goal id, when, poses by then)
+        self.unconfirmed: tuple[int, float, int] | None = None
         self.last_approach_at = -math.inf  # project-clock time of the last approach sent
 
     def goto(self, waypoint: str, poi: Poi) -> Goal:
@@ -132,12 +134,40 @@ class Actions:
                     self.stale_responses += 1
                     if self.before is not None and code != ACTIVE:
                         self.before = None  # the one answer it was still owed has come
+                elif goal.kind == "goto" and code == SUCCEEDED:  # a later pose may show it
+                    self.unconfirmed = (goal.id, at, world.poses_at_answer)
                 if self.on_doubt is not None:
                     self.on_doubt(code, goal, judgement)
                 return None
+        return self._answered(goal, known, at)
+
+    def confirm(self, world: World, grace: float) -> Goal | None:
+        """An arrival not believed for want of a pose that shows it, believed now that one
+        does: a pose received after the answer, within ``grace`` seconds of it, within
+        the tolerance of the goal (a robot may publish the answer before the pose). The
+        goal it ends, or None."""
+        pending, unconfirmed = self.pending, self.unconfirmed
+        if unconfirmed is None:
+            return None
+        goal_id, at, poses = unconfirmed
+        if pending is None or pending.id != goal_id or world.now - at > grace:
+            self.unconfirmed = None
+            return None
+        pose = world.pose
+        if pose is None or world.poses_at_answer <= poses:
+            return None
+        if distance(pose.value, pending) > world.tolerance:
+            return None
+        self.unconfirmed = None
+        log.info("arrival at %s believed: the pose shows it", pending.target)
+        return self._answered(pending, SUCCEEDED, at)
+
+    def _answered(self, goal: Goal, known: Response, at: float) -> Goal:
+        """``goal`` with its answer ``known`` believed."""
         goal = replace(goal, code=known, answered_at=at, acknowledged=True)
         if known.terminal:  # this goal's end: an older goal's answer is no more due
             self.before = None
+            self.unconfirmed = None
         self.pending = None if goal.done else goal
         if self.latest is not None and self.latest.id == goal.id:
             self.latest = goal

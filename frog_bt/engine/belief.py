@@ -15,7 +15,10 @@ the robot also says (STYLE: "Believe only what fits"):
   ``navigation.tolerance`` metres of the goal; an approach's success only while the
   visitor is still seen (camera detections fresher than ``recruit.detection_max_age``).
   An answer that does not fit is *doubted*: not acted on, and the goal waits on for the
-  next answer or its own timeout.
+  next answer or its own timeout; an arrival is still believed if a pose received after
+  it, within ``navigation.pose_grace`` seconds, shows the robot there
+  (:meth:`~frog_bt.engine.actions.Actions.confirm`: a robot may publish "arrived" just
+  before its last pose).
 
 :func:`judge` is pure: a goal, a code and what the robot said besides, in; a
 :class:`Judgement` out. :class:`~frog_bt.engine.actions.Actions` applies it; every answer

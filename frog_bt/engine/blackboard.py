@@ -109,13 +109,14 @@ class Snapshot:
         inputs: Inputs,
         clock: Clock,
         actions: Actions,
-        believe: tuple[float, float] | None = None,
+        believe: tuple[float, float, float] | None = None,
     ) -> None:
         self.board = board
         self.inputs = inputs
         self.clock = clock
         self.actions = actions
-        # (navigation.tolerance, recruit.detection_max_age): judge the robot's answers
+        # (navigation.tolerance, recruit.detection_max_age, navigation.pose_grace): judge
+        # the robot's answers
         self.believe = believe
         events = board.get(keys.EVENTS)  # the executive's, kept across trees
         self.events = events if events is not None else EventLog()
@@ -151,4 +152,14 @@ class Snapshot:
                     detection_max_age=believe[1],
                 )
             self.actions.on_response(code, at, world)
+        if believe is not None and self.actions.unconfirmed is not None:
+            world = World(
+                now=board.get(keys.NOW) or 0.0,
+                pose=board.get(keys.POSE),
+                persons=board.get(keys.PERSONS),
+                poses_at_answer=self.inputs.poses,
+                tolerance=believe[0],
+                detection_max_age=believe[1],
+            )
+            self.actions.confirm(world, believe[2])
         set_(keys.GOAL, self.actions.latest)

@@ -103,7 +103,11 @@ class Core:
             self.inputs,
             clock,
             self.actions,
-            believe=(site.navigation.tolerance, site.recruit.detection_max_age),
+            believe=(
+                site.navigation.tolerance,
+                site.recruit.detection_max_age,
+                site.navigation.pose_grace,
+            ),
         )
         self.root = tree.root
         self.stops = [

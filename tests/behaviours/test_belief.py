@@ -116,6 +116,34 @@ def test_an_arrival_with_no_pose_is_not_believed_and_the_timeout_decides(tmp_pat
     assert bench.tick() == FAILURE
 
 
+def test_an_arrival_heard_just_before_the_pose_that_shows_it_is_believed(tmp_path):
+    # a robot may publish "arrived" before its last pose: within navigation.pose_grace
+    bench = Bench(write_tree(tmp_path, NAVIGATE_POI2))
+    seen = doubts(bench)
+    bench.tick()
+    bench.ros("response", 1)
+    bench.at("POI1a")
+    bench.ros("response", 2)
+    assert bench.tick() == RUNNING
+    assert seen[0].why == "arrival at POI2a heard 26 m from it: not believed"
+    bench.advance(1.5)
+    bench.at("POI2a")
+    assert bench.tick() == SUCCESS
+
+
+def test_a_pose_that_shows_the_arrival_too_late_does_not_confirm_it(tmp_path):
+    bench = Bench(write_tree(tmp_path, NAVIGATE_POI2))
+    bench.tick()
+    bench.ros("response", 1)
+    bench.at("POI1a")
+    bench.ros("response", 2)
+    bench.tick()
+    bench.advance(2.5)  # past navigation.pose_grace (2 s)
+    bench.at("POI2a")
+    assert bench.tick() == RUNNING
+    assert bench.core.actions.unconfirmed is None
+
+
 def test_an_immediate_refusal_of_a_first_goal_is_believed(tmp_path):
     # nothing open before it: a 4 at once is this goal's refusal (a robot on its charger)
     bench = Bench(write_tree(tmp_path, NAVIGATE_POI2))
