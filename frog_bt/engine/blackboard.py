@@ -139,27 +139,26 @@ class Snapshot:
                     set_(keys.FRONTEND_READY, True)
             inp.events.clear()
         set_(keys.EVENTS, self.events)
-        board, believe = self.board, self.believe
-        for code, at, poses in board.get(keys.RESPONSES) or ():
-            world = None
-            if believe is not None:
-                world = World(
-                    now=board.get(keys.NOW) or at,
-                    pose=board.get(keys.POSE),
-                    persons=board.get(keys.PERSONS),
-                    poses_at_answer=poses,
-                    tolerance=believe[0],
-                    detection_max_age=believe[1],
-                )
-            self.actions.on_response(code, at, world)
-        if believe is not None and self.actions.unconfirmed is not None:
-            world = World(
-                now=board.get(keys.NOW) or 0.0,
-                pose=board.get(keys.POSE),
-                persons=board.get(keys.PERSONS),
-                poses_at_answer=self.inputs.poses,
-                tolerance=believe[0],
-                detection_max_age=believe[1],
-            )
-            self.actions.confirm(world, believe[2])
+        actions, believe = self.actions, self.believe
+        for code, at, poses in self.board.get(keys.RESPONSES) or ():
+            actions.on_response(code, at, self._world(poses))
+        if believe is not None and actions.unconfirmed is not None:
+            world = self._world(self.inputs.poses)
+            assert world is not None
+            actions.confirm(world, believe[2])
         set_(keys.GOAL, self.actions.latest)
+
+    def _world(self, poses: int) -> World | None:
+        """What the robot says besides its answers, as the judge sees it (None: answers
+        are not judged), ``poses`` the poses received before the answer."""
+        believe, board = self.believe, self.board
+        if believe is None:
+            return None
+        return World(
+            now=board.get(keys.NOW) or 0.0,
+            pose=board.get(keys.POSE),
+            persons=board.get(keys.PERSONS),
+            poses_at_answer=poses,
+            tolerance=believe[0],
+            detection_max_age=believe[1],
+        )
