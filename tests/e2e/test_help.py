@@ -12,8 +12,10 @@ from tour import Running, after_ticks
 
 from frog_bt.engine.operator import Command
 from frog_bt.model import keys
+from frog_bt.model.events import RobotCommand
 from frog_bt.model.help import Help, HelpAbout
 from frog_bt.runtime import decisions
+from frog_bt.runtime.observer import listen
 
 DOCK_FAILS = {"docking": {"dock_failures": 3}}  # the tour's three tries fail, a fourth works
 
@@ -133,13 +135,23 @@ def test_a_pause_while_driving_stops_the_robot_within_one_tick() -> None:
             await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 60)  # off to POI0
             ticks = exe.core.ticks
             await after_ticks(exe, lambda: exe.core.ticks >= ticks + 3)  # under way
+            stops: list[int] = []  # the tick each stop goal went out in (as it went out)
+            listen(
+                exe,
+                lambda e: (
+                    stops.append(exe.core.ticks + 1)
+                    if e.goal is not None and e.goal.target == "(stop here)"
+                    else None
+                ),
+                RobotCommand,
+            )
             assert (await exe.staff.submit(Command.PAUSE)).ok
             paused_at = exe.core.ticks
             await run.sim.wait_for(
                 lambda r: r.channel == "/GotoWayPoint" and r.t >= 0 and _stop_goal(r, world),
                 10,
             )
-            assert exe.core.ticks <= paused_at + 1  # sent in the tick after the pause
+            assert stops and stops[0] <= paused_at + 1  # sent in the tick after the pause
             here = world.pose
             ticks = exe.core.ticks
             await after_ticks(exe, lambda: exe.core.ticks >= ticks + 30)  # seconds go by
