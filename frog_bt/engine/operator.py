@@ -177,13 +177,13 @@ class Operator:
         if command is Command.RETRY:
             board.set(keys.HELP_ANSWER, HelpAnswer.RETRY)
             return Answer(True, Msg("trying again: {step}", step=Msg(_STEP[help_.about])))
-        refusal = self._not_done(help_)
+        refusal = self.not_done(help_)
         if refusal is not None:
             return Answer(False, refusal)
         board.set(keys.HELP_ANSWER, HelpAnswer.DONE_BY_HAND)
         return Answer(True, Msg("going on: {done}", done=Msg(help_.about.by_hand)))
 
-    def _not_done(self, help_: Help) -> Msg | None:
+    def not_done(self, help_: Help) -> Msg | None:
         """Why ``done_by_hand`` cannot be true yet, from what the robot reports; None."""
         about = help_.about
         if about in (HelpAbout.DOCK, HelpAbout.HOME, HelpAbout.UNDOCK, HelpAbout.CRASHED):
