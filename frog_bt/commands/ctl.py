@@ -234,7 +234,7 @@ def _run(args: argparse.Namespace) -> int:
             stranger = _stranger(token, headers, exc.headers, said, base)
             if stranger:
                 return _fail(stranger)
-            _say(f"refused: {reason}")
+            _say(_in_words(N_("refused: {why}"), said, why=reason))
             return 1
         return _fail(f"{exc.code}: {reason}")
     except (urllib.error.URLError, OSError, ValueError) as exc:
@@ -258,11 +258,21 @@ def _run(args: argparse.Namespace) -> int:
     if not isinstance(answer, dict) or answer.get("ok") is not True:
         reason = _reason(raw, "no reason given")
         if isinstance(answer, dict) and answer.get("ok") is False:
-            _say(f"refused: {reason}")
+            _say(_in_words(N_("refused: {why}"), raw, why=reason))
             return 1
         return _fail(f'the console did not say "ok": true (so nothing was done): {raw[:80]!r}')
-    _say(f"done: {answer.get('did', '')}")
+    _say(_in_words(N_("done: {what}"), raw, what=answer.get("did", "")))
     return 0
+
+
+def _in_words(msgid: str, body: bytes, **args: Any) -> str:
+    """``msgid`` in the language the console answered in (its answer's ``language``)."""
+    try:
+        answer = json.loads(body)
+    except (ValueError, RecursionError):
+        answer = None
+    lang = answer.get("language") if isinstance(answer, dict) else None
+    return Msg(msgid, **args).say(translator(lang if isinstance(lang, str) else None))
 
 
 # ------------------------------------------------------------------ status, in words
@@ -326,7 +336,7 @@ def state_lines(state: dict[str, Any]) -> list[str]:
             out.append(f"  {field(N_('Done'), help_['by_hand'])}")
         answers = " | ".join(f"frog-bt ctl {a}" for a in help_.get("answers", []))
         out.append("  " + Msg("Answer with: {commands}", commands=answers).say(words))
-    for alert in state.get("alerts", []):
+    for alert in [*state.get("alerts", []), *state.get("cleared", [])]:
         raised = alert.get("state") == "raised"
         label = N_("The robot needs help") if raised else N_("Solved")
         out.append(field(label, alert.get("text", "")))
