@@ -121,7 +121,21 @@ def console_url(text: str | None) -> str:
     (a wildcard host reached on loopback); UsageError when it is none of those."""
     text = (text or "").strip() or DEFAULT_CONSOLE
     if "://" in text:
-        return text.rstrip("/")
+        url = urllib.parse.urlsplit(text)
+        if url.scheme in ("ws", "wss"):
+            raise UsageError(
+                "--console",
+                text,
+                f"{url.scheme}:// is the console's stream, not its address: give "
+                f"{'https' if url.scheme == 'wss' else 'http'}://{url.netloc}",
+            )
+        if url.scheme not in ("http", "https") or not url.netloc:
+            raise UsageError("--console", text, "expected http://HOST:PORT or https://HOST")
+        path = url.path + "/"  # a page's or an API's address: the console's is above /api/
+        path = path[: path.index("/api/")] if "/api/" in path else url.path
+        return urllib.parse.urlunsplit((url.scheme, url.netloc, path.rstrip("/"), "", ""))
+    if ":" not in text.rstrip("/") and not text.isdigit():  # a bare host: the default port
+        text = f"{text.rstrip('/')}:{DEFAULT_CONSOLE.rpartition(':')[2]}"
     host, port = console_address(text.rstrip("/"))
     host = WILDCARDS.get(host, host)
     return f"http://[{host}]:{port}" if ":" in host else f"http://{host}:{port}"
@@ -195,7 +209,8 @@ def _run(args: argparse.Namespace) -> int:
         base = console_url(given)
     except UsageError as exc:
         where = "--console" if args.console is not None else ENV
-        return _fail(f"{where} {given}: {exc.detail}, or a URL")
+        hint = "" if "://" in (given or "") else ", or a URL"
+        return _fail(f"{where} {given}: {exc.detail}{hint}")
     headers = {"Content-Type": "application/json", "User-Agent": f"{CTL_AGENT}/{__version__}"}
     token: str | None = None
     if args.token_file is not None:
