@@ -221,6 +221,16 @@ class Safety(_Model):
     people_max_age: Positive = 2.0  # seconds: older /PeopleUPO is stale
     face_silence: Positive = 3.0  # seconds without face data while the stream is on: say so
 
+    @model_validator(mode="after")
+    def _resume_above_low(self) -> Safety:
+        if self.battery_resume < self.battery_low:
+            raise PathError(
+                ("battery_resume",),
+                f"expected at least battery_low ({self.battery_low:g}): a tour would start "
+                "with a battery it aborts at",
+            )
+        return self
+
 
 class Checkpoint(_Model):
     confirm: Positive = 3.0  # seconds to wait for /docking/state before resuming a tour

@@ -20,6 +20,7 @@ from typing import Any
 from frog_bt.behaviours import load_tree
 from frog_bt.clock import SimClock
 from frog_bt.config import Site
+from frog_bt.model.help import Help
 from frog_bt.runtime.executive import Executive, Outcome
 from frog_bt.sim import Simulator
 from frog_bt.sim.scenario import Scenario
@@ -99,6 +100,16 @@ class Rehearsal:
         if self.task is None or self.task.done() or not exe.client.link.connected:
             return None
         return exe.clock.now() if exe.clock.ready else None
+
+    def lend_hands(self) -> None:
+        """``done_by_hand`` does the step first, as a person would: the simulated robot is
+        put on its charger (or off it), its fault fixed (frog-bt demo --console)."""
+        self.executive.staff.by_hand = self.by_hand
+
+    def by_hand(self, help_: Help) -> None:
+        """Do what ``help_`` asks of a person in the simulator (published at its next
+        step; the executive's staff apply ``done_by_hand`` once it sees it)."""
+        self.sim.world.by_hand(help_.about.value)
 
     async def finish(self, timeout: float = 60.0) -> Outcome:
         """The executive's outcome (with ``once``: after one tour); TimeoutError after

@@ -68,3 +68,20 @@ def test_a_stop_is_named_in_the_sites_language() -> None:
     english = site.model_copy(update={"language": "en"})
     assert (english.name("POI2"), english.name("SHOP")) == ("Hunting Courtyard", "Shop")
     assert site.name("NOWHERE") == "NOWHERE"
+
+
+def test_a_battery_resume_below_battery_low_is_refused_at_its_line(tmp_path: Path) -> None:
+    from frog_bt.errors import ConfigError
+
+    text = Path("config/site.yaml").read_text("utf-8")
+    lines = text.splitlines()
+    at = next(i for i, line in enumerate(lines) if line.strip().startswith("battery_resume:"))
+    lines[at] = "  battery_resume: 10"
+    site = tmp_path / "site.yaml"
+    site.write_text("\n".join(lines) + "\n", "utf-8")
+    with pytest.raises(ConfigError) as info:
+        load_site(site)
+    assert str(info.value) == (
+        f"{site}:{at + 1}:19: safety.battery_resume: expected at least battery_low (20): "
+        "a tour would start with a battery it aborts at"
+    )

@@ -167,6 +167,7 @@ async def start_people(
     webhooks = Webhooks(
         executive.site.alerts,  # its ack links' key comes from the token
         ack_secret=settings.token if settings is not None else None,
+        language=executive.site.language,
     )
     executive.observers.attach(executive, [webhooks])  # every alert change
     logctx.run_as(executive, webhooks.start)  # its lines are the executive's (console log)

@@ -121,7 +121,21 @@ def console_url(text: str | None) -> str:
     (a wildcard host reached on loopback); UsageError when it is none of those."""
     text = (text or "").strip() or DEFAULT_CONSOLE
     if "://" in text:
-        return text.rstrip("/")
+        url = urllib.parse.urlsplit(text)
+        if url.scheme in ("ws", "wss"):
+            raise UsageError(
+                "--console",
+                text,
+                f"{url.scheme}:// is the console's stream, not its address: give "
+                f"{'https' if url.scheme == 'wss' else 'http'}://{url.netloc}",
+            )
+        if url.scheme not in ("http", "https") or not url.netloc:
+            raise UsageError("--console", text, "expected http://HOST:PORT or https://HOST")
+        path = url.path + "/"  # a page's or an API's address: the console's is above /api/
+        path = path[: path.index("/api/")] if "/api/" in path else url.path
+        return urllib.parse.urlunsplit((url.scheme, url.netloc, path.rstrip("/"), "", ""))
+    if ":" not in text.rstrip("/") and not text.isdigit():  # a bare host: the default port
+        text = f"{text.rstrip('/')}:{DEFAULT_CONSOLE.rpartition(':')[2]}"
     host, port = console_address(text.rstrip("/"))
     host = WILDCARDS.get(host, host)
     return f"http://[{host}]:{port}" if ":" in host else f"http://{host}:{port}"
@@ -195,7 +209,8 @@ def _run(args: argparse.Namespace) -> int:
         base = console_url(given)
     except UsageError as exc:
         where = "--console" if args.console is not None else ENV
-        return _fail(f"{where} {given}: {exc.detail}, or a URL")
+        hint = "" if "://" in (given or "") else ", or a URL"
+        return _fail(f"{where} {given}: {exc.detail}{hint}")
     headers = {"Content-Type": "application/json", "User-Agent": f"{CTL_AGENT}/{__version__}"}
     token: str | None = None
     if args.token_file is not None:
@@ -234,7 +249,7 @@ def _run(args: argparse.Namespace) -> int:
             stranger = _stranger(token, headers, exc.headers, said, base)
             if stranger:
                 return _fail(stranger)
-            _say(f"refused: {reason}")
+            _say(_in_words(N_("refused: {why}"), said, why=reason))
             return 1
         return _fail(f"{exc.code}: {reason}")
     except (urllib.error.URLError, OSError, ValueError) as exc:
@@ -258,11 +273,21 @@ def _run(args: argparse.Namespace) -> int:
     if not isinstance(answer, dict) or answer.get("ok") is not True:
         reason = _reason(raw, "no reason given")
         if isinstance(answer, dict) and answer.get("ok") is False:
-            _say(f"refused: {reason}")
+            _say(_in_words(N_("refused: {why}"), raw, why=reason))
             return 1
         return _fail(f'the console did not say "ok": true (so nothing was done): {raw[:80]!r}')
-    _say(f"done: {answer.get('did', '')}")
+    _say(_in_words(N_("done: {what}"), raw, what=answer.get("did", "")))
     return 0
+
+
+def _in_words(msgid: str, body: bytes, **args: Any) -> str:
+    """``msgid`` in the language the console answered in (its answer's ``language``)."""
+    try:
+        answer = json.loads(body)
+    except (ValueError, RecursionError):
+        answer = None
+    lang = answer.get("language") if isinstance(answer, dict) else None
+    return Msg(msgid, **args).say(translator(lang if isinstance(lang, str) else None))
 
 
 # ------------------------------------------------------------------ status, in words
@@ -326,7 +351,7 @@ def state_lines(state: dict[str, Any]) -> list[str]:
             out.append(f"  {field(N_('Done'), help_['by_hand'])}")
         answers = " | ".join(f"frog-bt ctl {a}" for a in help_.get("answers", []))
         out.append("  " + Msg("Answer with: {commands}", commands=answers).say(words))
-    for alert in state.get("alerts", []):
+    for alert in [*state.get("alerts", []), *state.get("cleared", [])]:
         raised = alert.get("state") == "raised"
         label = N_("The robot needs help") if raised else N_("Solved")
         out.append(field(label, alert.get("text", "")))

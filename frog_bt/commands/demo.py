@@ -9,9 +9,12 @@ simulated and wall time the tour took. Exits 0 only when the tour ended docked
 with every stop visited.
 
 With --console the tour runs at a speed a person can follow (2x unless --speed says
-otherwise), and the console stays open after the tour, so that the day and the last tour
-can be read, until Ctrl-C (SIGINT or SIGTERM). The default --timeout grows as the speed
-falls: 300 wall seconds at the default 50x, the same simulated time at any other speed.
+otherwise), and the executive runs on, as on a robot, until Ctrl-C (SIGINT or SIGTERM):
+a request for help holds until someone answers it on the page, and "done by hand" is
+done in the simulator first, as a person would (the robot put on its charger, or off
+it, its fault fixed). The summary is printed when the first tour is over. The default
+--timeout grows as the speed falls: 300 wall seconds at the default 50x, the same
+simulated time at any other speed.
 """
 
 from __future__ import annotations
@@ -130,7 +133,11 @@ async def _demo(site: Site, tree: LoadedTree, scenario: Scenario, args: argparse
         observers.extend(attach_observers(executive, record=args.record, rerun=rerun))
 
     wall0 = time.monotonic()
-    rehearsal = Rehearsal(scenario, site=site, tree=tree, prepare=prepare)
+    # With a console the executive goes on after its tour, as on a robot: a request for
+    # help holds until a person answers it on the page (or Ctrl-C), and "done by hand"
+    # is done in the simulator first, as a person would (Rehearsal.lend_hands).
+    held = bool(args.console)
+    rehearsal = Rehearsal(scenario, site=site, tree=tree, prepare=prepare, once=not held)
     sim0 = rehearsal.sim.clock.now()
     people = None
     try:
@@ -141,6 +148,9 @@ async def _demo(site: Site, tree: LoadedTree, scenario: Scenario, args: argparse
                 print(f"frog-bt: {exc}", file=sys.stderr)
                 rehearsal.executive.stop(str(exc), 2)
                 return 2
+            if held and people.console is not None:
+                rehearsal.lend_hands()
+                return await _held(args, scenario, summary, rehearsal, people.console, wall0, sim0)
             timed_out = False
             try:
                 outcome = await rehearsal.finish(args.timeout)
@@ -148,40 +158,74 @@ async def _demo(site: Site, tree: LoadedTree, scenario: Scenario, args: argparse
                 timed_out = True
         outcome = rehearsal.executive.outcome
         if timed_out:  # said after the executive stopped (stopping says "no tour ended")
-            outcome.code, outcome.reason = (
-                1,
-                f"no docked finish within {args.timeout:g} s of wall time "
-                f"(--timeout {args.timeout:g} at --speed {scenario.speed:g}): "
-                "give a longer --timeout",
-            )
+            outcome.code, outcome.reason = 1, _too_slow(args.timeout, scenario.speed)
         close_all(observers)
         observers.clear()
-        code = _report(args, scenario, summary, rehearsal, outcome, wall0, sim0, rerun)
-        if people is not None and people.console is not None:
-            await _hold_open(people.console)
-        return code
+        return _report(args, scenario, summary, rehearsal, outcome, wall0, sim0, rerun)
     finally:
         if people is not None:
             await people.close()
         close_all(observers)
 
 
-async def _hold_open(console: Console) -> None:
-    """Keep the console open, the last state on it, until SIGINT or SIGTERM."""
+def _too_slow(timeout: float, speed: float) -> str:
+    return (
+        f"no docked finish within {timeout:g} s of wall time "
+        f"(--timeout {timeout:g} at --speed {speed:g}): give a longer --timeout"
+    )
+
+
+async def _held(
+    args: argparse.Namespace,
+    scenario: Scenario,
+    summary: TourSummary,
+    rehearsal: Rehearsal,
+    console: Console,
+    wall0: float,
+    sim0: float,
+) -> int:
+    """With a console: the executive runs until SIGINT or SIGTERM, whatever happens. The
+    summary is printed when the first tour is over (or after ``--timeout``); the exit
+    code is the summary's."""
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
-    print(
-        f"frog-bt demo: the console stays open at http://{console.host}:{console.bound_port}/ "
-        "(Ctrl-C to end)",
-        flush=True,
-    )
     try:
-        await stop.wait()
+        print(
+            f"frog-bt demo: the console is at http://{console.host}:{console.bound_port}/ "
+            "(Ctrl-C to end)",
+            flush=True,
+        )
+        over = asyncio.create_task(_first_tour_over(summary))
+        stopped = asyncio.create_task(stop.wait())
+        await asyncio.wait({over, stopped}, timeout=args.timeout, return_when="FIRST_COMPLETED")
+        over.cancel()
+        outcome = rehearsal.executive.outcome
+        if not summary.tours and not stop.is_set():
+            outcome.code, outcome.reason = 1, _too_slow(args.timeout, scenario.speed)
+        rerun = None if args.rerun == "off" else args.rerun
+        code = _report(args, scenario, summary, rehearsal, outcome, wall0, sim0, rerun)
+        if not stop.is_set():
+            print(
+                f"frog-bt demo: the console stays open at http://{console.host}:"
+                f"{console.bound_port}/ and the robot goes on (Ctrl-C to end)",
+                flush=True,
+            )
+        await stopped
+        return code
     finally:
         for sig in (signal.SIGINT, signal.SIGTERM):
             loop.remove_signal_handler(sig)
+
+
+async def _first_tour_over(summary: TourSummary) -> None:
+    """Returns once the first tour has ended or was aborted (the summary heard it)."""
+    while not summary.tours:
+        await asyncio.sleep(FIRST_TOUR_POLL)
+
+
+FIRST_TOUR_POLL = 0.2  # wall seconds between looks at the summary
 
 
 def _report(

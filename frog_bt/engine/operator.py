@@ -53,6 +53,15 @@ _STEP = {
     HelpAbout.FAULT: N_("fault"),
     HelpAbout.CRASHED: N_("home"),
 }
+# /docking/state in words staff use (a refusal never quotes the robot's codes)
+DOCKING_WORDS = {
+    "docked": N_("on its charger"),
+    "undocked": N_("off its charger"),
+    "docking": N_("docking"),
+    "undocking": N_("leaving its charger"),
+    "failed": N_("stuck after a failed docking"),
+    "nothing": N_("silent about its charger"),
+}
 TREE_COMMANDS = frozenset(Command) - {Command.ACK_ALERT}
 SENT_HOME = AbortReason(AbortCause.OPERATOR, "operator")
 
@@ -177,13 +186,13 @@ class Operator:
         if command is Command.RETRY:
             board.set(keys.HELP_ANSWER, HelpAnswer.RETRY)
             return Answer(True, Msg("trying again: {step}", step=Msg(_STEP[help_.about])))
-        refusal = self._not_done(help_)
+        refusal = self.not_done(help_)
         if refusal is not None:
             return Answer(False, refusal)
         board.set(keys.HELP_ANSWER, HelpAnswer.DONE_BY_HAND)
         return Answer(True, Msg("going on: {done}", done=Msg(help_.about.by_hand)))
 
-    def _not_done(self, help_: Help) -> Msg | None:
+    def not_done(self, help_: Help) -> Msg | None:
         """Why ``done_by_hand`` cannot be true yet, from what the robot reports; None."""
         about = help_.about
         if about in (HelpAbout.DOCK, HelpAbout.HOME, HelpAbout.UNDOCK, HelpAbout.CRASHED):
@@ -192,10 +201,9 @@ class Operator:
             state = reading.value if reading is not None else "nothing"
             if state != want:
                 return Msg(
-                    "the robot reports {state} on /docking/state, not {want}: "
-                    "finish the step, then answer again",
-                    state=str(state),
-                    want=want.value,
+                    "the robot says it is {state}, not {want}: finish the step, then answer again",
+                    state=Msg(DOCKING_WORDS.get(str(state), N_("in a state it does not name"))),
+                    want=Msg(DOCKING_WORDS[want.value]),
                 )
         if about is HelpAbout.FAULT:
             diagnostics = self.board.get(keys.DIAGNOSTICS)

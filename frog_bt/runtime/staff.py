@@ -24,6 +24,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
@@ -34,6 +35,7 @@ from frog_bt.i18n import Msg
 from frog_bt.model import keys
 from frog_bt.model.channels import Carried, CarriedIncident
 from frog_bt.model.events import Event, OperatorDone
+from frog_bt.model.help import Help
 from frog_bt.model.links import LinkStatus
 from frog_bt.model.outcomes import Incident, IncidentKind, TourState
 from frog_bt.runtime.alerts import AlertBook, Facts
@@ -59,6 +61,8 @@ class Queued:
     answer: asyncio.Future[Answer]
     by: str = ""  # who sent it: console, ctl, link (recorded with the answer)
     occurrence: str | None = None  # ack_alert from a link: only this raise of the alert
+    ready: Callable[[], bool] | None = None  # held in the queue until this holds
+    help: Help | None = None  # done_by_hand in a rehearsal: the request it answers
 
 
 class StaffHost(Protocol):
@@ -88,6 +92,9 @@ class Staff:
     _remember_until: float | None = None
     _pause_ran_out: bool = False
     _touring: bool = False
+    # a rehearsal's hands (frog-bt demo): before ``done_by_hand`` is checked, the
+    # simulated robot is put where a person would have put it
+    by_hand: Callable[[Help], None] | None = None
 
     def __post_init__(self) -> None:
         site = self.executive.site
@@ -100,9 +107,16 @@ class Staff:
     ) -> Answer:
         """Queue ``command`` (sent ``by`` console, ctl or an acknowledgement link); its
         answer once applied at the next tick (or refused). ``occurrence``: ``ack_alert``
-        acknowledges only that raise of the alert (an acknowledgement link's)."""
+        acknowledges only that raise of the alert (an acknowledgement link's).
+        ``done_by_hand`` in a rehearsal first does the step (:attr:`by_hand`), and is
+        applied at the first tick that sees it done, before the tree hears of it."""
         answer: asyncio.Future[Answer] = asyncio.get_running_loop().create_future()
         queued = Queued(command, alert_id, answer, by, occurrence)
+        help_ = self.executive.core.board.get(keys.HELP)
+        if command is Command.DONE_BY_HAND and self.by_hand is not None and help_ is not None:
+            self.by_hand(help_)
+            queued.help = help_
+            queued.ready = lambda: self.executive.core.operator.not_done(help_) is None
         self._queue.append(queued)
         self.executive.wake()
         try:
@@ -123,6 +137,15 @@ class Staff:
         """Apply what was queued, in order, between two ticks."""
         queue, self._queue = self._queue, []
         for queued in queue:
+            if queued.help is not None and self.executive.core.board.get(keys.HELP) is None:
+                # the robot saw the step done (a fault gone) and went on by itself
+                answer = Answer(True, Msg("going on: {done}", done=Msg(queued.help.about.by_hand)))
+                log.info("operator %s: %s", queued.command, answer.text)
+                queued.answer.set_result(answer)
+                continue
+            if queued.ready is not None and not queued.ready():
+                self._queue.append(queued)  # a rehearsal's hands are still at work
+                continue
             answer = self.apply(queued.command, queued.alert_id, queued.by, queued.occurrence)
             if not queued.answer.done():
                 queued.answer.set_result(answer)

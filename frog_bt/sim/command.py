@@ -35,9 +35,9 @@ time just runs slower.
 
 Scenarios: --scenario takes a built-in name (default, morning, afternoon,
 bored, no_visitor, declines, wander_off, nav_failure, undock_failure, fault,
-silent_frontend; and where the robot asks a person for help: dock_fails,
-undock_fails, home_fails, fault_persists; and where the robot's word is not to be
-taken as it comes: late_arrival, long_fault, out_of_order) or the path of a YAML file. Every key is
+silent_frontend; where the robot asks a person for help: dock_fails, undock_fails,
+home_fails, fault_persists; and where the robot's word is not to be taken as it comes:
+late_arrival, long_fault, out_of_order) or the path of a YAML file. Every key is
 optional; `extends: NAME|FILE` starts from another scenario. Times called `at`
 are seconds of simulated time after the start.
 

@@ -32,14 +32,20 @@ class Battery:
 
 
 def active_faults(
-    faults: Iterable[FaultSpec], elapsed: float, arrivals: Mapping[str, float] | None = None
+    faults: Iterable[FaultSpec],
+    elapsed: float,
+    arrivals: Mapping[str, float] | None = None,
+    fixed_at: float | None = None,
 ) -> list[DiagnosticStatus]:
     """Statuses of the faults active ``elapsed`` seconds after the scenario start;
-    ``arrivals``: when the robot first arrived at each scenario POI (``on_arrival``)."""
+    ``arrivals``: when the robot first arrived at each scenario POI (``on_arrival``);
+    ``fixed_at``: when a person fixed every fault then reported (a rehearsal's hands)."""
     t = elapsed + 1e-9  # a step time of 2.9999999 is 3
     out = []
     for f in faults:
         start = f.at if f.at is not None else (arrivals or {}).get(f.on_arrival or "")
+        if start is not None and fixed_at is not None and start <= fixed_at:
+            continue
         if start is not None and start <= t and (f.duration is None or t < start + f.duration):
             out.append(DiagnosticStatus(f.level, f.name, f.text, "frog"))
     return out

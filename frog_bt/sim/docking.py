@@ -59,6 +59,14 @@ class Docking:
         self.state = "docking" if command == "dock" else "undocking"
         return self.state
 
+    def put(self, docked: bool) -> str:
+        """A person puts the robot on its charger (``docked``) or moves it off: any
+        process stops; the state to publish now."""
+        self._process = None
+        self.docked = docked
+        self.state = "docked" if docked else "undocked"
+        return self.state
+
     def step(self, dt: float) -> str | None:
         """Advance the running process; the new state when it finishes, else None."""
         process = self._process

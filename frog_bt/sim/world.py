@@ -134,6 +134,7 @@ class World:
         self.faces_on = False
         self.approach: Approach | None = None
         self.arrivals: dict[str, float] = {}  # scenario POI -> first arrival (on_arrival faults)
+        self.fixed_at: float | None = None  # a person fixed the faults reported then
         self.late: list[tuple[float, Out]] = []  # answers held back: (due, what)
         self.malformed = 0
         self._rates = {
@@ -264,6 +265,26 @@ class World:
             elif state in ("ended", "aborted"):
                 self.crowd.tour_over(self.pose)
 
+    # ------------------------------------------------------------ a person's hands
+
+    def by_hand(self, about: str) -> None:
+        """A person does the step the robot could not (``about``, as the executive's help
+        names it): ``dock``, ``home`` and ``crashed`` put the robot on its charger,
+        ``undock`` moves it off, ``fault`` fixes the faults reported now. What changed is
+        published at the next step."""
+        self.navigator.cancel()
+        self.approach = None
+        if about == "fault":
+            self.fixed_at = self.elapsed
+            self._rates[DIAGNOSTIC].next = self.elapsed
+            return
+        self.docking.put(about != "undock")
+        if about != "undock":
+            d = self.dock_pose
+            self.pose = RobotPose(d.x, d.y, d.yaw, d.exact)
+        self._rates[DOCKING_STATE].next = self.elapsed
+        self._rates[POSE].next = self.elapsed
+
     # ------------------------------------------------------------ time
 
     def step(self, dt: float) -> list[Out]:
@@ -329,7 +350,7 @@ class World:
         if self.faces_on and rates[FACES].due(elapsed):
             out.append((FACES, msgs.face_data(now, self.crowd.faces())))
         if rates[DIAGNOSTIC].due(elapsed):
-            faults = active_faults(self.scenario.faults, elapsed, self.arrivals)
+            faults = active_faults(self.scenario.faults, elapsed, self.arrivals, self.fixed_at)
             statuses = [self.battery.status(), *faults]
             out.append((DIAGNOSTIC, msgs.diagnostic_array(now, statuses)))
         if rates[DOCKING_STATE].due(elapsed):

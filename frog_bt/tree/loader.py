@@ -273,7 +273,10 @@ class _Builder:
         scope = dict(variables)
         for k, v in extra.items():
             scope[str(k)] = self._subst(v, file, (*path, "with", k), variables)
-        node, _ = self.file(Path(file).parent / target, scope)
+        included = Path(file).parent / target
+        if self.documents is None and not included.is_file():  # said at the line including it
+            raise TreeError(file, (*path, "include"), f"no such file: {included}")
+        node, _ = self.file(included, scope)
         return [node] if node is not None else []
 
     def _foreach(

@@ -36,12 +36,12 @@ def test_ctl_exit_codes_and_answers(tmp_path: Path, capsys: pytest.CaptureFixtur
     # ctl answers in the site's language (config/site.yaml: es)
     assert refused == (
         1,
-        "refused: no está en ninguna parada ni yendo a una: no hay nada que saltar",
+        "no se ha hecho: no está en ninguna parada ni yendo a una: no hay nada que saltar",
         "",
     )
     assert done == (
         0,
-        "done: termina la visita: el robot vuelve a la base y se pone a cargar",
+        "hecho: termina la visita: el robot vuelve a la base y se pone a cargar",
         "",
     )
     assert main(["ctl", "ack_alert"]) == 2

@@ -175,7 +175,7 @@ def test_ctl_ignores_proxies_and_refuses_an_answer_that_is_not_the_consoles(
 
     out = asyncio.run(main())
     code, said, err = out["through"]  # type: ignore[misc]
-    assert (code, err) == (0, "") and said.startswith("done: "), out["through"]
+    assert (code, err) == (0, "") and said.startswith("hecho: "), out["through"]
     assert out["proxy asked"] == []  # the token never went to the proxy
     assert out["paused"] is True  # the console itself did it
     code, said, err = out["stranger"]  # type: ignore[misc]

@@ -45,6 +45,7 @@ def test_ctl_answers_a_robot_that_needs_help(
         return out
 
     before, retried = asyncio.run(run())
-    assert before == (1, "refused: ahora el robot no necesita ayuda")  # the site speaks Spanish
-    assert retried[0] == 0 and retried[1].startswith("done: lo vuelve a intentar")
+    # the site speaks Spanish
+    assert before == (1, "no se ha hecho: ahora el robot no necesita ayuda")
+    assert retried[0] == 0 and retried[1].startswith("hecho: lo vuelve a intentar")
     assert senders == [("retry", "ctl"), ("retry", "ctl")]  # recorded as sent by ctl

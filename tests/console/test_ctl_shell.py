@@ -31,6 +31,9 @@ from frog_bt.errors import UsageError
         ("http://frog-1:8080/", "http://frog-1:8080"),
         ("https://frog-1.museum.example", "https://frog-1.museum.example"),
         (None, "http://127.0.0.1:8080"),
+        ("http://frog-1:8080/api/state", "http://frog-1:8080"),  # an API's address: its console
+        ("https://x.example/frog/api/command", "https://x.example/frog"),  # a proxy's prefix
+        ("frog-1", "http://frog-1:8080"),  # a bare host: the console's default port
     ],
 )
 def test_console_addresses_as_run_takes_them(given: str | None, url: str) -> None:
@@ -40,8 +43,12 @@ def test_console_addresses_as_run_takes_them(given: str | None, url: str) -> Non
 def test_a_console_that_is_no_address_is_a_usage_error(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    with pytest.raises(UsageError):
-        console_url("frog-1")
+    with pytest.raises(
+        UsageError, match="the console's stream, not its address: give http://frog-1:8080"
+    ):
+        console_url("ws://frog-1:8080/api/stream")
+    with pytest.raises(UsageError, match="expected http://HOST:PORT"):
+        console_url("ftp://frog-1")
     monkeypatch.setenv("FROG_BT_CONSOLE", "frog-1:http")
     assert main(["ctl", "status"]) == 2
     assert capsys.readouterr().err.startswith("frog-bt ctl: FROG_BT_CONSOLE frog-1:http:")

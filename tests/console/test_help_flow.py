@@ -66,7 +66,7 @@ def test_a_failed_dock_is_shown_escalated_and_answered_from_the_api() -> None:
     )
     assert help_["answers"] == ["retry", "done_by_hand", "service_off"]
     assert isinstance(help_["since"], float)
-    assert out["refused"][0] == 409 and "not docked" in out["refused"][1]["reason"]
+    assert out["refused"][0] == 409 and "not on its charger" in out["refused"][1]["reason"]
     assert out["done"][0] == 200 and out["done"][1]["ok"] is True
     assert out["after"]["help"] is None
     states = [(g["id"], g["state"], g.get("repeat", 0)) for g in out["got"]]

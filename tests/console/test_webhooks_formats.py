@@ -168,19 +168,21 @@ def test_ntfy_json_publish_at_the_root_priority_from_severity() -> None:
         jsonschema.validate(g.body, NTFY, format_checker=CHECKER)
         assert g.body["topic"] == "frog-alerts" and g.body["click"] == CONSOLE
     raised, again, _, resolved = (g.body for g in got)
-    assert raised["title"] == "frog needs help: fault"
-    assert raised["priority"] == 5 and raised["tags"][:2] == ["rotating_light", "fault"]
+    assert raised["title"] == "frog needs help: electronics fault"
+    assert raised["priority"] == 5
+    assert raised["tags"] == ["rotating_light", "electronics fault", "frog", "error"]
     assert raised["message"] == (
         "The robot reports an electronics fault: motors: overheated. Call the robot team.\n"
-        "Answers: service off, ack alert."
+        "Answers: Out of service, Seen."
     )
-    assert again["title"] == "frog still needs help after 10 min: fault"
+    assert again["title"] == "frog still needs help after 10 min: electronics fault"
     assert again["message"].startswith("Nobody has acknowledged this for 10 min.\n")
     assert again["priority"] == 5
     [action] = raised["actions"]
     assert action["action"] == "view" and action["label"] == "Acknowledge"
     check_link(action["url"], "fault")
-    assert resolved["priority"] == 3 and resolved["title"] == "frog: resolved: fault"
+    assert resolved["priority"] == 3
+    assert resolved["title"] == "frog: resolved: electronics fault"
     assert resolved["tags"][0] == "white_check_mark"
 
 

@@ -109,7 +109,7 @@ def test_demo_out_of_time_says_so_naming_timeout(tmp_path):
     )
 
 
-def test_demo_with_console_stays_open_after_the_tour_until_ctrl_c(tmp_path):
+def test_demo_with_console_runs_on_after_the_tour_until_ctrl_c(tmp_path):
     import json
     import re
     import signal
@@ -136,7 +136,8 @@ def test_demo_with_console_stays_open_after_the_tour_until_ctrl_c(tmp_path):
         assert found, "".join(lines) + proc.stderr.read()  # type: ignore[union-attr]
         with urllib.request.urlopen(found.group(0) + "api/state", timeout=10) as r:
             state = json.load(r)
-        assert state["tours"] == {"started": 1, "completed": 1, "aborted": 0}  # the day
+        assert state["tours"]["completed"] >= 1 and state["tours"]["aborted"] == 0  # the day
+        assert state["links"]["rosbridge"] == "connected"  # the robot goes on, as on a robot
         assert proc.poll() is None  # still open, after the tour
         proc.send_signal(signal.SIGINT)
         assert proc.wait(timeout=20) == 0

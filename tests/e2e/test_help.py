@@ -36,7 +36,8 @@ def test_a_dock_that_fails_holds_and_asks_then_done_by_hand_carries_it_on() -> N
             assert not exe._stopping.is_set()  # it waits for a person, it does not exit
             await after_ticks(exe, lambda: "docking_failed" in exe.staff.book.active)
             answer = await exe.staff.submit(Command.DONE_BY_HAND)
-            assert not answer.ok and "failed on /docking/state, not docked" in answer.text
+            assert not answer.ok
+            assert "stuck after a failed docking, not on its charger" in answer.text
 
             docked_by_hand(run)
             await after_ticks(exe, lambda: run.sim.world.docking_state == "docked")

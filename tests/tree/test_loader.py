@@ -90,7 +90,7 @@ def test_the_shipped_tour_loads_and_has_every_stop(site):
         ),
         (
             "root: {type: Sequence, memory: true, children: [{include: missing.yaml}]}",
-            "missing.yaml: cannot read",
+            "t.yaml: root.children[0].include: no such file: missing.yaml",
         ),
         ("root: {type: FinishPoi, poi: '{place}'}", "t.yaml: root.poi: unknown variable 'place'"),
         ("root: {type: FinishPoi, poi: POI1, when: sunny}", "t.yaml: root.when: unknown variable"),
@@ -109,6 +109,17 @@ def test_error_inside_an_included_file_names_that_file(tmp_path, site):
         tmp_path, "root: {type: Sequence, memory: true, children: [{include: inner.yaml}]}", site
     )
     assert message.startswith("inner.yaml: root.colour: unknown key")
+
+
+def test_a_missing_include_is_named_at_the_line_that_includes_it(tmp_path, site):
+    path = write_tree(
+        tmp_path,
+        "root:\n  type: Sequence\n  memory: true\n  children:\n    - {include: gone.yaml}\n",
+    )
+    with pytest.raises(TreeError) as info:
+        load_tree(path, site)
+    message = str(info.value).replace(str(tmp_path) + "/", "")
+    assert message == "t.yaml:5:17: root.children[0].include: no such file: gone.yaml"
 
 
 def test_self_inclusion_is_refused(tmp_path, site):

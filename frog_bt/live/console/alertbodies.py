@@ -29,6 +29,7 @@ from typing import Any
 from urllib.parse import urlsplit, urlunsplit
 
 from frog_bt.config import Webhook
+from frog_bt.i18n import N_, Msg, translator
 from frog_bt.model.channels import Alert
 
 ALERTNAME = "FrogRobotNeedsHelp"
@@ -52,10 +53,53 @@ class Outgoing:
 
 @dataclass(frozen=True, slots=True)
 class Sender:
-    """Who tells: the robot's name and the console's public URL ("" when none)."""
+    """Who tells: the robot's name, the console's public URL ("" when none) and the
+    site's language (every word a person reads on a phone is in it)."""
 
     robot: str
     console_url: str = ""
+    language: str = "en"
+
+    def say(self, msg: Msg) -> str:
+        return msg.say(translator(self.language))
+
+
+# What staff call each kind of alert and each answer (the page's buttons' words).
+KIND_WORDS = {
+    "docking_failed": N_("docking failed"),
+    "undocking_failed": N_("undocking failed"),
+    "gave_up": N_("could not go on"),
+    "fault_persists": N_("fault persists"),
+    "executive_crashed": N_("executive stopped during a tour"),
+    "internal_error": N_("internal error"),
+    "fault": N_("electronics fault"),
+    "rosbridge_down": N_("robot unreachable"),
+    "battery_low": N_("battery low"),
+    "frontend_silent": N_("screen and sound silent"),
+    "no_visitor": N_("no visitor"),
+    "stop_given_up": N_("stop given up"),
+    "pause_ran_out": N_("pause ran out"),
+}
+ANSWER_WORDS = {
+    "retry": N_("Try again"),
+    "done_by_hand": N_("Done"),
+    "service_off": N_("Out of service"),
+    "service_on": N_("Back in service"),
+    "home": N_("Send home"),
+    "ack_alert": N_("Seen"),
+}
+SEVERITY_WORDS = {"ERROR": N_("error"), "WARN": N_("warning")}
+
+
+def kind_words(kind: str, sender: Sender) -> str:
+    """An alert's kind as staff call it, in the site's language."""
+    words = KIND_WORDS.get(kind)
+    return sender.say(Msg(words)) if words else kind.replace("_", " ")
+
+
+def answer_words(answers: tuple[str, ...] | list[str], sender: Sender) -> str:
+    """The commands that answer an alert, by the page's buttons' words."""
+    return ", ".join(sender.say(Msg(ANSWER_WORDS[a])) if a in ANSWER_WORDS else a for a in answers)
 
 
 def target(hook: Webhook) -> str:
@@ -116,38 +160,55 @@ def generic(out: Outgoing, sender: Sender) -> dict[str, Any]:
 
 def ntfy(out: Outgoing, sender: Sender, topic: str) -> dict[str, Any]:
     a = out.alert
-    label = a.kind.replace("_", " ") + (f" ({a.subject})" if a.subject else "")
+    say = sender.say
+    label = kind_words(a.kind, sender) + (f" ({a.subject})" if a.subject else "")
+    text = _short(a.what or a.text)
+    robot = sender.robot
     if a.state == "cleared":
-        title, priority, icon = f"{sender.robot}: resolved: {label}", RESOLVED, "white_check_mark"
-        lines = [f"Resolved: {_short(a.what or a.text)}"]
+        title = say(Msg("{robot}: resolved: {what}", robot=robot, what=label))
+        priority, icon = RESOLVED, "white_check_mark"
+        lines = [say(Msg("Resolved: {text}", text=text))]
     elif a.state == "acknowledged":
-        title, priority, icon = f"{sender.robot}: acknowledged: {label}", ACKNOWLEDGED, "ok_hand"
-        lines = [f"Someone has it: {_short(a.what or a.text)}"]
+        title = say(Msg("{robot}: acknowledged: {what}", robot=robot, what=label))
+        priority, icon = ACKNOWLEDGED, "ok_hand"
+        lines = [say(Msg("Someone has it: {text}", text=text))]
     else:
         priority = PRIORITY[a.severity]
         icon = "rotating_light" if a.severity == "ERROR" else "warning"
-        title = (
-            f"{sender.robot} still needs help after {waited(a.waited)}: {label}"
+        title = say(
+            Msg(
+                "{robot} still needs help after {time}: {what}",
+                robot=robot,
+                time=waited(a.waited),
+                what=label,
+            )
             if a.repeat
-            else f"{sender.robot} needs help: {label}"
+            else Msg("{robot} needs help: {what}", robot=robot, what=label)
         )
         lines = [_short(a.text)]
         if a.repeat:
-            lines.insert(0, f"Nobody has acknowledged this for {waited(a.waited)}.")
+            lines.insert(
+                0, say(Msg("Nobody has acknowledged this for {time}.", time=waited(a.waited)))
+            )
         if a.answers:
-            lines.append("Answers: " + ", ".join(x.replace("_", " ") for x in a.answers) + ".")
+            lines.append(say(Msg("Answers: {answers}.", answers=answer_words(a.answers, sender))))
     payload: dict[str, Any] = {
         "topic": topic,
         "title": title,
         "message": "\n".join(lines),
         "priority": priority,
-        "tags": [icon, a.kind, sender.robot, a.severity.lower()],
+        "tags": [icon, kind_words(a.kind, sender), robot, say(Msg(SEVERITY_WORDS[a.severity]))],
     }
     if sender.console_url:
         payload["click"] = sender.console_url
     if out.ack_url and a.state != "acknowledged":
         payload["actions"] = [
-            {"action": "view", "label": "Acknowledge", "url": out.ack_url, "clear": True}
+            {
+                "action": "view",
+                "label": say(Msg("Acknowledge")),
+                "url": out.ack_url,
+                "clear": True,
+            }
         ]
     return payload
 
@@ -166,12 +227,14 @@ def _am_alert(out: Outgoing, sender: Sender) -> dict[str, Any]:
         "description": _short(a.todo),
         "text": _short(a.text),
         "dedup_key": a.key,
-        "answers": ", ".join(a.answers),
+        "answers": answer_words(a.answers, sender),
     }
     if a.repeat:
-        annotations["waited"] = f"{waited(a.waited)} without acknowledgement"
+        annotations["waited"] = sender.say(
+            Msg("{time} without acknowledgement", time=waited(a.waited))
+        )
     if a.state == "acknowledged":
-        annotations["acknowledged"] = "yes"
+        annotations["acknowledged"] = sender.say(Msg("yes"))
     if out.ack_url:
         annotations["ack_url"] = out.ack_url
     ends = out.at if a.state == "cleared" else out.at + HOLD

@@ -13,7 +13,9 @@ const LINK_WORDS = () => ({connected: t("connected"), reconnecting: t("reconnect
   wall: t("wall clock"), "/clock": t("simulated clock"), "waiting for /clock": t("waiting for the clock")});
 const LINK_NAMES = () => ({rosbridge: t("The robot"), frontend: t("Screen and sound"), clock: t("Clock")});
 const CONFIRM_FOR = 6000;  // ms a first tap waits for the confirming one
+const ANSWER_FOR = 15000;  // ms a "done" answer stays in view (a refusal stays until tapped)
 let site = null, latest = null, words = {}, lang = "en", armed = null;
+let connected = false, sending = false;  // buttons work only when connected, one command at a time
 
 function t(msgid, args) {  // msgid in the chosen language, {fields} filled in
   let text = words[msgid] || msgid;
@@ -74,12 +76,13 @@ $("lang").addEventListener("change", () => {
 
 // ------------------------------------------------------------------ the staff code
 
-function token(why) {
+function token(why, steering) {  // steering: the code is asked for a command (reads may need none)
   let code = sessionStorage.getItem("frog-token");
   if (!code) {
     code = prompt(why || t("Staff code (asked once per session):"));
     if (code) { sessionStorage.setItem("frog-token", code); $("login").hidden = true; }
-    else showLogin(t("Without the staff code the robot can be neither shown nor steered from here."));
+    else showLogin(steering ? t("Without the staff code the robot cannot be steered from here.")
+      : t("Without the staff code the robot can be neither shown nor steered from here."));
   }
   return code;
 }
@@ -94,30 +97,44 @@ function showLogin(why) {
   $("login").hidden = false;
 }
 
-function refused() {  // a wrong code: say so, forget it, ask again
+function refused(steering) {  // a wrong code: say so, forget it, ask again
   sessionStorage.removeItem("frog-token");
-  return token(t("That staff code was not accepted. Enter it again:"));
+  return token(t("That staff code was not accepted. Enter it again:"), steering);
 }
 
 $("login-again").addEventListener("click", () => { if (token()) start(); });
 
 // ------------------------------------------------------------------ commands
 
-function answer(ok, text) {
+let answerTimer = null;
+function answer(ok, text) {  // a banner at the foot of the screen, in view wherever the finger is
+  clearTimeout(answerTimer);
   $("answer").className = ok ? "ok" : "bad";
   $("answer").textContent = text;
+  if (ok && text !== "…") answerTimer = setTimeout(() => { $("answer").textContent = ""; }, ANSWER_FOR);
+}
+$("answer").addEventListener("click", () => { $("answer").textContent = ""; });
+
+function enableButtons() {  // what the robot can do now, when connected and nothing is on its way
+  const can = connected && !sending && latest ? latest.can || [] : [];
+  document.querySelectorAll("button[data-command]").forEach((b) => {
+    b.disabled = !can.includes(b.dataset.command);
+    if (b.disabled && armed && armed.button === b) disarm();
+  });
+  document.querySelectorAll("button[data-ack]").forEach((b) => { b.disabled = !connected || sending; });
 }
 
 async function send(command, extra) {
-  let code = token();
+  let code = token(null, true);
   if (!code) return;
+  sending = true; enableButtons();
   answer(true, "…");
   try {
     for (let tries = 0; tries < 2; tries++) {
       const r = await fetch(`/api/command?lang=${encodeURIComponent(lang)}`, {method: "POST",
         headers: {"Content-Type": "application/json", "Authorization": "Bearer " + code},
         body: JSON.stringify(Object.assign({command}, extra || {}))});
-      if (r.status === 401) { code = refused(); if (!code) { answer(false, t("Not done: no staff code.")); return; } continue; }
+      if (r.status === 401) { code = refused(true); if (!code) { answer(false, t("Not done: no staff code.")); return; } continue; }
       const body = await r.json();
       if (r.status === 429) { answer(false, t("Not done: too many tries. Wait a moment and try again.")); return; }
       answer(body.ok, body.ok ? t("Done: {what}", {what: body.did}) : t("Not done: {why}", {why: body.reason}));
@@ -125,6 +142,8 @@ async function send(command, extra) {
     }
   } catch (e) {
     answer(false, t("Not done: no answer from the robot's computer"));
+  } finally {
+    sending = false; enableButtons();
   }
 }
 
@@ -252,6 +271,7 @@ function alertRow(a) {
   const button = el("button", {}, t("Seen"));
   button.dataset.ack = a.id;
   button.addEventListener("click", () => send("ack_alert", {id: a.id}));
+  button.disabled = !connected || sending;
   const state = a.state === "cleared" ? "cleared" : "raised";
   return el("div", {class: `alert ${state}`, role: "alert"},
     el("span", {}, el("strong", {}, a.state === "raised" ? t("The robot needs help") : t("Solved"), ":"), " ", a.text),
@@ -283,7 +303,7 @@ function render(s) {
   const first = site && site.stops.length ? name(site.stops[0]) : "–";
   $("next").textContent = s.next_stop ? name(s.next_stop) : s.touring && !s.stop ? first : "–";
   $("atstop").textContent = s.stop ? (s.at_stop_s === null ? t("on the way") : duration(s.at_stop_s)) : "–";
-  $("visitor").textContent = s.visitor === null ? "–" : t("on a tour");
+  $("visitor").textContent = s.visitor === null ? "–" : s.introducing ? t("being greeted") : t("on a tour");
   $("battery").textContent = s.battery === null ? "–" : `${Math.round(s.battery)} %`;
   $("meter").style.width = s.engagement === null || s.engagement === undefined ? "0" : `${Math.round((s.engagement + 1) * 50)}%`;
   $("links").replaceChildren(...Object.entries(s.links).flatMap(([n, st]) => linkRow(n, st, s.links_for_s[n])));
@@ -292,12 +312,9 @@ function render(s) {
   $("last").replaceChildren(...s.day.last.map((l) => el("li", {}, l)));
   $("path").textContent = s.path.join("  ›  ");
   $("log").textContent = s.log.join("\n");
-  $("alerts").replaceChildren(...s.alerts.map(alertRow));
+  $("alerts").replaceChildren(...s.alerts.concat(s.cleared || []).map(alertRow));
   $("holding").replaceChildren(...(s.holding || []).map(holdingRow));
-  document.querySelectorAll("button[data-command]").forEach((b) => {
-    b.disabled = !(s.can || []).includes(b.dataset.command);
-    if (b.disabled && armed && armed.button === b) disarm();
-  });
+  enableButtons();
   drawMap(s);
 }
 
@@ -314,8 +331,11 @@ async function streamURL() {  // off loopback: a one-use ticket, so the token st
 async function connect() {
   const ws = new WebSocket(await streamURL());
   ws.addEventListener("open", () => { $("offline").hidden = true; });
-  ws.addEventListener("message", (e) => render(JSON.parse(e.data)));
-  ws.addEventListener("close", () => { $("offline").hidden = false; setTimeout(connect, 2000); });
+  ws.addEventListener("message", (e) => { connected = true; render(JSON.parse(e.data)); });
+  ws.addEventListener("close", () => {
+    connected = false; enableButtons();
+    $("offline").hidden = false; setTimeout(connect, 2000);
+  });
 }
 
 let started = false;

@@ -13,6 +13,7 @@ from datetime import datetime
 from typing import TYPE_CHECKING
 
 from frog_bt.engine.tally import LEFT_STOPS
+from frog_bt.i18n import N_, Msg, say
 from frog_bt.model.events import Event, FrontendIn, FrontendOut
 from frog_bt.model.frontend import FrontendMessage, StartPoi, Tour, UserPositive
 
@@ -20,10 +21,25 @@ if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host
 
 LAST_TOURS = 10
+# a tour's reason (the words of the tour message) as staff say it, by how it starts
+REASONS = (
+    ("operator", N_("sent home by staff")),
+    ("battery", N_("battery low")),
+    ("electronics fault", N_("electronics fault")),
+    ("paused longer", N_("paused too long")),
+)
+
+
+def reason_words(reason: str) -> Msg | str:
+    """Why a tour ended early, in words staff use (a reason not known: as it was given)."""
+    return next((Msg(words) for start, words in REASONS if reason.startswith(start)), reason)
 
 
 class Day:
-    def __init__(self) -> None:
+    """``language``: the site's, which the day's lines are written in."""
+
+    def __init__(self, language: str = "en") -> None:
+        self.language = language
         self.started = 0
         self.completed = 0
         self.aborted = 0
@@ -70,13 +86,17 @@ class Day:
             else:
                 self.aborted += 1
             start = self._local(self._tour_start) + "-" if self._tour_start else ""
-            parts = [f"{len(self._stops)} stops"]
+            parts = [say(Msg("{n} stops", n=len(self._stops)), self.language)]
             left = self._host.core.journal.tally.stops_left() if self._host else []
             if left:
-                parts.append(f"skipped {', '.join(left)}")
+                parts.append(say(Msg("skipped {stops}", stops=", ".join(left)), self.language))
             if message.reason:
-                parts.append(message.reason)
-            self.last.appendleft(
-                f"{start}{self._local(t)} tour {message.state}: {'; '.join(parts)}"
+                parts.append(say(reason_words(message.reason), self.language))
+            when, said = start + self._local(t), "; ".join(parts)
+            line = (
+                Msg("{when} tour ended: {parts}", when=when, parts=said)
+                if message.state == "ended"
+                else Msg("{when} tour aborted: {parts}", when=when, parts=said)
             )
+            self.last.appendleft(say(line, self.language))
             self._tour_start = None

@@ -415,10 +415,11 @@ async def post_command(request: web.Request) -> web.Response:
         command, alert_id if isinstance(alert_id, str) else "", by=sender
     )
     request.app[PAGES].changed.set()
-    words = say(by_name(answer.words, request.app[EXECUTIVE].site), asked_language(request))
+    lang = asked_language(request)
+    words = say(by_name(answer.words, request.app[EXECUTIVE].site), lang)
     if not answer.ok:
-        return refuse(409, words)
-    return web.json_response({"ok": True, "did": words})
+        return web.json_response({"ok": False, "reason": words, "language": lang}, status=409)
+    return web.json_response({"ok": True, "did": words, "language": lang})
 
 
 ROUTES = [
@@ -485,7 +486,7 @@ def make_app(
         origins or Origins("127.0.0.1", executive.site.alerts.console_url),
         proxies=networks(cfg.trusted_proxies),
     )
-    app[SHOWN] = Shown(Day(), LogLines(owner=executive), StopClock())
+    app[SHOWN] = Shown(Day(executive.site.language), LogLines(owner=executive), StopClock())
     app[PAGES] = Pages(cfg.push_every)
     access = app[ACCESS]
     app[ACK_DESK] = AckDesk(

@@ -29,6 +29,7 @@ from frog_bt.text import InertFormatter
 
 if TYPE_CHECKING:
     from frog_bt.live.console.day import Day
+    from frog_bt.model.channels import Alert
     from frog_bt.runtime.executive import Executive
 
 Behaviour = py_trees.behaviour.Behaviour
@@ -156,6 +157,7 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock)
         "waypoint": board.get(keys.WAYPOINT) if touring else None,
         "at_stop_s": stop_clock.seen(stop, now, arrived),
         "visitor": board.get(keys.VISITOR) if touring else None,
+        "introducing": doing.msgid == INTRODUCING,
         "engagement": board.get(keys.ENGAGEMENT_METER),
         "battery": diagnostics.value.battery if diagnostics is not None else None,
         "paused": bool(board.get(keys.PAUSED)),
@@ -164,18 +166,10 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock)
         "touring": touring,
         "links": links,
         "links_for_s": {name: now - since[name][1] for name in links if name in since},
-        "alerts": [
-            {
-                "id": a.id,
-                "kind": a.kind,
-                "text": a.text,
-                "since": a.since,
-                "state": a.state,
-                "severity": a.severity,
-                "answers": list(a.answers),
-            }
-            for a in book.shown()
-        ],
+        # CONTRACT §7: the alerts raised now (a cleared one leaves the list)...
+        "alerts": [_alert(a) for a in book.shown() if a.state != "cleared"],
+        # ... and, for the page, the cleared ones no person has acknowledged yet (grey)
+        "cleared": [_alert(a) for a in book.shown() if a.state == "cleared"],
         # acknowledged, and still true: the page says so until it is resolved
         "holding": [
             {"id": a.id, "kind": a.kind, "text": a.text, "since": a.since}
@@ -200,6 +194,21 @@ def state(executive: Executive, day: Day, logs: LogLines, stop_clock: StopClock)
         "path": [node.name for node in path],
         "log": list(logs.lines),
         "time": now,
+    }
+
+
+INTRODUCING = "Introducing itself to a visitor"  # runtime/phrase.py's words for it
+
+
+def _alert(a: Alert) -> dict[str, Any]:
+    return {
+        "id": a.id,
+        "kind": a.kind,
+        "text": a.text,
+        "since": a.since,
+        "state": a.state,
+        "severity": a.severity,
+        "answers": list(a.answers),
     }
 
 

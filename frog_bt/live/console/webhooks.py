@@ -258,6 +258,7 @@ class Webhooks:
         *,
         ack_secret: str | None = None,
         wall: Callable[[], float] = time.time,
+        language: str = "en",
     ) -> None:
         self.cfg = cfg
         self.robot = robot or cfg.robot
@@ -265,7 +266,7 @@ class Webhooks:
         self.wall = wall
         self._key = link_key(ack_secret) if ack_secret and cfg.console_url else None
         self._started: dict[str, float] = {}  # alert id -> wall time it was raised
-        sender = Sender(self.robot, cfg.console_url)
+        sender = Sender(self.robot, cfg.console_url, language)
         # a plain URL is validated here too: ``model_copy(update=...)`` does not validate
         hooks = [Webhook.model_validate(h) for h in cfg.webhooks]
         self.destinations = [Destination(hook, cfg, sender, self.stats, wall) for hook in hooks]
