@@ -50,7 +50,8 @@ class Batch:
     outputs: list[tuple[int, float, str, str, Any]] = field(default_factory=list)
     # ^ side ("ros" | "frontend"), channel (topic | message type), payload
     events: list[tuple[int, float, str, Any]] = field(default_factory=list)  # type, message
-    statuses: list[tuple[int, float, tuple[Status, ...]]] = field(default_factory=list)
+    statuses: list[tuple[int, float, tuple[tuple[int, Status], ...]]] = field(default_factory=list)
+    # ^ the nodes whose status changed in that tick: (pre-order number, status), in order
     notes: list[tuple[int, float, str, Level]] = field(default_factory=list)
     blackboard: list[tuple[int, float, str, Any]] = field(default_factory=list)  # key, value
 
@@ -98,10 +99,10 @@ class Rows:
         self.batch_ticks = batch_ticks
         self.on_full = on_full
         self.host: Host | None = None
+        self.raw_inputs = False  # keep inputs as received (msgspec.Raw), for another process
         self._behaviours = list(index.behaviours)
         self._position = {b: i for i, b in enumerate(self._behaviours)}  # by identity
-        self._statuses: tuple[Status, ...] = ()
-        self._current: list[Status] = []
+        self._current: list[Status | None] = [None] * len(self._behaviours)
         self._scan_all = True  # read every node's status at the next tick
         self._last_note: Note | None = None
         self._blackboard: dict[str, Any] = {}
@@ -158,7 +159,9 @@ class Rows:
         if role == "pose":
             self.batch.poses.append((*stamp, value.x, value.y, value.yaw))
         elif role is not None:
-            self.batch.inputs.append((*stamp, role, value))
+            # Another process decodes the bytes again: cheaper to hand over than the values.
+            raw = event.raw if self.raw_inputs else None
+            self.batch.inputs.append((*stamp, role, value if raw is None else raw))
 
     def ros_out(self, out: RobotCommand) -> None:
         stamp = self._stamp(out.t)
@@ -187,24 +190,26 @@ class Rows:
             batch.restamp(t)
             self._unstamped = False
         touched = getattr(core, "touched", None)
+        current = self._current
+        changes: list[tuple[int, Status]] = []
         if self._scan_all or touched is None:
-            statuses = tuple([b.status for b in self._behaviours])
-            self._current = list(statuses)
+            for i, node in enumerate(self._behaviours):
+                if current[i] is not node.status:
+                    current[i] = node.status
+                    changes.append((i, node.status))
             self._scan_all = touched is None
-            changed = statuses != self._statuses
         else:
             # Only the nodes the tick reached or stopped can have changed (Core.touched):
-            # the cost follows the active path, not the size of the tour.
-            current, position, changed = self._current, self._position, False
+            # the cost follows the active path, not the size of the tour; and only the
+            # changes are kept (a row is not a copy of the whole tree).
+            position = self._position
             for node in touched:
                 i = position.get(node)
                 if i is not None and current[i] is not node.status:
                     current[i] = node.status
-                    changed = True
-            statuses = tuple(current) if changed else self._statuses
-        if changed:
-            self._statuses = statuses
-            batch.statuses.append((tick, t, statuses))
+                    changes.append((i, node.status))
+        if changes:
+            batch.statuses.append((tick, t, tuple(changes)))
         notes = core.journal.notes
         if notes and notes[-1] is not self._last_note:
             i = len(notes) - 1

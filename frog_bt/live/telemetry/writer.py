@@ -41,6 +41,8 @@ STATUS_COLORS = {
     Status.FAILURE: 0xE5484DFF,
     Status.INVALID: 0x8B949EFF,
 }
+CODES = {status: i for i, status in enumerate(STATUS_COLORS)}  # a status as a small int
+COLOR_TABLE = np.array(list(STATUS_COLORS.values()), dtype=np.uint32)  # code -> colour
 ROUTE_COLORS = (0xA371F7AA, 0x39C5CFAA, 0xDB61A2AA, 0x8B949EAA)  # one per period of the day
 ZONE_COLORS = {"volume": 0x3FB95099, "special": 0xDB61A299}
 FACING, NOT_FACING, TRACKED = 0x3FB950FF, 0xFF8C42FF, 0x8B949E66
@@ -94,7 +96,7 @@ class Writer:
         self.index = index
         self.topics = {site.topic(role): role for role in ("goto", "approach", "icl", "dock")}
         self.facing = (site.recruit.facing_min, site.recruit.facing_max)
-        self._statuses: tuple[Status, ...] = ()
+        self._codes = np.full(len(index), CODES[Status.INVALID], dtype=np.uint8)  # now
         self._trail: deque[tuple[float, float]] = deque(maxlen=TRAIL_POINTS)
         self._poses_since_trail = 0
         self._docking: str | None = None
@@ -294,36 +296,31 @@ class Writer:
                 columns=rr.TextLog.columns(text=[r[3] for r in rows], level=[r[2] for r in rows]),
             )
 
-    def _write_statuses(self, rows: list[tuple[int, float, tuple[Status, ...]]]) -> Iterator[None]:
-        # A step reads about STATUSES_PER_STEP node statuses: a few rows of a big tree.
-        per_step = max(1, STATUSES_PER_STEP // max(1, len(self.index)))
-        changes: dict[int, list[tuple[int, float, str]]] = {}
-        colors: list[np.ndarray] = []
-        previous = self._statuses
+    def _write_statuses(
+        self, rows: list[tuple[int, float, tuple[tuple[int, Status], ...]]]
+    ) -> Iterator[None]:
+        # Each row holds the changes of one tick; the graph needs every node's colour per
+        # row: the codes of all nodes are kept here and a row's colours read off them.
+        # A step reads about STATUSES_PER_STEP node colours: a few rows of a big tree.
+        nodes = len(self.index)
+        per_step = max(1, STATUSES_PER_STEP // max(1, nodes))
+        lanes: dict[int, list[tuple[int, float, str]]] = {}
+        codes = self._codes
+        colors = np.empty((len(rows), nodes), dtype=np.uint32)
         for start in range(0, len(rows), per_step):
-            part = rows[start : start + per_step]
-            colors.append(
-                np.array(
-                    [[STATUS_COLORS[s] for s in statuses] for _, _, statuses in part],
-                    dtype=np.uint32,
-                )
-            )
-            for tick, t, statuses in part:
-                for i, status in enumerate(statuses):
-                    if not previous or previous[i] is not status:
-                        changes.setdefault(i, []).append((tick, t, status.name))
-                previous = statuses
+            for n, (tick, t, changes) in enumerate(rows[start : start + per_step], start):
+                for i, status in changes:
+                    codes[i] = CODES[status]
+                    lanes.setdefault(i, []).append((tick, t, status.name))
+                colors[n] = COLOR_TABLE[codes]
             yield
-        self._statuses = previous
         self.rec.send_columns(
             "bt/graph",
             indexes=_times(rows),
-            columns=rr.GraphNodes.columns(colors=np.concatenate(colors).reshape(-1)).partition(
-                [len(self.index)] * len(rows)
-            ),
+            columns=rr.GraphNodes.columns(colors=colors.reshape(-1)).partition([nodes] * len(rows)),
         )
         yield
-        for n, (i, lane) in enumerate(changes.items(), 1):
+        for n, (i, lane) in enumerate(lanes.items(), 1):
             self.rec.send_columns(
                 status_path(self.index.nodes[i].key),
                 indexes=_times(lane),
