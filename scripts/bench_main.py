@@ -334,12 +334,11 @@ def report(results: dict[str, Any], rows: list[dict[str, Any]]) -> str:
     phases = [(k, ticks[k].get("telemetry_phases")) for k in ticks if "-on" in k]
     phases = [(k, p) for k, p in phases if p]
     if phases:
+        off = {k: get(ticks, k.replace("-on", "-off"), "all", "p50_us") for k, _ in phases}
         body = [
             [
                 f"{k.split('-')[0]} stops",
-                f"{ticks[k]['all']['p50_us'] - ticks[k.replace('-on', '-off')]['all']['p50_us']:+.1f}"
-                if k.replace("-on", "-off") in ticks and "all" in ticks[k.replace("-on", "-off")]
-                else "n/a",
+                f"{ticks[k]['all']['p50_us'] - off[k]:+.1f}" if off[k] else "n/a",
                 f"{p['serialise'].get('p50_us', 0):.0f} / {p['serialise'].get('max_us', 0):.0f}",
                 f"{p['hand_over'].get('p50_us', 0):.0f} / {p['hand_over'].get('max_us', 0):.0f}",
                 f"{p['write_us_per_batch']:.0f}",

@@ -45,8 +45,8 @@ from frog_bt.runtime.checkpoint import save as save_checkpoint
 from frog_bt.runtime.notify import Notifier
 from frog_bt.runtime.observer import Observers
 from frog_bt.runtime.staff import Staff
-from frog_bt.runtime.warm import warm
 from frog_bt.runtime.status import link_line, status_line
+from frog_bt.runtime.warm import warm
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.warning_limit import WarningLimiter
 
