@@ -66,6 +66,19 @@ SCENARIO: dict[str, Any] = {
 }
 
 
+class _Null:
+    """An observer that hears every event and does nothing with it."""
+
+    def attach(self, host: Any) -> None:
+        pass
+
+    def on_event(self, event: Any) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
 def phase_of(node: Any, dock: str, recruit_at: str) -> str:
     kind = type(node).__name__
     if kind in ("WaitFrontendIdle", "ConfirmResume"):
@@ -119,7 +132,11 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
     )
     observers: list[Any] = []
     writes: list[int] = []
-    if telemetry != "off":  # as frog-bt run --record FILE --rerun save:FILE attaches them
+    if telemetry == "null":  # an observer that does nothing: what listening alone costs
+        from frog_bt.runtime.observer import attach_all
+
+        observers = attach_all(executive, [_Null()])
+    elif telemetry != "off":  # as frog-bt run --record FILE --rerun save:FILE attaches them
         from frog_bt.commands.run import attach_observers
         from frog_bt.runtime.memory import pin_malloc_thresholds
 
@@ -220,7 +237,7 @@ def main() -> None:
     p.add_argument("--stops", type=int, default=7)
     p.add_argument(
         "--telemetry",
-        choices=("on", "off", "record", "rerun"),
+        choices=("on", "off", "record", "rerun", "null"),
         default="off",
         help="on: --record FILE and --rerun save:FILE.rrd; or either alone",
     )

@@ -18,6 +18,7 @@ tick.
 from __future__ import annotations
 
 import math
+import operator
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -38,7 +39,9 @@ if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host
 
 Status = py_trees.common.Status
-ENGAGEMENT_KEYS: tuple[Key[Any], ...] = (keys.ENGAGEMENT_METER, keys.ENGAGEMENT_DECISION)
+BOARD_KEYS: tuple[Key[Any], ...] = (keys.ENGAGEMENT_METER, keys.ENGAGEMENT_DECISION, keys.SKIPPED)
+_status = operator.attrgetter("status")
+Behaviour = py_trees.behaviour.Behaviour
 
 
 @dataclass(slots=True)
@@ -108,6 +111,7 @@ class Rows:
         self._blackboard: dict[str, Any] = {}
         self._ticks_since_drain = 0
         self._unstamped = False
+        self._pending: list[tuple[Core, int, float, list[Behaviour], list[Status]]] = []
 
     def attach(self, host: Host) -> None:
         """Follow ``host``'s events (its core now, whichever that is)."""
@@ -181,48 +185,53 @@ class Rows:
             self.batch.events.append((*stamp, message.type, message))
 
     def tick(self, core: Core) -> None:
-        """After each tick: what changed in the tree, the notes, the engagement keys."""
+        """After each tick (the host tells it once the tick's callback is over, before the
+        next tick: :meth:`~frog_bt.runtime.observer.Observers.later`): the statuses of the
+        nodes it touched, then :meth:`settle`."""
         if not core.clock.ready:
             self._scan_all = True  # this tick's changes are not followed
             return
-        tick, t, batch = core.ticks, core.clock.now(), self.batch
-        if self._unstamped:
-            batch.restamp(t)
-            self._unstamped = False
-        touched = getattr(core, "touched", None)
-        current = self._current
-        changes: list[tuple[int, Status]] = []
+        touched = getattr(core, "told", None)
         if self._scan_all or touched is None:
-            for i, node in enumerate(self._behaviours):
-                if current[i] is not node.status:
-                    current[i] = node.status
-                    changes.append((i, node.status))
+            nodes = self._behaviours
             self._scan_all = touched is None
         else:
             # Only the nodes the tick reached or stopped can have changed (Core.touched):
-            # the cost follows the active path, not the size of the tour; and only the
-            # changes are kept (a row is not a copy of the whole tree).
-            position = self._position
-            for node in touched:
+            # the cost follows the active path, not the size of the tour.
+            nodes = touched
+        self._pending.append((core, core.ticks, core.clock.now(), nodes, [*map(_status, nodes)]))
+        self.settle()
+
+    def settle(self) -> None:
+        """The rows of the ticks taken since the last call: the statuses that changed (only
+        those: a row is not a copy of the tree), the new notes, the engagement keys."""
+        pending, self._pending = self._pending, []
+        batch, current, position = self.batch, self._current, self._position
+        for core, tick, t, nodes, statuses in pending:
+            if self._unstamped:
+                batch.restamp(t)
+                self._unstamped = False
+            changes: list[tuple[int, Status]] = []
+            for node, status in zip(nodes, statuses, strict=True):
                 i = position.get(node)
-                if i is not None and current[i] is not node.status:
-                    current[i] = node.status
-                    changes.append((i, node.status))
-        if changes:
-            batch.statuses.append((tick, t, tuple(changes)))
-        notes = core.journal.notes
-        if notes and notes[-1] is not self._last_note:
-            i = len(notes) - 1
-            while i >= 0 and notes[i] is not self._last_note:
-                i -= 1
-            batch.notes.extend((tick, n.at, n.text, n.level) for n in notes[i + 1 :])
-            self._last_note = notes[-1]
-        for key in ENGAGEMENT_KEYS:
-            value = core.board.get(key)
-            if value is not self._blackboard.get(key.name):
-                self._blackboard[key.name] = value
-                batch.blackboard.append((tick, t, key.name, value))
-        self._ticks_since_drain += 1
+                if i is not None and current[i] is not status:
+                    current[i] = status
+                    changes.append((i, status))
+            if changes:
+                batch.statuses.append((tick, t, tuple(changes)))
+            notes = core.journal.notes
+            if notes and notes[-1] is not self._last_note:
+                i = len(notes) - 1
+                while i >= 0 and notes[i] is not self._last_note:
+                    i -= 1
+                batch.notes.extend((tick, n.at, n.text, n.level) for n in notes[i + 1 :])
+                self._last_note = notes[-1]
+            for key in BOARD_KEYS:
+                value = core.board.get(key)
+                if value is not self._blackboard.get(key.name):
+                    self._blackboard[key.name] = value
+                    batch.blackboard.append((tick, t, key.name, value))
+            self._ticks_since_drain += 1
         if self._ticks_since_drain >= self.batch_ticks and self.on_full is not None:
             self.on_full()
 
@@ -230,6 +239,8 @@ class Rows:
 
     def drain(self) -> Batch:
         """The rows buffered so far; the buffer starts afresh."""
+        if self._pending:
+            self.settle()
         batch, self.batch = self.batch, Batch()
         self._ticks_since_drain = 0
         if self._unstamped:  # drained before the first tick with a time
