@@ -101,8 +101,26 @@ def test_blueprint_is_in_the_file(recorded: Recorded):
             name = batch.column("ViewBlueprint:display_name").to_pylist()[0][0]
             views[name] = kind
     assert views["Map"] == "2D"
-    assert views["Behaviour tree"] == "Graph"
+    assert views["Running path"] == "Graph"
+    assert views["Whole tree"] == "Graph"
+    assert views["Stops"] == "StateTimeline"
+    assert views["Bookmarks"] == "TextLog"
     assert views["Tour phases"] == "StateTimeline"
     assert views["All nodes"] == "StateTimeline"
     assert views["Log"] == "TextLog"
     assert views["Engagement"] == "TimeSeries"
+
+
+def test_the_running_path_is_a_small_graph_from_the_root(recorded: Recorded):
+    rows = recorded.values("/bt/path", "GraphNodes:node_ids")
+    assert len(rows) > 10
+    whole = recorded.values("/bt/graph", "GraphNodes:node_ids", static=True)[0]
+    for ids in rows:
+        assert ids[0] == whole[0]  # the root first
+        assert 1 < len(ids) < len(whole) // 2  # a path with its siblings, not the tree
+    assert len({tuple(ids) for ids in rows}) > 3  # it follows the tour
+
+
+def test_each_stop_has_a_lane_reached_then_played(recorded: Recorded):
+    lane = [s[0] for s in recorded.values("/stops/POI1", "StateChange:state")]
+    assert lane[:2] == ["reached", "played"]

@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from frog_bt.errors import DecodeError
+from frog_bt.live.telemetry.layout import TreeIndex
 from frog_bt.live.telemetry.observer import TelemetryObserver
 from frog_bt.live.telemetry.rows import Batch
 from frog_bt.live.telemetry.spec import parse_spec
@@ -125,6 +126,8 @@ def _serve(
                     telemetry.writer.write(deserialise(data))
                 except Exception:
                     log.exception("rerun telemetry: could not write a batch")
+            elif kind == "tree":
+                telemetry.writer.reload(*item[1:])  # type: ignore[arg-type]
             elif kind == "links":
                 telemetry.writer.write_links(*item[1:])  # type: ignore[arg-type]
             elif kind == "close":
@@ -203,6 +206,9 @@ class TelemetryProcess(TelemetryObserver):
 
     def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]) -> None:
         self._send(("links", tick, t, changes))
+
+    def _write_tree(self, tick: int, t: float, index: TreeIndex, generation: int) -> None:
+        self._send(("tree", tick, t, index, generation))
 
     def _flush_soon(self) -> None:
         self.flush()

@@ -27,7 +27,18 @@ import py_trees
 
 from frog_bt.live.telemetry.layout import TreeIndex
 from frog_bt.model import keys
-from frog_bt.model.events import Event, FrontendIn, FrontendOut, RobotCommand, RobotInput, Ticked
+from frog_bt.model.events import (
+    AlertChanged,
+    Doubted,
+    Event,
+    Faulted,
+    FrontendIn,
+    FrontendOut,
+    OperatorDone,
+    RobotCommand,
+    RobotInput,
+    Ticked,
+)
 from frog_bt.model.key import Key
 from frog_bt.model.outcomes import Level
 from frog_bt.model.wire import INPUTS
@@ -39,8 +50,14 @@ if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host
 
 Status = py_trees.common.Status
-BOARD_KEYS: tuple[Key[Any], ...] = (keys.ENGAGEMENT_METER, keys.ENGAGEMENT_DECISION, keys.SKIPPED)
+BOARD_KEYS: tuple[Key[Any], ...] = (
+    keys.ENGAGEMENT_METER,
+    keys.ENGAGEMENT_DECISION,
+    keys.SKIPPED,  # a stop's lane: skipped
+    keys.TARGET,  # a stop's lane: reached (the POI driven to when a drive succeeds)
+)
 _status = operator.attrgetter("status")
+MARKS = frozenset({OperatorDone, AlertChanged, Doubted, Faulted})  # bookmarks on the timeline
 Behaviour = py_trees.behaviour.Behaviour
 
 
@@ -57,6 +74,8 @@ class Batch:
     # ^ the nodes whose status changed in that tick: (pre-order number, status), in order
     notes: list[tuple[int, float, str, Level]] = field(default_factory=list)
     blackboard: list[tuple[int, float, str, Any]] = field(default_factory=list)  # key, value
+    marks: list[tuple[int, float, str, str, str]] = field(default_factory=list)
+    # ^ bookmarks: kind ("staff" | "doubted" | "fault"), level, text
 
     def restamp(self, t: float) -> None:
         """Give rows that arrived before the clock had a time (NaN) the time ``t``."""
@@ -70,7 +89,7 @@ class Batch:
 
     def _stamped(self) -> tuple[list[tuple[Any, ...]], ...]:
         """The rows stamped with the time: ``(tick, t, ...)``."""
-        return (self.poses, self.inputs, self.outputs, self.events)
+        return (self.poses, self.inputs, self.outputs, self.events, self.marks)
 
     def __len__(self) -> int:
         return (
@@ -81,6 +100,7 @@ class Batch:
             + len(self.statuses)
             + len(self.notes)
             + len(self.blackboard)
+            + len(self.marks)
         )
 
 
@@ -117,6 +137,14 @@ class Rows:
         """Follow ``host``'s events (its core now, whichever that is)."""
         self.host = host
 
+    def reindex(self, index: TreeIndex) -> None:
+        """Follow another tree (a reload): its nodes, every status read afresh."""
+        self.index = index
+        self._behaviours = list(index.behaviours)
+        self._position = {b: i for i, b in enumerate(self._behaviours)}
+        self._current = [None] * len(self._behaviours)
+        self._scan_all = True
+
     def detach(self) -> None:
         """Stop following (after close nothing more is buffered)."""
         self.host = None
@@ -140,6 +168,33 @@ class Rows:
             self.frontend_out(event)  # type: ignore[arg-type]
         elif kind is FrontendIn:
             self.frontend_in(event)  # type: ignore[arg-type]
+        elif kind in MARKS:
+            self.mark(event)
+
+    def mark(self, event: Event) -> None:
+        """A bookmark: staff acted (a command, an alert raised for help, acknowledged), a
+        robot's answer was not believed, or the executive's own code failed."""
+        stamp = self._stamp(event.t)
+        if stamp is None:
+            return
+        if isinstance(event, OperatorDone):
+            by = f" ({event.by})" if event.by else ""
+            word = "done" if event.ok else "refused"
+            row = ("staff", "INFO" if event.ok else "WARN", f"{event.command}{by}: {word}")
+        elif isinstance(event, AlertChanged):
+            alert = event.alert
+            row = (
+                "staff",
+                "WARN" if alert.state == "raised" else "INFO",
+                f"alert {alert.kind} {alert.state}: {alert.text}",
+            )
+        elif isinstance(event, Doubted):
+            row = ("doubted", "WARN", f"/FROG_response {event.code} not believed: {event.why}")
+        elif isinstance(event, Faulted):
+            row = ("fault", "ERROR", f"{event.where}: {event.what} failed ({event.count}x)")
+        else:
+            return
+        self.batch.marks.append((*stamp, *row))
 
     def _stamp(self, t: float) -> tuple[int, float] | None:
         """(tick, t) for a row arriving now; None when detached. Before the clock has a
