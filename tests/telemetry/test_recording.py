@@ -7,6 +7,8 @@ import itertools
 from rerun.chunk import RrdReader
 from telemetry_tour import Recorded
 
+from frog_bt.live.telemetry.writer import TRAIL_EVERY
+
 
 def test_the_tour_itself_went_fine(recorded: Recorded):
     assert recorded.outcome.code == 0, recorded.outcome.reason
@@ -18,7 +20,7 @@ def test_robot_pose_rows_cover_the_tour(recorded: Recorded):
     poses = recorded.rows("/map/robot")
     assert poses > 500  # /FROG_pose at 10 Hz for minutes of sim time
     assert recorded.rows("/map/robot/heading") == poses
-    assert recorded.rows("/map/robot/trail") >= poses // 20
+    assert recorded.rows("/map/robot/trail") >= poses // TRAIL_EVERY
     positions = recorded.values("/map/robot", "Points2D:positions")
     xs = [p[0][0] for p in positions]
     ys = [p[0][1] for p in positions]

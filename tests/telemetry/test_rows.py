@@ -63,7 +63,7 @@ def test_rows_belong_to_the_tick_that_consumes_or_produces_them(bench: Bench):
     bench.ros("response", 2)
     assert rows.batch.inputs[-1][:3] == (4, t3, "response")
     batch = rows.drain()
-    assert len(batch) == 7 and len(rows.batch) == 0
+    assert len(batch) == 8 and len(rows.batch) == 0  # /target among them (a stop lane)
 
 
 def test_notes_are_taken_once_even_when_the_list_is_trimmed(bench: Bench):

@@ -53,7 +53,7 @@ R_ROUTE, R_TRAIL, R_ZONE, R_ARROW = -1.5, -2.0, -1.0, -1.5
 PERIODIC = frozenset({"engagement"})  # front-end commands sent on a timer: DEBUG, not INFO
 TRAIL_STEP = 0.5  # metres between trail points
 TRAIL_POINTS = 1000  # the trail keeps the last 500 m or so
-TRAIL_EVERY = 20  # poses between two logged trails (2 s at 10 Hz)
+TRAIL_EVERY = 40  # poses between two logged trails (4 s at 10 Hz; the trail is most of a file)
 PATH_CHAR, PATH_GAP, PATH_LEVEL = 7.5, 24.0, 60.0  # the running path's layout (graph units)
 LANES_PER_STEP = 4  # status lanes written per step of a batch
 STATUSES_PER_STEP = 2000  # node statuses (rows x nodes) read per step of a batch
@@ -357,7 +357,7 @@ class Writer:
         lanes: dict[int, list[tuple[int, float, str]]] = {}
         codes = self._codes
         colors = np.empty((len(rows), nodes), dtype=np.uint32)
-        paths: list[tuple[int, float, tuple[int, ...], np.ndarray]] = []
+        paths: list[tuple[int, float, tuple[int, ...] | None, np.ndarray]] = []
         for start in range(0, len(rows), per_step):
             for n, (tick, t, changes) in enumerate(rows[start : start + per_step], start):
                 for i, status in changes:
@@ -402,12 +402,16 @@ class Writer:
             if at < 0:
                 return tuple(shown)
 
-    def _write_paths(self, rows: list[tuple[int, float, tuple[int, ...], np.ndarray]]) -> None:
-        """The running path as its own small graph (``{bt}/path``): one row per change of
-        its nodes or their colours; laid out level by level, each level centred."""
+    def _write_paths(
+        self, rows: list[tuple[int, float, tuple[int, ...] | None, np.ndarray]]
+    ) -> None:
+        """The running path as its own small graph (``{bt}/path``), laid out level by level,
+        each level centred: its nodes, labels, places and edges when they change (``shown``
+        not None), its colours whenever they change (the viewer keeps the latest of each)."""
         nodes = self.index.nodes
-        ids, labels, positions, colors, edges, lengths, edge_lengths = [], [], [], [], [], [], []
-        for _, _, shown, row_colors in rows:
+        ids, labels, positions, edges, lengths, edge_lengths = [], [], [], [], [], []
+        for _, _, shown, _ in (r for r in rows if r[2] is not None):
+            assert shown is not None
             by_depth: dict[int, list[int]] = {}
             for i in shown:
                 by_depth.setdefault(nodes[i].depth, []).append(i)
@@ -419,26 +423,31 @@ class Writer:
                     labels.append(nodes[i].name)
                     positions.append((x + w / 2, nodes[i].depth * PATH_LEVEL))
                     x += w
-            colors.append(row_colors)
             lengths.append(len(shown))
             pairs = [(nodes[nodes[i].parent].key, nodes[i].key) for i in shown[1:]]  # type: ignore[index]
             edges.extend(pairs)
             edge_lengths.append(len(pairs))
-        times = _times(rows)
+        path = f"{self.bt}/path"
+        if lengths:
+            times = _times([r for r in rows if r[2] is not None])
+            self.rec.send_columns(
+                path,
+                indexes=times,
+                columns=rr.GraphNodes.columns(
+                    node_ids=ids, labels=labels, positions=np.array(positions, dtype=np.float32)
+                ).partition(lengths),
+            )
+            self.rec.send_columns(
+                path,
+                indexes=times,
+                columns=rr.GraphEdges.columns(edges=edges).partition(edge_lengths),
+            )
         self.rec.send_columns(
-            f"{self.bt}/path",
-            indexes=times,
-            columns=rr.GraphNodes.columns(
-                node_ids=ids,
-                labels=labels,
-                positions=np.array(positions, dtype=np.float32),
-                colors=np.concatenate(colors),
-            ).partition(lengths),
-        )
-        self.rec.send_columns(
-            f"{self.bt}/path",
-            indexes=times,
-            columns=rr.GraphEdges.columns(edges=edges).partition(edge_lengths),
+            path,
+            indexes=_times(rows),
+            columns=rr.GraphNodes.columns(colors=np.concatenate([r[3] for r in rows])).partition(
+                [len(r[3]) for r in rows]
+            ),
         )
 
     def _write_stops(self, batch: Batch) -> None:
