@@ -132,4 +132,4 @@ class Samples:
     def window(self, start: float, end: float) -> np.ndarray:
         """Levels of the samples with ``start < t <= end``."""
         t = _np().asarray(self._t, dtype=float)
-        return self.levels()[(t > start) & (t <= end)]
+        return self.levels()[(t > start) & (t <= end)]  # type: ignore[no-any-return]

@@ -47,12 +47,11 @@ class TelemetryObserver(ABC):
             self.on_links(host.clock.now() if host.clock.ready else 0.0, links)
 
     def on_event(self, event: Event) -> None:
-        kind = type(event)
-        if kind is LinksChanged:
+        if isinstance(event, LinksChanged):
             self.on_links(event.t, event.links)
             return
-        if kind is Ticked and self._host is not None and self._host.core is not self._core:
-            self._reloaded(self._host.core, event.t)  # type: ignore[attr-defined]
+        if type(event) is Ticked and self._host is not None and self._host.core is not self._core:
+            self._reloaded(self._host.core, event.t)
         self.rows.on_event(event)
 
     def _reloaded(self, core: Core, t: float) -> None:

@@ -333,8 +333,8 @@ class Writer:
             logs.setdefault("log/notes", []).append((tick, t, level.value, text))
         self._read_blackboard(batch)
         self._write_stops(batch)
-        for tick, t, kind, level, text in batch.marks:
-            logs.setdefault(MARK_PATHS[kind], []).append((tick, t, level, text))
+        for tick, t, kind, mark_level, text in batch.marks:
+            logs.setdefault(MARK_PATHS[kind], []).append((tick, t, mark_level, text))
         for path, rows in logs.items():
             if not rows:  # an empty temporal chunk crashes the 0.41 viewer's time panel
                 continue
