@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import gc
+import resource
 import sys
 import tempfile
 import time
@@ -63,6 +64,19 @@ SCENARIO: dict[str, Any] = {
         }
     ],
 }
+
+
+class _Null:
+    """An observer that hears every event and does nothing with it."""
+
+    def attach(self, host: Any) -> None:
+        pass
+
+    def on_event(self, event: Any) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
 
 
 def phase_of(node: Any, dock: str, recruit_at: str) -> str:
@@ -118,7 +132,11 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
     )
     observers: list[Any] = []
     writes: list[int] = []
-    if telemetry != "off":  # as frog-bt run --record FILE --rerun save:FILE attaches them
+    if telemetry == "null":  # an observer that does nothing: what listening alone costs
+        from frog_bt.runtime.observer import attach_all
+
+        observers = attach_all(executive, [_Null()])
+    elif telemetry != "off":  # as frog-bt run --record FILE --rerun save:FILE attaches them
         from frog_bt.commands.run import attach_observers
         from frog_bt.runtime.memory import pin_malloc_thresholds
 
@@ -165,11 +183,35 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
     finally:
         await sim.stop()
         close0 = time.perf_counter()
+        children0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         for observer in observers:
             observer.close()
+        children1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         close_s = time.perf_counter() - close0
+        sizes = {
+            f.name: f.stat().st_size for f in workdir.iterdir() if f.suffix in (".rrd", ".mcap")
+        }
     wall = time.monotonic() - wall0
     every = [dt for values in samples.values() for dt in values]
+    # Telemetry's phases: on the tick (its taps: the overhead above), then after the tick
+    # serialise and hand over (this process), then write (the writer child, its CPU time).
+    handover: dict[str, Any] = {}
+    timings = getattr(observers[-1], "timings", None) if observers else None
+    if timings is not None:
+        batches = len(timings.serialise)
+        child_s = (children1.ru_utime + children1.ru_stime) - (
+            children0.ru_utime + children0.ru_stime
+        )
+        handover = {
+            "batches": batches,
+            "serialise": summary_us(timings.serialise),
+            "hand_over": summary_us(timings.hand_over),
+            "write_child_cpu_s": child_s,
+            "write_us_per_batch": child_s * 1e6 / max(1, batches),
+            "after_tick_us_per_tick": (sum(timings.serialise) + sum(timings.hand_over))
+            / 1e3
+            / max(1, len(every)),
+        }
     return {
         "stops": stops,
         "telemetry": telemetry,
@@ -183,6 +225,9 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
         "phases": {p: summary_us(samples[p]) for p in PHASES if samples.get(p)},
         "telemetry_writes": summary_us(writes),  # steps of writing rows to rerun
         "telemetry_write_us_per_tick": sum(writes) / 1e3 / max(1, len(every)),
+        "telemetry_phases": handover,
+        "telemetry_dropped_batches": getattr(observers[-1], "dropped", 0) if observers else 0,
+        "file_bytes": sizes,  # the recording and the .rrd of the tour
         "gc_collections": [s["collections"] for s in gc.get_stats()],
     }
 
@@ -192,7 +237,7 @@ def main() -> None:
     p.add_argument("--stops", type=int, default=7)
     p.add_argument(
         "--telemetry",
-        choices=("on", "off", "record", "rerun"),
+        choices=("on", "off", "record", "rerun", "null"),
         default="off",
         help="on: --record FILE and --rerun save:FILE.rrd; or either alone",
     )

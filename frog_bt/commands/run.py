@@ -233,13 +233,6 @@ def run(args: argparse.Namespace) -> int:
         logs.setup(args.verbose, args.log_format)  # run: may have chosen it
         tree = load_tree(args.tree, site)
         settings = resolve(args, site)
-        if args.watch and settings.rerun:
-            raise UsageError(
-                "--watch",
-                "",
-                "cannot be combined with --rerun (the viewer's "
-                "tree layout is fixed when it starts)",
-            )
         console = console_settings(args)
         lock = claim_checkpoint(settings.checkpoint) if settings.checkpoint else None
     except FrogError as exc:

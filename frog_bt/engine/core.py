@@ -122,6 +122,7 @@ class Core:
         # changed is among them (a status changes only in its node's tick or in stop()),
         # so observers can follow the tree in O(active path) rather than O(tree).
         self.touched: list[Behaviour] = []
+        self.told: list[Behaviour] = []  # the nodes the last tick touched, for its observers
         observed.attach(tree.root, self.touched)
 
     def who(self, node: Behaviour | None) -> str:
@@ -251,6 +252,10 @@ class Core:
         observers (they may read this core's tree, board and journal as the tick left
         them); the root's status."""
         self.setup()
+        emit = self.emit
+        settle = getattr(emit, "settle", None)
+        if settle is not None:
+            settle()  # the observers have heard the last tick's end before this one starts
         self.trace.decided.clear()
         self.pause_ran_out = self.operator.check_pause(self.clock.now())
         touched = self.touched
@@ -263,8 +268,16 @@ class Core:
         status = self.root.status
         if self.after_tick is not None:
             self.after_tick()
-        if self.emit:
-            self.emit(Ticked(self.clock.now(), self.ticks, status.name))  # type: ignore[arg-type]
+        if emit:
+            ticked = Ticked(self.clock.now(), self.ticks, status.name)  # type: ignore[arg-type]
+            # told once the tick's callback is over (Observers.later): off the tick's path
+            later = getattr(emit, "later", None)
+            if later is not None:
+                self.told = touched.copy()  # what the observers read as touched by it
+                later(ticked)
+            else:
+                self.told = touched
+                emit(ticked)
         touched.clear()
         return status
 

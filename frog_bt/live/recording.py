@@ -377,7 +377,9 @@ class Recorder:
         self._write(FAULT, event.t, channels.encode(fault))
 
     def _tick(self, event: Ticked) -> None:
-        self._write(TICK, event.t, channels.encode(channels.Tick(event.tick, event.status)))
+        # In order with the rest, but encoded once the tick is over (see _add): the tick
+        # itself only appends.
+        self._write(TICK, event.t, event)  # type: ignore[arg-type]
 
     # ------------------------------------------------------------ writing
 
@@ -414,13 +416,15 @@ class Recorder:
             self._add(topic, ns, data)
             self._last_ns = ns
 
-    def _add(self, topic: str, ns: int, data: bytes) -> None:
+    def _add(self, topic: str, ns: int, data: bytes | Ticked) -> None:
+        if type(data) is Ticked:
+            data = channels.encode(channels.Tick(data.tick, data.status))
         cid = self._channels.get(topic)
         if cid is None:  # a channel of ours, first used now (or an unknown topic)
             cid = self._channels[self.channel(topic, OWN_TYPES.get(topic, "unknown"))]
         seq = self._sequence.get(cid, 0)
         self._sequence[cid] = seq + 1
-        self._queue.append((cid, ns, data, seq & 0xFFFFFFFF))
+        self._queue.append((cid, ns, data, seq & 0xFFFFFFFF))  # type: ignore[arg-type]
         self.messages += 1
 
     def _drain(self) -> None:

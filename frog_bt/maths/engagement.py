@@ -17,9 +17,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
+
+
+def _np() -> Any:
+    """numpy, imported on first use: ``frog-bt run`` starts without it (0.1 s) and
+    warms it in a thread once connected (:func:`frog_bt.runtime.warm.warm`)."""
+    import numpy
+
+    return numpy
 
 
 class FaceLike(Protocol):
@@ -60,7 +69,7 @@ class Decision:
 
 def vote(levels: np.ndarray) -> tuple[int, int]:
     """(engaged votes, not-engaged votes) of ``levels``."""
-    engaged = int(np.count_nonzero(levels >= 0.0))
+    engaged = int(_np().count_nonzero(levels >= 0.0))
     return engaged, int(levels.size) - engaged
 
 
@@ -75,15 +84,16 @@ def meter(levels: np.ndarray) -> float | None:
         side = levels[levels < 0.0]
     else:
         side = levels
-    return float(np.clip(side.mean(), -1.0, 1.0))
+    return float(_np().clip(side.mean(), -1.0, 1.0))
 
 
 def edge_indices(n: int, edge: float) -> np.ndarray:
     """Indices of the first and last ``ceil(edge·n)`` of ``n`` samples, each once."""
+    np_ = _np()
     if n == 0:
-        return np.empty(0, dtype=np.intp)
+        return np_.empty(0, dtype=np_.intp)  # type: ignore[no-any-return]
     k = min(n, math.ceil(edge * n - 1e-9))
-    return np.union1d(np.arange(k), np.arange(n - k, n))
+    return np_.union1d(np_.arange(k), np_.arange(n - k, n))  # type: ignore[no-any-return]
 
 
 def decide(levels: np.ndarray, edge: float = 0.15, on_tie: bool = False) -> Decision:
@@ -117,9 +127,9 @@ class Samples:
         return f"{len(self)} samples: {levels}{more}"
 
     def levels(self) -> np.ndarray:
-        return np.asarray(self._level, dtype=float)
+        return _np().asarray(self._level, dtype=float)  # type: ignore[no-any-return]
 
     def window(self, start: float, end: float) -> np.ndarray:
         """Levels of the samples with ``start < t <= end``."""
-        t = np.asarray(self._t, dtype=float)
-        return self.levels()[(t > start) & (t <= end)]
+        t = _np().asarray(self._t, dtype=float)
+        return self.levels()[(t > start) & (t <= end)]  # type: ignore[no-any-return]

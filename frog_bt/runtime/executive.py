@@ -46,6 +46,7 @@ from frog_bt.runtime.notify import Notifier
 from frog_bt.runtime.observer import Observers
 from frog_bt.runtime.staff import Staff
 from frog_bt.runtime.status import link_line, status_line
+from frog_bt.runtime.warm import warm
 from frog_bt.tree.loader import LoadedTree
 from frog_bt.warning_limit import WarningLimiter
 
@@ -206,6 +207,8 @@ class Executive:
         self.emit(AlertChanged(t, alert))
 
     def _on_link(self, state: LinkState) -> None:
+        if state.connected and not self.was_connected:
+            warm()  # numpy and the like, for later, now that the wire is up
         self.was_connected = self.was_connected or state.connected
         actions = self.core.actions
         if not state.connected:

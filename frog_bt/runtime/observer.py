@@ -13,6 +13,7 @@ None there). :class:`Observers` is the list a host keeps and tells.
 
 from __future__ import annotations
 
+import asyncio
 import logging
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
@@ -66,6 +67,8 @@ class Observers:
     def __init__(self) -> None:
         self._observers: list[Observer] = []
         self._calls: list[Callable[[Event], None]] = []  # their on_event, bound once
+        self._later: list[Event] = []  # told once the current callback is over (later())
+        self._scheduled = False
         self.failures: dict[tuple[str, str], int] = {}  # (observer, error) -> how many
 
     def __bool__(self) -> bool:
@@ -90,6 +93,8 @@ class Observers:
     def emit(self, event: Event) -> None:
         """Tell every observer, in the order they attached. An observer that fails is
         counted and logged once (per observer and kind of error), never the tick's end."""
+        if self._later:
+            self.settle()
         for call in self._calls:
             try:
                 call(event)
@@ -107,6 +112,35 @@ class Observers:
                 type(event).__name__,
                 escape(f"{type(exc).__name__}: {exc}")[:LINE],
             )
+
+    def later(self, event: Event) -> None:
+        """Tell ``event`` once the event loop's current callback (the tick) is over, still
+        before any later event and before the next tick (:meth:`settle`, which the core
+        calls as a tick starts): the order every observer hears is the same, and their
+        work on a tick's end (telemetry's statuses, the recorder's tick record, the status
+        line) is off the tick's path. At once without an event loop (replay)."""
+        self._later.append(event)
+        if self._scheduled:
+            return
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:
+            self.settle()
+            return
+        self._scheduled = True
+        loop.call_soon(self.settle)
+
+    def settle(self) -> None:
+        """Tell the events held by :meth:`later` now (nothing when none are held)."""
+        self._scheduled = False
+        while self._later:
+            held, self._later = self._later, []
+            for event in held:
+                for call in self._calls:
+                    try:
+                        call(event)
+                    except Exception as exc:
+                        self.failed(call, exc, event)
 
     __call__ = emit  # a core's ``emit``: false while nobody listens
 

@@ -4,7 +4,7 @@ The recordings' tick channel (``/frog_bt/tick``) has each tick's number and the 
 status, not every node's; so each recording is replayed on the tree
 (:class:`~frog_bt.offline.replay.Replay`, which ticks exactly where the live executive
 did) with a :class:`Counter` attached as an observer: after each tick it reads the nodes
-the tick touched (``core.touched``: ticked or stopped) and their statuses. Nodes are
+the tick touched (``core.told``: ticked or stopped) and their statuses. Nodes are
 counted by their place in the tree (pre-order), so one tree file counts across tours.
 """
 
@@ -49,7 +49,7 @@ class Counter:
         if not isinstance(event, Ticked):
             return
         seen: set[int] = set()
-        for node in self.host.core.touched:
+        for node in self.host.core.told:
             i = self._index.get(id(node))
             if i is None or i in seen:
                 continue  # a node stopped and ticked again in one tick counts once

@@ -148,11 +148,6 @@ def _run(*argv: str, cwd=None) -> subprocess.CompletedProcess[str]:
             "--rerun bogus: expected spawn, save:FILE.rrd, connect[:URL], serve or off",
         ),
         (
-            ["--watch", "--rerun", "save:t.rrd"],
-            "--watch: cannot be combined with --rerun (the viewer's tree layout is fixed when it "
-            "starts)",
-        ),
-        (
             ["--config", "/no/such/site.yaml"],
             "/no/such/site.yaml: cannot read: No such file or directory",
         ),

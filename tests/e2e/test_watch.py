@@ -173,3 +173,69 @@ def test_a_reload_keeps_a_pause_and_its_timer() -> None:
     bench.clock.advance(bench.site.operator.pause_max)
     reason = second.operator.check_pause(bench.clock.now())
     assert reason is not None and "paused longer than" in reason.text
+
+
+def test_run_watch_rerun_the_viewer_follows_a_reloaded_tree(tmp_path: Path) -> None:
+    """``run --watch --rerun save:``: telemetry attached as ``run`` attaches it (its writer
+    process); after the reload the file has the new tree (graph, lanes, running path)
+    beside the first, a layout that opens on it, and a bookmark at the reload."""
+    from rerun.chunk import RrdReader
+
+    from frog_bt.commands.run import attach_observers
+    from frog_bt.runtime.observer import close_all
+
+    tour_file = copy_trees(tmp_path)
+    site = load_site()
+    tree = load_tree(tour_file, site)
+    rrd = tmp_path / "watch.rrd"
+
+    async def main() -> None:
+        async with Running({"frontend": {"idle_at": 10_000}}, site=site, tree=tree) as run:
+            exe = run.executive
+            observers = attach_observers(exe, record=None, rerun=f"save:{rrd}")
+            try:
+                watch = Watch(tour_file, None, tree, exe.offer)
+                await run.sim.wait_for(lambda r: r.channel == "/docking/state", 30)
+                await after_ticks(exe, lambda: bool(exe.core.ticks and exe.idle()))
+                text = tour_file.read_text()
+                tour_file.write_text(text.replace(f"name: {WAIT}", f"name: {WAIT} again"))
+                assert await watch.check() is True
+                await after_ticks(exe, lambda: exe.swaps > 0)
+                ticks = exe.core.ticks
+                await after_ticks(exe, lambda: exe.core.ticks > ticks + 3)
+            finally:
+                close_all(observers)
+
+    asyncio.run(main())
+    chunks: dict[str, list] = {}
+    reader = RrdReader(rrd)
+    for chunk in reader.stream():
+        chunks.setdefault(str(chunk.entity_path), []).append(chunk)
+
+    def values(entity: str, component: str, static: bool = False) -> list:
+        out: list = []
+        for chunk in chunks.get(entity, ()):
+            batch = chunk.to_record_batch()
+            if chunk.is_static == static and component in batch.schema.names:
+                out += batch.column(component).to_pylist()
+        return out
+
+    first = values("/bt/graph", "GraphNodes:labels", static=True)
+    second = values("/bt/tree2/graph", "GraphNodes:labels", static=True)
+    assert first and second
+    assert f"{WAIT} again" in second[-1] and f"{WAIT} again" not in first[-1]
+    # the new tree's lanes and running path follow it from the reload on
+    lanes = [p for p in chunks if p.startswith("/bt/tree2/status/")]
+    assert any(values(p, "StateChange:state") for p in lanes)
+    paths = values("/bt/tree2/path", "GraphNodes:labels")
+    assert paths and any(f"{WAIT} again" in labels for labels in paths)
+    [mark] = values("/log/bookmarks/reload", "TextLog:text")
+    assert "tree reloaded" in mark[0]
+    # the last layout sent opens on the new tree
+    origins = []
+    for blueprint in reader.blueprints():
+        for chunk in reader.stream(store=blueprint):
+            batch = chunk.to_record_batch()
+            if "ViewBlueprint:space_origin" in batch.schema.names:
+                origins += [o[0] for o in batch.column("ViewBlueprint:space_origin").to_pylist()]
+    assert "/bt/tree2/path" in origins

@@ -7,6 +7,8 @@ import itertools
 from rerun.chunk import RrdReader
 from telemetry_tour import Recorded
 
+from frog_bt.live.telemetry.writer import TRAIL_EVERY
+
 
 def test_the_tour_itself_went_fine(recorded: Recorded):
     assert recorded.outcome.code == 0, recorded.outcome.reason
@@ -18,7 +20,7 @@ def test_robot_pose_rows_cover_the_tour(recorded: Recorded):
     poses = recorded.rows("/map/robot")
     assert poses > 500  # /FROG_pose at 10 Hz for minutes of sim time
     assert recorded.rows("/map/robot/heading") == poses
-    assert recorded.rows("/map/robot/trail") >= poses // 20
+    assert recorded.rows("/map/robot/trail") >= poses // TRAIL_EVERY
     positions = recorded.values("/map/robot", "Points2D:positions")
     xs = [p[0][0] for p in positions]
     ys = [p[0][1] for p in positions]
@@ -101,8 +103,26 @@ def test_blueprint_is_in_the_file(recorded: Recorded):
             name = batch.column("ViewBlueprint:display_name").to_pylist()[0][0]
             views[name] = kind
     assert views["Map"] == "2D"
-    assert views["Behaviour tree"] == "Graph"
+    assert views["Running path"] == "Graph"
+    assert views["Whole tree"] == "Graph"
+    assert views["Stops"] == "StateTimeline"
+    assert views["Bookmarks"] == "TextLog"
     assert views["Tour phases"] == "StateTimeline"
     assert views["All nodes"] == "StateTimeline"
     assert views["Log"] == "TextLog"
     assert views["Engagement"] == "TimeSeries"
+
+
+def test_the_running_path_is_a_small_graph_from_the_root(recorded: Recorded):
+    rows = recorded.values("/bt/path", "GraphNodes:node_ids")
+    assert len(rows) > 10
+    whole = recorded.values("/bt/graph", "GraphNodes:node_ids", static=True)[0]
+    for ids in rows:
+        assert ids[0] == whole[0]  # the root first
+        assert 1 < len(ids) < len(whole) // 2  # a path with its siblings, not the tree
+    assert len({tuple(ids) for ids in rows}) > 3  # it follows the tour
+
+
+def test_each_stop_has_a_lane_reached_then_played(recorded: Recorded):
+    lane = [s[0] for s in recorded.values("/stops/POI1", "StateChange:state")]
+    assert lane[:2] == ["reached", "played"]

@@ -48,7 +48,6 @@ class Telemetry(TelemetryObserver):
         self, rec: RecordingStream, site: Site, tree: LoadedTree, *, batch_ticks: int = BATCH_TICKS
     ) -> None:
         """Log to ``rec`` (a ``rerun.RecordingStream`` with its sink already set)."""
-        from frog_bt.live.telemetry.blueprint import default_blueprint
         from frog_bt.live.telemetry.writer import Writer
 
         super().__init__(site, tree, batch_ticks=batch_ticks)
@@ -58,8 +57,7 @@ class Telemetry(TelemetryObserver):
         self.writer = Writer(rec, site, self.index)
         self._writing: deque[tuple[int, Iterator[None]]] = deque()  # batches being written
         self.write_errors = 0  # batches that could not be written (logged, never raised)
-        rec.send_blueprint(default_blueprint(self.index), make_active=True, make_default=True)
-        self.writer.write_static()
+        self.writer.write_static()  # with the default layout (a blueprint)
 
     @classmethod
     def open(
@@ -90,6 +88,13 @@ class Telemetry(TelemetryObserver):
         else:
             rec.spawn(port=sink.port)
         return cls(rec, site, tree)
+
+    def _write_tree(self, tick: int, t: float, index: TreeIndex, generation: int) -> None:
+        try:
+            self.writer.reload(tick, t, index, generation)
+        except Exception:  # telemetry must never stop the robot
+            self.write_errors += 1
+            log.exception("rerun telemetry: could not write the reloaded tree")
 
     def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]) -> None:
         try:

@@ -1,16 +1,18 @@
 """The default viewer layout sent with every recording (imports rerun; loaded lazily).
 
-The tree gets the whole width: it is wide (one column per leaf), and a
-narrower view makes its labels too small to read without zooming::
+The tree opens on its running path (the root down to the running leaf, with the
+siblings of each node on it: a few dozen nodes, legible at 1,400 px); the whole
+tree is the next tab. The time panel runs on the tour's own clock (``time``)::
 
-    ┌──────────────────────────────────────────────────────────────────────┐
-    │ Behaviour tree: the graph, node colours following their status       │
-    ├───────────────────┬──────────────────────────────┬───────────────────┤
-    │ Map: POIs, route, │ Status lanes: tour phases |  │ Log: decisions,   │
-    │ zones, robot and  │ all nodes (tabs)             │ commands, events  │
-    │ trail, visitors,  ├──────────────────────────────┤                   │
-    │ goal              │ Engagement | People | Battery│                   │
-    └───────────────────┴──────────────────────────────┴───────────────────┘
+    ┌─────────────────────────────────────────┬────────────────────────────┐
+    │ Running path | Whole tree (tabs)        │ Map: POIs, route, zones,   │
+    │                                         │ robot, trail, visitors     │
+    ├─────────────────────────────────────────┼────────────────────────────┤
+    │ Stops | Tour phases | All nodes | Links │ Log | Bookmarks (tabs):    │
+    ├─────────────────────────────────────────┤ time, level, text          │
+    │ Engagement | People seen | Battery %    │                            │
+    └─────────────────────────────────────────┴────────────────────────────┘
+    time panel: the `time` timeline, bookmarks (staff, doubted, faults, reload) as rows
 """
 
 from __future__ import annotations
@@ -29,15 +31,26 @@ SO_FAR = rrb.archetypes.TimeAxis(
 )
 
 
-def default_blueprint(index: TreeIndex) -> rrb.Blueprint:
-    phases = [f"+ /{status_path(index.nodes[i].key)}" for i in index.phases()]
-    lanes = rrb.Tabs(
-        rrb.StateTimelineView(
-            name="Tour phases", origin="/bt/status", contents=phases, time_view=SO_FAR
-        ),
-        rrb.StateTimelineView(name="All nodes", origin="/bt/status", time_view=SO_FAR),
+def default_blueprint(
+    index: TreeIndex, bt: str = "bt", stops: list[str] | None = None
+) -> rrb.Blueprint:
+    """The layout above for the tree logged under ``bt`` (``bt/tree2`` after a reload)."""
+    phases = [f"+ /{status_path(index.nodes[i].key, bt)}" for i in index.phases()]
+    tree = rrb.Tabs(
+        rrb.GraphView(name="Running path", origin=f"/{bt}/path"),
+        rrb.GraphView(name="Whole tree", origin=f"/{bt}/graph"),
+        active_tab=0,
     )
-    plots = rrb.Horizontal(
+    lanes = rrb.Tabs(
+        rrb.StateTimelineView(name="Stops", origin="/stops", time_view=SO_FAR),
+        rrb.StateTimelineView(
+            name="Tour phases", origin=f"/{bt}/status", contents=phases, time_view=SO_FAR
+        ),
+        rrb.StateTimelineView(name="All nodes", origin=f"/{bt}/status", time_view=SO_FAR),
+        rrb.StateTimelineView(name="Links", origin="/links", time_view=SO_FAR),
+        active_tab=0,
+    )
+    plots = rrb.Tabs(
         *(
             rrb.TimeSeriesView(
                 name=name,
@@ -52,38 +65,39 @@ def default_blueprint(index: TreeIndex) -> rrb.Blueprint:
             )
         )
     )
-    bottom = rrb.Horizontal(
-        rrb.Spatial2DView(name="Map", origin="/", contents=["+ /map/**"]),
-        rrb.Vertical(
-            lanes,
-            rrb.StateTimelineView(name="Links", origin="/links", time_view=SO_FAR),
-            plots,
-            row_shares=[5, 3, 4],
-        ),
+    log_columns = rrb.archetypes.TextLogColumns(
+        timeline_columns=[
+            rrb.components.TimelineColumn(TIME, visible=True),
+            rrb.components.TimelineColumn(TICK, visible=False),
+        ],
+        text_log_columns=[
+            rrb.components.TextLogColumn("loglevel"),
+            rrb.components.TextLogColumn("body"),
+            rrb.components.TextLogColumn("entitypath", visible=False),
+        ],
+    )
+    logs = rrb.Tabs(
         rrb.TextLogView(
             name="Log",
             origin="/log",
-            columns=rrb.archetypes.TextLogColumns(
-                # the viewer cuts time columns to "#..." this narrow; a row click sets the cursor
-                timeline_columns=[
-                    rrb.components.TimelineColumn(TIME, visible=False),
-                    rrb.components.TimelineColumn(TICK, visible=False),
-                ],
-                text_log_columns=[
-                    rrb.components.TextLogColumn("loglevel"),
-                    rrb.components.TextLogColumn("body"),
-                    rrb.components.TextLogColumn("entitypath", visible=False),
-                ],
-            ),
+            columns=log_columns,
             rows=rrb.archetypes.TextLogRows(filter_by_log_level=["INFO", "WARN", "ERROR"]),
         ),
-        column_shares=[7, 7, 6],
+        rrb.TextLogView(name="Bookmarks", origin="/log/bookmarks", columns=log_columns),
+    )
+    top = rrb.Horizontal(
+        tree,
+        rrb.Spatial2DView(name="Map", origin="/", contents=["+ /map/**"]),
+        column_shares=[3, 2],
+    )
+    bottom = rrb.Horizontal(
+        rrb.Vertical(lanes, plots, row_shares=[3, 2]), logs, column_shares=[1, 1]
     )
     return rrb.Blueprint(
-        rrb.Vertical(
-            rrb.GraphView(name="Behaviour tree", origin="/bt/graph"), bottom, row_shares=[1, 2]
-        ),
+        rrb.Vertical(top, bottom, row_shares=[3, 2]),
         rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
-        rrb.TimePanel(state="collapsed", timeline=TICK, play_state="following"),
+        # the tour's own clock (sim or wall time), so that a time from the report or the
+        # console's log finds the moment; the tick timeline is one click away
+        rrb.TimePanel(state="expanded", timeline=TIME, play_state="following"),
     )

@@ -12,11 +12,12 @@ from typing import TYPE_CHECKING
 
 from frog_bt.live.telemetry.layout import TreeIndex
 from frog_bt.live.telemetry.rows import Rows
-from frog_bt.model.events import Event, LinksChanged
+from frog_bt.model.events import Event, LinksChanged, Ticked
 from frog_bt.model.links import LinkStatus, changed
 
 if TYPE_CHECKING:
     from frog_bt.config import Site
+    from frog_bt.engine.core import Core
     from frog_bt.model.links import Links
     from frog_bt.runtime.observer import Host
     from frog_bt.tree.loader import LoadedTree
@@ -29,6 +30,7 @@ class TelemetryObserver(ABC):
         self.site = site
         self.tree = tree
         self.index = TreeIndex.of(tree.root)
+        self.generation = 1  # the tree's number: a reload (run --watch) starts the next
         self.rows = Rows(site, self.index, batch_ticks=batch_ticks, on_full=self._full)
         self._host: Host | None = None
         self._links: dict[str, LinkStatus] = {}
@@ -39,15 +41,29 @@ class TelemetryObserver(ABC):
         """Follow the host's events and, live, each link's state."""
         self.rows.attach(host)
         self._host = host
+        self._core = host.core
         links = host.links
         if links is not None:
             self.on_links(host.clock.now() if host.clock.ready else 0.0, links)
 
     def on_event(self, event: Event) -> None:
-        if type(event) is LinksChanged:
+        if isinstance(event, LinksChanged):
             self.on_links(event.t, event.links)
-        else:
-            self.rows.on_event(event)
+            return
+        if type(event) is Ticked and self._host is not None and self._host.core is not self._core:
+            self._reloaded(self._host.core, event.t)
+        self.rows.on_event(event)
+
+    def _reloaded(self, core: Core, t: float) -> None:
+        """The host runs another tree (``run --watch``): what was buffered goes out with the
+        old tree's numbering, then the new tree is numbered, sent and followed."""
+        self.flush()
+        self._core = core
+        self.tree = core.tree
+        self.index = TreeIndex.of(core.tree.root)
+        self.generation += 1
+        self.rows.reindex(self.index)
+        self._write_tree(core.ticks, t, TreeIndex(self.index.nodes), self.generation)
 
     def on_links(self, t: float, links: Links) -> None:
         changes = changed(self._links, links)
@@ -68,6 +84,10 @@ class TelemetryObserver(ABC):
             return
         self._flush_pending = True
         loop.call_soon(self._flush_soon)
+
+    @abstractmethod
+    def _write_tree(self, tick: int, t: float, index: TreeIndex, generation: int) -> None:
+        """A reloaded tree (its nodes only), from ``tick`` on."""
 
     @abstractmethod
     def _write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]) -> None: ...

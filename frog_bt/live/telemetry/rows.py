@@ -18,6 +18,7 @@ tick.
 from __future__ import annotations
 
 import math
+import operator
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -26,7 +27,18 @@ import py_trees
 
 from frog_bt.live.telemetry.layout import TreeIndex
 from frog_bt.model import keys
-from frog_bt.model.events import Event, FrontendIn, FrontendOut, RobotCommand, RobotInput, Ticked
+from frog_bt.model.events import (
+    AlertChanged,
+    Doubted,
+    Event,
+    Faulted,
+    FrontendIn,
+    FrontendOut,
+    OperatorDone,
+    RobotCommand,
+    RobotInput,
+    Ticked,
+)
 from frog_bt.model.key import Key
 from frog_bt.model.outcomes import Level
 from frog_bt.model.wire import INPUTS
@@ -38,7 +50,15 @@ if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host
 
 Status = py_trees.common.Status
-ENGAGEMENT_KEYS: tuple[Key[Any], ...] = (keys.ENGAGEMENT_METER, keys.ENGAGEMENT_DECISION)
+BOARD_KEYS: tuple[Key[Any], ...] = (
+    keys.ENGAGEMENT_METER,
+    keys.ENGAGEMENT_DECISION,
+    keys.SKIPPED,  # a stop's lane: skipped
+    keys.TARGET,  # a stop's lane: reached (the POI driven to when a drive succeeds)
+)
+_status = operator.attrgetter("status")
+MARKS = frozenset({OperatorDone, AlertChanged, Doubted, Faulted})  # bookmarks on the timeline
+Behaviour = py_trees.behaviour.Behaviour
 
 
 @dataclass(slots=True)
@@ -50,9 +70,12 @@ class Batch:
     outputs: list[tuple[int, float, str, str, Any]] = field(default_factory=list)
     # ^ side ("ros" | "frontend"), channel (topic | message type), payload
     events: list[tuple[int, float, str, Any]] = field(default_factory=list)  # type, message
-    statuses: list[tuple[int, float, tuple[Status, ...]]] = field(default_factory=list)
+    statuses: list[tuple[int, float, tuple[tuple[int, Status], ...]]] = field(default_factory=list)
+    # ^ the nodes whose status changed in that tick: (pre-order number, status), in order
     notes: list[tuple[int, float, str, Level]] = field(default_factory=list)
     blackboard: list[tuple[int, float, str, Any]] = field(default_factory=list)  # key, value
+    marks: list[tuple[int, float, str, str, str]] = field(default_factory=list)
+    # ^ bookmarks: kind ("staff" | "doubted" | "fault"), level, text
 
     def restamp(self, t: float) -> None:
         """Give rows that arrived before the clock had a time (NaN) the time ``t``."""
@@ -66,7 +89,7 @@ class Batch:
 
     def _stamped(self) -> tuple[list[tuple[Any, ...]], ...]:
         """The rows stamped with the time: ``(tick, t, ...)``."""
-        return (self.poses, self.inputs, self.outputs, self.events)
+        return (self.poses, self.inputs, self.outputs, self.events, self.marks)
 
     def __len__(self) -> int:
         return (
@@ -77,6 +100,7 @@ class Batch:
             + len(self.statuses)
             + len(self.notes)
             + len(self.blackboard)
+            + len(self.marks)
         )
 
 
@@ -98,19 +122,28 @@ class Rows:
         self.batch_ticks = batch_ticks
         self.on_full = on_full
         self.host: Host | None = None
+        self.raw_inputs = False  # keep inputs as received (msgspec.Raw), for another process
         self._behaviours = list(index.behaviours)
         self._position = {b: i for i, b in enumerate(self._behaviours)}  # by identity
-        self._statuses: tuple[Status, ...] = ()
-        self._current: list[Status] = []
+        self._current: list[Status | None] = [None] * len(self._behaviours)
         self._scan_all = True  # read every node's status at the next tick
         self._last_note: Note | None = None
         self._blackboard: dict[str, Any] = {}
         self._ticks_since_drain = 0
         self._unstamped = False
+        self._pending: list[tuple[Core, int, float, list[Behaviour], list[Status]]] = []
 
     def attach(self, host: Host) -> None:
         """Follow ``host``'s events (its core now, whichever that is)."""
         self.host = host
+
+    def reindex(self, index: TreeIndex) -> None:
+        """Follow another tree (a reload): its nodes, every status read afresh."""
+        self.index = index
+        self._behaviours = list(index.behaviours)
+        self._position = {b: i for i, b in enumerate(self._behaviours)}
+        self._current = [None] * len(self._behaviours)
+        self._scan_all = True
 
     def detach(self) -> None:
         """Stop following (after close nothing more is buffered)."""
@@ -135,6 +168,33 @@ class Rows:
             self.frontend_out(event)  # type: ignore[arg-type]
         elif kind is FrontendIn:
             self.frontend_in(event)  # type: ignore[arg-type]
+        elif kind in MARKS:
+            self.mark(event)
+
+    def mark(self, event: Event) -> None:
+        """A bookmark: staff acted (a command, an alert raised for help, acknowledged), a
+        robot's answer was not believed, or the executive's own code failed."""
+        stamp = self._stamp(event.t)
+        if stamp is None:
+            return
+        if isinstance(event, OperatorDone):
+            by = f" ({event.by})" if event.by else ""
+            word = "done" if event.ok else "refused"
+            row = ("staff", "INFO" if event.ok else "WARN", f"{event.command}{by}: {word}")
+        elif isinstance(event, AlertChanged):
+            alert = event.alert
+            row = (
+                "staff",
+                "WARN" if alert.state == "raised" else "INFO",
+                f"alert {alert.kind} {alert.state}: {alert.text}",
+            )
+        elif isinstance(event, Doubted):
+            row = ("doubted", "WARN", f"/FROG_response {event.code} not believed: {event.why}")
+        elif isinstance(event, Faulted):
+            row = ("fault", "ERROR", f"{event.where}: {event.what} failed ({event.count}x)")
+        else:
+            return
+        self.batch.marks.append((*stamp, *row))
 
     def _stamp(self, t: float) -> tuple[int, float] | None:
         """(tick, t) for a row arriving now; None when detached. Before the clock has a
@@ -158,7 +218,9 @@ class Rows:
         if role == "pose":
             self.batch.poses.append((*stamp, value.x, value.y, value.yaw))
         elif role is not None:
-            self.batch.inputs.append((*stamp, role, value))
+            # Another process decodes the bytes again: cheaper to hand over than the values.
+            raw = event.raw if self.raw_inputs else None
+            self.batch.inputs.append((*stamp, role, value if raw is None else raw))
 
     def ros_out(self, out: RobotCommand) -> None:
         stamp = self._stamp(out.t)
@@ -178,46 +240,53 @@ class Rows:
             self.batch.events.append((*stamp, message.type, message))
 
     def tick(self, core: Core) -> None:
-        """After each tick: what changed in the tree, the notes, the engagement keys."""
+        """After each tick (the host tells it once the tick's callback is over, before the
+        next tick: :meth:`~frog_bt.runtime.observer.Observers.later`): the statuses of the
+        nodes it touched, then :meth:`settle`."""
         if not core.clock.ready:
             self._scan_all = True  # this tick's changes are not followed
             return
-        tick, t, batch = core.ticks, core.clock.now(), self.batch
-        if self._unstamped:
-            batch.restamp(t)
-            self._unstamped = False
-        touched = getattr(core, "touched", None)
+        touched = getattr(core, "told", None)
         if self._scan_all or touched is None:
-            statuses = tuple([b.status for b in self._behaviours])
-            self._current = list(statuses)
+            nodes = self._behaviours
             self._scan_all = touched is None
-            changed = statuses != self._statuses
         else:
             # Only the nodes the tick reached or stopped can have changed (Core.touched):
             # the cost follows the active path, not the size of the tour.
-            current, position, changed = self._current, self._position, False
-            for node in touched:
+            nodes = touched
+        self._pending.append((core, core.ticks, core.clock.now(), nodes, [*map(_status, nodes)]))
+        self.settle()
+
+    def settle(self) -> None:
+        """The rows of the ticks taken since the last call: the statuses that changed (only
+        those: a row is not a copy of the tree), the new notes, the engagement keys."""
+        pending, self._pending = self._pending, []
+        batch, current, position = self.batch, self._current, self._position
+        for core, tick, t, nodes, statuses in pending:
+            if self._unstamped:
+                batch.restamp(t)
+                self._unstamped = False
+            changes: list[tuple[int, Status]] = []
+            for node, status in zip(nodes, statuses, strict=True):
                 i = position.get(node)
-                if i is not None and current[i] is not node.status:
-                    current[i] = node.status
-                    changed = True
-            statuses = tuple(current) if changed else self._statuses
-        if changed:
-            self._statuses = statuses
-            batch.statuses.append((tick, t, statuses))
-        notes = core.journal.notes
-        if notes and notes[-1] is not self._last_note:
-            i = len(notes) - 1
-            while i >= 0 and notes[i] is not self._last_note:
-                i -= 1
-            batch.notes.extend((tick, n.at, n.text, n.level) for n in notes[i + 1 :])
-            self._last_note = notes[-1]
-        for key in ENGAGEMENT_KEYS:
-            value = core.board.get(key)
-            if value is not self._blackboard.get(key.name):
-                self._blackboard[key.name] = value
-                batch.blackboard.append((tick, t, key.name, value))
-        self._ticks_since_drain += 1
+                if i is not None and current[i] is not status:
+                    current[i] = status
+                    changes.append((i, status))
+            if changes:
+                batch.statuses.append((tick, t, tuple(changes)))
+            notes = core.journal.notes
+            if notes and notes[-1] is not self._last_note:
+                i = len(notes) - 1
+                while i >= 0 and notes[i] is not self._last_note:
+                    i -= 1
+                batch.notes.extend((tick, n.at, n.text, n.level) for n in notes[i + 1 :])
+                self._last_note = notes[-1]
+            for key in BOARD_KEYS:
+                value = core.board.get(key)
+                if value is not self._blackboard.get(key.name):
+                    self._blackboard[key.name] = value
+                    batch.blackboard.append((tick, t, key.name, value))
+            self._ticks_since_drain += 1
         if self._ticks_since_drain >= self.batch_ticks and self.on_full is not None:
             self.on_full()
 
@@ -225,6 +294,8 @@ class Rows:
 
     def drain(self) -> Batch:
         """The rows buffered so far; the buffer starts afresh."""
+        if self._pending:
+            self.settle()
         batch, self.batch = self.batch, Batch()
         self._ticks_since_drain = 0
         if self._unstamped:  # drained before the first tick with a time

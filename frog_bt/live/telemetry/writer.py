@@ -41,6 +41,8 @@ STATUS_COLORS = {
     Status.FAILURE: 0xE5484DFF,
     Status.INVALID: 0x8B949EFF,
 }
+CODES = {status: i for i, status in enumerate(STATUS_COLORS)}  # a status as a small int
+COLOR_TABLE = np.array(list(STATUS_COLORS.values()), dtype=np.uint32)  # code -> colour
 ROUTE_COLORS = (0xA371F7AA, 0x39C5CFAA, 0xDB61A2AA, 0x8B949EAA)  # one per period of the day
 ZONE_COLORS = {"volume": 0x3FB95099, "special": 0xDB61A299}
 FACING, NOT_FACING, TRACKED = 0x3FB950FF, 0xFF8C42FF, 0x8B949E66
@@ -51,16 +53,30 @@ R_ROUTE, R_TRAIL, R_ZONE, R_ARROW = -1.5, -2.0, -1.0, -1.5
 PERIODIC = frozenset({"engagement"})  # front-end commands sent on a timer: DEBUG, not INFO
 TRAIL_STEP = 0.5  # metres between trail points
 TRAIL_POINTS = 1000  # the trail keeps the last 500 m or so
-TRAIL_EVERY = 20  # poses between two logged trails (2 s at 10 Hz)
+TRAIL_EVERY = 40  # poses between two logged trails (4 s at 10 Hz; the trail is most of a file)
+PATH_CHAR, PATH_GAP, PATH_LEVEL = 7.5, 24.0, 60.0  # the running path's layout (graph units)
 LANES_PER_STEP = 4  # status lanes written per step of a batch
 STATUSES_PER_STEP = 2000  # node statuses (rows x nodes) read per step of a batch
 Goal = tuple[str, float, float, float]  # waypoint, x, y, yaw
 GoalRow = tuple[int, int, float, Goal | None]  # tick, 0 input / 1 output, t, goal or cleared
 
 
-def status_path(key: str) -> str:
-    """The status lane of a node (keys need no escaping, see TreeNode.key)."""
-    return f"bt/status/{key}"
+def status_path(key: str, bt: str = "bt") -> str:
+    """The status lane of a node (keys need no escaping, see TreeNode.key); ``bt`` is the
+    tree's root entity (``bt``, ``bt/tree2`` for the first reloaded tree, ...)."""
+    return f"{bt}/status/{key}"
+
+
+def tree_root(generation: int) -> str:
+    """The entity under which a tree is logged: ``bt``, then ``bt/tree2``, ``bt/tree3``."""
+    return "bt" if generation == 1 else f"bt/tree{generation}"
+
+
+STOP_STATES = ("to come", "reached", "played", "skipped")
+STOP_COLORS = np.array([0x8B949EFF, 0x58A6FFFF, 0x2EA043FF, 0xE5484DFF], dtype=np.uint32)
+MARK_PATHS = {"staff": "log/bookmarks/staff", "doubted": "log/bookmarks/doubted"}
+MARK_PATHS["fault"] = "log/bookmarks/faults"
+RELOAD_PATH = "log/bookmarks/reload"
 
 
 HEALTH_COLORS = {
@@ -94,7 +110,13 @@ class Writer:
         self.index = index
         self.topics = {site.topic(role): role for role in ("goto", "approach", "icl", "dock")}
         self.facing = (site.recruit.facing_min, site.recruit.facing_max)
-        self._statuses: tuple[Status, ...] = ()
+        self._codes = np.full(len(index), CODES[Status.INVALID], dtype=np.uint8)  # now
+        self.bt = "bt"  # the tree's root entity (a reload logs the next tree beside it)
+        self._path: tuple[int, ...] = ()  # the nodes of the running-path view, as last logged
+        self._shown = np.empty(0, dtype=np.uint8)  # and their status codes
+        self.stops = [stop.poi for stop in site.tour.stops]
+        self._target: str | None = None  # the POI being driven to (blackboard /target)
+        self._stop_state: dict[str, str] = {}
         self._trail: deque[tuple[float, float]] = deque(maxlen=TRAIL_POINTS)
         self._poses_since_trail = 0
         self._docking: str | None = None
@@ -105,7 +127,15 @@ class Writer:
     # ------------------------------------------------------------ static
 
     def write_static(self) -> None:
+        from frog_bt.live.telemetry.blueprint import default_blueprint
+
         rec, site = self.rec, self.site
+        rec.send_blueprint(
+            default_blueprint(self.index, self.bt, self.stops), make_active=True, make_default=True
+        )
+        stop_config = rr.StateConfiguration(values=list(STOP_STATES), colors=STOP_COLORS)
+        for poi in dict.fromkeys(self.stops):
+            rec.log(f"stops/{poi}", stop_config, static=True)
         rec.log("map", rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)  # map y points up
         marks = poi_marks(site)
         rec.log(
@@ -210,11 +240,30 @@ class Writer:
             static=True,
         )
 
+    def reload(self, tick: int, t: float, index: TreeIndex, generation: int) -> None:
+        """Another tree runs from ``tick`` on (``run --watch``): logged beside the first
+        (``bt/tree2``, ...), the default layout follows it, and the timeline marks it."""
+        from frog_bt.live.telemetry.blueprint import default_blueprint
+
+        self.index = index
+        self.bt = tree_root(generation)
+        self._codes = np.full(len(index), CODES[Status.INVALID], dtype=np.uint8)
+        self._path = ()
+        self._write_tree()
+        self.rec.send_blueprint(
+            default_blueprint(index, self.bt, self.stops), make_active=True, make_default=True
+        )
+        self._set_time(tick, t)
+        self.rec.log(
+            RELOAD_PATH,
+            rr.TextLog(f"tree reloaded: {len(index)} nodes, now under /{self.bt}", level="WARN"),
+        )
+
     def _write_tree(self) -> None:
-        rec, nodes = self.rec, self.index.nodes
+        rec, nodes, bt = self.rec, self.index.nodes, self.bt
         ids = [n.key for n in nodes]
         rec.log(
-            "bt/graph",
+            f"{bt}/graph",
             rr.GraphNodes(
                 ids,
                 positions=tidy_layout(self.index),
@@ -224,7 +273,7 @@ class Writer:
             static=True,
         )  # colours are temporal: static ones would win
         rec.log(
-            "bt/graph",
+            f"{bt}/graph",
             rr.GraphEdges([(ids[a], ids[b]) for a, b in self.index.edges()], graph_type="directed"),
             static=True,
         )
@@ -235,7 +284,7 @@ class Writer:
             ),
         )
         for node in nodes:
-            rec.log(status_path(node.key), config, static=True)
+            rec.log(status_path(node.key, bt), config, static=True)
         links = rr.StateConfiguration(
             values=[s.value for s in LinkStatus],
             colors=np.array([HEALTH_COLORS[s.health] for s in LinkStatus], dtype=np.uint32),
@@ -283,6 +332,9 @@ class Writer:
         for tick, t, text, level in batch.notes:  # the level is the note's incident kind's
             logs.setdefault("log/notes", []).append((tick, t, level.value, text))
         self._read_blackboard(batch)
+        self._write_stops(batch)
+        for tick, t, kind, mark_level, text in batch.marks:
+            logs.setdefault(MARK_PATHS[kind], []).append((tick, t, mark_level, text))
         for path, rows in logs.items():
             if not rows:  # an empty temporal chunk crashes the 0.41 viewer's time panel
                 continue
@@ -294,44 +346,141 @@ class Writer:
                 columns=rr.TextLog.columns(text=[r[3] for r in rows], level=[r[2] for r in rows]),
             )
 
-    def _write_statuses(self, rows: list[tuple[int, float, tuple[Status, ...]]]) -> Iterator[None]:
-        # A step reads about STATUSES_PER_STEP node statuses: a few rows of a big tree.
-        per_step = max(1, STATUSES_PER_STEP // max(1, len(self.index)))
-        changes: dict[int, list[tuple[int, float, str]]] = {}
-        colors: list[np.ndarray] = []
-        previous = self._statuses
+    def _write_statuses(
+        self, rows: list[tuple[int, float, tuple[tuple[int, Status], ...]]]
+    ) -> Iterator[None]:
+        # Each row holds the changes of one tick; the graph needs every node's colour per
+        # row: the codes of all nodes are kept here and a row's colours read off them.
+        # A step reads about STATUSES_PER_STEP node colours: a few rows of a big tree.
+        nodes = len(self.index)
+        per_step = max(1, STATUSES_PER_STEP // max(1, nodes))
+        lanes: dict[int, list[tuple[int, float, str]]] = {}
+        codes = self._codes
+        colors = np.empty((len(rows), nodes), dtype=np.uint32)
+        paths: list[tuple[int, float, tuple[int, ...] | None, np.ndarray]] = []
         for start in range(0, len(rows), per_step):
-            part = rows[start : start + per_step]
-            colors.append(
-                np.array(
-                    [[STATUS_COLORS[s] for s in statuses] for _, _, statuses in part],
-                    dtype=np.uint32,
-                )
-            )
-            for tick, t, statuses in part:
-                for i, status in enumerate(statuses):
-                    if not previous or previous[i] is not status:
-                        changes.setdefault(i, []).append((tick, t, status.name))
-                previous = statuses
+            for n, (tick, t, changes) in enumerate(rows[start : start + per_step], start):
+                for i, status in changes:
+                    codes[i] = CODES[status]
+                    lanes.setdefault(i, []).append((tick, t, status.name))
+                colors[n] = COLOR_TABLE[codes]
+                shown = self._running_path(codes)
+                if shown != self._path or any(
+                    codes[i] != self._shown[k] for k, i in enumerate(shown)
+                ):
+                    self._path, self._shown = shown, codes[list(shown)].copy()
+                    paths.append((tick, t, shown, colors[n][list(shown)]))
             yield
-        self._statuses = previous
+        if paths:
+            self._write_paths(paths)
+            yield
         self.rec.send_columns(
-            "bt/graph",
+            f"{self.bt}/graph",
             indexes=_times(rows),
-            columns=rr.GraphNodes.columns(colors=np.concatenate(colors).reshape(-1)).partition(
-                [len(self.index)] * len(rows)
-            ),
+            columns=rr.GraphNodes.columns(colors=colors.reshape(-1)).partition([nodes] * len(rows)),
         )
         yield
-        for n, (i, lane) in enumerate(changes.items(), 1):
+        for n, (i, lane) in enumerate(lanes.items(), 1):
             self.rec.send_columns(
-                status_path(self.index.nodes[i].key),
+                status_path(self.index.nodes[i].key, self.bt),
                 indexes=_times(lane),
                 columns=rr.StateChange.columns(state=[r[2] for r in lane]),
             )
             if n % LANES_PER_STEP == 0:
                 yield
         yield
+
+    def _running_path(self, codes: np.ndarray) -> tuple[int, ...]:
+        """The nodes of the running-path view: from the root down every running child (the
+        first, for a parallel), with the children of each node on that path."""
+        nodes, running = self.index.nodes, CODES[Status.RUNNING]
+        shown, at = [0], 0
+        while True:
+            children = nodes[at].children
+            shown.extend(children)
+            at = next((c for c in children if codes[c] == running), -1)
+            if at < 0:
+                return tuple(shown)
+
+    def _write_paths(
+        self, rows: list[tuple[int, float, tuple[int, ...] | None, np.ndarray]]
+    ) -> None:
+        """The running path as its own small graph (``{bt}/path``), laid out level by level,
+        each level centred: its nodes, labels, places and edges when they change (``shown``
+        not None), its colours whenever they change (the viewer keeps the latest of each)."""
+        nodes = self.index.nodes
+        ids, labels, positions, edges, lengths, edge_lengths = [], [], [], [], [], []
+        for _, _, shown, _ in (r for r in rows if r[2] is not None):
+            assert shown is not None
+            by_depth: dict[int, list[int]] = {}
+            for i in shown:
+                by_depth.setdefault(nodes[i].depth, []).append(i)
+            for level in by_depth.values():
+                widths = [len(nodes[i].name) * PATH_CHAR + PATH_GAP for i in level]
+                x = -sum(widths) / 2
+                for i, w in zip(level, widths, strict=True):
+                    ids.append(nodes[i].key)
+                    labels.append(nodes[i].name)
+                    positions.append((x + w / 2, nodes[i].depth * PATH_LEVEL))
+                    x += w
+            lengths.append(len(shown))
+            pairs = [(nodes[nodes[i].parent].key, nodes[i].key) for i in shown[1:]]  # type: ignore[index]
+            edges.extend(pairs)
+            edge_lengths.append(len(pairs))
+        path = f"{self.bt}/path"
+        if lengths:
+            times = _times([r for r in rows if r[2] is not None])
+            self.rec.send_columns(
+                path,
+                indexes=times,
+                columns=rr.GraphNodes.columns(
+                    node_ids=ids, labels=labels, positions=np.array(positions, dtype=np.float32)
+                ).partition(lengths),
+            )
+            self.rec.send_columns(
+                path,
+                indexes=times,
+                columns=rr.GraphEdges.columns(edges=edges).partition(edge_lengths),
+            )
+        self.rec.send_columns(
+            path,
+            indexes=_times(rows),
+            columns=rr.GraphNodes.columns(colors=np.concatenate([r[3] for r in rows])).partition(
+                [len(r[3]) for r in rows]
+            ),
+        )
+
+    def _write_stops(self, batch: Batch) -> None:
+        """One lane per stop: reached (a drive to it succeeded), played (its content
+        started), skipped; from the responses, ``start_poi`` and the blackboard."""
+        moments: list[tuple[int, int, float, str, str]] = []  # tick, order, t, what, value
+        for tick, t, role, value in batch.inputs:
+            if role == "response" and value == 2:
+                moments.append((tick, 0, t, "arrived", ""))
+        for tick, t, side, channel, payload in batch.outputs:
+            if side == "frontend" and channel == "start_poi":
+                moments.append((tick, 1, t, "played", getattr(payload, "poi", "")))
+        for tick, t, key, value in batch.blackboard:
+            if key == "/target":
+                moments.append((tick, 2, t, "target", value or ""))
+            elif key == "/skipped" and value:
+                moments.append((tick, 2, t, "skipped", value))
+        lanes: dict[str, list[tuple[int, float, str]]] = {}
+        for tick, _, t, what, value in sorted(moments, key=lambda m: m[:3]):
+            if what == "target":
+                self._target = value or None
+                continue
+            poi = self._target if what == "arrived" else value
+            state = "reached" if what == "arrived" else what
+            if poi in self.stops and self._stop_state.get(poi) != state:
+                self._stop_state[poi] = state
+                lanes.setdefault(poi, []).append((tick, t, state))
+        for poi, rows in lanes.items():
+            self.rec.send_columns(
+                f"stops/{poi}",
+                indexes=_times(rows),
+                columns=rr.StateChange.columns(state=[r[2] for r in rows]),
+            )
 
     def _write_poses(self, rows: list[tuple[int, float, float, float, float]]) -> Iterator[None]:
         xy = np.array([(r[2], r[3]) for r in rows], dtype=np.float64)
