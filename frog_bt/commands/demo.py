@@ -97,6 +97,10 @@ def run(args: argparse.Namespace) -> int:
         tree = load_tree(args.tree, site)
         scenario = load_scenario(args.scenario)
         console_settings(args)
+        if args.record:  # checked before anything starts: one line, not a traceback
+            from frog_bt.commands.run import record_target
+
+            args.record = record_target(Path(args.record))
     except (DefinitionError, UsageError) as exc:
         for line in error_lines(exc):
             print(f"frog-bt: {line}", file=sys.stderr)

@@ -146,3 +146,17 @@ def test_demo_with_console_runs_on_after_the_tour_until_ctrl_c(tmp_path):
             proc.kill()
             proc.wait()
     assert "outcome:   tour ended docked, every stop visited" in "".join(lines)
+
+
+def test_demo_recording_into_a_missing_folder_is_one_line_not_a_traceback(tmp_path):
+    result = subprocess.run(
+        [sys.executable, "-m", "frog_bt", "demo", "--record", "nodir/x.mcap", "--rerun", "off"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=tmp_path,
+    )
+    assert result.returncode == 2
+    assert result.stderr.splitlines() == [
+        "frog-bt: --record nodir/x.mcap: cannot write there: nodir does not exist"
+    ]
