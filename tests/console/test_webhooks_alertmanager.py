@@ -124,7 +124,7 @@ def test_a_real_alertmanager_shows_the_alert_active_then_resolved(alertmanager: 
         "The robot reports an electronics fault: motors: overheated."
     )
     assert alert["annotations"]["description"] == "Call the robot team."
-    assert alert["annotations"]["ack_url"].startswith(f"{CONSOLE}/ack/fault?exp=")
+    assert alert["annotations"]["ack_url"].startswith(f"{CONSOLE}/ack/fault?at=")
     assert alert["generatorURL"] == CONSOLE
     assert alert["status"]["state"] in ("active", "unprocessed")  # both: firing
     ends = dt.datetime.fromisoformat(alert["endsAt"].replace("Z", "+00:00"))
