@@ -119,11 +119,20 @@ def read_token(path: Path) -> str:
     return token
 
 
-async def start_console(executive: Executive, settings: ConsoleSettings) -> Console:
-    """The console for ``executive``, listening; UsageError when the port cannot be bound."""
+async def start_console(
+    executive: Executive, settings: ConsoleSettings, webhooks: Webhooks | None = None
+) -> Console:
+    """The console for ``executive``, listening (its shift's handovers told to
+    ``webhooks``); UsageError when the port cannot be bound."""
     from frog_bt.live.console.server import Console
 
-    console = Console(executive, settings.host, settings.port, settings.token)
+    console = Console(
+        executive,
+        settings.host,
+        settings.port,
+        settings.token,
+        tell=webhooks.hand_over if webhooks is not None else None,
+    )
     console.attach()
     try:
         await console.start()
@@ -168,8 +177,9 @@ async def start_people(
         executive.site.alerts,  # its ack links' key comes from the token
         ack_secret=settings.token if settings is not None else None,
         language=executive.site.language,
+        tz=executive.clock.tz,
     )
     executive.observers.attach(executive, [webhooks])  # every alert change
     logctx.run_as(executive, webhooks.start)  # its lines are the executive's (console log)
-    console = await start_console(executive, settings) if settings is not None else None
+    console = await start_console(executive, settings, webhooks) if settings is not None else None
     return People(console, webhooks)

@@ -122,22 +122,23 @@ function enableButtons() {  // what the robot can do now, when connected and not
     if (b.disabled && armed && armed.button === b) disarm();
   });
   document.querySelectorAll("button[data-ack]").forEach((b) => { b.disabled = !connected || sending; });
+  $("hand-over").disabled = !connected || sending;
 }
 
-async function send(command, extra) {
+async function post(path, payload, done) {  // a command (or a handover) with the staff code
   let code = token(null, true);
   if (!code) return;
   sending = true; enableButtons();
   answer(true, "…");
   try {
     for (let tries = 0; tries < 2; tries++) {
-      const r = await fetch(`/api/command?lang=${encodeURIComponent(lang)}`, {method: "POST",
+      const r = await fetch(`${path}?lang=${encodeURIComponent(lang)}`, {method: "POST",
         headers: {"Content-Type": "application/json", "Authorization": "Bearer " + code},
-        body: JSON.stringify(Object.assign({command}, extra || {}))});
+        body: JSON.stringify(payload)});
       if (r.status === 401) { code = refused(true); if (!code) { answer(false, t("Not done: no staff code.")); return; } continue; }
       const body = await r.json();
       if (r.status === 429) { answer(false, t("Not done: too many tries. Wait a moment and try again.")); return; }
-      answer(body.ok, body.ok ? t("Done: {what}", {what: body.did}) : t("Not done: {why}", {why: body.reason}));
+      answer(body.ok, body.ok ? t("Done: {what}", {what: done(body)}) : t("Not done: {why}", {why: body.reason}));
       return;
     }
   } catch (e) {
@@ -145,6 +146,19 @@ async function send(command, extra) {
   } finally {
     sending = false; enableButtons();
   }
+}
+
+function send(command, extra) {
+  return post("/api/command", Object.assign({command}, extra || {}), (body) => body.did);
+}
+
+$("hand-over").addEventListener("click", () => post("/api/handover", {},
+  (body) => { renderHandover(body.handover); return t("the handover is composed and sent"); }));
+
+function renderHandover(h) {  // the last handover, in the site's language, as text
+  $("handover-title").textContent = h ? h.title : t("No handover yet.");
+  $("handover").replaceChildren(...(h ? h.sections.flatMap((s) =>
+    [el("h3", {}, s.title), el("ul", {}, ...s.lines.map((l) => el("li", {}, l)))]) : []));
 }
 
 function disarm() {
@@ -314,6 +328,7 @@ function render(s) {
   $("log").textContent = s.log.join("\n");
   $("alerts").replaceChildren(...s.alerts.concat(s.cleared || []).map(alertRow));
   $("holding").replaceChildren(...(s.holding || []).map(holdingRow));
+  renderHandover(s.handover);
   enableButtons();
   drawMap(s);
 }
