@@ -378,6 +378,12 @@ class StaffCfg(_Model):
         BeforeValidator(_local_times),
         Field(json_schema_extra={"items": {"type": "string", "pattern": r"^\d{1,2}:\d{2}$"}}),
     ] = []
+    # seconds a pairing link (frog-bt ctl pair NAME, the page's QR code) stays valid
+    pairing_ttl: Annotated[float, Field(gt=0, le=3600, allow_inf_nan=False)] = 300.0
+    # where paired devices are kept (0600); default: beside the console's token file
+    # (<token file>.devices); under systemd the token's directory is read-only: name one
+    # in the service's state directory
+    devices_file: str | None = None
 
 
 class Recording(_Model):

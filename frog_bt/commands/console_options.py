@@ -43,6 +43,19 @@ class ConsoleSettings:
     host: str
     port: int
     token: str | None
+    token_file: Path | None = None  # paired devices are kept beside it
+
+
+def devices_file(settings: ConsoleSettings, configured: str | None) -> Path | None:
+    """Where the paired devices are kept: ``staff.devices_file``, else beside the token
+    file (``<token file>.devices``); None without a token (pairing is off)."""
+    if settings.token is None:
+        return None
+    if configured:
+        return Path(configured)
+    if settings.token_file is None:
+        return None
+    return settings.token_file.with_name(settings.token_file.name + ".devices")
 
 
 def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
@@ -73,7 +86,7 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
             f"{host} is not loopback: anyone on the "
             "network could steer the robot; give --console-token-file",
         )
-    return ConsoleSettings(host, port, token)
+    return ConsoleSettings(host, port, token, args.console_token_file)
 
 
 def console_address(text: str, what: str = "--console") -> tuple[str, int]:
@@ -124,6 +137,7 @@ async def start_console(
 ) -> Console:
     """The console for ``executive``, listening (its shift's handovers told to
     ``webhooks``); UsageError when the port cannot be bound."""
+    from frog_bt.live.console.devices import Devices
     from frog_bt.live.console.server import Console
 
     console = Console(
@@ -132,6 +146,7 @@ async def start_console(
         settings.port,
         settings.token,
         tell=webhooks.hand_over if webhooks is not None else None,
+        devices=Devices(devices_file(settings, executive.site.staff.devices_file)),
     )
     console.attach()
     try:

@@ -68,9 +68,12 @@ from frog_bt.live.console.acklink import answer_proof, console_id, link_key
 from frog_bt.live.console.ackpage import ACK_DESK, AckDesk, get_ack, post_ack
 from frog_bt.live.console.bearer import Tickets, bearer, matches
 from frog_bt.live.console.day import Day
+from frog_bt.live.console.devices import Devices, Pairings
 from frog_bt.live.console.gate import Door, GatedSite, OutOfFiles, connection_cap
 from frog_bt.live.console.handover import Handover, shown
 from frog_bt.live.console.origins import Origins, is_loopback, split_host
+from frog_bt.live.console.pairing import CLAIM, DEVICE, PAIR_DESK, PairDesk, device_of
+from frog_bt.live.console.pairing import ROUTES as PAIR_ROUTES
 from frog_bt.live.console.shift import Shift
 from frog_bt.live.console.state import LogLines, StopClock, site_map, state, tree
 from frog_bt.live.console.stream import CLOSE_TIMEOUT, Pages, close_all, serve
@@ -163,7 +166,8 @@ ASSETS = web.AppKey("assets", Assets)
 def load_assets() -> Assets:
     files = resources.files("frog_bt.live.console")
     page = files.joinpath("page.html").read_text("utf-8")
-    styles = re.findall(r"<style>(.*?)</style>", page, re.DOTALL)
+    pair_page = files.joinpath("pair.html").read_text("utf-8")
+    styles = re.findall(r"<style>(.*?)</style>", page + pair_page, re.DOTALL)
     hashes = " ".join(
         f"'sha256-{base64.b64encode(hashlib.sha256(s.encode()).digest()).decode()}'" for s in styles
     )
@@ -246,7 +250,14 @@ def reads_open(access: Access, request: web.Request) -> bool:
 def token_refusal(access: Access, request: web.Request) -> web.Response | None:
     """None when the request may go on (the right token is never refused here, whatever
     anyone's failures); else the 401, or the 429 of a failure over its budget."""
-    if matches(bearer(request.headers.get("Authorization")), access.token):
+    given = bearer(request.headers.get("Authorization"))
+    if matches(given, access.token):
+        return None
+    devices = request.app[PAIR_DESK].devices
+    device = devices.find(given) if access.token is not None else None
+    if device is not None:  # a paired phone: its own key, its name on what it does
+        request[DEVICE] = device
+        devices.seen(device)
         return None
     if request.path == "/api/stream" and access.tickets.spend(request.query.get("ticket", "")):
         return None
@@ -270,7 +281,7 @@ async def guard(request: web.Request, handler: Handler) -> web.StreamResponse:
     if not access.origins.origin_ok(request.headers.get("Origin"), here):
         return refuse(403, "a page from another origin may not use this console")
     needs_token = request.method != "GET" or not reads_open(access, request)
-    if needs_token and request.path.startswith("/api"):
+    if needs_token and request.path.startswith("/api") and request.path != CLAIM:
         refusal = token_refusal(access, request)
         if refusal is not None:
             return refusal
@@ -326,6 +337,12 @@ def by_name(words: Msg | str, site: Site) -> Msg | str:
         return words
     args = {k: site.name(v) if k == "stop" and isinstance(v, str) else v for k, v in words.args}
     return Msg(words.msgid, **args)
+
+
+def public_url(console_url: str, request: web.Request) -> str:
+    """The console's address as a phone reaches it: ``alerts.console_url``, else the
+    address this request named (its ``Host``, already checked to be the console's)."""
+    return console_url or f"{request.scheme}://{request.host}"
 
 
 def asked_language(request: web.Request) -> str:
@@ -404,7 +421,11 @@ async def push(app: web.Application) -> None:
 
 
 def sender(request: web.Request) -> str:
-    """Who sent a command (recorded as its ``by``): ``ctl`` or the console."""
+    """Who sent a command (recorded as its ``by``): a paired device by its name
+    (``device:NAME``, plain text of at most 64 characters), ``ctl`` or the console."""
+    device = device_of(request)
+    if device is not None:
+        return f"device:{device.name}"
     return "ctl" if request.headers.get("User-Agent", "").startswith(CTL_AGENT) else "console"
 
 
@@ -471,6 +492,7 @@ ROUTES = [
     web.post("/api/ticket", post_ticket),
     web.post("/api/command", post_command),
     web.post("/api/handover", post_handover),
+    *PAIR_ROUTES,
     web.get("/ack/{alert_id}", get_ack, allow_head=False),  # shows; HEAD not even that
     web.post("/ack/{alert_id}", post_ack),  # the page's one button acknowledges
 ]
@@ -514,11 +536,13 @@ def make_app(
     loopback: bool,
     origins: Origins | None = None,
     tell: Callable[[Handover], None] | None = None,
+    devices: Devices | None = None,
 ) -> web.Application:
     """``executive``'s console as an application: its routes, its state, its lifetime.
     ``token`` (None: commands are off); ``loopback``: whether reads may need no token;
     ``origins``: the console's own (bound by :class:`Console` once it listens); ``tell``:
-    where a shift's handover goes (the webhooks)."""
+    where a shift's handover goes (the webhooks); ``devices``: the paired devices (None:
+    pairing is off)."""
     cfg = executive.site.console
     app = web.Application(middlewares=[guard], client_max_size=cfg.max_body)
     app[EXECUTIVE] = executive
@@ -550,6 +574,15 @@ def make_app(
         access.client,
         app[PAGES].changed.set,
     )
+    app[PAIR_DESK] = PairDesk(
+        devices or Devices(None),
+        Pairings(executive.site.staff.pairing_ttl),
+        token,
+        access.failures,
+        access.client,
+        lambda request: public_url(executive.site.alerts.console_url, request),
+        asked_language,
+    )
     app[ASSETS] = load_assets()
     app.add_routes(ROUTES)
     app.cleanup_ctx.extend([log_lines, pusher])
@@ -574,12 +607,18 @@ class Console:
         max_connections: int | None = None,
         header_timeout: float = HEADER_TIMEOUT,
         tell: Callable[[Handover], None] | None = None,
+        devices: Devices | None = None,
     ) -> None:
         self.executive = executive
         self.host, self.port = host, port
         self.origins = Origins(host, executive.site.alerts.console_url)
         self.app = make_app(
-            executive, token=token, loopback=is_loopback(host), origins=self.origins, tell=tell
+            executive,
+            token=token,
+            loopback=is_loopback(host),
+            origins=self.origins,
+            tell=tell,
+            devices=devices,
         )
         self.door = Door(connection_cap() if max_connections is None else max_connections)
         self.bound_port: int | None = None
