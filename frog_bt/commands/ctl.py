@@ -310,11 +310,14 @@ def _run(args: argparse.Namespace) -> int:
 
 def _paired(answer: dict[str, Any], raw: bytes) -> int:
     """The pairing link as a QR code for the phone to scan, and as text."""
-    from frog_bt.live.console.qr import terminal
-
     link = str(answer.get("link", ""))
     minutes = round(float(answer.get("expires_in", 0)) / 60)
-    print(terminal(link), end="")
+    try:
+        from frog_bt.live.console.qr import terminal
+
+        print(terminal(link), end="")
+    except ImportError:  # no segno here: the link alone, to open on the phone
+        print("frog-bt ctl: no QR code (segno is missing: pip install segno)", file=sys.stderr)
     _say(link)
     _say(
         _in_words(N_("scan this code with the phone within {m} min; it works once"), raw, m=minutes)

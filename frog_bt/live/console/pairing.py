@@ -87,8 +87,10 @@ def _staff_token(request: web.Request, desk: PairDesk) -> bool:
 
 
 async def post_pair(request: web.Request) -> web.Response:
-    from frog_bt.live.console.qr import svg_path
-
+    try:
+        from frog_bt.live.console.qr import svg_path
+    except ImportError:  # an install of the console extra from before segno joined it
+        return _refuse(request, 409, Msg("pairing needs segno: pip install -e '.[console]'"))
     desk = request.app[PAIR_DESK]
     if desk.devices.path is None:
         return _refuse(

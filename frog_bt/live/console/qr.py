@@ -8,13 +8,13 @@ import io
 import re
 from typing import Any
 
+import segno  # ImportError here: the console extra lacks it (pairing.py, ctl.py say so)
+
 _SVG_PATH = re.compile(r'<path[^>]* d="([^"]+)"')
 _SIZE = re.compile(r'<svg[^>]* width="(\d+)" height="(\d+)"')
 
 
 def _code(text: str) -> Any:
-    import segno
-
     return segno.make(text, error="m", micro=False)
 
 
