@@ -19,6 +19,7 @@ from urllib.parse import urlsplit
 from pydantic import (
     AfterValidator,
     BaseModel,
+    BeforeValidator,
     ConfigDict,
     Field,
     field_validator,
@@ -342,6 +343,49 @@ class ConsoleCfg(_Model):
         return out
 
 
+def _local_times(values: Any) -> Any:
+    """``["14:00", "20:00"]`` as times of day, in order, each once; YAML 1.1 reads an
+    unquoted 14:00 as the sexagesimal integer 840, which is taken as 14:00 too."""
+    if not isinstance(values, list):
+        raise ValueError('expected a list of local times, e.g. ["14:00", "20:00"]')
+    out: list[dtime] = []
+    for i, value in enumerate(values):
+        if isinstance(value, int) and not isinstance(value, bool) and 0 <= value < 24 * 60:
+            at = dtime(value // 60, value % 60)
+        elif isinstance(value, str) and len(value) <= 5 and value.count(":") == 1:
+            hours, _, minutes = value.partition(":")
+            if not (hours.isdigit() and minutes.isdigit() and len(minutes) == 2):
+                raise PathError((i,), f'expected a local time HH:MM (e.g. "14:00"), got {value!r}')
+            if int(hours) > 23 or int(minutes) > 59:
+                raise PathError((i,), f"expected a time of day from 00:00 to 23:59, got {value!r}")
+            at = dtime(int(hours), int(minutes))
+        else:
+            shown = inert(str(value), 40)
+            raise PathError((i,), f'expected a local time HH:MM (e.g. "14:00"), got {shown!r}')
+        if at in out:
+            raise PathError((i,), f"{at:%H:%M} is given twice")
+        out.append(at)
+    return sorted(out)
+
+
+class StaffCfg(_Model):
+    """The people who run the robot by shifts (the console)."""
+
+    # local times (the site's, Europe/Madrid) at which the console composes a handover for
+    # the next shift and sends it to the alerts' webhooks (json, ntfy); [] for none
+    handover: Annotated[
+        list[dtime],
+        BeforeValidator(_local_times),
+        Field(json_schema_extra={"items": {"type": "string", "pattern": r"^\d{1,2}:\d{2}$"}}),
+    ] = []
+    # seconds a pairing link (frog-bt ctl pair NAME, the page's QR code) stays valid
+    pairing_ttl: Annotated[float, Field(gt=0, le=3600, allow_inf_nan=False)] = 300.0
+    # where paired devices are kept (0600); default: beside the console's token file
+    # (<token file>.devices); under systemd the token's directory is read-only: name one
+    # in the service's state directory
+    devices_file: str | None = None
+
+
 class Recording(_Model):
     max_bytes: Annotated[int, Field(gt=0)] = 20_000_000_000  # --record DIR: disk budget
 
@@ -415,6 +459,7 @@ class Site(_Model):
     run: RunCfg = RunCfg()
     alerts: AlertsCfg = AlertsCfg()
     console: ConsoleCfg = ConsoleCfg()
+    staff: StaffCfg = StaffCfg()
     topics: dict[Literal[tuple(INPUTS) + tuple(OUTPUTS)], str] = {}  # type: ignore[valid-type]
 
     def name(self, poi: str) -> str:

@@ -13,10 +13,11 @@ shipped as package data). English is the source language: it needs no catalog.
 * :func:`translator` gives the catalog of one language (cached per process: catalogs are
   read-only data, not state).
 
-Catalogs are kept with Babel (``pybabel extract -F frog_bt/locale/babel.cfg -k Msg -k N_
--k t -o frog_bt/locale/frog_bt.pot .``, then ``pybabel update`` and ``pybabel compile -d
-frog_bt/locale -D frog_bt``); ``tests/console/test_words.py`` fails when a marked string
-has no Spanish translation or the ``.mo`` is older than its ``.po``.
+Catalogs are kept with Babel (``pybabel extract --no-wrap -F frog_bt/locale/babel.cfg -k Msg
+-k N_ -k t -o frog_bt/locale/frog_bt.pot .``, then ``pybabel update --no-wrap`` and ``pybabel
+compile -d frog_bt/locale -D frog_bt``: docs/CONSOLE.md, *Languages*);
+``tests/console/test_words.py`` fails when a marked string has no Spanish translation or
+the ``.mo`` is older than its ``.po``.
 """
 
 from __future__ import annotations

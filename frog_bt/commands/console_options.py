@@ -43,6 +43,19 @@ class ConsoleSettings:
     host: str
     port: int
     token: str | None
+    token_file: Path | None = None  # paired devices are kept beside it
+
+
+def devices_file(settings: ConsoleSettings, configured: str | None) -> Path | None:
+    """Where the paired devices are kept: ``staff.devices_file``, else beside the token
+    file (``<token file>.devices``); None without a token (pairing is off)."""
+    if settings.token is None:
+        return None
+    if configured:
+        return Path(configured)
+    if settings.token_file is None:
+        return None
+    return settings.token_file.with_name(settings.token_file.name + ".devices")
 
 
 def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
@@ -73,7 +86,7 @@ def console_settings(args: argparse.Namespace) -> ConsoleSettings | None:
             f"{host} is not loopback: anyone on the "
             "network could steer the robot; give --console-token-file",
         )
-    return ConsoleSettings(host, port, token)
+    return ConsoleSettings(host, port, token, args.console_token_file)
 
 
 def console_address(text: str, what: str = "--console") -> tuple[str, int]:
@@ -119,11 +132,22 @@ def read_token(path: Path) -> str:
     return token
 
 
-async def start_console(executive: Executive, settings: ConsoleSettings) -> Console:
-    """The console for ``executive``, listening; UsageError when the port cannot be bound."""
+async def start_console(
+    executive: Executive, settings: ConsoleSettings, webhooks: Webhooks | None = None
+) -> Console:
+    """The console for ``executive``, listening (its shift's handovers told to
+    ``webhooks``); UsageError when the port cannot be bound."""
+    from frog_bt.live.console.devices import Devices
     from frog_bt.live.console.server import Console
 
-    console = Console(executive, settings.host, settings.port, settings.token)
+    console = Console(
+        executive,
+        settings.host,
+        settings.port,
+        settings.token,
+        tell=webhooks.hand_over if webhooks is not None else None,
+        devices=Devices(devices_file(settings, executive.site.staff.devices_file)),
+    )
     console.attach()
     try:
         await console.start()
@@ -168,8 +192,9 @@ async def start_people(
         executive.site.alerts,  # its ack links' key comes from the token
         ack_secret=settings.token if settings is not None else None,
         language=executive.site.language,
+        tz=executive.clock.tz,
     )
     executive.observers.attach(executive, [webhooks])  # every alert change
     logctx.run_as(executive, webhooks.start)  # its lines are the executive's (console log)
-    console = await start_console(executive, settings) if settings is not None else None
+    console = await start_console(executive, settings, webhooks) if settings is not None else None
     return People(console, webhooks)

@@ -3,13 +3,16 @@
     frog-bt ctl home|skip|pause|resume|service_off|service_on|retry|done_by_hand
     frog-bt ctl ack_alert ID
     frog-bt ctl status [--json]
+    frog-bt ctl pair NAME | devices | unpair NAME
     [--console PORT|:PORT|HOST:PORT|URL] [--token-file F] [--timeout S]
 
 ``--console`` (or ``FROG_BT_CONSOLE``) is what ``run --console`` was given (``8080``,
 ``:8080``, ``0.0.0.0:8080``: a wildcard address is reached on loopback) or the console's
 URL (``http://frog:8080``, behind a proxy ``https://...``); default ``127.0.0.1:8080``.
 ``status`` prints the robot's state as plain lines in the site's words; ``--json``, the
-state as the console gives it.
+state as the console gives it. ``pair NAME`` prints the QR code of a one-time link that
+pairs a staff phone called NAME (``staff.pairing_ttl``), ``devices`` lists the paired
+ones, ``unpair NAME`` revokes one at once (all three with the staff token).
 
 Exit 0 when the command was applied (``status``: the state was read), 1 when the tour
 refused it (the reason is printed), 2 for a usage error, when the console cannot be
@@ -52,15 +55,19 @@ from frog_bt.text import escape
 DEFAULT_CONSOLE = "127.0.0.1:8080"
 ENV = "FROG_BT_CONSOLE"
 WILDCARDS = {"0.0.0.0": "127.0.0.1", "::": "::1", "": "127.0.0.1"}  # listen-on-all: ask loopback
+DEVICE_COMMANDS = ("pair", "devices", "unpair")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "command",
-        choices=[*(c.value for c in Command), "status"],
-        help="what to do (status: print the robot's state)",
+        choices=[*(c.value for c in Command), "status", *DEVICE_COMMANDS],
+        help="what to do (status: print the robot's state; pair NAME, devices, unpair NAME: "
+        "staff phones)",
     )
-    p.add_argument("id", nargs="?", help="with ack_alert: the alert's id")
+    p.add_argument(
+        "id", nargs="?", help="with ack_alert: the alert's id; with pair and unpair: the name"
+    )
     p.add_argument(
         "--console",
         metavar="ADDRESS",
@@ -228,8 +235,19 @@ def _run(args: argparse.Namespace) -> int:
         headers["X-Frog-Nonce"] = secrets.token_urlsafe(24)
     if args.command == "ack_alert" and not args.id:
         return _fail("ack_alert needs the alert's id (frog-bt ctl status lists them)")
+    if args.command in ("pair", "unpair") and not args.id:
+        return _fail(f"{args.command} needs the device's name, e.g. \"Lucía's phone\"")
     if args.command == "status":
         request = urllib.request.Request(f"{base}/api/state", headers=headers)
+    elif args.command == "devices":
+        request = urllib.request.Request(f"{base}/api/devices", headers=headers)
+    elif args.command in ("pair", "unpair"):
+        request = urllib.request.Request(
+            f"{base}/api/{args.command}",
+            method="POST",
+            data=json.dumps({"name": args.id}).encode(),
+            headers=headers,
+        )
     else:
         body = {"command": args.command, **({"id": args.id} if args.id else {})}
         request = urllib.request.Request(
@@ -276,8 +294,64 @@ def _run(args: argparse.Namespace) -> int:
             _say(_in_words(N_("refused: {why}"), raw, why=reason))
             return 1
         return _fail(f'the console did not say "ok": true (so nothing was done): {raw[:80]!r}')
+    if args.command == "pair":
+        return _paired(answer, raw)
+    if args.command == "devices":
+        lang = answer.get("language")
+        _say(
+            "\n".join(
+                device_lines(answer.get("devices", []), lang if isinstance(lang, str) else None)
+            )
+        )
+        return 0
     _say(_in_words(N_("done: {what}"), raw, what=answer.get("did", "")))
     return 0
+
+
+def _paired(answer: dict[str, Any], raw: bytes) -> int:
+    """The pairing link as a QR code for the phone to scan, and as text."""
+    link = str(answer.get("link", ""))
+    minutes = round(float(answer.get("expires_in", 0)) / 60)
+    try:
+        from frog_bt.live.console.qr import terminal
+
+        print(terminal(link), end="")
+    except ImportError:  # no segno here: the link alone, to open on the phone
+        print("frog-bt ctl: no QR code (segno is missing: pip install segno)", file=sys.stderr)
+    _say(link)
+    _say(
+        _in_words(N_("scan this code with the phone within {m} min; it works once"), raw, m=minutes)
+    )
+    return 0
+
+
+def device_lines(devices: list[Any], lang: str | None = None) -> list[str]:
+    """A heading, then one line per paired device: its name, when it was paired and last
+    seen (local time), tab-separated."""
+    from datetime import datetime
+
+    from frog_bt.clock import SITE_TZ
+
+    def when(t: object) -> str:
+        if not isinstance(t, int | float):
+            return "-"
+        return datetime.fromtimestamp(t, SITE_TZ).strftime("%Y-%m-%d %H:%M")
+
+    words = translator(lang)
+    heading = "\t".join(Msg(w).say(words) for w in (N_("Device"), N_("Paired"), N_("Last seen")))
+    if not devices:
+        return [Msg(N_("No device is paired.")).say(words)]
+    return [heading] + [
+        "\t".join(
+            (
+                escape(str(d.get("name", "")))[:64],
+                when(d.get("paired_at")),
+                when(d.get("last_seen")),
+            )
+        )
+        for d in devices
+        if isinstance(d, dict)
+    ]
 
 
 def _in_words(msgid: str, body: bytes, **args: Any) -> str:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
+from pathlib import Path
 from typing import Any
 
 import aiohttp
@@ -20,11 +21,14 @@ async def console_tour(
     *,
     token: str | None = TOKEN,
     once: bool = True,
+    token_file: Path | None = None,
     **kwargs: Any,
 ) -> AsyncIterator[tuple[Running, People, str]]:
-    """The rehearsal, what was started for the people around it, and the console's URL."""
+    """The rehearsal, what was started for the people around it, and the console's URL
+    (``token_file``: where the token came from; paired devices are kept beside it)."""
     async with Running(scenario or {}, once=once, **kwargs) as run:
-        people = await start_people(run.executive, ConsoleSettings("127.0.0.1", 0, token), [])
+        settings = ConsoleSettings("127.0.0.1", 0, token, token_file)
+        people = await start_people(run.executive, settings, [])
         try:
             assert people.console is not None
             yield run, people, f"http://127.0.0.1:{people.console.bound_port}"

@@ -17,6 +17,7 @@ def test_the_routes_are_the_contracts_and_declared_once() -> None:
     assert sorted((r.method, r.path) for r in ROUTES) == [  # type: ignore[attr-defined]
         ("GET", "/"),
         ("GET", "/ack/{alert_id}"),
+        ("GET", "/api/devices"),
         ("GET", "/api/site"),
         ("GET", "/api/state"),
         ("GET", "/api/stream"),
@@ -24,9 +25,15 @@ def test_the_routes_are_the_contracts_and_declared_once() -> None:
         ("GET", "/api/words"),
         ("GET", "/console.js"),
         ("GET", "/favicon.ico"),
+        ("GET", "/pair"),
+        ("GET", "/pair.js"),
         ("POST", "/ack/{alert_id}"),
         ("POST", "/api/command"),
+        ("POST", "/api/handover"),
+        ("POST", "/api/pair"),
+        ("POST", "/api/pair/claim"),
         ("POST", "/api/ticket"),
+        ("POST", "/api/unpair"),
     ]
 
 

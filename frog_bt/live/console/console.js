@@ -76,7 +76,11 @@ $("lang").addEventListener("change", () => {
 
 // ------------------------------------------------------------------ the staff code
 
+const DEVICE = "frog-device";  // a paired phone's own key (pair.js keeps it), used before any code
+
 function token(why, steering) {  // steering: the code is asked for a command (reads may need none)
+  const key = localStorage.getItem(DEVICE);
+  if (key) return key;
   let code = sessionStorage.getItem("frog-token");
   if (!code) {
     code = prompt(why || t("Staff code (asked once per session):"));
@@ -87,8 +91,8 @@ function token(why, steering) {  // steering: the code is asked for a command (r
   return code;
 }
 
-function authHeaders() {  // the token travels in a header, never in a URL
-  const code = sessionStorage.getItem("frog-token");
+function authHeaders() {  // the key or the token travels in a header, never in a URL
+  const code = localStorage.getItem(DEVICE) || sessionStorage.getItem("frog-token");
   return code ? {"Authorization": "Bearer " + code} : {};
 }
 
@@ -98,11 +102,23 @@ function showLogin(why) {
 }
 
 function refused(steering) {  // a wrong code: say so, forget it, ask again
+  if (localStorage.getItem(DEVICE)) {  // this phone was unpaired: its key no longer works
+    localStorage.removeItem(DEVICE); localStorage.removeItem(DEVICE + "-name");
+    showDevice();
+    showLogin(t("This phone is no longer paired: enter the staff code, or pair it again."));
+    return null;
+  }
   sessionStorage.removeItem("frog-token");
   return token(t("That staff code was not accepted. Enter it again:"), steering);
 }
 
 $("login-again").addEventListener("click", () => { if (token()) start(); });
+
+function showDevice() {  // a paired phone says whose it is
+  const name = localStorage.getItem(DEVICE) && localStorage.getItem(DEVICE + "-name");
+  $("device").hidden = !name;
+  $("device").textContent = name ? t("This phone: {name}", {name}) : "";
+}
 
 // ------------------------------------------------------------------ commands
 
@@ -122,22 +138,24 @@ function enableButtons() {  // what the robot can do now, when connected and not
     if (b.disabled && armed && armed.button === b) disarm();
   });
   document.querySelectorAll("button[data-ack]").forEach((b) => { b.disabled = !connected || sending; });
+  $("hand-over").disabled = !connected || sending;
+  $("pair-go").disabled = !connected || sending;
 }
 
-async function send(command, extra) {
+async function post(path, payload, done) {  // a command (or a handover) with the staff code
   let code = token(null, true);
   if (!code) return;
   sending = true; enableButtons();
   answer(true, "…");
   try {
     for (let tries = 0; tries < 2; tries++) {
-      const r = await fetch(`/api/command?lang=${encodeURIComponent(lang)}`, {method: "POST",
+      const r = await fetch(`${path}?lang=${encodeURIComponent(lang)}`, {method: "POST",
         headers: {"Content-Type": "application/json", "Authorization": "Bearer " + code},
-        body: JSON.stringify(Object.assign({command}, extra || {}))});
+        body: JSON.stringify(payload)});
       if (r.status === 401) { code = refused(true); if (!code) { answer(false, t("Not done: no staff code.")); return; } continue; }
       const body = await r.json();
       if (r.status === 429) { answer(false, t("Not done: too many tries. Wait a moment and try again.")); return; }
-      answer(body.ok, body.ok ? t("Done: {what}", {what: body.did}) : t("Not done: {why}", {why: body.reason}));
+      answer(body.ok, body.ok ? t("Done: {what}", {what: done(body)}) : t("Not done: {why}", {why: body.reason}));
       return;
     }
   } catch (e) {
@@ -145,6 +163,38 @@ async function send(command, extra) {
   } finally {
     sending = false; enableButtons();
   }
+}
+
+function send(command, extra) {
+  return post("/api/command", Object.assign({command}, extra || {}), (body) => body.did);
+}
+
+$("hand-over").addEventListener("click", () => post("/api/handover", {},
+  (body) => { renderHandover(body.handover); return t("the handover is composed and sent"); }));
+
+$("pair").addEventListener("submit", (e) => {  // a QR code of a one-time link for a new phone
+  e.preventDefault();
+  const name = $("pair-name").value.trim();
+  if (!name) { answer(false, t("Not done: {why}", {why: t("a device needs a name, such as Lucía's phone")})); return; }
+  post("/api/pair", {name}, (body) => {
+    drawQR(body.qr);
+    $("pair-link").textContent = body.link;
+    $("pair-shown").hidden = false;
+    return t("scan this code with the phone within {m} min; it works once", {m: Math.round(body.expires_in / 60)});
+  });
+});
+
+function drawQR(qr) {  // the path data of segno's SVG, set as an attribute: no markup parsed
+  const n = qr.size;
+  $("qr").setAttribute("viewBox", `0 0 ${n} ${n}`);
+  $("qr").replaceChildren(svg("rect", {width: n, height: n, fill: "#fff"}),
+    svg("path", {d: qr.path, stroke: "#000", "stroke-width": 1, fill: "none"}));
+}
+
+function renderHandover(h) {  // the last handover, in the site's language, as text
+  $("handover-title").textContent = h ? h.title : t("No handover yet.");
+  $("handover").replaceChildren(...(h ? h.sections.flatMap((s) =>
+    [el("h3", {}, s.title), el("ul", {}, ...s.lines.map((l) => el("li", {}, l)))]) : []));
 }
 
 function disarm() {
@@ -314,13 +364,14 @@ function render(s) {
   $("log").textContent = s.log.join("\n");
   $("alerts").replaceChildren(...s.alerts.concat(s.cleared || []).map(alertRow));
   $("holding").replaceChildren(...(s.holding || []).map(holdingRow));
+  renderHandover(s.handover);
   enableButtons();
   drawMap(s);
 }
 
 async function streamURL() {  // off loopback: a one-use ticket, so the token stays out of URLs
   const base = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/api/stream`;
-  if (!sessionStorage.getItem("frog-token")) return base;
+  if (!authHeaders().Authorization) return base;
   try {
     const r = await fetch("/api/ticket", {method: "POST", headers: authHeaders()});
     if (r.ok) return `${base}?ticket=${encodeURIComponent((await r.json()).ticket)}`;
@@ -345,6 +396,7 @@ async function start() {
   if (!s) return;  // no code, or a wrong one: the page says so and offers to ask again
   started = true; site = s; $("login").hidden = true;
   await loadWords(localStorage.getItem("frog-lang") || site.language || "es");
+  showDevice();
   drawMap(latest); connect();
 }
 

@@ -16,6 +16,8 @@
 * ``GET /ack/{alert_id}?at=&exp=&sig=`` — a notification's signed link: a plain page in
   the site's language saying what it would acknowledge, with one button; ``POST`` (the
   button) acknowledges that raise of that alert, once (:mod:`~.ackpage`);
+* ``POST /api/handover`` — with the token: the shift handed over now (:mod:`~.shift`):
+  composed, sent to the webhooks, kept as the page's *Relevo*, and answered;
 * ``POST /api/command`` — ``{"command": C}`` (``"id"`` with ``ack_alert``), with
   ``Authorization: Bearer TOKEN``: 200 ``{"ok": true, "did"}`` once applied at the next
   tick, 409 ``{"ok": false, "reason"}`` when the tour cannot do it now, 400 malformed or
@@ -66,8 +68,13 @@ from frog_bt.live.console.acklink import answer_proof, console_id, link_key
 from frog_bt.live.console.ackpage import ACK_DESK, AckDesk, get_ack, post_ack
 from frog_bt.live.console.bearer import Tickets, bearer, matches
 from frog_bt.live.console.day import Day
+from frog_bt.live.console.devices import Devices, Pairings
 from frog_bt.live.console.gate import Door, GatedSite, OutOfFiles, connection_cap
+from frog_bt.live.console.handover import Handover, shown
 from frog_bt.live.console.origins import Origins, is_loopback, split_host
+from frog_bt.live.console.pairing import CLAIM, DEVICE, PAIR_DESK, PairDesk, device_of
+from frog_bt.live.console.pairing import ROUTES as PAIR_ROUTES
+from frog_bt.live.console.shift import Shift
 from frog_bt.live.console.state import LogLines, StopClock, site_map, state, tree
 from frog_bt.live.console.stream import CLOSE_TIMEOUT, Pages, close_all, serve
 from frog_bt.live.console.throttle import Failures, Network, Rates, client_of, networks
@@ -125,6 +132,7 @@ class Shown:
     changes (the tree per core and tick, the map per site)."""
 
     day: Day
+    shift: Shift
     logs: LogLines
     stop_clock: StopClock
     cached: dict[str, tuple[object, int, bytes]] = field(default_factory=dict)
@@ -158,7 +166,8 @@ ASSETS = web.AppKey("assets", Assets)
 def load_assets() -> Assets:
     files = resources.files("frog_bt.live.console")
     page = files.joinpath("page.html").read_text("utf-8")
-    styles = re.findall(r"<style>(.*?)</style>", page, re.DOTALL)
+    pair_page = files.joinpath("pair.html").read_text("utf-8")
+    styles = re.findall(r"<style>(.*?)</style>", page + pair_page, re.DOTALL)
     hashes = " ".join(
         f"'sha256-{base64.b64encode(hashlib.sha256(s.encode()).digest()).decode()}'" for s in styles
     )
@@ -201,12 +210,22 @@ async def secure_headers(request: web.Request, response: web.StreamResponse) -> 
 
 
 def snapshot(app: web.Application) -> dict[str, Any]:
-    shown = app[SHOWN]
+    kept = app[SHOWN]
     token = app[ACCESS].token
     return {
-        **state(app[EXECUTIVE], shown.day, shown.logs, shown.stop_clock),
+        **state(app[EXECUTIVE], kept.day, kept.logs, kept.stop_clock),
         "console": console_id(token) if token is not None else None,
+        "handover": _handover(app, kept.shift.last),
     }
+
+
+def _handover(app: web.Application, last: Handover | None) -> dict[str, Any] | None:
+    """The last handover as the page shows it (the site's language), or None."""
+    if last is None:
+        return None
+    executive = app[EXECUTIVE]
+    site = executive.site
+    return shown(last, site.alerts.robot, site.language, executive.clock.tz)
 
 
 # ---------------------------------------------------------------- guard
@@ -231,7 +250,14 @@ def reads_open(access: Access, request: web.Request) -> bool:
 def token_refusal(access: Access, request: web.Request) -> web.Response | None:
     """None when the request may go on (the right token is never refused here, whatever
     anyone's failures); else the 401, or the 429 of a failure over its budget."""
-    if matches(bearer(request.headers.get("Authorization")), access.token):
+    given = bearer(request.headers.get("Authorization"))
+    if matches(given, access.token):
+        return None
+    devices = request.app[PAIR_DESK].devices
+    device = devices.find(given) if access.token is not None else None
+    if device is not None:  # a paired phone: its own key, its name on what it does
+        request[DEVICE] = device
+        devices.seen(device)
         return None
     if request.path == "/api/stream" and access.tickets.spend(request.query.get("ticket", "")):
         return None
@@ -255,7 +281,7 @@ async def guard(request: web.Request, handler: Handler) -> web.StreamResponse:
     if not access.origins.origin_ok(request.headers.get("Origin"), here):
         return refuse(403, "a page from another origin may not use this console")
     needs_token = request.method != "GET" or not reads_open(access, request)
-    if needs_token and request.path.startswith("/api"):
+    if needs_token and request.path.startswith("/api") and request.path != CLAIM:
         refusal = token_refusal(access, request)
         if refusal is not None:
             return refusal
@@ -313,6 +339,12 @@ def by_name(words: Msg | str, site: Site) -> Msg | str:
     return Msg(words.msgid, **args)
 
 
+def public_url(console_url: str, request: web.Request) -> str:
+    """The console's address as a phone reaches it: ``alerts.console_url``, else the
+    address this request named (its ``Host``, already checked to be the console's)."""
+    return console_url or f"{request.scheme}://{request.host}"
+
+
 def asked_language(request: web.Request) -> str:
     """The language an answer is given in: ``?lang=`` (the page's), else the site's."""
     return language(request.query.get("lang") or request.app[EXECUTIVE].site.language)
@@ -356,6 +388,7 @@ async def push(app: web.Application) -> None:
     after each tick: the console costs the tick nothing."""
     loop = asyncio.get_running_loop()
     pages, executive, failures = app[PAGES], app[EXECUTIVE], app[ACCESS].failures
+    shift = app[SHOWN].shift
     last, last_at, last_phase = "", 0.0, ""
     while True:
         # asyncio.timeout, not wait_for: on Python 3.11 wait_for can swallow a cancel
@@ -364,6 +397,9 @@ async def push(app: web.Application) -> None:
             async with asyncio.timeout(PHASE_POLL):
                 await pages.changed.wait()
         failures.flush()  # the failed attempts of the last minute, once a minute
+        clock = executive.core.clock
+        if clock.ready and shift.check(clock.now()) is not None:  # no tick meanwhile
+            pages.changed.set()
         now_phase = phase(executive.core)
         due = (
             pages.changed.is_set()
@@ -382,6 +418,29 @@ async def push(app: web.Application) -> None:
 
 
 # ---------------------------------------------------------------- commands
+
+
+def sender(request: web.Request) -> str:
+    """Who sent a command (recorded as its ``by``): a paired device by its name
+    (``device:NAME``, plain text of at most 64 characters), ``ctl`` or the console."""
+    device = device_of(request)
+    if device is not None:
+        return f"device:{device.name}"
+    return "ctl" if request.headers.get("User-Agent", "").startswith(CTL_AGENT) else "console"
+
+
+async def post_handover(request: web.Request) -> web.Response:
+    """``POST /api/handover``: the shift handed over now, by whoever asked."""
+    access = request.app[ACCESS]
+    if not access.rates.take(access.client(request)):
+        return refuse(429, "too many commands: wait a second")
+    executive = request.app[EXECUTIVE]
+    if not executive.core.clock.ready:
+        return refuse(409, "the executive has no time yet: nothing to hand over")
+    handover = request.app[SHOWN].shift.hand_over(executive.core.clock.now(), by=sender(request))
+    request.app[PAGES].changed.set()
+    return web.json_response({"ok": True, "handover": _handover(request.app, handover)})
+
 
 UTF8 = (None, "utf-8", "utf8")
 
@@ -410,9 +469,8 @@ async def post_command(request: web.Request) -> web.Response:
     access = request.app[ACCESS]
     if not access.rates.take(access.client(request)):
         return refuse(429, "too many commands: wait a second")
-    sender = "ctl" if request.headers.get("User-Agent", "").startswith(CTL_AGENT) else "console"
     answer = await request.app[EXECUTIVE].staff.submit(
-        command, alert_id if isinstance(alert_id, str) else "", by=sender
+        command, alert_id if isinstance(alert_id, str) else "", by=sender(request)
     )
     request.app[PAGES].changed.set()
     lang = asked_language(request)
@@ -433,6 +491,8 @@ ROUTES = [
     web.get("/api/stream", get_stream),
     web.post("/api/ticket", post_ticket),
     web.post("/api/command", post_command),
+    web.post("/api/handover", post_handover),
+    *PAIR_ROUTES,
     web.get("/ack/{alert_id}", get_ack, allow_head=False),  # shows; HEAD not even that
     web.post("/ack/{alert_id}", post_ack),  # the page's one button acknowledges
 ]
@@ -470,11 +530,19 @@ async def close_pages(app: web.Application) -> None:
 
 
 def make_app(
-    executive: Executive, *, token: str | None, loopback: bool, origins: Origins | None = None
+    executive: Executive,
+    *,
+    token: str | None,
+    loopback: bool,
+    origins: Origins | None = None,
+    tell: Callable[[Handover], None] | None = None,
+    devices: Devices | None = None,
 ) -> web.Application:
     """``executive``'s console as an application: its routes, its state, its lifetime.
     ``token`` (None: commands are off); ``loopback``: whether reads may need no token;
-    ``origins``: the console's own (bound by :class:`Console` once it listens)."""
+    ``origins``: the console's own (bound by :class:`Console` once it listens); ``tell``:
+    where a shift's handover goes (the webhooks); ``devices``: the paired devices (None:
+    pairing is off)."""
     cfg = executive.site.console
     app = web.Application(middlewares=[guard], client_max_size=cfg.max_body)
     app[EXECUTIVE] = executive
@@ -486,7 +554,16 @@ def make_app(
         origins or Origins("127.0.0.1", executive.site.alerts.console_url),
         proxies=networks(cfg.trusted_proxies),
     )
-    app[SHOWN] = Shown(Day(executive.site.language), LogLines(owner=executive), StopClock())
+    book = executive.staff.book
+    shift = Shift(
+        executive.site.staff.handover,
+        lambda: [
+            (a, a.id not in book.unacknowledged)
+            for a in sorted(book.active.values(), key=lambda a: a.since)
+        ],
+        tell,
+    )
+    app[SHOWN] = Shown(Day(executive.site.language), shift, LogLines(owner=executive), StopClock())
     app[PAGES] = Pages(cfg.push_every)
     access = app[ACCESS]
     app[ACK_DESK] = AckDesk(
@@ -496,6 +573,15 @@ def make_app(
         access.rates,
         access.client,
         app[PAGES].changed.set,
+    )
+    app[PAIR_DESK] = PairDesk(
+        devices or Devices(None),
+        Pairings(executive.site.staff.pairing_ttl),
+        token,
+        access.failures,
+        access.client,
+        lambda request: public_url(executive.site.alerts.console_url, request),
+        asked_language,
     )
     app[ASSETS] = load_assets()
     app.add_routes(ROUTES)
@@ -520,12 +606,19 @@ class Console:
         *,
         max_connections: int | None = None,
         header_timeout: float = HEADER_TIMEOUT,
+        tell: Callable[[Handover], None] | None = None,
+        devices: Devices | None = None,
     ) -> None:
         self.executive = executive
         self.host, self.port = host, port
         self.origins = Origins(host, executive.site.alerts.console_url)
         self.app = make_app(
-            executive, token=token, loopback=is_loopback(host), origins=self.origins
+            executive,
+            token=token,
+            loopback=is_loopback(host),
+            origins=self.origins,
+            tell=tell,
+            devices=devices,
         )
         self.door = Door(connection_cap() if max_connections is None else max_connections)
         self.bound_port: int | None = None
@@ -541,8 +634,9 @@ class Console:
         self._started = False
 
     def attach(self) -> None:
-        """The day's tally among the executive's observers."""
-        self.executive.observers.attach(self.executive, [self.app[SHOWN].day])
+        """The day's tally and the shift among the executive's observers."""
+        kept = self.app[SHOWN]
+        self.executive.observers.attach(self.executive, [kept.day, kept.shift])
 
     async def start(self) -> None:
         """Listen; OSError when the address cannot be bound (then :meth:`close`)."""

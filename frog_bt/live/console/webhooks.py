@@ -1,6 +1,8 @@
 """Alerts to people's phones and to the site's alert router: each alert change POSTed to
 every destination of ``alerts.webhooks``, in the format it understands
-(:mod:`.alertbodies`: the generic JSON, ntfy, Alertmanager).
+(:mod:`.alertbodies`: the generic JSON, ntfy, Alertmanager); and a shift's handover
+(:mod:`.handover`) to those people read (the generic JSON and ntfy), through the same
+queues (:meth:`Webhooks.hand_over`).
 
 Never on the tick: :meth:`Webhooks.notify` only queues. Each destination has its own
 bounded queue and its own task (:class:`Destination`), so a dead receiver delays nobody
@@ -29,15 +31,18 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
+from datetime import tzinfo
 from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
 import msgspec
 
+from frog_bt.clock import SITE_TZ
 from frog_bt.config import AlertsCfg, Webhook
-from frog_bt.live.console import alertbodies
+from frog_bt.live.console import alertbodies, handover
 from frog_bt.live.console.acklink import ack_link, link_key
 from frog_bt.live.console.alertbodies import Outgoing, Sender
+from frog_bt.live.console.handover import Handover
 from frog_bt.model.channels import Alert
 from frog_bt.model.events import AlertChanged, Event
 from frog_bt.warning_limit import WarningLimiter
@@ -51,6 +56,8 @@ log = logging.getLogger(__name__)
 QUEUE = 256  # alert changes waiting to be posted, per destination
 BODY_MAX = 32_768  # bytes of a body sent (text fields are cut well before)
 ANSWER_MAX = 4096  # bytes of an answer read
+HANDOVER_FORMATS = ("json", "ntfy")  # Alertmanager routes alerts, not handovers
+Told = Outgoing | Handover  # what a destination sends: an alert change, or a handover
 
 
 def redact(url: str) -> str:
@@ -87,8 +94,10 @@ class Destination:
         sender: Sender,
         stats: WebhookStats,
         wall: Callable[[], float],
+        tz: tzinfo = SITE_TZ,
     ) -> None:
         self.hook = hook
+        self.tz = tz
         self.cfg = cfg
         self.sender = sender
         self.stats = stats
@@ -96,14 +105,14 @@ class Destination:
         self.shown = redact(hook.url)
         self.url = alertbodies.target(hook)
         self.refresh = alertbodies.REFRESH if hook.format == "alertmanager" else None
-        self.queue: deque[Outgoing] = deque()
+        self.queue: deque[Told] = deque()
         self.firing: dict[str, Outgoing] = {}  # alertmanager: id -> latest, to re-send
         self.busy = False
         self._ready = asyncio.Event()
         self._warnings = WarningLimiter(60.0, logger=log)
         self.task: asyncio.Task[None] | None = None
 
-    def put(self, out: Outgoing) -> None:
+    def put(self, out: Told) -> None:
         if len(self.queue) >= QUEUE:
             self.queue.popleft()
             self.stats.dropped += 1
@@ -141,8 +150,11 @@ class Destination:
                     out = self.queue[0]
                     self.busy = True
                     try:
-                        self._track(out)
-                        await self._post(session, self._encode(out), out.alert.id)
+                        if isinstance(out, Handover):
+                            await self._post(session, self._encode_handover(out), "the handover")
+                        else:
+                            self._track(out)
+                            await self._post(session, self._encode(out), f"alert {out.alert.id}")
                     finally:
                         self.busy = False
                     if self.queue and self.queue[0] is out:
@@ -164,7 +176,7 @@ class Destination:
         await self._post(
             session,
             msgspec.json.encode(alertbodies.alertmanager(outs, self.sender)),
-            "(still firing)",
+            "alerts (still firing)",
         )
 
     def _encode(self, out: Outgoing) -> bytes:
@@ -182,6 +194,13 @@ class Destination:
                 }
             )
         return data
+
+    def _encode_handover(self, h: Handover) -> bytes:
+        if self.hook.format == "ntfy":
+            data = handover.ntfy(h, self.sender, alertbodies.ntfy_topic(self.hook), self.tz)
+        else:
+            data = handover.generic(h, self.sender, self.tz)
+        return msgspec.json.encode(data)
 
     async def _post(self, session: aiohttp.ClientSession, data: bytes, what: str) -> None:
         import aiohttp
@@ -202,7 +221,7 @@ class Destination:
                     if response.status < 500:
                         self.stats.failed += 1
                         log.warning(
-                            "webhook %s refused alert %s: HTTP %d%s",
+                            "webhook %s refused %s: HTTP %d%s",
                             self.shown,
                             what,
                             response.status,
@@ -227,7 +246,7 @@ class Destination:
             delay *= 2
         self.stats.failed += 1
         log.warning(
-            "webhook %s: alert %s not delivered after %d tries (%s)",
+            "webhook %s: %s not delivered after %d tries (%s)",
             self.shown,
             what,
             self.cfg.webhook_attempts,
@@ -259,6 +278,7 @@ class Webhooks:
         ack_secret: str | None = None,
         wall: Callable[[], float] = time.time,
         language: str = "en",
+        tz: tzinfo = SITE_TZ,
     ) -> None:
         self.cfg = cfg
         self.robot = robot or cfg.robot
@@ -269,7 +289,7 @@ class Webhooks:
         sender = Sender(self.robot, cfg.console_url, language)
         # a plain URL is validated here too: ``model_copy(update=...)`` does not validate
         hooks = [Webhook.model_validate(h) for h in cfg.webhooks]
-        self.destinations = [Destination(hook, cfg, sender, self.stats, wall) for hook in hooks]
+        self.destinations = [Destination(hook, cfg, sender, self.stats, wall, tz) for hook in hooks]
 
     def start(self) -> None:
         loop = asyncio.get_running_loop()
@@ -297,6 +317,13 @@ class Webhooks:
         out = Outgoing(alert, at, started, self.link(alert, at))
         for d in self.destinations:
             d.put(out)
+
+    def hand_over(self, h: Handover) -> None:
+        """Queue a shift's handover for every destination that shows one to people (the
+        generic JSON and ntfy; no I/O)."""
+        for d in self.destinations:
+            if d.hook.format in HANDOVER_FORMATS:
+                d.put(h)
 
     def link(self, alert: Alert, at: float) -> str:
         """The signed link acknowledging this raise of ``alert`` on this robot ("" without
