@@ -83,8 +83,8 @@ INTERNAL = frozenset({"status", "feedback_message", "iterator"})
 LAZY = (keys.DIAGNOSTICS, keys.PERSONS, keys.PEOPLE, keys.FACES)  # answered as read
 # what the operator reads of the board (engine/operator.py) besides the tree's nodes
 OPERATOR_READS = frozenset(
-    (keys.TOUR_STATE, keys.HOME, keys.ABORT_REASON, keys.PAUSED, keys.IN_SERVICE, keys.SKIP)
-    + (keys.HELP, keys.HELP_ANSWER, keys.DOCKING)
+    {keys.TOUR_STATE, keys.HOME, keys.ABORT_REASON, keys.PAUSED, keys.IN_SERVICE, keys.SKIP}
+    | {keys.HELP, keys.HELP_ANSWER, keys.DOCKING}
 )
 TIME = 1e9  # a float this large is a project-clock time (encoded relative to now)
 
@@ -384,7 +384,9 @@ class Real:
         board._values = {k: _clone(v, memo) for k, v in values.items()}
         core.standing.values.clear()
         core.standing.values.update({k: _clone(v, memo) for k, v in lasting.items()})
-        core.snapshot.events = self._board_get(keys.EVENTS)
+        events = self._board_get(keys.EVENTS)
+        assert events is not None  # the snapshot writes it before the first tick
+        core.snapshot.events = events
         core.standing.paused_since = paused_since
         inputs = core.inputs
         inputs.latest = dict(latest)
@@ -557,9 +559,9 @@ class Real:
             asking = next((i for i in self.running() if _role(self.worlds[i]) == "help"), 0)
             step.events.append((VEvent.HELP, asking, self.world_view()))
         for i in self.retries:
-            node = self.nodes[i]
+            retry: Any = self.nodes[i]
             was = self.live_failures[i] if self.live_status[i] is RUNNING else 0
-            if node.status is RUNNING and node.failures > was:
+            if retry.status is RUNNING and retry.failures > was:
                 step.events.append((VEvent.RETRY, i, self.world_view()))
         if board.get(keys.HOME) is None:
             self.robot.homing = False
@@ -639,7 +641,7 @@ class Real:
             if w.key is not None:
                 nodes.append((i, w.key(node)))
                 continue
-            fields = []
+            fields: list[Hashable] = []
             for name in w.state:
                 value = getattr(node, name, None)
                 if name in w.indexes and isinstance(value, int):
@@ -768,6 +770,7 @@ def _clone(value: Any, memo: dict[int, Any]) -> Any:
     found = memo.get(id(value))
     if found is not None:
         return found
+    out: Any
     if isinstance(value, EventLog):
         out = EventLog.__new__(EventLog)
         out._events = deque(value._events, maxlen=value._events.maxlen)
