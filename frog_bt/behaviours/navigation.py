@@ -146,7 +146,6 @@ class AtPoi(Leaf):
 
 @register
 class SkipStop(Leaf):
-    world = World()
     """Give up on ``poi`` for this tour (its navigation kept failing).
 
     Writes ``/skipped`` = ``poi``. SUCCESS.
@@ -155,6 +154,7 @@ class SkipStop(Leaf):
     Params = PoiParams
     params: PoiParams
     writes = (keys.SKIPPED,)
+    world = World()
 
     def update(self) -> Status:
         self.set(keys.SKIPPED, self.params.poi)
@@ -168,12 +168,12 @@ class SkipStop(Leaf):
 
 @register
 class Skipped(Leaf):
-    world = World()
     """Is ``poi`` being skipped? Reads ``/skipped`` (optional). SUCCESS if so, else FAILURE."""
 
     Params = PoiParams
     params: PoiParams
     optional_reads = (keys.SKIPPED,)
+    world = World()
 
     def update(self) -> Status:
         return SUCCESS if self.get(keys.SKIPPED) == self.params.poi else FAILURE
