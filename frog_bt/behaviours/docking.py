@@ -14,6 +14,7 @@ from frog_bt.model import keys
 from frog_bt.model.outcomes import DockingState, IncidentKind
 from frog_bt.tree import leaf
 from frog_bt.tree.leaf import RUNNING, SUCCESS, Status
+from frog_bt.tree.world import Channel, World
 
 TARGET = {"dock": DockingState.DOCKED, "undock": DockingState.UNDOCKED}
 BUSY = {"dock": DockingState.DOCKING, "undock": DockingState.UNDOCKING}
@@ -49,6 +50,18 @@ class Docking(GoalLeaf):
     params: Params
     reads = (keys.DOCKING, keys.NOW)
     optional_reads = (keys.POSE,)
+    world = World(
+        inputs=(Channel.DOCKING, Channel.POSE, Channel.CLOCK),
+        state=(*GoalLeaf.world.state, "already", "took", "away"),
+        times=GoalLeaf.world.times,
+        timer=GoalLeaf.world.timer,
+        docking=lambda n: (
+            (TARGET[n.params.action].value, DockingState.FAILED.value)
+            if n.sent_at is not None and not n.already and n.away is None
+            else ()
+        ),
+        why="the robot reports the state asked for, or failed, at the next tick",
+    )
 
     def default_timeout(self) -> float:
         timeouts = self.ctx.site.timeouts

@@ -21,6 +21,7 @@ from frog_bt.model import keys
 from frog_bt.model.frontend import Engagement
 from frog_bt.tree.decorators import FrogDecorator
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
+from frog_bt.tree.world import Channel, World
 
 
 @register_decorator
@@ -39,6 +40,16 @@ class FaceStream(FrogDecorator):
 
     reads = (keys.FACES, keys.NOW)
     writes = (keys.ICL, keys.ENGAGEMENT, keys.ENGAGEMENT_METER)
+    world = World(
+        inputs=(Channel.FACES,),
+        state=("samples", "last_face_data", "next_meter"),
+        times=("last_face_data", "next_meter"),
+        copy=("samples",),
+        key=lambda n: tuple(float(v) for v in n.samples.levels()),
+        why="engagement: one face sample per stream, engaged or not, or none; the vote "
+        "over many samples is the maths' own (tests/maths). When the meter is sent "
+        "changes what it says, not what the tree decides",
+    )
 
     def provides(self) -> tuple[keys.Key[Any], ...]:
         """What the child may read while the stream is on (the data-flow check)."""
@@ -112,6 +123,7 @@ class DecideEngagement(Leaf):
     params: Params
     optional_reads = (keys.ENGAGEMENT,)
     writes = (keys.ENGAGED, keys.ENGAGEMENT_DECISION)
+    world = World()
 
     def update(self) -> Status:
         cfg = self.ctx.site.engagement
@@ -133,6 +145,7 @@ class Engaged(Leaf):
     """
 
     reads = (keys.ENGAGED,)
+    world = World()
 
     def update(self) -> Status:
         engaged = self.get(keys.ENGAGED)

@@ -33,6 +33,7 @@ from frog_bt.model.ros import Pose
 from frog_bt.model.wire import SUCCEEDED
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Status
 from frog_bt.tree.node import NodeParams
+from frog_bt.tree.world import Channel, World
 
 __all__ = ["Failure", "GoalLeaf", "goal_state"]
 
@@ -71,6 +72,13 @@ class GoalLeaf(Leaf):
 
     waits_while_paused: ClassVar[bool] = False  # the operator's pause holds the sending
     params: TimedParams
+    world = World(
+        inputs=(Channel.GOAL, Channel.CLOCK),
+        state=("goal", "latest", "sent_at", "timeout"),
+        times=("sent_at",),
+        timer=lambda n: n.sent_at + n.timeout if n.sent_at is not None else None,
+        active="sent_at",
+    )
 
     def __init_subclass__(cls, **kwargs: object) -> None:
         super().__init_subclass__(**kwargs)

@@ -15,6 +15,7 @@ from frog_bt.model.progress import EMPTY
 from frog_bt.model.ros import Pose
 from frog_bt.tree import leaf
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Status
+from frog_bt.tree.world import Channel, Role, World
 
 # What a person's help is about, as the alerts name the incident behind it.
 INCIDENT = {
@@ -57,6 +58,12 @@ class AskForHelp(Leaf):
     reads = (keys.NOW, keys.DIAGNOSTICS)
     optional_reads = (keys.HELP_ANSWER, keys.HELP_RESTORED, keys.POSE, keys.DOCKING)
     writes = (keys.HELP, keys.HELP_ANSWER, keys.HELP_RESTORED, keys.GAVE_UP, keys.PROGRESS)
+    world = World(
+        inputs=(Channel.OPERATOR, Channel.DIAGNOSTICS, Channel.DOCKING),
+        state=("asking",),
+        waits=True,
+        role=Role.HELP,
+    )
 
     def initialise(self) -> None:
         self.asking: Help | None = None

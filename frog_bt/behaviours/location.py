@@ -26,6 +26,7 @@ from frog_bt.model.key import Reading
 from frog_bt.model.ros import Pose
 from frog_bt.tree.decorators import FrogDecorator
 from frog_bt.tree.leaf import Status
+from frog_bt.tree.world import Channel, World
 
 
 def fresh_pose(node: FrogDecorator) -> Reading[Pose] | None:
@@ -54,6 +55,13 @@ class LocationAware(FrogDecorator):
     """
 
     reads = (keys.POSE, keys.NOW)
+    world = World(
+        inputs=(Channel.POSE,),
+        state=("zones", "membership", "percent"),
+        copy=("membership",),
+        key=lambda n: getattr(n, "percent", None),
+        why="the zone follows from where the robot is (a waypoint)",
+    )
 
     def initialise(self) -> None:
         cfg = self.ctx.site.zones.volume
@@ -90,6 +98,12 @@ class GuidedDrive(FrogDecorator):
     reads = (keys.POSE, keys.NOW)
     optional_reads = (keys.WAYPOINT, keys.SPECIAL_DONE)
     writes = (keys.SPECIAL_DONE,)
+    world = World(
+        inputs=(Channel.POSE,),
+        state=("_on", "spots"),
+        key=lambda n: n._on,
+        why="follow_me and special content follow from where the robot is (a waypoint)",
+    )
 
     def __init__(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
         super().__init__(*args, **kwargs)

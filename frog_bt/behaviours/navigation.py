@@ -12,6 +12,7 @@ from frog_bt.model import keys
 from frog_bt.model.goals import Goal
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.tree.leaf import FAILURE, SUCCESS, Leaf, Params, Status
+from frog_bt.tree.world import Channel, Role, World
 
 
 class PoiParams(Params):
@@ -53,6 +54,16 @@ class Navigate(GoalLeaf):
     optional_reads = (keys.PAUSED, keys.POSE)
     writes = (keys.TARGET, keys.WAYPOINT, keys.SKIPPED)
     waits_while_paused = True
+    world = World(
+        inputs=(Channel.GOAL, Channel.POSE, Channel.OPERATOR, Channel.CLOCK),
+        state=GoalLeaf.world.state,
+        times=GoalLeaf.world.times,
+        timer=GoalLeaf.world.timer,
+        active="sent_at",
+        role=Role.DRIVE,
+        why="the robot arrives (a pose at the waypoint, then /FROG_response 2) or fails "
+        "(3) at the next tick, or the timeout runs out: how long a drive takes is left out",
+    )
 
     def default_timeout(self) -> float:
         return self.ctx.site.timeouts.navigation
@@ -114,6 +125,11 @@ class AtPoi(Leaf):
     Params = PoiParams
     params: PoiParams
     optional_reads = (keys.POSE,)
+    world = World(
+        inputs=(Channel.POSE,),
+        why="where the robot is: at the waypoint of its last believed arrival (at the dock "
+        "at first), or away from every waypoint after a failed drive",
+    )
 
     def update(self) -> Status:
         site = self.ctx.site
@@ -138,6 +154,7 @@ class SkipStop(Leaf):
     Params = PoiParams
     params: PoiParams
     writes = (keys.SKIPPED,)
+    world = World()
 
     def update(self) -> Status:
         self.set(keys.SKIPPED, self.params.poi)
@@ -156,6 +173,7 @@ class Skipped(Leaf):
     Params = PoiParams
     params: PoiParams
     optional_reads = (keys.SKIPPED,)
+    world = World()
 
     def update(self) -> Status:
         return SUCCESS if self.get(keys.SKIPPED) == self.params.poi else FAILURE

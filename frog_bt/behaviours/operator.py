@@ -18,6 +18,8 @@ from frog_bt.model import keys
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.tree.decorators import FrogDecorator
 from frog_bt.tree.leaf import RUNNING, SUCCESS, Leaf, Status
+from frog_bt.tree.world import Channel, World
+from frog_bt.tree.world import Role as WorldRole
 
 
 @register_decorator
@@ -35,6 +37,7 @@ class OperatorSkip(FrogDecorator):
     optional_reads = (keys.SKIP,)
     role = Role.STOP  # the core asks the running ones what a skip would leave
     _requested = False
+    world = World(inputs=(Channel.OPERATOR,), state=("skips", "_requested"))
 
     def stop_poi(self) -> str:
         return self.params.poi
@@ -71,6 +74,7 @@ class WaitInService(Leaf):
     """
 
     optional_reads = (keys.IN_SERVICE,)
+    world = World(inputs=(Channel.OPERATOR,), waits=True, role=WorldRole.IDLE)
 
     def update(self) -> Status:
         if self.get(keys.IN_SERVICE) is False:

@@ -19,6 +19,7 @@ from frog_bt.model import keys
 from frog_bt.model.frontend import Projector as ProjectorCommand
 from frog_bt.tree.decorators import FrogDecorator
 from frog_bt.tree.leaf import Status
+from frog_bt.tree.world import Channel, World
 
 
 def recent_speed(history: deque[tuple[float, float, float]]) -> float:
@@ -46,6 +47,14 @@ class Projector(FrogDecorator):
     params: Params
     reads = (keys.POSE, keys.NOW)
     optional_reads = (keys.WAYPOINT,)
+    world = World(
+        inputs=(Channel.POSE,),
+        state=("_on", "history"),
+        copy=("history",),
+        key=lambda n: n._on,
+        why="the arrival estimate needs the robot's speed over seconds, which verify leaves "
+        "out: the projector goes on within projector.radius of the stop",
+    )
 
     def __init__(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
         super().__init__(*args, **kwargs)

@@ -17,6 +17,8 @@ from frog_bt.model.goals import Goal
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.model.ros import PersonDetection, Pose
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
+from frog_bt.tree.world import Channel, World
+from frog_bt.tree.world import Role as WorldRole
 
 Timeout = Field(
     None,
@@ -64,6 +66,11 @@ class SeekVisitor(Leaf):
     reads = (keys.PERSONS, keys.POSE, keys.NOW)
     optional_reads = (keys.DECLINED, keys.APPROACH_FAILED)
     writes = (keys.VISITOR,)
+    world = World(
+        inputs=(Channel.VISITOR, Channel.POSE),
+        waits=True,
+        why="two visitors who may face the robot, or nobody: a declined one is passed over",
+    )
 
     def update(self) -> Status:
         cfg = self.ctx.site.recruit
@@ -118,6 +125,20 @@ class ApproachVisitor(GoalLeaf):
     optional_reads = (keys.APPROACH_FAILED, keys.PAUSED, keys.POSE)
     writes = (keys.APPROACH_FAILED,)
     waits_while_paused = True
+    world = World(
+        inputs=(Channel.GOAL, Channel.VISITOR, Channel.OPERATOR, Channel.CLOCK),
+        state=(*GoalLeaf.world.state, "visitor"),
+        times=GoalLeaf.world.times,
+        timer=lambda n: (
+            n.sent_at + n.timeout
+            if n.sent_at is not None
+            else n.ctx.actions.last_approach_at + n.ctx.site.recruit.approach_interval
+        ),
+        active="sent_at",
+        role=WorldRole.APPROACH,
+        why="the robot reaches the visitor (while the camera sees them) or fails at the "
+        "next tick; the next approach waits recruit.approach_interval",
+    )
 
     def default_timeout(self) -> float:
         return self.ctx.site.timeouts.approach
@@ -165,6 +186,7 @@ class StartIntroduction(Leaf):
     """
 
     optional_reads = (keys.ICL, keys.PAUSED)
+    world = World(inputs=(Channel.OPERATOR,), role=WorldRole.SPEAK)
 
     def update(self) -> Status:
         if self.get(keys.PAUSED):
@@ -185,6 +207,7 @@ class AskTour(Leaf):
     """
 
     optional_reads = (keys.ENGAGED, keys.PAUSED)
+    world = World(inputs=(Channel.OPERATOR,), role=WorldRole.SPEAK)
 
     def update(self) -> Status:
         if self.get(keys.PAUSED):
@@ -211,6 +234,15 @@ class WaitAnswer(Leaf):
     reads = (keys.EVENTS, keys.VISITOR, keys.NOW)
     optional_reads = (keys.DECLINED,)
     writes = (keys.DECLINED,)
+    world = World(
+        inputs=(Channel.FRONTEND, Channel.CLOCK),
+        state=("since", "started", "timeout"),
+        times=("started",),
+        indexes=("since",),
+        timer=lambda n: n.started + n.timeout,
+        frontend=lambda n: (UserPositive(), UserNegative()),
+        waits=True,
+    )
 
     def initialise(self) -> None:
         self.since = self.need(keys.EVENTS).last_index

@@ -25,6 +25,7 @@ from frog_bt.model.ros import Diagnostics
 from frog_bt.text import LINE, inert
 from frog_bt.tree.decorators import FrogDecorator
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
+from frog_bt.tree.world import Channel, World
 
 log = logging.getLogger(__name__)
 
@@ -53,6 +54,10 @@ class MustAbort(Leaf):
     reads = (keys.DIAGNOSTICS, keys.NOW)
     optional_reads = (keys.TOUR_STATE, keys.ABORT_REASON, keys.HOME)
     writes = (keys.ABORT_REASON,)
+    world = World(
+        inputs=(Channel.DIAGNOSTICS, Channel.OPERATOR),
+        why="battery: low (below safety.battery_low) or full; a fault or none",
+    )
 
     def update(self) -> Status:
         if self.get(keys.ABORT_REASON) is not None:
@@ -95,6 +100,7 @@ class ClearAbort(Leaf):
 
     optional_reads = (keys.ABORT_REASON,)
     writes = (keys.ABORT_REASON, keys.ABORT_REASON_LAST, keys.HOME)
+    world = World()
 
     def update(self) -> Status:
         self.set(keys.ABORT_REASON_LAST, self.get(keys.ABORT_REASON))
@@ -114,6 +120,7 @@ class GiveUp(Leaf):
     """
 
     writes = (keys.TOUR_STATE, keys.TOUR_REASON, keys.PROGRESS, keys.GAVE_UP)
+    world = World()
 
     def update(self) -> Status:
         cause = self.ctx.journal.last_incident()
@@ -147,6 +154,12 @@ class ConfirmResume(Leaf):
     reads = (keys.DOCKING, keys.NOW)
     optional_reads = (keys.RESUME,)
     writes = (keys.RESUME, keys.RESUMED, keys.PROGRESS, keys.TOUR_STATE)
+    world = World(
+        inputs=(Channel.DOCKING, Channel.CLOCK),
+        state=("started",),
+        times=("started",),
+        timer=lambda n: n.started + n.ctx.site.checkpoint.confirm,
+    )
 
     def initialise(self) -> None:
         self.started = self.ctx.clock.now()
@@ -195,6 +208,7 @@ class Checkpointed(FrogDecorator):
     writes = (keys.VISITOR, keys.RESUME, keys.PROGRESS)
     skips_child = True  # resumed: SUCCESS without the child (the data-flow check)
     _skip = False
+    world = World(state=("_skip",))
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
         # Resumed past this part: py_trees' plain behaviour tick (initialise, update,

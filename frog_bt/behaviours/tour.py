@@ -9,10 +9,11 @@ from pydantic import Field
 from frog_bt.behaviours.registry import register
 from frog_bt.config import Timeouts
 from frog_bt.model import keys
-from frog_bt.model.frontend import EVENTS, Tour
+from frog_bt.model.frontend import EVENTS, FrontendIdle, Tour
 from frog_bt.model.outcomes import IncidentKind, TourState
 from frog_bt.model.progress import EMPTY
 from frog_bt.tree.leaf import FAILURE, RUNNING, SUCCESS, Leaf, Params, Status
+from frog_bt.tree.world import Channel, Role, World
 
 
 @register
@@ -26,6 +27,13 @@ class WaitFrontendIdle(Leaf):
     """
 
     reads = (keys.FRONTEND_READY, keys.NOW, keys.DIAGNOSTICS)
+    world = World(
+        inputs=(Channel.FRONTEND, Channel.DIAGNOSTICS),
+        frontend=lambda n: (FrontendIdle(),),
+        waits=True,
+        role=Role.IDLE,
+        why="battery: low (below safety.battery_low) or full; a fault or none",
+    )
 
     def update(self) -> Status:
         cfg = self.ctx.site.safety
@@ -73,6 +81,7 @@ class TourStatus(Leaf):
     params: Params
     optional_reads = (keys.ABORT_REASON,)
     writes = (keys.FRONTEND_READY, keys.TOUR_STATE, keys.TOUR_REASON, keys.PROGRESS)
+    world = World()
 
     def update(self) -> Status:
         p = self.params
@@ -119,6 +128,15 @@ class WaitEvent(Leaf):
 
     params: Params
     reads = (keys.EVENTS, keys.NOW)
+    world = World(
+        inputs=(Channel.FRONTEND, Channel.CLOCK),
+        state=("since", "started", "timeout"),
+        times=("started",),
+        indexes=("since",),
+        timer=lambda n: n.started + n.timeout,
+        frontend=lambda n: (EVENTS[n.params.event](),),
+        waits=True,
+    )
 
     def initialise(self) -> None:
         self.since = self.need(keys.EVENTS).last_index

@@ -16,6 +16,7 @@ from frog_bt.model.outcomes import IncidentKind
 from frog_bt.model.ros import Pose, TrackedPeople
 from frog_bt.tree import leaf
 from frog_bt.tree.leaf import FAILURE, INVALID, RUNNING, SUCCESS, Leaf, Status
+from frog_bt.tree.world import Channel, Role, World
 
 
 def someone_within(people: TrackedPeople, pose: Pose, radius: float) -> bool:
@@ -58,6 +59,14 @@ class VisitorFollows(Leaf):
 
     params: Params
     reads = (keys.PEOPLE, keys.POSE, keys.NOW)
+    world = World(
+        inputs=(Channel.VISITOR, Channel.POSE, Channel.CLOCK),
+        state=("radius", "grace", "started"),
+        times=("started",),
+        timer=lambda n: n.started + n.grace,
+        waits=True,
+        why="distance: someone tracked at the robot, or nobody near",
+    )
 
     def initialise(self) -> None:
         cfg = self.ctx.site.follow
@@ -125,6 +134,19 @@ class PlayContent(Leaf):
     params: Params
     reads = (keys.EVENTS, keys.NOW)
     optional_reads = (keys.WAYPOINT, keys.PAUSED)
+    world = World(
+        inputs=(Channel.FRONTEND, Channel.OPERATOR, Channel.CLOCK),
+        state=("playing", "waypoint", "since", "started", "timeout", "restart_seen"),
+        times=("started",),
+        indexes=("since", "restart_seen"),
+        timer=lambda n: n.started + n.timeout if getattr(n, "playing", False) else None,
+        frontend=lambda n: (
+            (ContentDone(n.params.poi, n.params.part),) if getattr(n, "playing", False) else ()
+        ),
+        active="playing",
+        waits=True,
+        role=Role.CONTENT,
+    )
 
     def initialise(self) -> None:
         self.playing = False
@@ -179,6 +201,7 @@ class FinishPoi(Leaf):
 
     Params = PoiParams
     params: PoiParams
+    world = World()
 
     def update(self) -> Status:
         self.ctx.send(FinishPoiCommand(self.params.poi))

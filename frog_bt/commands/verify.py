@@ -46,6 +46,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="draw the tree with the nodes of each broken run marked",
     )
     p.add_argument(
+        "--real",
+        action="store_true",
+        help="explore the real tree (its nodes ticked in a core, only the world abstracted; "
+        "restarts from each checkpoint too) instead of the model",
+    )
+    p.add_argument(
         "--conformance",
         type=Path,
         nargs="+",
@@ -63,7 +69,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     try:
         _, site, tree = load_tree_argument(args)
-        verdict = prove(tree, site)
+        verdict = prove(tree, site, real=args.real)
     except UsageError as exc:
         print(f"frog-bt: {exc}", file=sys.stderr)
         return 2

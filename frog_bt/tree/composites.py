@@ -17,6 +17,7 @@ from pydantic import Field
 from frog_bt.engine.observed import Observed
 from frog_bt.model.key import Scope
 from frog_bt.tree.node import Params
+from frog_bt.tree.world import World
 
 Behaviour = py_trees.behaviour.Behaviour
 ScopeName = Literal["tour", "visitor", "stop"]
@@ -28,6 +29,10 @@ SCOPE_DOC = (
 
 class _Composite(Observed, py_trees.composites.Composite):
     Params: ClassVar[type[Params]]
+    world = World(
+        state=("current_child",),
+        key=lambda n: n.children.index(n.current_child) if n.current_child is not None else -1,
+    )
 
     def initialise(self) -> None:
         self.start_scope()  # py_trees calls it from the tick, as the composite starts

@@ -26,6 +26,7 @@ from pydantic import BaseModel, Field
 
 from frog_bt.engine.observed import Observed
 from frog_bt.tree.node import FAILURE, RUNNING, Declared, Params, Status
+from frog_bt.tree.world import Channel, World
 
 
 class FrogDecorator(Observed, Declared, py_trees.decorators.Decorator):
@@ -71,6 +72,8 @@ class Retry(FrogDecorator, py_trees.decorators.Retry):
         )
 
     params: Params
+    # an unbounded retry's count changes nothing it does: kept out of the state
+    world = World(state=("failures",), key=lambda n: n.failures if n.params.attempts else 0)
 
     def base_kwargs(self, params: Any) -> dict[str, Any]:
         return {"num_failures": params.attempts or math.inf}
@@ -92,6 +95,12 @@ class Timeout(FrogDecorator):
         )
 
     params: Params
+    world = World(
+        inputs=(Channel.CLOCK,),
+        state=("deadline",),
+        times=("deadline",),
+        timer=lambda n: n.deadline,
+    )
 
     def initialise(self) -> None:
         self.deadline = self.ctx.clock.now() + self.params.seconds
@@ -111,3 +120,4 @@ class FailureIsSuccess(FrogDecorator, py_trees.decorators.FailureIsSuccess):
     (py_trees' ``FailureIsSuccess``)."""
 
     child_may_fail = True  # nothing the child writes is sure after it (the data-flow check)
+    world = World()

@@ -32,6 +32,7 @@ class Graph:
     parent: list[tuple[int, int]] = field(default_factory=list)  # (state, edge index in it)
     edges: list[list[tuple[int, Step]]] = field(default_factory=list)
     seconds: float = 0.0
+    starts: list[int] = field(default_factory=lambda: [0])  # a restart's too
 
     @property
     def transitions(self) -> int:
@@ -40,7 +41,7 @@ class Graph:
     def path(self, state: int) -> list[tuple[int, Step, int]]:
         """The shortest run to ``state``: (from, step, to) per tick."""
         out = []
-        while state > 0:
+        while self.parent[state][0] >= 0:
             src, k = self.parent[state]
             out.append((src, self.edges[src][k][1], state))
             state = src

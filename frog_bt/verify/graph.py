@@ -99,7 +99,8 @@ def find_loop(
 def _depths(graph: Graph) -> list[int]:
     depth = [0] * len(graph.states)
     for s in range(1, len(graph.states)):
-        depth[s] = depth[graph.parent[s][0]] + 1  # parents come first (breadth-first)
+        parent = graph.parent[s][0]  # parents come first (breadth-first); a start has none
+        depth[s] = depth[parent] + 1 if parent >= 0 else 0
     return depth
 
 
@@ -155,10 +156,10 @@ def monitor(graph: Graph, step_bit: Callable[[Step, bool], tuple[bool, int | Non
     """Breadth-first over (state, bit): ``step_bit(step, bit)`` gives the bit after the
     tick and, when the tick breaks the property, the node that did; the shortest run
     that breaks it, or None."""
-    start = (0, False)
+    starts = [(s, False) for s in graph.starts]
     prev: dict[tuple[int, bool], tuple[tuple[int, bool], Tick_]] = {}
-    queue = deque([start])
-    seen = {start}
+    queue = deque(starts)
+    seen = set(starts)
     while queue:
         node = queue.popleft()
         s, bit = node
@@ -167,7 +168,7 @@ def monitor(graph: Graph, step_bit: Callable[[Step, bool], tuple[bool, int | Non
             if broken is not None:
                 ticks = [(s, step, dst)]
                 cur = node
-                while cur != start:
+                while cur not in starts:
                     cur, tick = prev[cur]
                     ticks.append(tick)
                 return Run(ticks[::-1], nodes={broken})

@@ -24,6 +24,7 @@ from frog_bt.model.key import Scope
 from frog_bt.tree.composites import Parallel, Selector, Sequence
 from frog_bt.tree.decorators import FailureIsSuccess, Retry, Timeout
 from frog_bt.tree.leaf import Leaf
+from frog_bt.tree.world import world_of
 from frog_bt.verify.abstraction import Abstraction, abstraction_of
 from frog_bt.verify.world import Role
 
@@ -83,6 +84,7 @@ class CNode:
 class Model:
     tree: LoadedTree
     nodes: list[CNode]
+    real: bool = False  # compiled for the real tree's explorer (roles from ``world``)
 
     def named(self, name: str) -> list[CNode]:
         """The nodes with ``name`` (a name written once in an included file may name one
@@ -108,7 +110,11 @@ class Model:
                     at.file if at else self.tree.file,
                     at.path if at else (),
                     f"leaf type {type_name} declares no world interface for verify "
-                    "(a `verify` Abstraction on its class)",
+                    + (
+                        "(a `world` World on its class)"
+                        if self.real
+                        else "(a `verify` Abstraction on its class)"
+                    ),
                 )
             )
         return errors
@@ -152,8 +158,9 @@ def preorder(root: Behaviour) -> list[Behaviour]:
     return out
 
 
-def compile_tree(tree: LoadedTree, site: Site | None = None) -> Model:
-    """Number the nodes of ``tree`` and attach each leaf's abstraction."""
+def compile_tree(tree: LoadedTree, site: Site | None = None, real: bool = False) -> Model:
+    """Number the nodes of ``tree`` and attach each leaf's abstraction (``real``: its
+    role from the world interface its class declares, :mod:`frog_bt.tree.world`)."""
     dock = site.tour.dock if site is not None else "SHOP"
     nodes: list[CNode] = []
 
@@ -172,7 +179,11 @@ def compile_tree(tree: LoadedTree, site: Site | None = None) -> Model:
             n.synchronise = bool(getattr(policy, "synchronise", False))
         if kind is Kind.RETRY:
             n.attempts = n.params.get("attempts")
-        if kind is Kind.LEAF:
+        if kind is Kind.LEAF and real:
+            world = world_of(type(b))
+            n.declared = world is not None
+            n.abstraction = Abstraction(role=world.role if world is not None else Role.NONE)
+        elif kind is Kind.LEAF:
             n.abstraction, n.declared = abstraction_of(type(b))
         reads = (*getattr(b, "reads", ()), *getattr(b, "optional_reads", ()))
         n.reads = _names(reads)
@@ -188,4 +199,4 @@ def compile_tree(tree: LoadedTree, site: Site | None = None) -> Model:
         return n.index
 
     walk(tree.root, -1)
-    return Model(tree, nodes)
+    return Model(tree, nodes, real)

@@ -122,6 +122,12 @@ def broken_text(verdict: Verdict, fmt: str | None = None) -> str:
         if fmt:
             lines.append(draw(verdict.model, run_nodes(b.run), b.run.nodes, fmt))
     lines += [vacuous_finding(verdict, name) for name in verdict.vacuous]
+    lines += [
+        f"{cls}: keeps state its type does not declare: {', '.join(sorted(fields))} "
+        "(declare them in its `world`)"
+        for cls, fields in sorted(verdict.undeclared.items())
+    ]
+    lines += [f"{failed}: a node's code raised while verify explored" for failed in verdict.failed]
     g = verdict.graph
     lines.append(
         f"{len({b.name for b in verdict.broken})} properties broken, "

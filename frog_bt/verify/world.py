@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import enum
 
+from frog_bt.tree.world import Role as Role  # where it is declared, with the leaves
+
 # World slots (an index into the world tuple).
 STARTED = 0  # /tour_state is started
 ABORT = 1  # /abort_reason latched (MustAbort .. ClearAbort)
@@ -34,20 +36,6 @@ class By(enum.Enum):
     ROBOT = "robot"  # the robot's own outcome (navigation, docking), or time running out
     WORLD = "world"  # a person, the front end, the operator, the diagnostics
     QUIET = "quiet"  # nothing happened (no command, no fault): the default
-
-
-class Role(enum.Enum):
-    """What a leaf is to the built-in properties."""
-
-    NONE = "none"
-    DRIVE = "drive"  # sends the robot across the floor to a POI (a pause holds it)
-    APPROACH = "approach"  # drives the robot up to a visitor (a pause holds it)
-    CONTENT = "content"  # plays a stop's content (a pause holds its start)
-    SPEAK = "speak"  # says something to the visitor at once (introduction, question)
-    DOCK = "dock"
-    UNDOCK = "undock"
-    IDLE = "idle"  # waits, with no tour, for the next one
-    HELP = "help"  # holds and asks a person
 
 
 class Event(enum.Enum):

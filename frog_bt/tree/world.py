@@ -1,0 +1,83 @@
+"""What a node type tells ``frog-bt verify`` about itself: its world interface and its state.
+
+``verify --real`` ticks the real tree (:mod:`frog_bt.verify.real`); only the world is
+abstracted. Each node type says, on its class, as ``world = World(...)``:
+
+* ``inputs``: the parts of the world it listens to (:class:`Channel`): what the explorer
+  chooses for it at each tick, from a finite set (the robot's answer to its goal, the
+  front end's events, a visitor, the diagnostics, its wait running out);
+* ``state``: the instance fields it keeps between ticks (set in ``initialise`` or
+  ``update``), with ``times`` (project-clock times among them: encoded relative to now)
+  and ``indexes`` (front-end event indexes: relative to the newest event); ``copy``:
+  the mutable ones, copied on snapshot and restore. A field it keeps and does not
+  declare is an error verify reports by class;
+* ``timer``: when its wait runs out (project clock), the explorer may step the clock
+  there; ``frontend``: the front-end events it may be sent now; ``docking``: the
+  docking states the robot may report to it now (``/docking/state``); ``active``: the field
+  set while its action is out (a goal, content playing); ``waits``: while it runs it
+  waits for a person or the front end (not for the robot);
+* ``role``: what it is to the built-in properties; ``why``: where it abstracts a number
+  (engagement, a distance), the reason.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["Channel", "Role", "World"]
+
+
+class Channel(enum.Enum):
+    """A part of the world the explorer drives."""
+
+    GOAL = "the robot's answer to a goal"
+    DOCKING = "the docking state"
+    FRONTEND = "the front end's events"
+    VISITOR = "a visitor facing the robot, following, answering"
+    FACES = "a visitor's face: engaged or not"
+    DIAGNOSTICS = "battery and faults"
+    POSE = "where the robot is"
+    OPERATOR = "the operator's commands"
+    CLOCK = "a wait running out"
+
+
+class Role(enum.Enum):
+    """What a leaf is to the built-in properties."""
+
+    NONE = "none"
+    DRIVE = "drive"  # sends the robot across the floor to a POI (a pause holds it)
+    APPROACH = "approach"  # drives the robot up to a visitor (a pause holds it)
+    CONTENT = "content"  # plays a stop's content (a pause holds its start)
+    SPEAK = "speak"  # says something to the visitor at once (introduction, question)
+    DOCK = "dock"
+    UNDOCK = "undock"
+    IDLE = "idle"  # waits, with no tour, for the next one
+    HELP = "help"  # holds and asks a person
+
+
+@dataclass(frozen=True, slots=True)
+class World:
+    """A node type's world interface and state, as verify sees them."""
+
+    inputs: tuple[Channel, ...] = ()
+    state: tuple[str, ...] = ()
+    times: tuple[str, ...] = ()
+    indexes: tuple[str, ...] = ()
+    copy: tuple[str, ...] = ()
+    timer: Callable[[Any], float | None] | None = None
+    frontend: Callable[[Any], tuple[Any, ...]] | None = None
+    docking: Callable[[Any], tuple[str, ...]] | None = None
+    active: str = ""
+    waits: bool = False
+    role: Role = Role.NONE
+    key: Callable[[Any], Hashable] | None = None  # its own encoding of its state
+    why: str = ""
+
+
+def world_of(cls: type) -> World | None:
+    """The world interface a node type declares (inherited from a base), or None."""
+    found = getattr(cls, "world", None)
+    return found if isinstance(found, World) else None
