@@ -126,3 +126,21 @@ def test_the_running_path_is_a_small_graph_from_the_root(recorded: Recorded):
 def test_each_stop_has_a_lane_reached_then_played(recorded: Recorded):
     lane = [s[0] for s in recorded.values("/stops/POI1", "StateChange:state")]
     assert lane[:2] == ["reached", "played"]
+
+
+def test_the_tours_clock_starts_with_the_tour_not_in_1970(recorded: Recorded):
+    # rows logged before sim time had a /clock (the links, connecting) carry the tick only
+    import datetime
+
+    tour_day = datetime.datetime(2026, 1, 1)
+    stamps = [
+        stamp
+        for chunks in recorded.chunks.values()
+        for chunk in chunks
+        if not chunk.is_static
+        for batch in [chunk.to_record_batch()]
+        if "time" in batch.schema.names
+        for stamp in batch.column("time").to_pylist()
+        if stamp is not None
+    ]
+    assert stamps and min(stamps).replace(tzinfo=None) >= tour_day

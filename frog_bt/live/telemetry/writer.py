@@ -295,8 +295,11 @@ class Writer:
     def write_links(self, tick: int, t: float, changes: list[tuple[str, LinkStatus]]) -> None:
         """Links whose state changed at ``t``: their lanes, and one log line."""
         rec = self.rec
+        rec.reset_time()
         rec.set_time(TICK, sequence=tick)
-        rec.set_time(TIME, timestamp=np.datetime64(round(t * 1e9), "ns"))
+        if t > 0:  # before the clock has a time (sim time, no /clock yet): the tick only,
+            # not 1970 on the tour's clock (the timeline would open on 56 years)
+            rec.set_time(TIME, timestamp=np.datetime64(round(t * 1e9), "ns"))
         for name, state in changes:
             rec.log(link_path(name), rr.StateChange(state=state.value))
         level = "WARN" if any(s.health in (Health.WAIT, Health.BAD) for _, s in changes) else "INFO"
