@@ -7,13 +7,17 @@ fast-tour scenario with 15 % datagram loss each way. Faults, drawn per tour
 from ``--seed`` and injected at a random simulated time into that tour:
 
 * ``rosbridge``: the rosbridge server stops (every client dropped) and listens
-  again 2 s (wall) later;
+  again 5 s (simulated) later;
 * ``frontend``: the front end restarts (its numbering starts again at 1);
 * ``stale``: person detections, tracks and the robot's pose stop for 8 s
   (simulated): the perception goes stale;
 * ``battery``: once, at the middle tour, the battery falls to 15 %;
 * ``kill``: every ~10 tours, ``kill -9`` of the executive; it is started
   again at once, on the same checkpoint and recording directory.
+
+Faults go by simulated time: each waits on the simulator's clock for its moment in
+its tour, and one whose tour ended first goes into the next tour, 5 s in. The wall
+clock only catches a hang (``wall_timeout``), so a loaded machine gives the same day.
 
 The report (printed, and written as JSON with ``--out``) accounts for every
 tour from what the front end received: started, completed, aborted (with the
@@ -55,6 +59,8 @@ SOAK_SCENARIO: dict[str, Any] = {
 DEFAULT_SCRIPTS = Path(__file__).resolve().parents[2] / "shared" / "real-rosbridge"
 PERCEPTION = ("persons", "people", "pose")  # wire roles that go stale together
 KINDS = ("rosbridge", "frontend", "stale", "battery", "kill")
+OUTAGE = 5.0  # simulated seconds the simulator's rosbridge server is away
+CARRIED_DELAY = 5.0  # a fault whose tour ended first: this far into the next tour
 
 
 @dataclass
@@ -107,7 +113,7 @@ class Report:
     faults: dict[str, int] = field(default_factory=dict)
     rss_kb: list[int] = field(default_factory=list)
     events: list[str] = field(default_factory=list)  # tour states, in order
-    resends_taken: int = 0  # "tour started" resends the simulated front end took anew
+    resends_taken: int = 0  # tour-state resends the simulated front end took anew
     rss_growth_pct: float | None = None  # from the 10th tour's end (or the first) to the last
     wall_s: float = 0.0
     sim_s: float = 0.0
@@ -275,8 +281,14 @@ async def soak(
 
     started_parts: dict[tuple[str, str], object] = {}  # this tour's content parts -> seq
     since_restart = [True]  # a command reached the robot since the last server restart
+    tour_said: set[tuple[int, object]] = set()  # (executive start, seq) of each tour state
+    acked: list[tuple[float, object] | None] = [None]  # the front end's latest ack: (t, seq)
 
     def on_record(record: Record) -> None:
+        if record.side == "frontend" and record.direction == "out" and record.channel == "ack":
+            # the front end acks a datagram just before it logs what it holds: its seq
+            acked[0] = (record.t, record.payload.get("seq"))
+            return
         if record.side == "ros" and record.direction == "in":
             if not since_restart[0]:
                 since_restart[0] = True
@@ -291,6 +303,15 @@ async def soak(
             return
         if record.side != "frontend" or record.direction != "in" or record.channel != "tour":
             return
+        seq = acked[0][1] if acked[0] is not None and acked[0][0] == record.t else None
+        said = (executive.starts, seq)
+        if seq is not None and said in tour_said:
+            # A resend the simulated front end took anew (its dedup window is 10 s of
+            # simulated time; a lost ack and a slow executive resend later than that):
+            # one command of the executive's, one seq, counted once.
+            report.resends_taken += 1
+            return
+        tour_said.add(said)
         what = record.payload.get("state")
         report.events.append(f"{record.t:.1f} tour {what}")
         if report.completed + report.aborted >= tours:
@@ -302,11 +323,8 @@ async def soak(
                     report.resumed += 1  # a restarted executive says so again
                     killed_during_open[0] = False
                     return
-                # A second start without an end or a kill: the simulated front end took a
-                # resend of the same datagram anew (its dedup window is 10 s of sim time,
-                # 33 ms of wall time at 300x: a loaded machine's resends come later than
-                # that). The executive's own recording has one seq for both.
-                report.resends_taken += 1
+                report.events.append("a second tour started without an end or a kill")
+                report.unaccounted += 1  # the first one was never ended
                 return
             else:
                 state["tour"] += 1
@@ -331,38 +349,67 @@ async def soak(
                 ended.set()
 
     sim.log.add_listener(on_record)
+
+    def under_way(tour: int) -> bool:
+        return bool(state["open"]) and state["tour"] == tour
+
+    async def tour_event() -> None:
+        changed.clear()
+        await changed.wait()
+
+    async def at_or_closed(at: float, tour: int) -> bool:
+        """Wait until simulated time ``at`` in ``tour``; False when the tour ends first."""
+        sleeper = asyncio.ensure_future(sim.clock.sleep_until(at))
+        try:
+            while not sleeper.done() and under_way(tour):
+                event = asyncio.ensure_future(tour_event())
+                await asyncio.wait({sleeper, event}, return_when=asyncio.FIRST_COMPLETED)
+                event.cancel()
+        finally:
+            sleeper.cancel()
+        return under_way(tour)
+
+    async def drive_faults() -> None:
+        """Each fault at its simulated time in its tour, in order; a fault whose tour ends
+        first goes into the next tour (a fast or loaded day never skips one)."""
+        for fault in plan:
+            while True:
+                while not (state["open"] and state["tour"] >= fault.tour):
+                    await tour_event()
+                tour, started = int(state["tour"]), float(state["started_at"])
+                delay = fault.delay if tour == fault.tour else min(fault.delay, CARRIED_DELAY)
+                if await at_or_closed(started + delay, tour):
+                    break
+                report.events.append(f"{sim.clock.now():.1f} {fault.kind} carried past tour {tour}")
+            async with restarting:  # a kill starts it again: not the main loop too
+                await inject(fault, sim, site, executive, killed_during_open, server)
+            if fault.kind == "rosbridge" and server is not None:
+                since_restart[0] = False
+            fault.done_at = sim.clock.now()
+            report.events.append(f"{fault.done_at:.1f} {fault.kind} in tour {state['tour']}")
+            report.faults[fault.kind] = report.faults.get(fault.kind, 0) + 1
+
+    restarting = asyncio.Lock()
     wall0, sim0 = time.monotonic(), sim.clock.now()
     await executive.start()
-    pending = list(plan)
+    faults_task = asyncio.create_task(drive_faults(), name="soak faults")
     try:
-        deadline = wall0 + wall_timeout
+        deadline = wall0 + wall_timeout  # only catches a hang: faults go by simulated time
         while not ended.is_set():
             if time.monotonic() > deadline:
                 report.timed_out = True
                 break
-            due = [
-                f
-                for f in pending
-                if state["open"]
-                and (
-                    (f.tour == state["tour"] and sim.clock.now() - state["started_at"] >= f.delay)
-                    # a real server's restart whose tour ended first goes into the next one
-                    or (server is not None and f.kind == "rosbridge" and f.tour < state["tour"])
-                )
-            ]
-            for fault in due:
-                pending.remove(fault)
-                await inject(fault, sim, site, executive, killed_during_open, server)
-                if fault.kind == "rosbridge" and server is not None:
-                    since_restart[0] = False
-                fault.done_at = sim.clock.now()
-                report.faults[fault.kind] = report.faults.get(fault.kind, 0) + 1
-            if executive.proc is not None and executive.proc.returncode is not None:
-                await executive.start()  # it stopped on its own (it gave up): go on
-            changed.clear()
-            with contextlib.suppress(TimeoutError):  # a tour event, or look again
-                await asyncio.wait_for(changed.wait(), 0.1)
+            if faults_task.done() and faults_task.exception() is not None:
+                raise faults_task.exception()  # type: ignore[misc]
+            async with restarting:
+                if executive.proc is not None and executive.proc.returncode is not None:
+                    await executive.start()  # it stopped on its own (it gave up): go on
+            with contextlib.suppress(TimeoutError):  # the end, or look again
+                await asyncio.wait_for(ended.wait(), 0.5)
     finally:
+        faults_task.cancel()
+        with contextlib.suppress(asyncio.CancelledError):
+            await faults_task
         await executive.stop()
         await sim.stop()
     report.restarts = executive.starts - 1
@@ -395,7 +442,7 @@ async def inject(
         await server.restart()
     elif fault.kind == "rosbridge":
         await sim.stop_rosbridge()
-        await asyncio.sleep(2.0)  # the server is away for 2 s of wall time
+        await sim.clock.sleep(OUTAGE)  # the server is away for OUTAGE simulated seconds
         await sim.start_rosbridge()
     elif fault.kind == "frontend":
         sim.restart_frontend()

@@ -8,12 +8,10 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Protocol
 
 import py_trees
 
-from frog_bt.config import Site
 from frog_bt.model.key import Scope
 
 __all__ = ["Behaviour", "LoadedTree", "NodeTypes", "Path_", "Where"]
@@ -23,10 +21,10 @@ Behaviour = py_trees.behaviour.Behaviour
 
 
 class NodeTypes(Protocol):
-    """What a tree was built with (a :class:`~frog_bt.tree.factory.NodeFactory`)."""
+    """What a tree was built with (a :class:`~frog_bt.tree.registry.NodeRegistry`)."""
 
-    def export_xml(self, path: Path, site: Site | None) -> str:
-        """The tree file at ``path`` as BehaviorTree.CPP v4 XML."""
+    def names(self) -> list[str]:
+        """Every node type name."""
         ...
 
 

@@ -101,6 +101,8 @@ from frog_bt.model.events import (
 )
 from frog_bt.model.run import RUN_METADATA
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS, Keep
+from frog_bt.tree.btcpp import tree_xml
+from frog_bt.tree.registry import NodeRegistry
 
 if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host
@@ -330,11 +332,11 @@ class Recorder:
     def _tree_message(self, host: Host) -> bytes | None:
         """The tree that runs, so that a recording explains itself without the files."""
         tree = getattr(host.core, "tree", None)
-        if tree is None or tree.factory is None:
+        if tree is None or not isinstance(tree.factory, NodeRegistry):
             return None
         try:
             tree_file = Path(tree.file)
-            xml = tree.factory.export_xml(tree_file, host.site)
+            xml = tree_xml(tree_file, host.site, tree.factory)
         except Exception as exc:
             log.info("recording without the tree's XML: %s", exc)
             return None

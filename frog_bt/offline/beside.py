@@ -13,7 +13,7 @@ terms (:meth:`Said.story`).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from frog_bt.model.channels import ALERT, OPERATOR, Alert
 from frog_bt.recordings.commands import Command, local_time
@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from frog_bt.engine.core import Core
     from frog_bt.model.events import Event
     from frog_bt.model.links import Links
-    from frog_bt.offline.replay import Replay
+    from frog_bt.runtime.observer import Observers
 
 __all__ = ["ALERT_BOOK", "STAFF", "Beside", "Said", "alert_command"]
 
@@ -32,10 +32,25 @@ ALERT_BOOK = "the alert book (the executive)"  # who changes alerts: blame's wor
 STAFF = "staff (operator command)"  # who sent an operator command
 
 
+class Replayed(Protocol):
+    """What :class:`Beside` reads of its :class:`~frog_bt.offline.replay.Replay`."""
+
+    @property
+    def site(self) -> Site: ...
+    @property
+    def clock(self) -> Clock: ...
+    @property
+    def core(self) -> Core: ...
+    @property
+    def recorded_links(self) -> Links | None: ...
+    @property
+    def observers(self) -> Observers: ...
+
+
 class Beside:
     """The replay as the host of its :class:`~frog_bt.runtime.staff.Staff`."""
 
-    def __init__(self, replay: Replay) -> None:
+    def __init__(self, replay: Replayed) -> None:
         self._replay = replay
 
     @property

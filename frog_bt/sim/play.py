@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import frog_bt.sim.msgs as msgs
 from frog_bt.config import Site
 from frog_bt.errors import FrogError
 from frog_bt.model.channels import FRONTEND_IN, FRONTEND_OUT, PRIMER, from_ns
@@ -51,7 +52,6 @@ from frog_bt.recordings.reader import (
     RobotCommand,
     RobotInput,
 )
-from frog_bt.sim import msgs
 from frog_bt.sim.comparison import Comparison
 from frog_bt.sim.frontend_udp import Address, FrontendSocket
 from frog_bt.sim.rosbridge_protocol import BridgeServer, Incoming

@@ -28,9 +28,9 @@ import random
 from collections.abc import Awaitable, Callable, Mapping
 from typing import Any
 
+import frog_bt.sim.msgs as msgs
 from frog_bt.clock import ManualClock
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
-from frog_bt.sim import msgs
 from frog_bt.sim.frontend import FrontendModel
 from frog_bt.sim.frontend_udp import Address, FrontendSocket
 from frog_bt.sim.rosbridge_protocol import BridgeServer, Incoming

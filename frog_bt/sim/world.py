@@ -27,10 +27,10 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import frog_bt.sim.msgs as msgs
 from frog_bt.errors import ConfigError, DecodeError
 from frog_bt.model import ros
 from frog_bt.model.wire import ABORTED, ACTIVE, FAILED, INPUTS, OUTPUTS, SUCCEEDED
-from frog_bt.sim import msgs
 from frog_bt.sim.diagnostics import Battery, active_faults
 from frog_bt.sim.docking import Docking
 from frog_bt.sim.navigation import Navigator, RobotPose

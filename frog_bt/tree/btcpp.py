@@ -36,7 +36,7 @@ import yaml
 from frog_bt.config import Site
 from frog_bt.errors import TreeError
 from frog_bt.tree.catalogue import NodeType, catalogue
-from frog_bt.tree.factory import NodeFactory
+from frog_bt.tree.registry import NodeRegistry
 from frog_bt.yamlfile import load_yaml
 
 Load = Callable[[str], dict[str, Any]]  # a tree document, by the path that includes it
@@ -158,7 +158,7 @@ class _Exporter:
         return [element]
 
 
-def _model(types: set[str], factory: NodeFactory) -> ET.Element:
+def _model(types: set[str], factory: NodeRegistry) -> ET.Element:
     model = ET.Element("TreeNodesModel")
     nodes: dict[str, NodeType] = {n.name: n for n in catalogue(factory)}
     for name in sorted(types):
@@ -180,7 +180,7 @@ def _model(types: set[str], factory: NodeFactory) -> ET.Element:
 def to_xml(
     tree_path: Path,
     site: Site | None,
-    factory: NodeFactory,
+    factory: NodeRegistry,
     documents: dict[str, dict[str, Any]] | None = None,
 ) -> str:
     """The tree file at ``tree_path`` (and what it includes) as BT.CPP v4 XML; with
@@ -286,7 +286,7 @@ def read_xml(path: Path) -> tuple[dict[str, dict[str, Any]], str]:
     return documents, main
 
 
-def tree_xml(path: Path, site: Site | None, factory: NodeFactory) -> str:
+def tree_xml(path: Path, site: Site | None, factory: NodeRegistry) -> str:
     """The tree file at ``path`` as BT.CPP v4 XML: exported from its YAML files, or
     re-exported from an XML file (the same XML)."""
     if path.suffix.lower() == ".xml":

@@ -1,6 +1,6 @@
 """The catalogue of every node type a tree file can name: parameters, keys, docstring.
 
-Built from a node factory (:class:`~frog_bt.tree.factory.NodeFactory`: the tour's is
+Built from a node factory (:class:`~frog_bt.tree.registry.NodeRegistry`: the tour's is
 :data:`frog_bt.behaviours.FACTORY`)
 and the key declarations (:mod:`frog_bt.model.keys`), so it cannot drift from the code.
 ``frog-bt leaves`` prints it as Markdown or JSON; the node reference in ``docs/TREES.md``
@@ -21,7 +21,7 @@ from pydantic_core import PydanticUndefined
 
 from frog_bt.model.key import Key
 from frog_bt.model.keys import by_name
-from frog_bt.tree.factory import NodeFactory
+from frog_bt.tree.registry import NodeRegistry
 
 
 @dataclass(frozen=True, slots=True)
@@ -85,7 +85,7 @@ def _node(cls: Any, kind: str) -> NodeType:
     )
 
 
-def catalogue(factory: NodeFactory) -> list[NodeType]:
+def catalogue(factory: NodeRegistry) -> list[NodeType]:
     """Every node type of ``factory``, composites first, then decorators and leaves by
     name."""
     return [

@@ -1,80 +1,33 @@
-"""The node types a tree file can name, as one instance (BehaviorTree.CPP's
-``BehaviorTreeFactory``): the composites and decorators of this package, and the leaves
-registered into it.
+"""A node registry that also loads and exports trees: what a caller holds.
 
-The tree layer never imports the leaves: :mod:`frog_bt.behaviours` builds the tour's
-factory (:data:`frog_bt.behaviours.FACTORY`) and a test builds its own with a leaf of
-its own, so nothing global changes.
+:class:`NodeFactory` is a :class:`~frog_bt.tree.registry.NodeRegistry` (the node types
+by name) with :meth:`~NodeFactory.load` (the loader) and :meth:`~NodeFactory.export_xml`
+(BehaviorTree.CPP v4). It sits above both, so that neither imports it back: the tree
+package has no cycle, not even through an import inside a function.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
 from pathlib import Path
-from typing import TypeVar
 
 from frog_bt.config import Site
-from frog_bt.engine.loaded import Behaviour, LoadedTree
-from frog_bt.tree.composites import COMPOSITES
-from frog_bt.tree.decorators import DECORATORS, FrogDecorator
-from frog_bt.tree.leaf import Leaf
+from frog_bt.engine.loaded import LoadedTree
+from frog_bt.tree.btcpp import tree_xml
+from frog_bt.tree.loader import load_tree
+from frog_bt.tree.registry import NodeRegistry
 
 __all__ = ["NodeFactory"]
 
-L = TypeVar("L", bound=type[Leaf])
-D = TypeVar("D", bound=type[FrogDecorator])
 
-
-class NodeFactory:
-    """Composites, decorators and leaves by the name a tree file gives them."""
-
-    def __init__(
-        self, leaves: Iterable[type[Leaf]] = (), decorators: Iterable[type[FrogDecorator]] = ()
-    ) -> None:
-        self.composites = dict(COMPOSITES)
-        self.decorators: dict[str, type[FrogDecorator]] = dict(DECORATORS)
-        self.leaves: dict[str, type[Leaf]] = {}
-        for leaf in leaves:
-            self.register(leaf)
-        for decorator in decorators:
-            self.register_decorator(decorator)
-
-    def _free(self, name: str) -> None:
-        if name in self.leaves or name in self.composites or name in self.decorators:
-            raise ValueError(f"node type {name} registered twice")
-
-    def register(self, cls: L) -> L:
-        """Add a leaf type under its class name (a name registered twice is an error)."""
-        self._free(cls.__name__)
-        self.leaves[cls.__name__] = cls
-        return cls
-
-    def register_decorator(self, cls: D) -> D:
-        """Add a decorator type (a scope) under its class name."""
-        self._free(cls.__name__)
-        self.decorators[cls.__name__] = cls
-        return cls
-
-    def names(self) -> list[str]:
-        """Every type name, composites first."""
-        return [*self.composites, *self.decorators, *self.leaves]
-
-    def type_of(self, name: str) -> type[Behaviour]:
-        """The class a type name stands for; KeyError for an unknown one."""
-        found = self.composites.get(name) or self.decorators.get(name) or self.leaves.get(name)
-        if found is None:
-            raise KeyError(name)
-        return found
+class NodeFactory(NodeRegistry):
+    """Composites, decorators and leaves by the name a tree file gives them; loads and
+    exports tree files with them."""
 
     def load(self, path: str | Path | None = None, site: Site | None = None) -> LoadedTree:
         """Load, expand, build and check a tree file with these node types."""
-        from frog_bt.tree.loader import load_tree
-
         return load_tree(path, site, self)
 
     def export_xml(self, path: Path, site: Site | None) -> str:
         """The tree file at ``path`` as BehaviorTree.CPP v4 XML, its node model from these
         types."""
-        from frog_bt.tree.btcpp import tree_xml
-
         return tree_xml(path, site, self)

@@ -50,12 +50,13 @@ from frog_bt.engine.observed import Observed
 from frog_bt.errors import TreeError, TreeErrors, format_path
 from frog_bt.model.key import Scope
 from frog_bt.model.keys import by_name
+from frog_bt.tree.btcpp import read_xml
 from frog_bt.tree.flow import Gap, gaps
 from frog_bt.yamlfile import load_yaml_marked, validate
 from frog_bt.yamlmarks import Marks, line_of
 
 if TYPE_CHECKING:
-    from frog_bt.tree.factory import NodeFactory
+    from frog_bt.tree.registry import NodeRegistry
 
 DEFAULT_TREE_DIR = resources.tree_dir()
 DEFAULT_TREE = DEFAULT_TREE_DIR / resources.TREE_FILE
@@ -77,7 +78,7 @@ def site_variables(site: Site | None) -> dict[str, Any]:
 
 
 class _Builder:
-    def __init__(self, site: Site | None, factory: NodeFactory) -> None:
+    def __init__(self, site: Site | None, factory: NodeRegistry) -> None:
         self.site = site
         self.factory = factory
         self.where: dict[int, Where] = {}
@@ -434,15 +435,13 @@ def _at(tree: LoadedTree, node: Behaviour) -> str:
     return f"{type(node).__name__} {node.name!r} ({place})"
 
 
-def load_tree(path: str | Path | None, site: Site | None, factory: NodeFactory) -> LoadedTree:
+def load_tree(path: str | Path | None, site: Site | None, factory: NodeRegistry) -> LoadedTree:
     """Load, expand, build and check a tree file (default ``trees/tour.yaml``) whose node
     types are ``factory``'s."""
     path = Path(path) if path is not None else DEFAULT_TREE
     builder = _Builder(site, factory)
     source = path
     if path.suffix.lower() == ".xml":  # BehaviorTree.CPP v4 (Groot2): its trees as documents
-        from frog_bt.tree.btcpp import read_xml
-
         builder.documents, main = read_xml(path)
         path = path.parent / main
     root, description = None, ""

@@ -16,7 +16,7 @@ from typing import Any
 
 from frog_bt.config import Site
 from frog_bt.tree.catalogue import catalogue
-from frog_bt.tree.factory import NodeFactory
+from frog_bt.tree.registry import NodeRegistry
 
 TREE_SCHEMA_FILE = "tree.schema.json"
 SITE_SCHEMA_FILE = "site.schema.json"
@@ -88,7 +88,7 @@ def _params(cls: Any, defs: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
     return props, list(schema.get("required", []))
 
 
-def tree_schema(factory: NodeFactory) -> dict[str, Any]:
+def tree_schema(factory: NodeRegistry) -> dict[str, Any]:
     defs: dict[str, Any] = {}
     kinds: list[dict[str, Any]] = []
     for node in catalogue(factory):
