@@ -11,7 +11,7 @@ def compare_lanes(rec: Any, replay: Any, site: Any) -> None:
     that sent it), and a marker at the divergence (``/log/replay/divergence``)."""
     import rerun as rr
 
-    from frog_bt.live.telemetry.writer import TICK, TIME
+    from frog_bt.live.telemetry.layout import TICK, TIME
     from frog_bt.recordings.commands import describe, differences
 
     def at(t: float) -> None:

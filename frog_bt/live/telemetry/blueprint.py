@@ -20,8 +20,7 @@ from __future__ import annotations
 import rerun as rr
 import rerun.blueprint as rrb
 
-from frog_bt.live.telemetry.layout import TreeIndex
-from frog_bt.live.telemetry.writer import TICK, TIME, status_path
+from frog_bt.live.telemetry.layout import TICK, TIME, TreeIndex, status_path
 
 # Status lanes show the whole run up to the time cursor.
 SO_FAR = rrb.archetypes.TimeAxis(

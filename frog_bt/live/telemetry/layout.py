@@ -177,3 +177,12 @@ def _shape(
             left_edges[level] = min(left_edges[level], shape.left[level] + shift - centre)
             right_edges[level] = max(right_edges[level], shape.right[level] + shift - centre)
     return _Shape(offsets, [-half, *left_edges], [half, *right_edges])
+
+
+TICK, TIME = "tick", "time"  # the timelines: tick number, project-clock time
+
+
+def status_path(key: str, bt: str = "bt") -> str:
+    """The status lane of a node (keys need no escaping, see TreeNode.key); ``bt`` is the
+    tree's root entity (``bt``, ``bt/tree2`` for the first reloaded tree, ...)."""
+    return f"{bt}/status/{key}"

@@ -19,7 +19,7 @@ import py_trees
 import rerun as rr
 
 from frog_bt.config import Site
-from frog_bt.live.telemetry.layout import TreeIndex, tidy_layout
+from frog_bt.live.telemetry.layout import TICK, TIME, TreeIndex, status_path, tidy_layout
 from frog_bt.live.telemetry.rows import Batch
 from frog_bt.live.telemetry.site_map import poi_marks, tour_routes, zone_outlines
 from frog_bt.model.frontend import message_fields
@@ -32,7 +32,6 @@ if TYPE_CHECKING:
     from frog_bt.model.events import RobotCommand
 
 Status = py_trees.common.Status
-TICK, TIME = "tick", "time"  # the timelines: tick number, project-clock time
 
 STATES = ("RUNNING", "SUCCESS", "FAILURE", "INVALID")
 STATUS_COLORS = {
@@ -59,12 +58,6 @@ LANES_PER_STEP = 4  # status lanes written per step of a batch
 STATUSES_PER_STEP = 2000  # node statuses (rows x nodes) read per step of a batch
 Goal = tuple[str, float, float, float]  # waypoint, x, y, yaw
 GoalRow = tuple[int, int, float, Goal | None]  # tick, 0 input / 1 output, t, goal or cleared
-
-
-def status_path(key: str, bt: str = "bt") -> str:
-    """The status lane of a node (keys need no escaping, see TreeNode.key); ``bt`` is the
-    tree's root entity (``bt``, ``bt/tree2`` for the first reloaded tree, ...)."""
-    return f"{bt}/status/{key}"
 
 
 def tree_root(generation: int) -> str:
