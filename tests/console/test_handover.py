@@ -26,7 +26,7 @@ from frog_bt.model.frontend import Tour
 from frog_bt.runtime.observer import listen
 from frog_bt.yamlfile import validate
 
-HANDOVER_AT = "12:00"  # the default scenario starts at 10:30; the first tour ends near 10:42
+HANDOVER_AT = "11:00"  # the default scenario starts at 10:30; the first tour ends near 10:42
 
 
 def test_a_handover_at_a_configured_time_holds_the_days_figures() -> None:
@@ -41,7 +41,7 @@ def test_a_handover_at_a_configured_time_holds_the_days_figures() -> None:
                     ]
                 }
             )
-            staff = site.staff.model_copy(update={"handover": [time(12, 0), time(20, 0)]})
+            staff = site.staff.model_copy(update={"handover": [time(11, 0), time(20, 0)]})
             site = site.model_copy(update={"alerts": alerts, "staff": staff})
             scenario = {"docking": {"dock_failures": 3}}
             async with console_tour(scenario, site=site, once=False) as (run, people, url):

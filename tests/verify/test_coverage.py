@@ -23,11 +23,21 @@ sys.path.insert(0, str(Path(__file__).parents[1] / "recording"))
 from recorded_tour import record_tour
 
 
-def test_coverage_of_a_recorded_tour(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    # the seeding: one whole tour of the default scenario, nothing going wrong
-    (tmp_path / "season").mkdir()
-    recorded = record_tour(tmp_path / "season" / "tour.mcap")
+@pytest.fixture(scope="module")
+def one_tour(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The seeding, made once for this file: one whole tour of the default scenario,
+    nothing going wrong."""
+    path = tmp_path_factory.mktemp("one-tour") / "tour.mcap"
+    recorded = record_tour(path)
     assert recorded.outcome.code == 0, recorded.outcome.reason
+    return path
+
+
+def test_coverage_of_a_recorded_tour(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], one_tour: Path
+) -> None:
+    (tmp_path / "season").mkdir()
+    (tmp_path / "season" / "tour.mcap").write_bytes(one_tour.read_bytes())
     page = tmp_path / "coverage.html"
     assert main(["coverage", str(tmp_path / "season"), "-o", str(page)]) == 0
     out = capsys.readouterr().out.splitlines()
@@ -45,7 +55,7 @@ def test_coverage_of_a_recorded_tour(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert '<tr class="never"><td style="padding-left:3em">ClearAbort</td>' in html
     assert "<script" not in html
     # the same counts through the Executor seam (two worker processes, two copies)
-    (tmp_path / "season" / "copy.mcap").write_bytes(recorded.path.read_bytes())
+    (tmp_path / "season" / "copy.mcap").write_bytes(one_tour.read_bytes())
     assert main(["coverage", str(tmp_path / "season"), "--jobs", "2"]) == 0
     doubled = capsys.readouterr().out.splitlines()
     assert doubled[-1].startswith("2 recordings: ")
@@ -54,11 +64,10 @@ def test_coverage_of_a_recorded_tour(tmp_path: Path, capsys: pytest.CaptureFixtu
 
 
 def test_verify_says_which_share_of_the_explored_states_a_season_reached(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], one_tour: Path
 ) -> None:
     (tmp_path / "season").mkdir()
-    recorded = record_tour(tmp_path / "season" / "tour.mcap")
-    assert recorded.outcome.code == 0
+    (tmp_path / "season" / "tour.mcap").write_bytes(one_tour.read_bytes())
     assert main(["verify", "--coverage", str(tmp_path / "season")]) == 0
     out = capsys.readouterr().out
     line = next(text for text in out.splitlines() if text.startswith("coverage: "))
@@ -86,15 +95,15 @@ def test_verify_says_which_share_of_the_explored_states_a_season_reached(
         v.model,
         site,
         lambda: factory.load(None, site),
-        [recorded.path],
+        [one_tour],
         lambda path, why: pytest.fail(why),
     )
     assert files == 1
     (step,) = outside
-    assert step.recording == recorded.path and step.tick > 1
+    assert step.recording == one_tour and step.tick > 1
     assert step.node == "PlayContent 'PlayContent POI1 a'" and step.what == "running"
     assert step.line() == (
-        f"{recorded.path}: tick {step.tick}: PlayContent 'PlayContent POI1 a' running: "
+        f"{one_tour}: tick {step.tick}: PlayContent 'PlayContent POI1 a' running: "
         "a step the explored model does not allow"
     )
 
