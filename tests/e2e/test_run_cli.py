@@ -28,7 +28,7 @@ def checkpoint_claim(path):
 
 
 async def _run_once() -> tuple[int, bytes, list[str], str]:
-    scenario = fast()
+    scenario = fast({"speed": 400.0})  # not paced by the executive (another process)
     listen = free_udp_port()
     sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=("127.0.0.1", listen))
     await sim.start()

@@ -17,7 +17,9 @@ from frog_bt.sim import Simulator
 
 
 async def _signal_mid_content(sig: int) -> tuple[int, list[str]]:
-    scenario = fast()
+    # a simulator not paced by the executive (it runs in another process): slow enough
+    # that the signal comes while POI1's content plays, even on a loaded machine
+    scenario = fast({"speed": 200.0})
     listen = free_udp_port()
     sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=("127.0.0.1", listen))
     await sim.start()

@@ -22,7 +22,7 @@ from frog_bt.sim.traffic import Record
 from frog_bt.tree.loader import LoadedTree
 
 # High speed and short content, as in tests/e2e: a tour takes a few seconds of wall time.
-FAST: dict[str, Any] = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
+FAST: dict[str, Any] = {"speed": 1000.0, "content": {"default": 10, "introduction": 8}}
 
 
 def scenario(data: dict[str, Any] | None = None) -> Scenario:
@@ -83,7 +83,7 @@ def record_tour(
 
 # Tours back to back: a fast robot, short content, a visitor who comes back.
 FAST_TOURS: dict[str, Any] = {
-    "speed": 400.0,
+    "speed": 1000.0,
     "navigation": {"speed": 3.0, "approach_time": 1.0},
     "docking": {"undock_time": 2.0, "dock_time": 3.0},
     "content": {"default": 4, "introduction": 3},

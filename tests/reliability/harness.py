@@ -29,7 +29,7 @@ from frog_bt.runtime.observer import attach_all, listen
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.sim.traffic import Record
 
-FAST = {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
+FAST = {"speed": 1000.0, "content": {"default": 10, "introduction": 8}}
 WAIT = 30.0  # wall seconds: a safety net for every wait, never a pace
 
 

@@ -379,7 +379,7 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
 
     day, checkpoint = tmp_path / "day", tmp_path / "checkpoint.json"
     scenario = scenario_from(
-        "default", {"speed": 400.0, "content": {"default": 10, "introduction": 8}}
+        "default", {"speed": 1000.0, "content": {"default": 10, "introduction": 8}}
     )
 
     async def run() -> None:

@@ -526,7 +526,7 @@ def _accepts_or_decode_error(ros_type: str, msg: Any) -> None:
 
 
 @pytest.mark.parametrize("ros_type", sorted(DECODERS))
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=80, deadline=None)
 @given(data=st.data())
 def test_decoder_accepts_or_raises_decode_error(ros_type: str, data: st.DataObject) -> None:
     make, _ = EXAMPLES[ros_type]
@@ -561,7 +561,7 @@ def _outcome(decode: Callable[[Any], Any], msg: Any) -> tuple[str, Any]:
 
 
 @pytest.mark.parametrize("ros_type", sorted(ROS_TYPES))
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=120, deadline=None)
 @given(data=st.data())
 def test_json_text_decodes_as_the_objects_convert(ros_type: str, data: st.DataObject) -> None:
     """Live (raw JSON from rosbridge) and in tests (Python objects) a message gives the same

@@ -163,7 +163,7 @@ def test_the_real_leaves_hold_their_guards(tmp_path: Path) -> None:
 
 
 def test_the_pause_check_deleted_from_play_content_breaks_pause_obeyed(tmp_path: Path) -> None:
-    v = verdict(tour(tmp_path, play="PlayContentNoPause"))
+    v = verdict(tour(tmp_path, play="PlayContentNoPause"), restarts=False)
     runs = broken(v)
     assert list(runs) == ["pause-obeyed"]
     run = runs["pause-obeyed"]
@@ -175,7 +175,7 @@ def test_the_pause_check_deleted_from_play_content_breaks_pause_obeyed(tmp_path:
 def test_the_service_check_deleted_from_wait_in_service_breaks_service_off(
     tmp_path: Path,
 ) -> None:
-    v = verdict(tour(tmp_path, wait="WaitInServiceNot"))
+    v = verdict(tour(tmp_path, wait="WaitInServiceNot"), restarts=False)
     runs = broken(v)
     assert list(runs) == ["service-off-obeyed"]
     run = runs["service-off-obeyed"]
