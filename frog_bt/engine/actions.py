@@ -18,11 +18,13 @@ one (it was replaced), or, within the tick that sent it, an older one.
 
 from __future__ import annotations
 
+import copy
 import itertools
 import logging
 import math
 from collections.abc import Callable
 from dataclasses import replace
+from typing import NamedTuple
 
 from frog_bt.clock import Clock
 from frog_bt.config import Poi
@@ -36,6 +38,19 @@ log = logging.getLogger(__name__)
 # (output role, value: the wire table encodes it, the goal it carries: goto and approach)
 Publish = Callable[[str, object, "Goal | None"], None]
 Doubt = Callable[[int, Goal, Judgement], None]  # an answer not believed: code, goal, why
+
+
+class Held(NamedTuple):
+    """What :class:`Actions` holds (:meth:`Actions.snapshot`)."""
+
+    ids: itertools.count[int]
+    pending: Goal | None
+    latest: Goal | None
+    before: Goal | None
+    stale_responses: int
+    doubted: int
+    unconfirmed: tuple[int, float, int] | None
+    last_approach_at: float
 
 
 class Actions:
@@ -63,6 +78,27 @@ class Actions:
         # an arrival heard before a pose that shows it: (goal id, when, poses by then)
         self.unconfirmed: tuple[int, float, int] | None = None
         self.last_approach_at = -math.inf  # project-clock time of the last approach sent
+
+    def snapshot(self) -> Held:
+        """Everything it holds, as values: :meth:`restore` gives it back (an explorer of
+        every run, ``verify --real``, steps back to a state this way). Goals are frozen."""
+        return Held(
+            copy.copy(self._ids),
+            self.pending,
+            self.latest,
+            self.before,
+            self.stale_responses,
+            self.doubted,
+            self.unconfirmed,
+            self.last_approach_at,
+        )
+
+    def restore(self, held: Held) -> None:
+        """Hold again what :meth:`snapshot` gave."""
+        self._ids = copy.copy(held.ids)
+        self.pending, self.latest, self.before = held.pending, held.latest, held.before
+        self.stale_responses, self.doubted = held.stale_responses, held.doubted
+        self.unconfirmed, self.last_approach_at = held.unconfirmed, held.last_approach_at
 
     def goto(self, waypoint: str, poi: Poi) -> Goal:
         now = self._clock.now()

@@ -326,16 +326,7 @@ class Real:
             core.standing.paused_since,
             dict(core.inputs.latest),
             core.inputs.poses,
-            copy.copy(actions._ids),
-            (
-                actions.pending,
-                actions.latest,
-                actions.before,
-                actions.stale_responses,
-                actions.doubted,
-                actions.unconfirmed,
-                actions.last_approach_at,
-            ),
+            actions.snapshot(),
             (
                 list(journal.notes),
                 list(journal.incidents),
@@ -372,7 +363,6 @@ class Real:
             paused_since,
             latest,
             poses,
-            ids,
             goals,
             journal,
             now,
@@ -394,17 +384,7 @@ class Real:
         for pending in inputs.pending.values():
             pending.clear()
         inputs.events.clear()
-        actions = core.actions
-        actions._ids = copy.copy(ids)
-        (
-            actions.pending,
-            actions.latest,
-            actions.before,
-            actions.stale_responses,
-            actions.doubted,
-            actions.unconfirmed,
-            actions.last_approach_at,
-        ) = goals
+        core.actions.restore(goals)
         j = core.journal
         j.notes, j.incidents = list(journal[0]), list(journal[1])
         j.incident_total = journal[2]

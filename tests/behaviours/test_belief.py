@@ -183,3 +183,17 @@ def test_answers_in_domain_terms():
     assert describe_answer(2, home) == "arrival at SHOP"
     assert describe_answer(3, home) == "failure of the drive to SHOP"
     assert describe_answer(4, approach_goal()) == "refusal of the approach of visitor 7"
+
+
+def test_what_actions_hold_is_given_back_whole(tmp_path):
+    bench = Bench(write_tree(tmp_path, NAVIGATE_POI2))
+    bench.tick()
+    actions = bench.core.actions
+    held = actions.snapshot()
+    first = actions.pending
+    second = actions.goto("SHOP", bench.site.pois["SHOP"])
+    assert actions.pending == second and actions.before == first
+    actions.restore(held)
+    assert actions.pending == first and actions.before is None
+    again = actions.goto("SHOP", bench.site.pois["SHOP"])
+    assert again.id == second.id  # the ids go on from where they were held
