@@ -226,7 +226,7 @@ def main() -> int:
     def short(poi: str) -> int:
         """Fault tours aborted before ``poi`` (where a fault strikes is not seeded)."""
         return sum(
-            k == "fault" and poi not in r["stops_visited"].split("; ")
+            k == "fault" and poi not in r["stops_reached"].split("; ")
             for r, k in zip(rows, kinds, strict=True)
         )
 

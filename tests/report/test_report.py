@@ -138,11 +138,11 @@ def test_csv_parquet_and_a_self_contained_html(corpus, tmp_path) -> None:
     parquet = pq.read_table(tmp_path / "r.parquet")
     assert str(parquet.schema.field("day").type) == "date32[day]"
     assert str(parquet.schema.field("start").type) == "timestamp[us, tz=Europe/Madrid]"
-    assert str(parquet.schema.field("stops_visited").type) == "list<element: string>"
+    assert str(parquet.schema.field("stops_reached").type) == "list<element: string>"
     got = parquet.to_pylist()
     assert [r["tour"] for r in got] == [int(r["tour"]) for r in table]
     assert [r["ended"] for r in got] == [r["ended"] for r in table]
-    assert ["; ".join(r["stops_visited"]) for r in got] == [r["stops_visited"] for r in table]
+    assert ["; ".join(r["stops_reached"]) for r in got] == [r["stops_reached"] for r in table]
 
     class Page(HTMLParser):
         def __init__(self) -> None:
@@ -287,7 +287,7 @@ def test_the_pieces_of_a_tour_are_joined_into_one() -> None:
     assert (
         first.robot,
         first.files,
-        first.stops_visited,
+        first.stops_reached,
         first.parts,
         first.distance_m,
         first.ended,
@@ -335,7 +335,7 @@ def test_a_tour_file_opening_with_the_tour_befores_end_resent_is_read_whole() ->
     assert (
         row.invitations,
         row.invitations_accepted,
-        row.stops_visited,
+        row.stops_reached,
         row.ended,
         row.duration_s,
         row.resumed,
@@ -418,7 +418,7 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
     assert got["totals"]["tours"] == 1 and got["totals"]["resumed"] == 1
     (row,) = got["tours"]
     assert row["resumed"] and row["ended"] == "ended" and len(row["files"]) >= 3
-    assert row["stops_visited"] == ["POI1", "POI2", "POI3", "POI4", "POI5", "END"]  # POI2 once
+    assert row["stops_reached"] == ["POI1", "POI2", "POI3", "POI4", "POI5", "END"]  # POI2 once
     # one run: the resumed executive's files keep the run id and name the run they resume
     runs = [open_recording(p).metadata[RUN_METADATA] for p in sorted(day.glob("*.mcap"))]
     assert len({r["id"] for r in runs}) == 1 and {r["robot"] for r in runs} == {"frog"}
@@ -462,7 +462,7 @@ def test_a_copy_beside_its_original_is_skipped_not_counted_twice(corpus, tmp_pat
     assert whole.endswith("and overlaps it in time: a copy (the longer one is read)")
     assert got["totals"]["tours"] == 1 and got["totals"]["provenance"]["runs"] == 1
     assert got["totals"]["provenance"]["suspicious"] == []
-    keep = ("approaches", "invitations", "visitors", "distance_m", "stops_visited", "ended")
+    keep = ("approaches", "invitations", "visitors", "distance_m", "stops_reached", "ended")
     assert [{k: r[k] for k in keep} for r in got["tours"]] == [
         {k: r[k] for k in keep} for r in one["tours"]
     ]
