@@ -8,7 +8,8 @@ the report (through each file's events) and ``frog-bt coverage`` (through a repl
 offline. Pure: no clock, no I/O, no configuration (the site's part of it comes in as a
 :class:`TourPlan`).
 
-What a visit of a stop comes to (:attr:`StopVisit.fate`), exactly one of:
+The stops counted are the tour's content stops (:attr:`TourPlan.content`); what a visit
+of one comes to (:attr:`StopVisit.fate`), exactly one of:
 
 * **skipped** (:class:`SkipWhy`): left before it was played. ``operator``: a ``skip``
   accepted while the robot drove there or played its content; ``navigation failed``: the
@@ -183,7 +184,7 @@ class StopVisit:
             arrived=self.arrived or later.arrived,
             skipped=later.skipped or self.skipped,
             goals_failed=self.goals_failed + later.goals_failed,
-            before_restart=self.seconds or 0.0,
+            before_restart=self.seconds if self.seconds is not None else self.before_restart,
         )
 
 
@@ -558,6 +559,8 @@ class TourLedger:
         """A goal to ``waypoint``: a visit of its stop opens (a goal sent again to the same
         stop is the same visit); a goal elsewhere closes the visit open."""
         poi = self.plan.waypoints.get(waypoint)
+        if poi not in self.plan.content:
+            poi = None  # a stop without content (a waypoint of the route) is not counted
         visit = self._visit()
         if visit is not None and poi is not None and visit.poi == poi and not visit.arrived:
             return
