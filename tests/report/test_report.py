@@ -20,8 +20,9 @@ from frog_bt.cli import main
 from frog_bt.config import load_site
 from frog_bt.model import channels
 from frog_bt.model.frontend import AskTour, FinishPoi, StartPoi, Tour, UserPositive
+from frog_bt.model.ledger import StopVisit
 from frog_bt.model.run import RUN_METADATA
-from frog_bt.offline.report.facts import FileFacts, Piece, StopFacts, _Pieces
+from frog_bt.offline.report.facts import FileFacts, Piece, _Pieces
 from frog_bt.offline.report.rows import Played, StopTime, join, rows
 from frog_bt.recordings.mcapfile import open_recording
 from frog_bt.recordings.reader import FrontendIn, FrontendOut, Primed
@@ -224,43 +225,43 @@ def test_the_pieces_of_a_tour_are_joined_into_one() -> None:
     # robot a: killed during POI2 (the halt said finish_poi), restarted at 410 (a file
     # of its own), the tour resumed at POI2
     before = Piece(
-        "a/1.mcap",
+        file="a/1.mcap",
         started=100.0,
         started_seq=1,
         t0=100.0,
         t1=400.0,
         stops=[
-            StopFacts("POI1", "POI1a", "ab", 200.0, 220.0),
-            StopFacts("POI2", "POI2a", "a", 380.0, 400.0),
+            StopVisit("POI1", 200.0, "POI1a", "ab", 200.0, 220.0, arrived=True),
+            StopVisit("POI2", 380.0, "POI2a", "a", 380.0, 400.0, arrived=True),
         ],
         distance=50.0,
     )
     after = Piece(
-        "a/2.mcap",
+        file="a/2.mcap",
         t0=405.0,
         t1=900.0,
         ended="ended",
         end_seq=30,
-        stops=[StopFacts("POI2", "POI2a", "ab", 450.0, 480.0)],
+        stops=[StopVisit("POI2", 450.0, "POI2a", "ab", 450.0, 480.0, arrived=True)],
         distance=70.0,
     )
     # robot b, the same hours: a rotation (the tour file opens just after `tour started`,
     # the end of the tour before resent into it), then a new executive whose first
     # `tour started` has seq 1 again: a new tour
-    opened = Piece("b/1.mcap", started=390.0, started_seq=7, t0=390.0, t1=390.0)
-    resent = Piece("b/2.mcap", t0=391.0, t1=391.0, ended="ended", end_seq=5)
+    opened = Piece(file="b/1.mcap", started=390.0, started_seq=7, t0=390.0, t1=390.0)
+    resent = Piece(file="b/2.mcap", t0=391.0, t1=391.0, ended="ended", end_seq=5)
     rotated = Piece(
-        "b/2.mcap",
+        file="b/2.mcap",
         started=391.0,
         started_seq=7,
         t0=391.0,
         t1=600.0,
         ended="ended",
         end_seq=60,
-        stops=[StopFacts("POI1", "POI1a", "a", 410.0, 420.0)],
+        stops=[StopVisit("POI1", 410.0, "POI1a", "a", 410.0, 420.0, arrived=True)],
     )
     fresh = Piece(
-        "b/3.mcap",
+        file="b/3.mcap",
         started=700.0,
         started_seq=7,
         t0=700.0,
