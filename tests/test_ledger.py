@@ -263,3 +263,11 @@ def test_no_stream_makes_a_stop_both_skipped_and_reached(steps) -> None:
         assert len(reached) + len(skipped) <= len(PLAN.content)  # "N of M" adds up
         assert set(row.played) <= reached
     assert ledger.completed + ledger.aborted <= len(ledger.rows)
+
+
+def test_stops_never_visited_are_listed_but_not_counted_as_left() -> None:
+    s = Script().tour("started").recruit().goto("SHOP").answer(2).tour("ended")
+    ledger = fold(PLAN, s.events)
+    (row,) = ledger.tours
+    assert row.skips(PLAN.content) == [(poi, SkipWhy.NOT_VISITED) for poi in STOPS]
+    assert row.left(PLAN.content) == [] and ledger.skipped() == 0

@@ -127,10 +127,11 @@ class TourSummary:
 
     @property
     def skipped(self) -> list[str]:
-        """The content stops the latest tour skipped (not reached), in tour order."""
+        """The content stops the latest tour left (skipped by the operator, given up, or
+        their visitor lost) and did not reach after, in tour order."""
         row = self.latest
         assert self.ledger is not None
-        return [poi for poi, _ in row.skips(self.ledger.plan.content)] if row else []
+        return row.left(self.ledger.plan.content) if row else []
 
     def stops(self) -> str:
         """The latest tour's stops: ``4 of 6 reached, 4 played; skipped POI3 (operator)``."""

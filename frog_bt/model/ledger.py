@@ -97,6 +97,9 @@ class SkipWhy(enum.StrEnum):
     NOT_VISITED = "not visited"
 
 
+LEFT = (SkipWhy.OPERATOR, SkipWhy.NAVIGATION, SkipWhy.VISITOR_LOST)
+
+
 class Fate(enum.StrEnum):
     UNDER_WAY = "under way"
     REACHED = "reached"
@@ -246,8 +249,13 @@ class TourRow:
         return [v.poi for v in self.stops if v.skipped is SkipWhy.OPERATOR]
 
     def skips(self, order: Iterable[str]) -> list[tuple[str, SkipWhy]]:
-        """The content stops of ``order`` this tour skipped, and why (:func:`skips`)."""
+        """The content stops of ``order`` this tour did not reach, and why (:func:`skips`)."""
         return skips(self.stops, list(order), self.ended)
+
+    def left(self, order: Iterable[str]) -> list[str]:
+        """The stops of :meth:`skips` that were left (by the operator, given up, or their
+        visitor lost), not merely never visited: what staff call "skipped"."""
+        return [poi for poi, why in self.skips(order) if why in LEFT]
 
 
 def skips(
@@ -329,8 +337,8 @@ class TourLedger:
         return tours[-1] if tours else None
 
     def skipped(self) -> int:
-        """Stops skipped, over all tours (each tour's :meth:`TourRow.skips`)."""
-        return sum(len(r.skips(self.plan.content)) for r in self.tours)
+        """Stops left, over all tours (each tour's :meth:`TourRow.left`)."""
+        return sum(len(r.left(self.plan.content)) for r in self.tours)
 
     # ------------------------------------------------------------ observer
 

@@ -82,7 +82,8 @@ class Day:
 
     @property
     def skipped(self) -> int:
-        """Stops skipped today (each tour's, as the report counts them)."""
+        """Stops skipped today: left by the operator, given up, or their visitor lost
+        (the report's ``stops_skipped`` with those reasons)."""
         return self.ledger.skipped()
 
     def _local(self, t: float) -> str:
@@ -93,7 +94,7 @@ class Day:
         """The line of a tour that just ended or aborted."""
         start = self._local(row.started) + "-" if row.started else ""
         parts = [say(Msg("{n} stops", n=len(row.reached)), self.language)]
-        left = [poi for poi, _ in row.skips(self.ledger.plan.content)]
+        left = row.left(self.ledger.plan.content)
         if left:
             parts.append(say(Msg("skipped {stops}", stops=", ".join(left)), self.language))
         if row.reason:
