@@ -51,6 +51,8 @@ def test_coverage_of_a_recorded_tour(
     assert line["SkipStop 'SkipStop POI1'"].endswith("never run")
     assert line["AskForHelp 'AskForHelp undock'"].endswith("never run")
     assert out[-2].startswith("1 recordings: ") and "never ran" in out[-2]
+    # the tour, as the one count of tours (and the report) has it
+    assert out[-3] == "tours: 1 (1 ended, 0 aborted); stops reached 6, played 6, skipped 0"
     html = page.read_text()
     assert '<tr class="never"><td style="padding-left:3em">ClearAbort</td>' in html
     assert "<script" not in html
