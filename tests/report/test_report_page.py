@@ -19,7 +19,7 @@ import chromium
 import pytest
 
 from frog_bt.cli import main
-from tests.recording.recorded_tour import FAST_TOURS
+from tests import seasons
 
 chromium.require()
 
@@ -29,7 +29,7 @@ from selenium.webdriver.remote.webelement import WebElement  # noqa: E402
 from selenium.webdriver.support.ui import Select, WebDriverWait  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
-from corpus_run import ACK_AFTER_S, make  # noqa: E402
+from corpus_run import ACK_AFTER_S  # noqa: E402
 
 WIDTHS = (1400, 1024)
 WAIT = 10.0  # seconds any one thing may take to show in the page (a bound, not a pace)
@@ -39,14 +39,12 @@ ONE_LINE_PX = 40  # a tour's row is one line of the table's text (about 25 px)
 @pytest.fixture(scope="module")
 def season(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, list[str]]:
     """The report's page (a file:// URL) and the seeded kind of each tour, in order."""
+    recordings, manifest = seasons.season(tmp_path_factory, "helped", **seasons.HELPED)
     out = tmp_path_factory.mktemp("season")
-    manifest = make(
-        out / "recordings", days=2, per_day=5, seed=1, jobs=2, help_each=1, fast=FAST_TOURS
-    )
     kinds = [t["kind"] for t in manifest["tours"]]
     assert {"dock_help", "home", "ack_alert", "skip"} <= set(kinds)
     html = out / "season.html"
-    assert main(["report", str(out / "recordings"), "-o", str(html), "--quiet"]) == 0
+    assert main(["report", str(recordings), "-o", str(html), "--quiet"]) == 0
     return html.as_uri(), kinds
 
 
@@ -236,7 +234,8 @@ def test_a_click_opens_a_tour_and_its_help(season, driver) -> None:
             strict=True,
         )
     )
-    assert said["Stops visited"] == "POI1 → POI2 → POI3 → POI4 → POI5 → END"
+    assert said["Stops reached"] == "POI1 → POI2 → POI3 → POI4 → POI5 → END", said
+    assert said["Stops played"] == said["Stops reached"], said
     # the answer, who sent it, and no refusal before it (the person answered once docked)
     assert re.fullmatch(r"\+[\d.]+ s done_by_hand \(ok\) by console", said["Operator"]), said
     assert "docking_failed (ERROR)" in said["Alerts"], said

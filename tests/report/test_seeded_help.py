@@ -23,20 +23,20 @@ from frog_bt import __version__
 from frog_bt.cli import main
 from frog_bt.clock import SITE_TZ
 from frog_bt.config import fingerprint, load_site
+from tests import seasons
 from tests.recording.recorded_tour import FAST_TOURS  # tours in under a second
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 from check_report import autonomy
 from corpus_run import HELP_KINDS, make
 
-SEED = 1  # 7 tours: one of each help kind, a bored visitor, a navigation failure
+# seasons.HELPED: 7 tours, one of each help kind, a bored visitor, a navigation failure
 DOCK_ATTEMPTS = 3  # config/site.yaml docking.attempts: all fail, then the robot asks
 
 
 @pytest.fixture(scope="module")
 def season(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
-    out = tmp_path_factory.mktemp("helped")
-    manifest = make(out, days=1, per_day=7, seed=SEED, jobs=2, help_each=1, fast=FAST_TOURS)
+    out, manifest = seasons.season(tmp_path_factory, "helped", **seasons.HELPED)
     for run, tour in zip(manifest["runs"], manifest["tours"], strict=True):
         assert run["code"] == (1 if tour["kind"] == "home" else 0), run
     return out, manifest
