@@ -35,8 +35,10 @@ def number(x: float | None, decimals: int) -> str:
 
 
 def measure(x: float | None, digits: int = 3) -> str:
-    """A measured total to ``digits`` significant digits."""
-    return number(x, significant(x, digits))
+    """A measured total to ``digits`` significant digits at most (the figures kept, to
+    a hundredth of an hour, say no more: 0.33 h, not 0.330 h)."""
+    text = number(x, significant(x, digits))
+    return text.rstrip("0").rstrip(".") if "." in text else text
 
 
 def estimate(e: Estimate, unit: str = "") -> str:
