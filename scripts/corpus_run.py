@@ -1,8 +1,8 @@
 """A season of recorded tours, seeded: what `frog-bt report` is tested and measured on.
 
 Each tour is a whole run of the real executive against the built-in simulator on sim
-time (fast content, 400x), recorded to one MCAP file named by its local start time,
-``YYYYMMDD-HHMMSS-tourNNNN.mcap``. From ``--seed``, per day (from 2026-06-01):
+time (fast content, 400x), recorded (``--no-idle``) to one MCAP file named by its local
+start time, ``YYYYMMDD-HHMMSS-tourNNNN.mcap``. From ``--seed``, per day (from 2026-06-01):
 ``--tours-per-day`` tours of one robot, one after another: the day's seven hours
 (09:00-12:30, 14:30-18:00, where POI1 and POI2 play their afternoon variants) cut in
 equal slots, each tour at a random moment of its slot early enough to end inside it
@@ -20,8 +20,9 @@ kind            weight  what happens
 ``fault``       0.05    a motor driver error 5 minutes in: the tour is aborted
 ==============  ======  =====================================================
 
-Then the season's help events, ``--help-each N`` tours of each kind below (default 4;
-none from :func:`make` unless asked), put in place of tours drawn above by a second
+Then the season's help events, ``--help-each N`` tours of each kind below (default 4,
+fewer when they would be more than half of the season; none from :func:`make` unless
+asked), put in place of tours drawn above by a second
 generator of the same seed (so the tours drawn above do not change), each with the
 default scenario's engaged visitor:
 
@@ -40,6 +41,12 @@ help kind        what happens
 
 Operator commands go through the executive's staff (``by``: console), as the console
 sends them.
+
+With ``--idle`` (the default; :func:`make`'s ``idle``) the robot's whole day in service
+is recorded as ``frog-bt run --record DIR`` records it: each slot's executive from the
+slot's opening to its closing, idle (docked, waiting for the front end) before and
+after its tour, one idle file, the tour file and another idle file, so that the
+report's hours in service are the day's and not the tours' alone.
 
 ``corpus.json`` beside the files lists every tour as seeded (file, day, local start,
 kind), the seed, the weights and the help events, and per tour (``runs``) what the
