@@ -28,6 +28,7 @@ from pydantic import (
 
 from frog_bt import resources
 from frog_bt.errors import ConfigError, UsageError
+from frog_bt.model.ledger import TourPlan
 from frog_bt.model.ros import Pose
 from frog_bt.model.wire import (
     DEFAULT_FRONTEND,
@@ -538,6 +539,24 @@ class Site(_Model):
 
     def stop_timeout(self, stop: Stop) -> float:
         return stop.content_timeout or self.timeouts.content
+
+    def tour_plan(self) -> TourPlan:
+        """What the one count of tours needs of this site (:mod:`frog_bt.model.ledger`)."""
+        waypoints = {}
+        for stop in self.tour.stops:
+            waypoints[stop.poi] = stop.poi
+            for variant in self.variants.get(stop.poi, ()):
+                waypoints[variant.waypoint] = stop.poi
+        return TourPlan(
+            stops=tuple(s.poi for s in self.tour.stops),
+            content=tuple(s.poi for s in self.tour.stops if s.content),
+            waypoints=waypoints,
+            topics={role: self.topic(role) for role in INPUTS},
+            face_stops=frozenset(s.poi for s in self.tour.stops if s.face_stream),
+            near=self.engagement.near,
+            edge=self.engagement.edge,
+            waypoint_of=self.waypoint_of,
+        )
 
 
 def _at(path: tuple[str | int, ...], message: str) -> PathError:

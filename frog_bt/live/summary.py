@@ -3,7 +3,10 @@
 :class:`TourSummary` is an :class:`~frog_bt.runtime.observer.Observer`: it watches
 the goals sent and answered, the content started, the visitors approached and
 recruited, and reads the incidents from the one tally
-(:class:`~frog_bt.engine.tally.Tally`).
+(:class:`~frog_bt.engine.tally.Tally`). Its tours, their stops (reached, played,
+skipped and why) and its verdict are the one count of tours'
+(:class:`~frog_bt.model.ledger.TourLedger`), the same fold the console and the report
+read.
 """
 
 from __future__ import annotations
@@ -14,7 +17,6 @@ from typing import TYPE_CHECKING, Any
 
 from frog_bt.config import Site
 from frog_bt.engine.context import Incident
-from frog_bt.engine.tally import Tally
 from frog_bt.maths.engagement import Decision
 from frog_bt.model import keys
 from frog_bt.model.events import (
@@ -26,7 +28,8 @@ from frog_bt.model.events import (
     RobotInput,
     Ticked,
 )
-from frog_bt.model.frontend import FrontendMessage, StartPoi, Tour, UserPositive
+from frog_bt.model.frontend import FrontendMessage, StartPoi, UserPositive
+from frog_bt.model.ledger import TourLedger, TourRow
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.model.ros import POSE
 from frog_bt.model.wire import SUCCEEDED
@@ -45,19 +48,23 @@ class TourSummary:
     recruited: list[int] = field(default_factory=list)
     decisions: list[tuple[str, Decision]] = field(default_factory=list)  # (about, decision)
     incidents: list[Incident] = field(default_factory=list)
-    tours: list[str] = field(default_factory=list)  # "ended" / "aborted: reason", in order
     doubted: list[str] = field(default_factory=list)  # robot answers not believed: why
     resumed: str | None = None
     _goal: str | None = None
     _last_decision: Any = None
     _seen_incidents: int = 0
     _host: Host | None = None
-    _tally: Tally | None = None
+    ledger: TourLedger | None = None  # the one count of tours, the site's plan
+
+    def __post_init__(self) -> None:
+        self.ledger = TourLedger(self.site.tour_plan())
 
     def waypoint_of(self, msg: dict[str, Any]) -> str:
         return self.site.waypoint_of(POSE.convert(msg))
 
     def on_event(self, event: Event) -> None:
+        assert self.ledger is not None
+        self.ledger.feed(event)
         kind = type(event)
         if kind is RobotInput:
             self._ros_in(event)  # type: ignore[arg-type]
@@ -87,8 +94,6 @@ class TourSummary:
     def _frontend_out(self, message: FrontendMessage) -> None:
         if isinstance(message, StartPoi):
             self.content.append((message.poi, message.waypoint, message.part))
-        elif isinstance(message, Tour) and message.state != "started":
-            self.tours.append(message.state + (f": {message.reason}" if message.reason else ""))
 
     def _frontend_in(self, message: FrontendMessage) -> None:
         if isinstance(message, UserPositive) and self.approached:
@@ -103,15 +108,45 @@ class TourSummary:
         journal = core.journal
         self.incidents.extend(journal.incidents_since(self._seen_incidents))
         self._seen_incidents = journal.incident_total
-        self._tally = journal.tally
         resumed = board.get(keys.RESUMED)
         if resumed and self.resumed is None:
             self.resumed = resumed
 
     @property
+    def tours(self) -> list[str]:
+        """The tours over: "ended" / "aborted: reason", in order."""
+        assert self.ledger is not None
+        return [
+            r.ended + (f": {r.reason}" if r.reason else "") for r in self.ledger.tours if r.ended
+        ]
+
+    @property
+    def latest(self) -> TourRow | None:
+        assert self.ledger is not None
+        return self.ledger.latest
+
+    @property
     def skipped(self) -> list[str]:
-        """Stops skipped or left in the latest tour (the one tally's)."""
-        return self._tally.stops_left() if self._tally is not None else []
+        """The content stops the latest tour left (skipped by the operator, given up, or
+        their visitor lost) and did not reach after, in tour order."""
+        row = self.latest
+        assert self.ledger is not None
+        return row.left(self.ledger.plan.content) if row else []
+
+    def stops(self) -> str:
+        """The latest tour's stops: ``4 of 6 reached, 4 played; skipped POI3 (operator)``."""
+        row = self.latest
+        assert self.ledger is not None
+        order = self.ledger.plan.content
+        if row is None:
+            return "none"
+        reached = len({p for p in row.reached if p in order})
+        played = len({p for p in row.played if p in order})
+        text = f"{reached} of {len(order)} reached, {played} played"
+        skips = row.skips(order)
+        if skips:
+            text += "; skipped " + ", ".join(f"{poi} ({why})" for poi, why in skips)
+        return text
 
     def attach(self, host: Host) -> None:
         self._host = host
@@ -149,6 +184,7 @@ class TourSummary:
         out = [
             f"route:     {' -> '.join(self.visited) or 'nowhere'}",
             f"content:   {played}",
+            f"stops:     {self.stops()}",
             f"visitors:  {_visitors(self.approached, self.recruited)}",
             *(
                 f"{'engaged?' if i == 0 else '':<10} {about}: {d.describe()}"

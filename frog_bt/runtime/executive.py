@@ -31,6 +31,7 @@ from frog_bt.model.channels import Alert
 from frog_bt.model.events import AlertChanged, Datagram, Event, LinksChanged
 from frog_bt.model.frontend import EVENTS, FrontendMessage
 from frog_bt.model.help import Help, HelpAbout
+from frog_bt.model.ledger import TourLedger
 from frog_bt.model.links import Links, states
 from frog_bt.model.outcomes import DockingState, IncidentKind, TourState
 from frog_bt.model.progress import EMPTY, Progress, Resume
@@ -58,7 +59,8 @@ ROSBRIDGE_FLUSH = 0.5  # wall seconds for the last frames to the robot (of the s
 
 @dataclass(slots=True)
 class Outcome:
-    """Why :meth:`Executive.run` returned: exit code, one-line reason, tours completed."""
+    """Why :meth:`Executive.run` returned: exit code, one-line reason, tours completed
+    (the one count of tours': :attr:`Executive.ledger`)."""
 
     code: int = 0
     reason: str = ""
@@ -89,6 +91,8 @@ class Executive:
         self.once = once
         self.outcome = Outcome()
         self.observers = Observers()  # every observer, told each event (on_event)
+        self.ledger = TourLedger(site.tour_plan())  # the one count of tours, told first
+        self.observers.attach(self, [self.ledger])
         self.client = RosbridgeClient(
             rosbridge_url, secret=secret, on_input=self._on_ros, on_link=self._on_link
         )
@@ -315,7 +319,7 @@ class Executive:
         then the alerts not yet acknowledged (``countdown``: a terminal's, see link_line)."""
         line = (
             link_line(self.client.url, self.client.link, self.clock.ready, countdown=countdown)
-            or f"{status_line(self.core)} | {self.links.text()}"
+            or f"{status_line(self.core, self.ledger)} | {self.links.text()}"
         )
         alerts = [a.kind for a in self.staff.book.shown() if a.state == "raised"]
         return line + (f" | ALERT: {', '.join(alerts)}" if alerts else "")
@@ -435,7 +439,7 @@ class Executive:
                 if self.once:
                     self.stop(reason, 1)
                 return
-            self.outcome.tours += 1
+            self.outcome.tours = self.ledger.completed
             if self.once:
                 self.stop("tour ended docked", 0)
         elif status == Status.FAILURE:

@@ -1,4 +1,7 @@
-"""The live one-line status: phase, POI, tree tip, visitor, battery — or the links.
+"""The live one-line status: phase, POI, stops, tree tip, visitor, battery — or the links.
+
+The stops (``stops 2 of 6``: reached of the tour's content stops) are the one count of
+tours' (:class:`~frog_bt.model.ledger.TourLedger`), as the console and the report count.
 
 While rosbridge is unreachable (or, on sim time, no ``/clock`` has come) the line
 says so instead of showing a tree that cannot tick::
@@ -23,6 +26,7 @@ from frog_bt.engine.walk import running_path
 from frog_bt.i18n import say
 from frog_bt.model import keys
 from frog_bt.model.events import Event, Ticked
+from frog_bt.model.ledger import TourLedger
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.observer import Host
 from frog_bt.runtime.phrase import doing
@@ -104,15 +108,27 @@ def _plain_error(error: str) -> str:
     return error[:80]
 
 
-def status_line(core: Core) -> str:
+def stops_part(ledger: TourLedger) -> str | None:
+    """``stops 2 of 6`` while a tour is open (reached of the content stops), else None."""
+    row = ledger.current
+    if row is None or (row.started is None and not row.of_a_tour()):
+        return None
+    order = ledger.plan.content
+    reached = {p for p in row.reached if p in order}
+    return f"stops {len(reached)} of {len(order)}"
+
+
+def status_line(core: Core, ledger: TourLedger | None = None) -> str:
     tip = core.root.tip()
     board = core.board
     diagnostics = board.get(keys.DIAGNOSTICS)
     battery = diagnostics.value.battery if diagnostics is not None else None
     visitor = board.get(keys.VISITOR)
+    stops = stops_part(ledger) if ledger is not None else None
     parts = [
         say(doing(core), core.site.language),  # in the staff's words
         f"poi {board.get(keys.WAYPOINT) or '-'}",
+        *([stops] if stops else []),
         f"tip {tip.name if tip else '-'}",
         f"visitor {visitor if visitor is not None else '-'}",
         f"battery {battery:.0f}%" if battery is not None else "battery -",
@@ -139,13 +155,17 @@ class StatusLine:
         self._last = ""
         self._drawn_at = 0.0
         self._host: Host | None = None
+        self.ledger: TourLedger | None = None
 
     def attach(self, host: Host) -> None:
         """Redraw after each tick (``frog-bt run`` also refreshes it while nothing ticks)."""
         self._host = host
+        self.ledger = TourLedger(host.site.tour_plan())
 
     def on_event(self, event: Event) -> None:
-        if type(event) is Ticked and self._host is not None:
+        if self.ledger is not None:
+            self.ledger.feed(event)
+        if isinstance(event, Ticked) and self._host is not None:
             self.update(self._host.core)
 
     def update(self, core: Core | None = None) -> None:
@@ -155,7 +175,7 @@ class StatusLine:
         if self.source is not None:
             line = self.source()
         elif core is not None:
-            line = status_line(core)
+            line = status_line(core, self.ledger)
         else:
             return
         if line == self._last:

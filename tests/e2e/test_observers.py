@@ -48,7 +48,7 @@ def test_every_observer_attaches_to_a_live_executive_and_closes(tmp_path: Path) 
     close_all(attached)  # idempotent
     assert attached == observers
     summary = observers[2]
-    assert isinstance(summary, TourSummary) and summary.complete
+    assert isinstance(summary, TourSummary) and summary.complete, summary.lines()
     assert (tmp_path / "one.mcap").stat().st_size > 0
     assert sorted(p.name.split("-")[-1] for p in (tmp_path / "dir").iterdir())[:1] == [
         "idle0001.mcap"

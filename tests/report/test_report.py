@@ -20,8 +20,9 @@ from frog_bt.cli import main
 from frog_bt.config import load_site
 from frog_bt.model import channels
 from frog_bt.model.frontend import AskTour, FinishPoi, StartPoi, Tour, UserPositive
+from frog_bt.model.ledger import StopVisit
 from frog_bt.model.run import RUN_METADATA
-from frog_bt.offline.report.facts import FileFacts, Piece, StopFacts, _Pieces
+from frog_bt.offline.report.facts import FileFacts, Piece, _Pieces
 from frog_bt.offline.report.rows import Played, StopTime, join, rows
 from frog_bt.recordings.mcapfile import open_recording
 from frog_bt.recordings.reader import FrontendIn, FrontendOut, Primed
@@ -138,11 +139,11 @@ def test_csv_parquet_and_a_self_contained_html(corpus, tmp_path) -> None:
     parquet = pq.read_table(tmp_path / "r.parquet")
     assert str(parquet.schema.field("day").type) == "date32[day]"
     assert str(parquet.schema.field("start").type) == "timestamp[us, tz=Europe/Madrid]"
-    assert str(parquet.schema.field("stops_visited").type) == "list<element: string>"
+    assert str(parquet.schema.field("stops_reached").type) == "list<element: string>"
     got = parquet.to_pylist()
     assert [r["tour"] for r in got] == [int(r["tour"]) for r in table]
     assert [r["ended"] for r in got] == [r["ended"] for r in table]
-    assert ["; ".join(r["stops_visited"]) for r in got] == [r["stops_visited"] for r in table]
+    assert ["; ".join(r["stops_reached"]) for r in got] == [r["stops_reached"] for r in table]
 
     class Page(HTMLParser):
         def __init__(self) -> None:
@@ -224,43 +225,43 @@ def test_the_pieces_of_a_tour_are_joined_into_one() -> None:
     # robot a: killed during POI2 (the halt said finish_poi), restarted at 410 (a file
     # of its own), the tour resumed at POI2
     before = Piece(
-        "a/1.mcap",
+        file="a/1.mcap",
         started=100.0,
         started_seq=1,
         t0=100.0,
         t1=400.0,
         stops=[
-            StopFacts("POI1", "POI1a", "ab", 200.0, 220.0),
-            StopFacts("POI2", "POI2a", "a", 380.0, 400.0),
+            StopVisit("POI1", 200.0, "POI1a", "ab", 200.0, 220.0, arrived=True),
+            StopVisit("POI2", 380.0, "POI2a", "a", 380.0, 400.0, arrived=True),
         ],
         distance=50.0,
     )
     after = Piece(
-        "a/2.mcap",
+        file="a/2.mcap",
         t0=405.0,
         t1=900.0,
         ended="ended",
         end_seq=30,
-        stops=[StopFacts("POI2", "POI2a", "ab", 450.0, 480.0)],
+        stops=[StopVisit("POI2", 450.0, "POI2a", "ab", 450.0, 480.0, arrived=True)],
         distance=70.0,
     )
     # robot b, the same hours: a rotation (the tour file opens just after `tour started`,
     # the end of the tour before resent into it), then a new executive whose first
     # `tour started` has seq 1 again: a new tour
-    opened = Piece("b/1.mcap", started=390.0, started_seq=7, t0=390.0, t1=390.0)
-    resent = Piece("b/2.mcap", t0=391.0, t1=391.0, ended="ended", end_seq=5)
+    opened = Piece(file="b/1.mcap", started=390.0, started_seq=7, t0=390.0, t1=390.0)
+    resent = Piece(file="b/2.mcap", t0=391.0, t1=391.0, ended="ended", end_seq=5)
     rotated = Piece(
-        "b/2.mcap",
+        file="b/2.mcap",
         started=391.0,
         started_seq=7,
         t0=391.0,
         t1=600.0,
         ended="ended",
         end_seq=60,
-        stops=[StopFacts("POI1", "POI1a", "a", 410.0, 420.0)],
+        stops=[StopVisit("POI1", 410.0, "POI1a", "a", 410.0, 420.0, arrived=True)],
     )
     fresh = Piece(
-        "b/3.mcap",
+        file="b/3.mcap",
         started=700.0,
         started_seq=7,
         t0=700.0,
@@ -287,7 +288,7 @@ def test_the_pieces_of_a_tour_are_joined_into_one() -> None:
     assert (
         first.robot,
         first.files,
-        first.stops_visited,
+        first.stops_reached,
         first.parts,
         first.distance_m,
         first.ended,
@@ -335,7 +336,7 @@ def test_a_tour_file_opening_with_the_tour_befores_end_resent_is_read_whole() ->
     assert (
         row.invitations,
         row.invitations_accepted,
-        row.stops_visited,
+        row.stops_reached,
         row.ended,
         row.duration_s,
         row.resumed,
@@ -418,7 +419,7 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
     assert got["totals"]["tours"] == 1 and got["totals"]["resumed"] == 1
     (row,) = got["tours"]
     assert row["resumed"] and row["ended"] == "ended" and len(row["files"]) >= 3
-    assert row["stops_visited"] == ["POI1", "POI2", "POI3", "POI4", "POI5", "END"]  # POI2 once
+    assert row["stops_reached"] == ["POI1", "POI2", "POI3", "POI4", "POI5", "END"]  # POI2 once
     # one run: the resumed executive's files keep the run id and name the run they resume
     runs = [open_recording(p).metadata[RUN_METADATA] for p in sorted(day.glob("*.mcap"))]
     assert len({r["id"] for r in runs}) == 1 and {r["robot"] for r in runs} == {"frog"}
@@ -462,7 +463,7 @@ def test_a_copy_beside_its_original_is_skipped_not_counted_twice(corpus, tmp_pat
     assert whole.endswith("and overlaps it in time: a copy (the longer one is read)")
     assert got["totals"]["tours"] == 1 and got["totals"]["provenance"]["runs"] == 1
     assert got["totals"]["provenance"]["suspicious"] == []
-    keep = ("approaches", "invitations", "visitors", "distance_m", "stops_visited", "ended")
+    keep = ("approaches", "invitations", "visitors", "distance_m", "stops_reached", "ended")
     assert [{k: r[k] for k in keep} for r in got["tours"]] == [
         {k: r[k] for k in keep} for r in one["tours"]
     ]

@@ -72,7 +72,10 @@ def test_each_row_is_what_the_robot_was_told_and_did(robot_day, by_kind, kind) -
     _, seen_all = robot_day
     seen, row = seen_all[kind], by_kind[kind]
     v = visits(seen, restarted=kind == "resumed")
-    assert row["stops_visited"] == [poi for poi, _, _ in v]
+    # every content visit is reached but those skipped (a skip is never also reached)
+    left = {s["poi"] for s in row["stops_skipped"]}
+    assert row["stops_reached"] == [poi for poi, _, _ in v if poi not in left]
+    assert set(row["stops_played"]) <= set(row["stops_reached"])
     assert row["parts"] == [{"poi": poi, "parts": parts} for poi, parts, _ in v]
     assert row["variants"] == list(dict.fromkeys(wp for poi, _, wp in v if wp != poi))
     assert row["approaches"] == sum(t == "/ApproachPeopleFar" for t, _ in seen.ros)
@@ -126,7 +129,7 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
         home["ended"],
         home["reason"],
         [(c["command"], c["ok"]) for c in home["operator"]],
-        home["stops_visited"],
+        home["stops_reached"],
         home["stops_skipped"],
         home["visitors"],
         home["interventions"],
@@ -135,7 +138,7 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
     # POI1 cannot be reached: three goals (two retries), skipped with its reason
     nav = by_kind["nav_failure"]
     assert nav["stops_skipped"] == [{"poi": "POI1", "why": "navigation failed"}]
-    assert nav["stops_visited"] == STOPS[1:]
+    assert nav["stops_reached"] == STOPS[1:]
     assert causes(nav).count(("navigation retry", "")) == 2
     assert ("stop given up", "POI1") in causes(nav)
     assert (nav["nav_retries"], nav["dock_retries"]) == (2, 0)
@@ -157,7 +160,8 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
         {"poi": "POI3", "why": "operator"},
         {"poi": "POI4", "why": "operator"},
     ]
-    assert skips["stops_visited"] == ["POI1", "POI2", "POI3", "POI5", "END"]
+    # POI3's content started, but it was left: not reached, not played (issue 39)
+    assert skips["stops_reached"] == skips["stops_played"] == ["POI1", "POI2", "POI5", "END"]
     assert [(c["command"], c["ok"]) for c in skips["operator"]] == [("skip", True)] * 2
     assert skips["interventions"] == 2
     assert causes(skips) == [("operator", "skip")] * 2
@@ -169,7 +173,7 @@ def test_what_each_kind_of_tour_shows(by_kind) -> None:
     # a visitor lost on the way: back to POI0, a second visitor, POI1 again for them
     wander = by_kind["wander_off"]
     assert (wander["visitors"], wander["approaches"], wander["invitations"]) == (2, 2, 2)
-    assert wander["stops_visited"] == ["POI1", *STOPS]
+    assert wander["stops_reached"] == ["POI1", *STOPS]
     assert wander["visitors_lost"] == 1 and causes(wander) == [("visitor lost", "")]
     assert (
         stop_seconds(wander)["POI1"] > stop_seconds(by_kind["afternoon"])["POI1"] * 1.5
@@ -186,7 +190,7 @@ def test_a_tour_resumed_after_a_restart_is_one_row(by_kind) -> None:
     # idle and tour file of the first executive, idle and tour file of the second
     assert len(row["files"]) == 4
     assert row["resumed"] is True and row["ended"] == "ended"
-    assert row["stops_visited"] == STOPS  # POI2, cut by the restart, once
+    assert row["stops_reached"] == STOPS  # POI2, cut by the restart, once
     assert row["parts"] == [
         {"poi": s, "parts": "ab" if s in ("POI1", "POI2") else "a"} for s in STOPS
     ]
@@ -296,7 +300,7 @@ def test_csv_and_parquet_read_back_as_the_rows(robot_day, tmp_path) -> None:
         table = list(csv.DictReader(f))
     assert [r["tour"] for r in table] == [str(r["tour"]) for r in got["tours"]]
     for line, r in zip(table, got["tours"], strict=True):
-        assert line["stops_visited"] == "; ".join(r["stops_visited"])
+        assert line["stops_reached"] == "; ".join(r["stops_reached"])
         assert line["start"] == r["start"] and line["ended"] == r["ended"]
     parquet = pq.read_table(tmp_path / "r.parquet").to_pylist()
     for p, r in zip(parquet, got["tours"], strict=True):
@@ -377,7 +381,7 @@ def test_cut_and_foreign_files_are_said_and_the_rest_is_read(robot_day, tmp_path
     rows = {r["day"]: r for r in got["tours"]}
     resumed = rows[day_of("resumed")]
     assert resumed["resumed"] is True and resumed["ended"] == "ended"
-    assert resumed["stops_visited"][-4:] == ["POI3", "POI4", "POI5", "END"]
+    assert resumed["stops_reached"][-4:] == ["POI3", "POI4", "POI5", "END"]
     home = rows[day_of("declined_then_home")]  # from its tour file alone
     assert (home["ended"], home["introduction"], home["resumed"]) == ("aborted", "declined", False)
 
@@ -403,7 +407,7 @@ def test_two_robots_tours_at_the_same_time_stay_apart(robot_day, tmp_path) -> No
     got = report(tmp_path, str(tmp_path / "frog1"), str(tmp_path / "frog2"))
     assert got["totals"]["provenance"]["skipped"] == []
     assert got["totals"]["provenance"]["suspicious"] == []
-    assert [(r["robot"], r["resumed"], r["stops_visited"]) for r in got["tours"]] == [
+    assert [(r["robot"], r["resumed"], r["stops_reached"]) for r in got["tours"]] == [
         ("frog1", True, STOPS),
         ("frog2", True, STOPS),
     ]

@@ -53,7 +53,7 @@ def test_coverage_of_a_recorded_tour(
     assert out[-2].startswith("1 recordings: ") and "never ran" in out[-2]
     # every outcome shown is one the key under the tree explains, and their counts add
     # up to the runs (a node halted while running is "stopped", never a bare "invalid")
-    key = " ".join(out[out.index(next(t for t in out if t.startswith("ran Nx: "))) : -2])
+    key = " ".join(out[out.index(next(t for t in out if t.startswith("ran Nx: "))) : -3])
     shown: set[str] = set()
     for text in out:
         if ": ran " in text:
@@ -64,6 +64,8 @@ def test_coverage_of_a_recorded_tour(
     assert shown >= {"succeeded", "failed"}, shown
     assert all(f"{word} (" in key for word in shown), (shown, key)
     assert "invalid" not in "\n".join(out).lower()
+    # the tour, as the one count of tours (and the report) has it
+    assert out[-3] == "tours: 1 (1 ended, 0 aborted); stops reached 6, played 6, skipped 0"
     html = page.read_text()
     assert "stopped (halted while running" in html
     assert '<tr class="never"><td style="padding-left:3em">ClearAbort</td>' in html

@@ -1,9 +1,10 @@
 """The day so far, for the console: tours started, completed and aborted, visitors
 recruited, stops skipped, and the last tours in one line each.
 
-An :class:`~frog_bt.runtime.observer.Observer`: it counts what crosses the core (the ``tour``
-messages to the front end, the visitors' yes, the incidents) and keeps no more than
-:data:`LAST_TOURS` lines.
+An :class:`~frog_bt.runtime.observer.Observer`: every figure is read from the one count of
+tours (:class:`~frog_bt.model.ledger.TourLedger`, fed each event), the same fold the demo
+summary, the status line and the report read; it keeps no more than :data:`LAST_TOURS`
+lines.
 """
 
 from __future__ import annotations
@@ -12,10 +13,11 @@ from collections import deque
 from datetime import datetime
 from typing import TYPE_CHECKING
 
-from frog_bt.engine.tally import LEFT_STOPS
 from frog_bt.i18n import N_, Msg, say
-from frog_bt.model.events import Event, FrontendIn, FrontendOut
-from frog_bt.model.frontend import FrontendMessage, StartPoi, Tour, UserPositive
+from frog_bt.model.events import Event, FrontendOut
+from frog_bt.model.frontend import Tour
+from frog_bt.model.ledger import TourLedger, TourPlan, TourRow
+from frog_bt.model.outcomes import TourState
 
 if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host
@@ -40,63 +42,67 @@ class Day:
 
     def __init__(self, language: str = "en") -> None:
         self.language = language
-        self.started = 0
-        self.completed = 0
-        self.aborted = 0
-        self.visitors = 0  # who said yes to a tour
+        self.ledger = TourLedger(TourPlan())  # the site's plan once attached
         self.last: deque[str] = deque(maxlen=LAST_TOURS)
         self._host: Host | None = None
-        self._tour_start: float | None = None
-        self._stops: list[str] = []
 
     def attach(self, host: Host) -> None:
         self._host = host
+        self.ledger = TourLedger(host.site.tour_plan())
 
     def on_event(self, event: Event) -> None:
-        kind = type(event)
-        if kind is FrontendOut:
-            self._out(event.t, event.message)  # type: ignore[union-attr]
-        elif kind is FrontendIn and isinstance(event.message, UserPositive):  # type: ignore[union-attr]
-            self.visitors += 1
+        before = self.ledger.current
+        self.ledger.feed(event)
+        match event:
+            case FrontendOut(t=t, message=Tour(state=state)) if state != TourState.STARTED:
+                if before is not None and before.ended:
+                    self._line(t, before)
+            case _:
+                pass
 
     def close(self) -> None:
         """Nothing to finish."""
+
+    @property
+    def started(self) -> int:
+        return self.ledger.started
+
+    @property
+    def completed(self) -> int:
+        return self.ledger.completed
+
+    @property
+    def aborted(self) -> int:
+        return self.ledger.aborted
+
+    @property
+    def visitors(self) -> int:
+        """Who said yes to a tour today."""
+        return self.ledger.said_yes
+
+    @property
+    def skipped(self) -> int:
+        """Stops skipped today: left by the operator, given up, or their visitor lost
+        (the report's ``stops_skipped`` with those reasons)."""
+        return self.ledger.skipped()
 
     def _local(self, t: float) -> str:
         assert self._host is not None
         return datetime.fromtimestamp(t, self._host.clock.tz).strftime("%H:%M")
 
-    @property
-    def skipped(self) -> int:
-        """Stops skipped or left today (the one tally's)."""
-        if self._host is None:
-            return 0
-        return self._host.core.journal.tally.count(*LEFT_STOPS)
-
-    def _out(self, t: float, message: FrontendMessage) -> None:
-        if isinstance(message, StartPoi) and message.part == "a":
-            self._stops.append(message.poi)
-        elif isinstance(message, Tour):
-            if message.state == "started":
-                self.started += 1
-                self._tour_start, self._stops = t, []
-                return
-            if message.state == "ended":
-                self.completed += 1
-            else:
-                self.aborted += 1
-            start = self._local(self._tour_start) + "-" if self._tour_start else ""
-            parts = [say(Msg("{n} stops", n=len(self._stops)), self.language)]
-            left = self._host.core.journal.tally.stops_left() if self._host else []
-            if left:
-                parts.append(say(Msg("skipped {stops}", stops=", ".join(left)), self.language))
-            if message.reason:
-                parts.append(say(reason_words(message.reason), self.language))
-            when, said = start + self._local(t), "; ".join(parts)
-            line = (
-                Msg("{when} tour ended: {parts}", when=when, parts=said)
-                if message.state == "ended"
-                else Msg("{when} tour aborted: {parts}", when=when, parts=said)
-            )
-            self.last.appendleft(say(line, self.language))
-            self._tour_start = None
+    def _line(self, t: float, row: TourRow) -> None:
+        """The line of a tour that just ended or aborted."""
+        start = self._local(row.started) + "-" if row.started else ""
+        parts = [say(Msg("{n} stops", n=len(row.reached)), self.language)]
+        left = row.left(self.ledger.plan.content)
+        if left:
+            parts.append(say(Msg("skipped {stops}", stops=", ".join(left)), self.language))
+        if row.reason:
+            parts.append(say(reason_words(row.reason), self.language))
+        when, said = start + self._local(t), "; ".join(parts)
+        line = (
+            Msg("{when} tour ended: {parts}", when=when, parts=said)
+            if row.ended == TourState.ENDED
+            else Msg("{when} tour aborted: {parts}", when=when, parts=said)
+        )
+        self.last.appendleft(say(line, self.language))

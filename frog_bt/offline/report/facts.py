@@ -19,13 +19,18 @@ opening of an idle file is no tour. A piece ends at ``tour ended`` (the robot is
 docked by then), or after ``tour aborted`` once the robot has driven back and docked
 (that drive is the tour's too), or at the end of the file.
 
+What a piece counts (stops reached, played and skipped, goals, visitors, ...) is the one
+count of tours, :class:`~frog_bt.model.ledger.TourLedger`, fed the file's events; the
+piece boundaries above are the ledger's rows.
+
 Channels read, through the one decoder of recordings (:mod:`frog_bt.recordings.reader`):
 ``/frontend/out`` (tour, start_poi, finish_poi, ask_tour), ``/frontend/in``
 (user_positive/negative, content_done), ``/GotoWayPoint``, ``/ApproachPeopleFar``,
 ``/FROG_response``, ``/docking/dock``, ``/docking/state``, ``/ICL_command``,
 ``/ICL_FaceDataStream``, ``/FROG_pose``, ``/diagnostic``, ``/frog_bt/operator``,
-``/frog_bt/alert`` and ``/frog_bt/primer`` (a rotated file: the front-end seqs sent just
-before it, so that a resend across the rotation is not taken for a new command). Topic
+``/frog_bt/alert``, ``/frog_bt/doubt`` and ``/frog_bt/primer`` (a rotated file: the
+front-end seqs sent just before it, so that a resend across the rotation is not taken
+for a new command). Topic
 names are the site's. A message that does not decode is counted (:attr:`FileFacts.bad`)
 and read past.
 """
@@ -33,17 +38,13 @@ and read past.
 from __future__ import annotations
 
 import hashlib
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from frog_bt.config import Site
-from frog_bt.engine.operator import Command as OperatorCommand
-from frog_bt.maths.engagement import decide
 from frog_bt.model.channels import (
     ALERT,
+    DOUBT,
     FRONTEND_IN,
     FRONTEND_OUT,
     OPERATOR,
@@ -55,34 +56,16 @@ from frog_bt.model.channels import (
 from frog_bt.model.channels import Alert as AlertMessage
 from frog_bt.model.channels import Operator as OperatorMessage
 from frog_bt.model.channels import Tree as TreeMessage
-from frog_bt.model.frontend import (
-    AskTour,
-    ContentDone,
-    FinishPoi,
-    FrontendMessage,
-    StartPoi,
-    Tour,
-    UserNegative,
-    UserPositive,
-)
-from frog_bt.model.outcomes import DiagnosticLevel, DockCommand, DockingState, FaceStream, TourState
-from frog_bt.model.ros import Diagnostics, FaceData, Pose
+from frog_bt.model.frontend import Tour
+from frog_bt.model.ledger import TourLedger, TourRow, step
+from frog_bt.model.outcomes import TourState
+from frog_bt.model.ros import Pose
 from frog_bt.model.run import read_metadata
-from frog_bt.model.wire import SUCCEEDED, Response
+from frog_bt.offline.record_events import as_event
 from frog_bt.recordings.mcapfile import RecordingError, open_recording
-from frog_bt.recordings.reader import (
-    FrontendIn,
-    FrontendOut,
-    Own,
-    Primed,
-    Reader,
-    Record,
-    RobotCommand,
-    RobotInput,
-)
+from frog_bt.recordings.reader import FrontendOut, Own, Primed, Reader, Record, RobotInput
 
-JUMP = 10.0  # metres: a pose step this long is a relocalisation, not a drive
-OWN = (FRONTEND_IN, FRONTEND_OUT, OPERATOR, ALERT, PRIMER, TREE)
+OWN = (FRONTEND_IN, FRONTEND_OUT, OPERATOR, ALERT, DOUBT, PRIMER, TREE)
 HOUR = 3600.0  # distance is summed per clock hour (cheap), then per local day
 ROS_ROLES = (
     "pose",
@@ -99,69 +82,13 @@ BAD_NOTED = 3  # reasons of bad messages a file's facts keep (all are counted)
 
 
 @dataclass
-class StopFacts:
-    """One visit of a content stop: from its part a to its ``finish_poi``."""
+class Piece(TourRow):
+    """One tour, or the part of one that a file holds: the ledger's row, and where it
+    was read (the front-end seqs of its start and end tell a resend in the next file)."""
 
-    poi: str  # the logical POI (POI1)
-    waypoint: str = ""  # the time-of-day variant played (POI1a / POI1b)
-    parts: str = ""  # "a", "ab"
-    start: float | None = None  # part a started
-    end: float | None = None  # finish_poi
-    samples: int = 0  # face samples stored (near and facing) from the stop to part a's end
-    edge_engaged: int = 0
-    edge_total: int = 0
-    face_stream: bool = False
-    a_end: float | None = None  # the front end said part a was done
-    before_restart: float = 0.0  # seconds of this visit before a restart cut it (joined)
-
-    @property
-    def seconds(self) -> float | None:
-        """Time at the stop: part a to ``finish_poi`` (and the time before a restart)."""
-        if self.start is None or self.end is None:
-            return None
-        return self.end - self.start + self.before_restart
-
-    @property
-    def decision(self) -> str:
-        """What the engagement gate did: ``b`` (part b played), ``a only`` (part a played
-        to its end, no part b) or ``none`` (part a was cut before the gate)."""
-        if "b" in self.parts:
-            return "b"
-        return "a only" if self.a_end is not None else "none"
-
-
-@dataclass
-class Piece:
-    """One tour, or the part of one that a file holds."""
-
-    file: str
-    started: float | None = None  # `tour started` (None: the piece opens with the file)
-    started_seq: int = 0  # its front-end seq: a resend of it in the next file is no new tour
-    t0: float = 0.0  # first event of the piece
-    t1: float = 0.0  # last event of the piece
-    ended: str = ""  # "ended" | "aborted" | "" (the file ended first)
-    reason: str = ""
-    end_seq: int = 0  # the front-end seq of its `tour ended`/`aborted`
-    distance: float = 0.0
-    stops: list[StopFacts] = field(default_factory=list)
-    goals: int = 0  # /GotoWayPoint sent
-    failed_goals: list[str] = field(default_factory=list)  # waypoints of goals answered 3/4
-    nav_retries: int = 0  # goals sent again to the waypoint whose goal had just failed
-    dock_retries: int = 0  # dock/undock sent again after /docking/state failed
-    approaches: int = 0
-    approaches_ok: int = 0
-    approached: list[int] = field(default_factory=list)  # person ids, in order
-    visitors: list[int] = field(default_factory=list)  # the approached who said yes
-    invitations: int = 0
-    accepted: int = 0
-    declined: int = 0
-    approaches_rejected: int = 0  # approaches answered 3/4
-    faults: list[tuple[str, str]] = field(default_factory=list)  # (name, message), each once
-    operator_skips: list[str] = field(default_factory=list)  # stops the operator skipped
-
-    def of_a_tour(self) -> bool:
-        """Something only a tour does happened in it."""
-        return bool(self.stops or self.invitations or self.approaches or self.goals or self.ended)
+    file: str = ""
+    started_seq: int = 0  # the seq of its `tour started`: a resend of it is no new tour
+    end_seq: int = 0  # the seq of its `tour ended`/`aborted`
 
 
 @dataclass(frozen=True)
@@ -212,262 +139,83 @@ class FileFacts:
 
 def stop_of(site: Site) -> dict[str, str]:
     """Waypoint (a POI or one of its time-of-day variants) -> logical POI of the tour."""
-    out = {}
-    for stop in site.tour.stops:
-        out[stop.poi] = stop.poi
-        for variant in site.variants.get(stop.poi, ()):
-            out[variant.waypoint] = stop.poi
-    return out
+    return dict(site.tour_plan().waypoints)
 
 
 class _Pieces:
-    """A state machine over one file's records, in time order (:meth:`take` each)."""
+    """One file's records, in time order (:meth:`take` each): its tours counted by the
+    one ledger (:class:`~frog_bt.model.ledger.TourLedger`), and what the file holds
+    besides (operator commands, alert changes, metres per hour, the tree)."""
 
     def __init__(self, path: str, site: Site) -> None:
-        self.site = site
         self.path = path
-        self.out: list[Piece] = []
-        self.piece: Piece | None = None
-        self.back: Piece | None = None  # an aborted tour's piece until the robot docks
-        self.opening = True  # the piece open is the file's opening one (no `tour started`)
+        self.ledger = TourLedger(site.tour_plan())
         self.primed = False  # the file opens with a /frog_bt/primer (an idle rotation)
-        self.pose: tuple[float, float] | None = None
-        self.goal: str | None = None  # waypoint of the goal awaiting its response
-        self.failed: str | None = None  # waypoint whose goal failed last
-        self.approach = False
-        self.dock: str | None = None  # the latest dock/undock command
-        self.dock_failed: str | None = None
-        self.asked = False
-        self.stream_on = False
-        self.samples: list[tuple[float, float]] = []  # (t, level) while the stream is on
         self.seen: set[int] = set()  # front-end seqs sent (a resend has the same one)
+        self.seqs: dict[int, tuple[int, int]] = {}  # id(row) -> (started seq, end seq)
+        self.pose: tuple[float, float] | None = None
         self.operator: list[OperatorCall] = []
         self.alerts: list[AlertChange] = []
         self.metres: dict[int, float] = {}
         self.tree = ""
         self.last: float | None = None  # the latest record's time
-        self.face_stops = {s.poi for s in site.tour.stops if s.face_stream}
-        self.stop_of = stop_of(site)
-        self.near = site.engagement.near
-        self.edge = site.engagement.edge
+        self.pose_topic = site.topic("pose")
 
     def first(self, t: float) -> None:
-        """The file's first message: a piece opens, in case the file opens inside a tour."""
-        self.piece = Piece(self.path, None, 0, t, t)
-        self.out.append(self.piece)
-        self.opening = True
+        """The file's first message: a row opens, in case the file opens inside a tour."""
+        self.ledger.begin(t)
 
     def finish(self) -> list[Piece]:
         """The pieces, but an opening one that held nothing of a tour (an idle file's)."""
-        return [p for p in self.out if p.started is not None or p.of_a_tour()]
+        out = []
+        for row in self.ledger.tours:
+            started, ended = self.seqs.get(id(row), (0, 0))
+            out.append(Piece(**vars(row), file=self.path, started_seq=started, end_seq=ended))
+        return out
 
     def take(self, record: Record) -> None:
         """One record of the file (acks, ticks and bad messages tell nothing here)."""
         self.last = record.t
-        if isinstance(record, RobotInput):
-            self.robot_input(record)
-        elif isinstance(record, RobotCommand):
-            self.robot_command(record)
-        elif isinstance(record, FrontendOut):
-            self.frontend_out(record.t, record.seq, record.message)
-        elif isinstance(record, FrontendIn):
-            self.frontend_in(record.t, record.message)
+        if isinstance(record, FrontendOut):
+            if record.seq in self.seen:
+                return  # a resend (datagram loss): not a new command
+            self.seen.add(record.seq)
         elif isinstance(record, Primed):
             self.primed = True  # a rotated file: the seqs sent just before it
             self.seen.update(record.primer.frontend_out_seqs)
+            return
+        elif isinstance(record, RobotInput) and record.topic == self.pose_topic:
+            self._pose(record.t, record.value)
         elif isinstance(record, Own):
             self.own(record)
-
-    def _current(self, t: float) -> Piece | None:
-        """The piece open now (None between a tour's end and the next start), its last
-        event moved to ``t``."""
-        if self.piece is not None:
-            self.piece.t1 = t
-        return self.piece
-
-    def _stop(self, poi: str) -> StopFacts | None:
-        if self.piece is None:
-            return None
-        for stop in reversed(self.piece.stops):
-            if stop.poi == poi:
-                return stop
-        return None
-
-    def frontend_out(self, t: float, seq: int, message: FrontendMessage) -> None:
-        if seq in self.seen:
-            return  # a resend (datagram loss): not a new command
-        self.seen.add(seq)
-        if isinstance(message, Tour):
-            self._tour(t, seq, message)
+        event = as_event(record)  # TEMPORARY: until the reader yields the events
+        if event is None:
             return
-        piece = self._current(t)
-        if piece is None:
+        before = self.ledger.current
+        self.ledger.feed(event)
+        if isinstance(record, FrontendOut) and isinstance(record.message, Tour):
+            self._seq(record.seq, record.message, before)
+
+    def _seq(self, seq: int, message: Tour, before: TourRow | None) -> None:
+        """Note the seq of a tour's start or end on its row."""
+        if message.state == TourState.STARTED:
+            row = self.ledger.current
+            if row is not None and row is not before:
+                self.seqs[id(row)] = (seq, 0)
+        elif before is not None and before.ended:
+            started, _ = self.seqs.get(id(before), (0, 0))
+            self.seqs[id(before)] = (started, seq)
+
+    def _pose(self, t: float, value: object) -> None:
+        """Metres driven per clock hour, in tours or not."""
+        if not isinstance(value, Pose):
             return
-        if isinstance(message, StartPoi):
-            poi, part = message.poi, message.part
-            stop = self._stop(poi)
-            if part == "a" or stop is None:
-                stop = StopFacts(poi, message.waypoint or poi, face_stream=poi in self.face_stops)
-                piece.stops.append(stop)
-                stop.start = t
-            if part not in stop.parts:
-                stop.parts += part
-            if part == "b":
-                self._engagement(stop, t)
-        elif isinstance(message, FinishPoi):
-            stop = self._stop(message.poi)
-            if stop is not None:
-                stop.end = t
-                if "b" not in stop.parts:
-                    self._engagement(stop, t)
-        elif isinstance(message, AskTour):
-            self.asked = True
-            piece.invitations += 1
-
-    def _tour(self, t: float, seq: int, message: Tour) -> None:
-        state = TourState(message.state)
-        if state is TourState.STARTED:
-            self._started(t, seq)
-            return
-        piece = self._current(t)
-        if piece is not None:  # (None: said again after the tour's end)
-            piece.ended, piece.reason, piece.end_seq = state.value, message.reason, seq
-            if state is TourState.ABORTED:
-                self.back = piece  # the robot returns to its dock: still this tour's
-        if piece is not None and self.opening:
-            # A tour file has no primer: this may be the tour before's end, resent
-            # (rows.join tells by its seq); what follows goes into a new opening
-            # piece, in case it is the open tour's.
-            self.piece = Piece(self.path, None, 0, t, t)
-            self.out.append(self.piece)
-        else:
-            self.piece, self.opening = None, False
-
-    def _started(self, t: float, seq: int) -> None:
-        piece = self.piece
-        if piece is not None and not self.opening:
-            return  # said again (a resend taken anew): the same tour
-        if piece is not None and not piece.of_a_tour():
-            self.out.remove(piece)  # an idle file's opening: no tour
-        self.back = None
-        self.piece = Piece(self.path, t, seq, t, t)
-        self.out.append(self.piece)
-        self.opening = False
-
-    def _engagement(self, stop: StopFacts, t: float) -> None:
-        """The face samples stored since the stop's start, and the edge vote over them
-        (:func:`frog_bt.maths.engagement.decide`, the executive's own rule)."""
-        if not stop.face_stream or stop.start is None:
-            return
-        end = stop.a_end if stop.a_end is not None else t
-        levels = [level for ts, level in self.samples if ts <= end]  # since the stream began
-        stop.samples = len(levels)
-        if levels:
-            d = decide(np.asarray(levels), self.edge)
-            stop.edge_engaged, stop.edge_total = d.engaged_votes, d.votes
-
-    def frontend_in(self, t: float, message: FrontendMessage) -> None:
-        if isinstance(message, ContentDone) and message.part == "a":
-            stop = self._stop(message.poi)
-            if stop is not None and stop.a_end is None:
-                stop.a_end = t  # the decision counts the samples up to here
-        if (
-            isinstance(message, UserPositive | UserNegative)
-            and self.piece is not None
-            and self.asked
-        ):
-            self.asked = False
-            piece = self.piece
-            if isinstance(message, UserPositive):
-                piece.accepted += 1
-                if piece.approached:
-                    piece.visitors.append(piece.approached[-1])
-            else:
-                piece.declined += 1
-
-    def robot_command(self, command: RobotCommand) -> None:
-        # the drive back after an abort is the aborted tour's
-        piece = self.back if self.back is not None else self.piece
-        t, role, value = command.t, command.role, command.value
-        if role == "goto" and isinstance(value, Pose):
-            goal, self.approach = self.site.waypoint_of(value), False
-            if piece is not None:
-                piece.goals += 1
-                piece.nav_retries += goal == self.failed
-                piece.t1 = t
-            self.goal, self.failed = goal, None
-        elif role == "approach" and isinstance(value, int):
-            self.approach, self.goal = True, None
-            piece = self.piece
-            if piece is not None:
-                piece.approaches += 1
-                piece.approached.append(value)
-                piece.t1 = t
-        elif role == "dock" and isinstance(value, str):
-            if piece is not None and value == self.dock_failed:
-                piece.dock_retries += 1
-            self.dock, self.dock_failed = value, None
-        elif role == "icl":
-            on = value == FaceStream.START
-            if on and not self.stream_on:
-                self.samples = []
-            self.stream_on = on
-
-    def robot_input(self, received: RobotInput) -> None:
-        piece = self.back if self.back is not None else self.piece
-        t, role, value = received.t, received.role, received.value
-        if role == "pose" and isinstance(value, Pose):
-            if self.pose is not None:
-                step = math.hypot(value.x - self.pose[0], value.y - self.pose[1])
-                if 0.0 < step < JUMP:
-                    hour = int(t // HOUR)
-                    self.metres[hour] = self.metres.get(hour, 0.0) + step
-                    if piece is not None:
-                        piece.distance += step
-            self.pose = (value.x, value.y)
-        elif role == "response" and isinstance(value, int):
-            self._response(Response.of(value), piece)
-        elif role == "docking_state" and isinstance(value, str):
-            state = DockingState.of(value)
-            if state in (DockingState.DOCKING, DockingState.UNDOCKING):
-                # what is under way (a file may open here)
-                self.dock = (
-                    DockCommand.DOCK if state is DockingState.DOCKING else DockCommand.UNDOCK
-                )
-            elif state is DockingState.FAILED and self.dock is not None:
-                self.dock_failed = self.dock
-            elif state is DockingState.DOCKED and self.back is not None:
-                self.back.t1, self.back = t, None  # home after the abort: the tour is over
-        elif role == "faces" and self.stream_on and isinstance(value, FaceData):
-            self.samples.extend(
-                (t, face.engagement)
-                for face in value.faces
-                if face.distance <= self.near and face.facing
-            )
-        elif role == "diagnostic" and piece is not None and isinstance(value, Diagnostics):
-            for status in value.statuses:
-                if status.level == DiagnosticLevel.ERROR:
-                    fault = (status.name, status.message)
-                    if fault not in piece.faults:
-                        piece.faults.append(fault)
-
-    def _response(self, response: Response | None, piece: Piece | None) -> None:
-        """A goal's or an approach's end (an active or unknown code changes nothing)."""
-        if response is None or not response.terminal:
-            return
-        if self.approach:
-            self.approach = False
-            if piece is not None:
-                if response is SUCCEEDED:
-                    piece.approaches_ok += 1
-                else:
-                    piece.approaches_rejected += 1
-        elif self.goal is not None:
-            if response is not SUCCEEDED:
-                self.failed = self.goal
-                if piece is not None:
-                    piece.failed_goals.append(self.goal)
-            self.goal = None
+        if self.pose is not None:
+            metres = step(self.pose, value)
+            if metres:
+                hour = int(t // HOUR)
+                self.metres[hour] = self.metres.get(hour, 0.0) + metres
+        self.pose = (value.x, value.y)
 
     def own(self, record: Own) -> None:
         """Operator commands and alert changes, in or out of a tour (rows assign them to
@@ -484,11 +232,6 @@ class _Pieces:
                     message.by,
                 )
             )
-            piece = self.back if self.back is not None else self.piece
-            if piece is not None and message.command == OperatorCommand.SKIP and message.ok:
-                at = self._skipping()
-                if at is not None:
-                    piece.operator_skips.append(at)
         elif isinstance(message, AlertMessage):
             self.alerts.append(
                 AlertChange(
@@ -503,15 +246,6 @@ class _Pieces:
             )
         elif isinstance(message, TreeMessage) and not self.tree:
             self.tree = hashlib.sha256(message.xml.encode()).hexdigest()[:12]
-
-    def _skipping(self) -> str | None:
-        """The stop an operator's skip leaves: the one playing, or the one driven to."""
-        if self.piece is None:
-            return None
-        stops = self.piece.stops
-        if stops and stops[-1].end is None:
-            return stops[-1].poi
-        return self.stop_of.get(self.goal) if self.goal is not None else None
 
 
 def read_file(path: str, site: Site) -> FileFacts:

@@ -237,7 +237,7 @@ def _tour(r: Row, order: list[str]) -> str:
     for i in r.incidents:
         incidents[str(i)] = incidents.get(str(i), 0) + 1
     said = ", ".join(k if n == 1 else f"{k} \u00d7{n}" for k, n in incidents.items())
-    reached = len({p for p in r.stops_visited if p in order})
+    reached = len({p for p in r.stops_reached if p in order})
     skipped = ", ".join(f"{s.poi} ({s.why})" for s in r.stops_skipped)
     cells = [
         (str(r.tour), str(r.tour)),
@@ -262,7 +262,8 @@ def _tour(r: Row, order: list[str]) -> str:
     )
     more = [
         ("Files", ", ".join(r.files)),
-        ("Stops visited", " → ".join(r.stops_visited) or "none"),
+        ("Stops reached", " → ".join(r.stops_reached) or "none"),
+        ("Stops played", " → ".join(r.stops_played) or "none"),
         ("Parts", ", ".join(str(p) for p in r.parts) or "none"),
         ("Engagement", ", ".join(str(v) for v in r.engagement) or "none"),
         (
@@ -295,7 +296,7 @@ def _tour(r: Row, order: list[str]) -> str:
         ("Incidents", said or "none"),
     ]
     details = "".join(f"<dt>{e(k)}</dt><dd>{e(v)}</dd>" for k, v in more)
-    stops = " ".join(dict.fromkeys(r.stops_visited))
+    stops = " ".join(dict.fromkeys(r.stops_reached))
     return (
         f'<tbody data-day="{e(r.day.isoformat())}" data-ending="{e(r.ended)}" '
         f'data-stops="{e(stops)}"><tr class="row">{tds}</tr>'

@@ -32,14 +32,15 @@ from typing import Any
 from frog_bt.clock import SITE_TZ
 from frog_bt.config import Site
 from frog_bt.engine.operator import Command
+from frog_bt.model.ledger import SkipWhy, StopVisit, skips
 from frog_bt.offline.report.alerts import Episode, episodes, runs_of
 from frog_bt.offline.report.causes import Cause, Incident
-from frog_bt.offline.report.facts import FileFacts, OperatorCall, Piece, StopFacts, stop_of
+from frog_bt.offline.report.facts import FileFacts, OperatorCall, Piece
 from frog_bt.offline.report.runs import lanes
 
-NAV_FAILED = "navigation failed"
-OPERATOR_SKIP = "operator"
-NOT_RECORDED = "not recorded (restart)"
+NAV_FAILED = SkipWhy.NAVIGATION.value
+OPERATOR_SKIP = SkipWhy.OPERATOR.value
+NOT_RECORDED = SkipWhy.NOT_RECORDED.value
 
 
 class Intervention(enum.StrEnum):
@@ -136,7 +137,7 @@ def _join(lane: str, files: list[FileFacts]) -> list[Tour]:
 @dataclass(frozen=True)
 class Skip:
     poi: str
-    why: str  # navigation failed | operator | not recorded (restart) | not visited
+    why: str  # a SkipWhy: operator | navigation failed | visitor lost | not recorded | not visited
 
     def __str__(self) -> str:
         return f"{self.poi}: {self.why}"
@@ -220,8 +221,9 @@ class Row:
     hour: int
     duration_s: float
     distance_m: float
-    stops_visited: list[str]  # in order (a stop visited again is listed again)
-    stops_skipped: list[Skip]
+    stops_reached: list[str]  # arrived, not skipped; in order (a stop visited again: again)
+    stops_played: list[str]  # reached, and its part a played to its end
+    stops_skipped: list[Skip]  # content stops not reached, each once, and why
     time_at_stops: list[StopTime]
     approaches: int
     approaches_accepted: int
@@ -276,10 +278,10 @@ class Row:
         return out
 
 
-def visits(tour: Tour) -> list[StopFacts]:
-    """The tour's stop visits in order; a visit cut by a restart and played again by the
+def visits(tour: Tour) -> list[StopVisit]:
+    """The tour's stop visits in order; a visit cut by a restart and carried on by the
     resumed executive is one (copies: the pieces are left as they are)."""
-    out: list[StopFacts] = []
+    out: list[StopVisit] = []
     last: Piece | None = None  # the piece of out[-1]
     for piece in tour.pieces:
         for stop in piece.stops:
@@ -288,33 +290,21 @@ def visits(tour: Tour) -> list[StopFacts]:
                 cut is not None
                 and last is not piece
                 and cut.poi == stop.poi
-                and cut.start is not None
-                and stop.start is not None
-                and tour.restarted(cut.start, stop.start)
+                and tour.restarted(cut.t, stop.t)
             ):
-                out[-1] = replace(
-                    stop,
-                    parts="".join(dict.fromkeys(cut.parts + stop.parts)),
-                    before_restart=cut.seconds or 0.0,
-                )
+                out[-1] = cut.carried_on(stop)
             else:
                 out.append(replace(stop))
             last = piece
     return out
 
 
-def skipped(tour: Tour, site: Site, stops: list[StopFacts], ended: str) -> list[Skip]:
-    """'POI: why' for each content stop of the tour order not visited, or left by the
-    operator; for a tour that did not end, only up to the last stop it reached. Why:
-    ``navigation failed`` (a goal there answered 3/4), ``operator`` (a skip accepted there
-    or on the way), ``not recorded (restart)`` (between what the recordings before and
-    after a restart hold: a killed writer loses its last second) or ``not visited``."""
+def skipped(tour: Tour, site: Site, stops: list[StopVisit], ended: str) -> list[Skip]:
+    """'POI: why' for each content stop of the tour order the tour did not reach
+    (:func:`frog_bt.model.ledger.skips`): for a tour that did not end, only up to the last
+    stop it reached or skipped; ``not recorded (restart)`` for one between what the
+    recordings before and after a restart hold (a killed writer loses its last second)."""
     order = [s.poi for s in site.tour.stops if s.content]
-    names = stop_of(site)
-    failed = {names.get(g, g) for p in tour.pieces for g in p.failed_goals}
-    by_operator = {s for p in tour.pieces for s in p.operator_skips}
-    visited = {s.poi for s in stops}
-    reached = visited | failed | by_operator
     lost: set[str] = set()  # stops in a gap the recordings of a restart leave
     at = {poi: i for i, poi in enumerate(order)}
     pieces = tour.pieces
@@ -323,19 +313,7 @@ def skipped(tour: Tour, site: Site, stops: list[StopFacts], ended: str) -> list[
             before = [at[s.poi] for p in pieces[:k] for s in p.stops if s.poi in at]
             after = [at[s.poi] for p in pieces[k:] for s in p.stops if s.poi in at]
             lost.update(order[max(before, default=-1) + 1 : min(after, default=len(order))])
-    reach = (
-        len(order)
-        if ended == "ended"
-        else max((order.index(poi) + 1 for poi in reached if poi in order), default=0)
-    )
-    out = []
-    for poi in order[:reach]:
-        if poi in by_operator:
-            out.append(Skip(poi, OPERATOR_SKIP))
-        elif poi not in visited:
-            why = NAV_FAILED if poi in failed else NOT_RECORDED if poi in lost else "not visited"
-            out.append(Skip(poi, why))
-    return out
+    return [Skip(poi, why.value) for poi, why in skips(stops, order, ended, frozenset(lost))]
 
 
 def row(
@@ -363,7 +341,7 @@ def row(
     for s in stops:
         if s.seconds is not None:
             seconds[s.poi] = round(seconds.get(s.poi, 0.0) + s.seconds, 1)
-    skips = skipped(tour, site, stops, ended)
+    skipped_stops = skipped(tour, site, stops, ended)
     visitors = len({v for p in pieces for v in p.visitors})
     faults = list(dict.fromkeys(f for p in pieces for f in p.faults))
     ops = [Call(round(c.t - start_t, 1), c.command, c.ok, c.by, c.text) for c in calls]
@@ -377,8 +355,9 @@ def row(
         hour=local.hour,
         duration_s=round(tour.last.t1 - start_t, 1),
         distance_m=round(sum(p.distance for p in pieces), 1),
-        stops_visited=[s.poi for s in stops],
-        stops_skipped=skips,
+        stops_reached=[s.poi for s in stops if s.reached],
+        stops_played=[s.poi for s in stops if s.played],
+        stops_skipped=skipped_stops,
         time_at_stops=[StopTime(poi, t) for poi, t in seconds.items()],
         approaches=sum(p.approaches for p in pieces),
         approaches_accepted=sum(p.approaches_ok for p in pieces),
@@ -392,10 +371,10 @@ def row(
         engagement=[
             Visit(s.poi, s.waypoint, s.samples, s.edge_engaged, s.edge_total, s.decision)
             for s in stops
-            if s.face_stream
+            if s.face_stream and s.parts
         ],
-        parts=[Played(s.poi, s.parts) for s in stops],
-        variants=list(dict.fromkeys(s.waypoint for s in stops if s.waypoint != s.poi)),
+        parts=[Played(s.poi, s.parts) for s in stops if s.parts],
+        variants=list(dict.fromkeys(s.waypoint for s in stops if s.parts and s.waypoint != s.poi)),
         faults=[f"{name}: {message}" for name, message in faults],
         nav_retries=sum(p.nav_retries for p in pieces),
         dock_retries=sum(p.dock_retries for p in pieces),
