@@ -1,8 +1,8 @@
 """A season of recorded tours, seeded: what `frog-bt report` is tested and measured on.
 
 Each tour is a whole run of the real executive against the built-in simulator on sim
-time (fast content, 400x), recorded to one MCAP file named by its local start time,
-``YYYYMMDD-HHMMSS-tourNNNN.mcap``. From ``--seed``, per day (from 2026-06-01):
+time (fast content, 400x), recorded (``--no-idle``) to one MCAP file named by its local
+start time, ``YYYYMMDD-HHMMSS-tourNNNN.mcap``. From ``--seed``, per day (from 2026-06-01):
 ``--tours-per-day`` tours of one robot, one after another: the day's seven hours
 (09:00-12:30, 14:30-18:00, where POI1 and POI2 play their afternoon variants) cut in
 equal slots, each tour at a random moment of its slot early enough to end inside it
@@ -20,8 +20,9 @@ kind            weight  what happens
 ``fault``       0.05    a motor driver error 5 minutes in: the tour is aborted
 ==============  ======  =====================================================
 
-Then the season's help events, ``--help-each N`` tours of each kind below (default 4;
-none from :func:`make` unless asked), put in place of tours drawn above by a second
+Then the season's help events, ``--help-each N`` tours of each kind below (default 4,
+fewer when they would be more than half of the season; none from :func:`make` unless
+asked), put in place of tours drawn above by a second
 generator of the same seed (so the tours drawn above do not change), each with the
 default scenario's engaged visitor:
 
@@ -40,6 +41,12 @@ help kind        what happens
 
 Operator commands go through the executive's staff (``by``: console), as the console
 sends them.
+
+With ``--idle`` (the default; :func:`make`'s ``idle``) the robot's whole day in service
+is recorded as ``frog-bt run --record DIR`` records it: each slot's executive from the
+slot's opening to its closing, idle (docked, waiting for the front end) before and
+after its tour, one idle file, the tour file and another idle file, so that the
+report's hours in service are the day's and not the tours' alone.
 
 ``corpus.json`` beside the files lists every tour as seeded (file, day, local start,
 kind), the seed, the weights and the help events, and per tour (``runs``) what the
@@ -90,8 +97,15 @@ FIRST_DAY = "2026-06-01"
 MORNING_MIN = 9 * 60  # the morning's tours from 09:00 (local minutes) ...
 AFTERNOON_MIN = 14 * 60 + 30  # ... the afternoon's from 14:30
 HALF_DAY_MIN = 3.5 * 60  # each for 3.5 hours
+# the robot's day in service: (from, to) in local minutes, the lunch break between
+SERVICE: tuple[tuple[float, float], ...] = (
+    (MORNING_MIN, MORNING_MIN + HALF_DAY_MIN),
+    (AFTERNOON_MIN, AFTERNOON_MIN + HALF_DAY_MIN),
+)
 LONGEST_TOUR_MIN = 18.0  # a seeded tour's longest run (a wanderer's: 17 simulated minutes)
 MOST_PER_DAY = int(2 * HALF_DAY_MIN // LONGEST_TOUR_MIN)
+HELP_EACH = 4  # --help-each's default, when the season has room for it (help_each_for)
+SEAM_S = 2.0  # an idle run stops this long before the next one starts (no overlap)
 TZ = "+02:00"  # the site's summer time (Europe/Madrid)
 
 
@@ -103,6 +117,31 @@ class Seeded:
     kind: str
     seed: int  # the simulator's seed for this tour
     file: str = ""  # relative to the corpus directory
+    # the robot's time in service around the tour (ISO 8601, local): from the start of
+    # its slot to its end, within the half-day the tour starts in; with ``idle``, the
+    # executive runs (idle) from ``opens`` and until ``closes``
+    opens: str = ""
+    closes: str = ""
+
+
+def most_per_day(service: tuple[tuple[float, float], ...] = SERVICE) -> int:
+    """Tours of one robot that fit a day of ``service`` one after another."""
+    return int(sum(b - a for a, b in service) // LONGEST_TOUR_MIN)
+
+
+def help_each_for(tours: int) -> int:
+    """``--help-each``'s default for a season of ``tours``: HELP_EACH of each help kind,
+    fewer when they would be more than half of the season's tours (0 below 10 tours)."""
+    return min(HELP_EACH, tours // (2 * len(HELP_KINDS)))
+
+
+def _clock(minute: float, service: tuple[tuple[float, float], ...]) -> tuple[float, int]:
+    """A minute of the day's time in service (from 0) as a local minute, and its period."""
+    for i, (a, b) in enumerate(service):
+        if minute < b - a or i == len(service) - 1:
+            return a + minute, i
+        minute -= b - a
+    raise AssertionError("no service periods")
 
 
 def plan(
@@ -111,39 +150,58 @@ def plan(
     seed: int,
     help_each: int = 0,
     weights: dict[str, float] | None = None,
+    service: tuple[tuple[float, float], ...] = SERVICE,
 ) -> list[Seeded]:
     """The tours of a season, from ``seed``: in start order, numbered from 1; then
     ``help_each`` tours of each help kind in place of tours drawn at random (a second
-    generator, so that the others are those ``help_each=0`` draws)."""
+    generator, so that the others are those ``help_each=0`` draws). ``service``: the
+    robot's day, (from, to) local minutes (default SERVICE: 09:00-12:30, 14:30-18:00),
+    cut in ``per_day`` equal slots of time in service, one tour in each."""
     weights = weights or KINDS
-    if per_day > MOST_PER_DAY:
+    most = most_per_day(service)
+    if per_day > most:
         raise ValueError(
-            f"{per_day} tours a day: at most {MOST_PER_DAY} fit one robot's 7 hours one "
-            "after another"
+            f"{per_day} tours a day: at most {most} fit one robot's "
+            f"{sum(b - a for a, b in service) / 60:g} hours one after another"
         )
     rng = random.Random(seed)
     out: list[Seeded] = []
     first = datetime.fromisoformat(f"{FIRST_DAY}T00:00:00{TZ}")
-    slot = 2 * HALF_DAY_MIN / per_day
+    slot = sum(b - a for a, b in service) / per_day
     number = 0
     for d in range(days):
         day = first + timedelta(days=d)
+        # one robot's day: its tours one after another, each at a random moment of its
+        # slot early enough to end inside it (a robot's tours cannot overlap)
+        at = [
+            _clock(i * slot + rng.uniform(0.0, max(0.0, slot - LONGEST_TOUR_MIN)), service)
+            for i in range(per_day)
+        ]
         starts = []
-        for i in range(per_day):
-            # one robot's day: its tours one after another, each at a random moment of
-            # its slot early enough to end inside it (a robot's tours cannot overlap)
-            minute = i * slot + rng.uniform(0.0, max(0.0, slot - LONGEST_TOUR_MIN))
-            if minute >= HALF_DAY_MIN:
-                minute += AFTERNOON_MIN - MORNING_MIN - HALF_DAY_MIN
-            starts.append(day + timedelta(minutes=MORNING_MIN + minute))
-        for start in starts:
+        for i, (minute, period) in enumerate(at):
+            # the time in service around it: from its slot's start to the next one's,
+            # from the start or to the end of its half-day when it is the first or last
+            first_of = i == 0 or at[i - 1][1] != period
+            last_of = i == per_day - 1 or at[i + 1][1] != period
+            start_, end_ = service[period]
+            opens = start_ if first_of else max(_clock(i * slot, service)[0], start_)
+            closes = end_ if last_of else min(_clock((i + 1) * slot, service)[0], end_)
+            starts.append([day + timedelta(minutes=m) for m in (minute, opens, closes)])
+        for start, opens, closes in starts:
             number += 1
             kind = rng.choices(list(weights), weights=list(weights.values()))[0]
             start = start.replace(microsecond=0)
             name = f"{start:%Y%m%d-%H%M%S}-tour{number:04d}.mcap"
             out.append(
                 Seeded(
-                    number, f"{day:%Y-%m-%d}", start.isoformat(), kind, rng.randrange(1 << 30), name
+                    number,
+                    f"{day:%Y-%m-%d}",
+                    start.isoformat(),
+                    kind,
+                    rng.randrange(1 << 30),
+                    name,
+                    opens.replace(microsecond=0).isoformat(),
+                    closes.replace(microsecond=0).isoformat(),
                 )
             )
     if help_each:
@@ -154,10 +212,20 @@ def plan(
     return out
 
 
-def _scenario(tour: Seeded, fast: dict[str, Any]) -> Any:
+def _scenario(tour: Seeded, fast: dict[str, Any], idle: bool = False) -> Any:
+    """The tour's simulator; with ``idle``, from the robot's opening (``tour.opens``):
+    the front end says idle at the tour's start, and never again after it."""
     from frog_bt.sim import scenario_from
 
     data: dict[str, Any] = {**fast, "start_time": tour.start, "seed": tour.seed}
+    if idle:
+        wait = (datetime.fromisoformat(tour.start) - datetime.fromisoformat(tour.opens)).seconds
+        data["start_time"] = tour.opens
+        data["frontend"] = {
+            **data.get("frontend", {}),
+            "idle_at": max(1.0, float(wait)),
+            "idle_after_tour": None,
+        }
     if tour.kind == "dock_help":
         data["docking"] = {**data.get("docking", {}), "dock_failures": 3}
     return scenario_from(SCENARIO.get(tour.kind, "default"), data)
@@ -231,8 +299,37 @@ async def _help(tour: Seeded, r: Any, acted: list[float]) -> None:
         acted.append(exe.clock.now())
 
 
-def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> dict[str, Any]:
-    """Run and record one tour (in a worker process); what happened, in brief."""
+async def _idle_until(r: Any, closes: float, over: Any) -> None:
+    """The executive of ``r`` runs on, idle, once the tour is ``over()``, until
+    ``closes`` (a little before: the next tour's executive opens then) on its clock, and
+    is stopped; or until it stops by itself."""
+    exe = r.executive
+
+    async def wait() -> None:
+        await _until(exe, over, 4 * 3600)
+        await exe.clock.sleep_until(closes - SEAM_S)
+        exe.stop("the robot's time in service is over", 0)
+
+    waiter = asyncio.ensure_future(wait())
+    await asyncio.wait([waiter, r.task], return_when=asyncio.FIRST_COMPLETED)
+    if not waiter.done():
+        waiter.cancel()
+    elif waiter.exception() is not None:
+        raise waiter.exception()  # type: ignore[misc]
+
+
+def record(
+    tour: Seeded, directory: str, fast: dict[str, Any] | None = None, idle: bool = False
+) -> dict[str, Any]:
+    """Run and record one tour (in a worker process); what happened, in brief.
+
+    ``idle``: the robot's time in service around it too, as ``frog-bt run --record DIR``
+    records a day: the executive starts at ``tour.opens`` and waits, docked, for the
+    front end's idle at the tour's start (an idle file), runs the tour (a tour file),
+    and waits again until ``tour.closes`` (an idle file); the files are named as
+    ``--record DIR`` names them, numbered by the tour's number."""
+    if idle:
+        return asyncio.run(_record_idle(tour, Path(directory), FAST if fast is None else fast))
     import tempfile
 
     from frog_bt.config import load_site
@@ -336,6 +433,101 @@ def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> 
     }
 
 
+async def _record_idle(tour: Seeded, directory: Path, fast: dict[str, Any]) -> dict[str, Any]:
+    """:func:`record` with ``idle``: one executive from ``tour.opens`` to ``tour.closes``
+    (two for a restart: the second resumes the tour and stays until ``closes``)."""
+    import tempfile
+
+    from frog_bt.config import load_site
+    from frog_bt.live.rotation import RecordingDir
+    from frog_bt.model.events import AlertChanged
+    from frog_bt.rehearsal import Rehearsal
+    from frog_bt.runtime.observer import attach_all, listen
+
+    directory.mkdir(parents=True, exist_ok=True)
+    closes = datetime.fromisoformat(tour.closes).timestamp()
+    scenario = _scenario(tour, fast, idle=True)
+    site = load_site()
+    acted: list[float] = []
+    alerts: list[dict[str, Any]] = []
+    files: list[Path] = []
+
+    def recordings() -> RecordingDir:
+        out = RecordingDir(directory, 1 << 50)
+        out.number = tour.number  # workers share the directory: numbered by the plan
+        return out
+
+    def prepare(exe: Any, recording: RecordingDir) -> None:
+        attach_all(exe, [recording])
+        listen(
+            exe,
+            lambda e: alerts.append(
+                {"t": e.t, "id": e.alert.id, "state": e.alert.state, "severity": e.alert.severity}
+            ),
+            AlertChanged,
+        )
+
+    def over(recording: RecordingDir) -> Any:
+        """The tour is over: its file is followed by an idle one."""
+        return lambda: recording.kind == "idle" and len(recording.files) > 1
+
+    t0 = time.monotonic()
+    with tempfile.TemporaryDirectory() as tmp:
+        first = recordings()
+        run = Rehearsal(
+            scenario,
+            site=site,
+            prepare=lambda exe: prepare(exe, first),
+            checkpoint=Path(tmp) / "checkpoint.json",
+            once=False,
+        )
+        try:
+            async with run:
+                if tour.kind == "restart":
+                    sim, address = run.sim, run.listen
+                    await sim.wait_for(_start_poi("POI3"), 60)
+                    run.own_sim = False  # the simulator (the robot, the visitor) goes on
+                else:
+                    if tour.kind in HELP_KINDS:
+                        await _help(tour, run, acted)
+                    await _idle_until(run, closes, over(first))
+                    outcome = await run.finish(120.0)
+        finally:
+            first.close()
+            files += first.files
+        if tour.kind == "restart":
+            second = recordings()
+            again = Rehearsal(
+                None,
+                sim=sim,
+                listen=address,
+                site=site,
+                prepare=lambda exe: prepare(exe, second),
+                checkpoint=Path(tmp) / "checkpoint.json",
+                once=False,
+            )
+            try:
+                async with again:
+                    await _idle_until(again, closes, over(second))
+                    outcome = await again.finish(120.0)
+            finally:
+                second.close()
+                files += second.files
+                await sim.stop()
+    tours = [p for p in files if "-tour" in p.name]
+    return {
+        "file": str(tours[0].relative_to(directory)) if tours else "",
+        "files": [str(p.relative_to(directory)) for p in files],
+        "code": outcome.code,
+        "reason": outcome.reason,
+        "wall_s": round(time.monotonic() - t0, 2),
+        "bytes": sum(p.stat().st_size for p in files),
+        "spans": [_span(p) for p in files],
+        "needed": _needed(acted, alerts),
+        "service": [datetime.fromisoformat(tour.opens).timestamp(), closes],
+    }
+
+
 def _span(path: Path) -> list[float]:
     """The file's first and last message times (seconds), from its MCAP summary."""
     from mcap.reader import make_reader
@@ -379,26 +571,32 @@ def make(
     help_each: int = 0,
     weights: dict[str, float] | None = None,
     fast: dict[str, Any] | None = None,
+    idle: bool = False,
+    service: tuple[tuple[float, float], ...] = SERVICE,
 ) -> dict[str, Any]:
     """Record the season into ``out`` and write ``out/corpus.json``; the manifest.
 
     ``help_each``: tours of each help kind (HELP_KINDS); ``weights``: the visitors'
-    kinds (default KINDS); ``fast``: the simulator's speed and timings (default FAST)."""
+    kinds (default KINDS); ``fast``: the simulator's speed and timings (default FAST);
+    ``idle``: the robot's whole day in service, the idle time between tours too
+    (:func:`record`); ``service``: that day (default SERVICE)."""
     import multiprocessing
 
     out.mkdir(parents=True, exist_ok=True)
-    tours = plan(days, per_day, seed, help_each, weights)
+    tours = plan(days, per_day, seed, help_each, weights, service)
     context = multiprocessing.get_context("fork")
     t0 = time.monotonic()
     results = []
     with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
-        futures = [pool.submit(record, t, str(out), fast) for t in tours]
+        futures = [pool.submit(record, t, str(out), fast, idle) for t in tours]
         for done, future in enumerate(futures, 1):
             results.append(future.result())
             if progress:
                 print(f"\rcorpus: {done}/{len(tours)} tours", end="", file=sys.stderr, flush=True)
     if progress:
         print(file=sys.stderr)
+    if idle:  # the tour files as --record DIR named them
+        tours = [replace(t, file=r["file"] or t.file) for t, r in zip(tours, results, strict=True)]
     manifest = {
         "seed": seed,
         "days": days,
@@ -411,6 +609,8 @@ def make(
             "ack_after_s": ACK_AFTER_S,
             "low_battery": LOW_BATTERY,
         },
+        "idle": idle,
+        "service": [[a, b] for a, b in service],
         "tours": [asdict(t) for t in tours],
         "runs": results,
         "wall_s": round(time.monotonic() - t0, 1),
@@ -419,34 +619,85 @@ def make(
     return manifest
 
 
-def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+class _Help(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Every option's default shown (one that depends on others says it in its help),
+    the description as written."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        if action.default is None or action.required:
+            return action.help
+        return super()._get_help_string(action)
+
+
+def options(argv: list[str] | None = None) -> argparse.Namespace:
+    """The command line, checked, with ``--help-each`` resolved for the season's size."""
+    p = argparse.ArgumentParser(
+        prog="scripts/corpus",
+        description=__doc__.split("\n\n")[0] + "\n\n    scripts/corpus --out season/",
+        formatter_class=_Help,
+    )
     p.add_argument("--out", type=Path, required=True, help="the corpus directory")
-    p.add_argument("--days", type=int, default=10)
-    p.add_argument("--tours-per-day", type=int, default=20)
-    p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--help-each", type=int, default=4, help="tours of each help kind (0: none)")
+    p.add_argument("--days", type=int, default=10, help="days of the season (from 2026-06-01)")
+    p.add_argument(
+        "--tours-per-day",
+        type=int,
+        default=20,
+        help=f"one robot's tours a day, one after another (at most {MOST_PER_DAY})",
+    )
+    p.add_argument("--seed", type=int, default=1, help="the seed of everything drawn")
+    p.add_argument(
+        "--help-each",
+        type=int,
+        default=None,
+        help=f"tours of each help kind ({', '.join(HELP_KINDS)}); 0: none (default: "
+        f"{HELP_EACH}, fewer when {HELP_EACH * len(HELP_KINDS)} help tours would be more "
+        "than half of the season: none below 10 tours)",
+    )
+    p.add_argument(
+        "--idle",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="record the robot's whole day in service (09:00-12:30, 14:30-18:00), the "
+        "idle time between tours too, as `frog-bt run --record DIR` does; --no-idle: "
+        "the tours alone (faster)",
+    )
     p.add_argument("--jobs", type=int, default=2, help="tours recorded at once (processes)")
-    a = p.parse_args()
+    a = p.parse_args(argv)
     for option, value, least in (
         ("--days", a.days, 1),
         ("--tours-per-day", a.tours_per_day, 1),
         ("--jobs", a.jobs, 1),
-        ("--help-each", a.help_each, 0),
+        ("--help-each", 0 if a.help_each is None else a.help_each, 0),
     ):
         if value < least:
             p.error(f"{option} {value}: expected {least} or more")
-    if a.help_each * len(HELP_KINDS) > a.days * a.tours_per_day:
-        p.error(
-            f"--help-each {a.help_each}: {a.help_each * len(HELP_KINDS)} help tours "
-            f"({len(HELP_KINDS)} kinds) do not fit a season of {a.days * a.tours_per_day} tours"
-        )
     if a.tours_per_day > MOST_PER_DAY:
         p.error(
-            f"--tours-per-day: at most {MOST_PER_DAY} tours fit one robot's day one after another"
+            f"--tours-per-day {a.tours_per_day}: at most {MOST_PER_DAY} tours fit one robot's "
+            "day one after another"
         )
+    tours = a.days * a.tours_per_day
+    if a.help_each is None:
+        a.help_each = help_each_for(tours)
+    if a.help_each * len(HELP_KINDS) > tours:
+        p.error(
+            f"--help-each {a.help_each}: {a.help_each * len(HELP_KINDS)} help tours "
+            f"({len(HELP_KINDS)} kinds) do not fit a season of {tours} tours"
+        )
+    return a
+
+
+def main(argv: list[str] | None = None) -> None:
+    a = options(argv)
     manifest = make(
-        a.out, a.days, a.tours_per_day, a.seed, a.jobs, progress=True, help_each=a.help_each
+        a.out,
+        a.days,
+        a.tours_per_day,
+        a.seed,
+        a.jobs,
+        progress=True,
+        help_each=a.help_each,
+        idle=a.idle,
     )
     kinds: dict[str, int] = {}
     for t in manifest["tours"]:

@@ -3,7 +3,9 @@
 Each recording is replayed on the tree (the recordings' tick channel has the root's
 status per tick, not each node's; a replay ticks exactly where the executive did), and
 every node's runs and outcomes are counted over all of them. Printed as the tree, one
-line per node, with the nodes the recordings never ran marked, then one line of the tours
+line per node (how often it ran, and how each run ended: succeeded, failed, stopped
+while running, or still running when its recording ended; a key under the tree says
+what each means), with the nodes the recordings never ran marked, then one line of the tours
 they hold (stops reached, played, skipped: counted as `frog-bt report` counts them);
 `-o FILE.html` writes the tree as a self-contained page. `--jobs N` replays N files at a
 time (processes), `--scheduler ADDRESS` on a dask.distributed cluster: the same Executor
@@ -19,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import textwrap
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -46,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
     from frog_bt.config import load_site
     from frog_bt.offline.corpus import recordings
     from frog_bt.offline.executors import ExecutorError, executor
-    from frog_bt.verify.coverage import NodeCount, add, lines, never_run, page
+    from frog_bt.verify.coverage import KEY, NodeCount, add, lines, never_run, page
     from frog_bt.verify.model import compile_tree
 
     try:
@@ -80,6 +83,7 @@ def run(args: argparse.Namespace) -> int:
         print("frog-bt: no recording could be read", file=sys.stderr)
         return 2
     print("\n".join(lines(model, counts)))
+    print(textwrap.fill(KEY, 88))
     print(
         f"tours: {tours['tours']} ({tours['ended']} ended, {tours['aborted']} aborted); "
         f"stops reached {tours['reached']}, played {tours['played']}, "

@@ -9,8 +9,9 @@ restart that resumed it), and writes:
   --csv FILE      one row per tour, for pandas or R
   --parquet FILE  the same rows as Parquet (lists as list columns, zoned times)
   --json FILE     the totals, the rows and the files skipped
-  --compare DIR…  a second season beside the first: every rate in both, and the
-                  difference with its 95 % interval
+  --compare DIR…  a second season beside the first: every headline figure of the
+                  page in both, under its label, and the difference with its 95 %
+                  interval
 
 The recordings in one directory are one robot's: give each robot its own. A file that
 is not a recording, or is damaged beyond reading, is reported and skipped; one cut
@@ -124,6 +125,8 @@ def run(args: argparse.Namespace) -> int:
     from frog_bt.offline.executors import ExecutorError, executor
     from frog_bt.offline.report import outputs
     from frog_bt.offline.report.compare import compare
+    from frog_bt.offline.report.intervals import proportion
+    from frog_bt.offline.report.precision import estimate
 
     for wanted, module in (
         (args.output, "matplotlib"),
@@ -174,11 +177,10 @@ def run(args: argparse.Namespace) -> int:
     except ExecutorError as exc:
         print(f"frog-bt report: {exc}", file=sys.stderr)
         return 2
-    rate = t["completion_rate"]
+    completion = estimate(proportion(t["rates"]["completion"]), " %")  # to its precision
     print(
         f"frog-bt report: {len(files)} files, {t['tours']} tours, {t['completed']} "
-        f"completed ({'-' if rate is None else f'{100 * rate:.1f} %'}), "
-        f"{t['resumed']} resumed, {len(skipped)} skipped"
+        f"completed ({completion}), {t['resumed']} resumed, {len(skipped)} skipped"
     )
     if other:
         c = t["compare"]

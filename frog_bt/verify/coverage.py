@@ -72,24 +72,42 @@ class Counter:
         pass
 
 
+# Each outcome a line can show, in its words, and what it means (KEY, printed with them).
+WORDS = {"SUCCESS": "succeeded", "FAILURE": "failed", "INVALID": "stopped"}
+UNFINISHED = "still running"
+KEY = (
+    "ran Nx: the times a node started (ticked when it was not running); each run "
+    "ended in one of: succeeded (returned SUCCESS); failed (returned FAILURE); stopped "
+    "(halted while running, before it returned: its parent moved on, a higher-priority "
+    "branch took over, a guard or timeout cut it short, or the tour was aborted); "
+    f"{UNFINISHED} (running when its recording ended). never run: no recorded tick reached it."
+)
+
+
 def never_run(counts: list[NodeCount]) -> list[int]:
     return [i for i, c in enumerate(counts) if c.runs == 0]
 
 
+def outcomes(c: NodeCount) -> str:
+    """``succeeded 3, stopped 1, still running 1``: every run's end, in words (they add
+    up to the runs)."""
+    parts = [f"{WORDS[k]} {c.outcomes[k]}" for k in WORDS if c.outcomes.get(k)]
+    parts += [f"{k.lower()} {v}" for k, v in sorted(c.outcomes.items()) if k not in WORDS and v]
+    running = c.runs - sum(c.outcomes.values())
+    if running > 0:
+        parts.append(f"{UNFINISHED} {running}")
+    return ", ".join(parts)
+
+
 def lines(model: Model, counts: list[NodeCount]) -> list[str]:
-    """One line per node, indented as the tree: runs, outcomes, or never run."""
+    """One line per node, indented as the tree: runs, how they ended, or never run."""
     depth = [0] * len(model.nodes)
     out = []
     for n in model.nodes:
         if n.parent >= 0:
             depth[n.index] = depth[n.parent] + 1
         c = counts[n.index]
-        what = (
-            "never run"
-            if c.runs == 0
-            else f"ran {c.runs}x: "
-            + ", ".join(f"{k.lower()} {v}" for k, v in sorted(c.outcomes.items()))
-        )
+        what = "never run" if c.runs == 0 else f"ran {c.runs}x: {outcomes(c)}"
         out.append(f"{'  ' * depth[n.index]}{n.label()}: {what}")
     return out
 
@@ -103,10 +121,10 @@ def page(tree: LoadedTree, model: Model, counts: list[NodeCount], files: int) ->
             depth[n.index] = depth[n.parent] + 1
         c = counts[n.index]
         cls = ' class="never"' if c.runs == 0 else ""
-        outcomes = ", ".join(f"{k.lower()} {v}" for k, v in sorted(c.outcomes.items()))
         rows.append(
             f'<tr{cls}><td style="padding-left:{depth[n.index]}em">'
-            f"{html.escape(n.label())}</td><td>{c.runs}</td><td>{html.escape(outcomes)}</td></tr>"
+            f"{html.escape(n.label())}</td><td>{c.runs}</td>"
+            f"<td>{html.escape(outcomes(c))}</td></tr>"
         )
     never = len(never_run(counts))
     return (
@@ -116,7 +134,8 @@ def page(tree: LoadedTree, model: Model, counts: list[NodeCount], files: int) ->
         f"<h1>Coverage of {html.escape(tree.file)}</h1>"
         f"<p>{files} recordings; {len(model.nodes) - never} of {len(model.nodes)} nodes ran; "
         f"{never} never ran (shaded).</p>"
-        "<table><tr><th>node</th><th>runs</th><th>outcomes</th></tr>"
+        f"<p>{html.escape(KEY)}</p>"
+        "<table><tr><th>node</th><th>runs</th><th>how they ended</th></tr>"
         + "".join(rows)
         + "</table></body></html>\n"
     )

@@ -164,8 +164,40 @@ def test_compare_tells_the_seeded_difference_from_the_same_rate(tmp_path) -> Non
         for row in (re.findall(r"<td>(.*?)</td>", r) for r in table.split("<tr>"))
         if row
     }
-    assert cells["part_b:POI2"][3] == "-100.0 points" and cells["part_b:POI2"][5] == "yes"
-    assert cells["completion"][3] == "+0.0 points" and cells["completion"][5] == "no"
+    assert cells["Part b at POI2"][3] == "-100 points" and cells["Part b at POI2"][5] == "yes"
+    assert cells["Completion rate"][3] == "+0 points" and cells["Completion rate"][5] == "no"
+    # every headline figure of the page, under the page's own label, each difference
+    # with its interval (a count or total measured whole says it has none)
+    page = html.read_text()
+    labels = [
+        label
+        for ident in ("summary", "reliability")
+        for label in re.findall(
+            r"<tr><th>(.*?)</th>", page.split(f'id="{ident}">', 1)[1].split("</table>", 1)[0]
+        )
+    ]
+    assert len(labels) >= 18 and "Tours per hour in service" in labels
+    assert "Interventions per 100 tours" in labels and "Time to acknowledge an alert" in labels
+    assert [label for label in cells if label != "figure"] == labels
+    for label in labels:
+        moved, interval = cells[label][3], cells[label][4]
+        if moved != "\u2013":
+            assert re.fullmatch(r"[+-]\d+(\.\d+)?( \S+)?", moved), (label, moved)
+            assert interval in ("measured: none", "too few for an interval") or re.fullmatch(
+                r"[+-]\d+(\.\d+)? to [+-]\d+(\.\d+)?", interval
+            ), (label, interval)
+    for label in (
+        "Tours per hour in service",
+        "Interventions per 100 tours",
+        "Autonomy (hours with no one needed)",
+        "Completion rate",
+    ):
+        assert " to " in cells[label][4], (label, cells[label])
+    assert cells["Hours in service"][4] == "measured: none"
+    figures = json.loads(
+        page.split('<script type="application/json" id="totals">', 1)[1].split("</script>")[0]
+    )["compare"]["figures"]
+    assert [f["label"] for f in figures] == labels
 
 
 def test_compare_mistakes_are_named(tmp_path, capsys) -> None:

@@ -43,17 +43,31 @@ def test_coverage_of_a_recorded_tour(
     out = capsys.readouterr().out.splitlines()
     line = {text.strip().split(":")[0]: text for text in out}
     # what the tour did ran...
-    assert "ran 1x: success 1" in line["Docking 'Docking undock'"]
-    assert "success 1" in line["Navigate 'Navigate POI1'"]
+    assert "ran 1x: succeeded 1" in line["Docking 'Docking undock'"]
+    assert "succeeded 1" in line["Navigate 'Navigate POI1'"]
     # ...and what nothing in it called for never did
-    assert "failure" in line["Sequence 'Abort politely'"]  # its guard fails every tick
+    assert "failed" in line["Sequence 'Abort politely'"]  # its guard fails every tick
     assert line["ClearAbort"].endswith("never run")
     assert line["SkipStop 'SkipStop POI1'"].endswith("never run")
     assert line["AskForHelp 'AskForHelp undock'"].endswith("never run")
     assert out[-2].startswith("1 recordings: ") and "never ran" in out[-2]
+    # every outcome shown is one the key under the tree explains, and their counts add
+    # up to the runs (a node halted while running is "stopped", never a bare "invalid")
+    key = " ".join(out[out.index(next(t for t in out if t.startswith("ran Nx: "))) : -3])
+    shown: set[str] = set()
+    for text in out:
+        if ": ran " in text:
+            runs = int(text.split(": ran ")[1].split("x")[0])
+            ends = text.split("x: ", 1)[1].split(", ")
+            shown.update(e.rsplit(" ", 1)[0] for e in ends)
+            assert sum(int(e.rsplit(" ", 1)[1]) for e in ends) == runs, text
+    assert shown >= {"succeeded", "failed"}, shown
+    assert all(f"{word} (" in key for word in shown), (shown, key)
+    assert "invalid" not in "\n".join(out).lower()
     # the tour, as the one count of tours (and the report) has it
     assert out[-3] == "tours: 1 (1 ended, 0 aborted); stops reached 6, played 6, skipped 0"
     html = page.read_text()
+    assert "stopped (halted while running" in html
     assert '<tr class="never"><td style="padding-left:3em">ClearAbort</td>' in html
     assert "<script" not in html
     # the same counts through the Executor seam (two worker processes, two copies)
@@ -62,7 +76,7 @@ def test_coverage_of_a_recorded_tour(
     doubled = capsys.readouterr().out.splitlines()
     assert doubled[-1].startswith("2 recordings: ")
     twice = {text.strip().split(":")[0]: text for text in doubled}
-    assert "ran 2x: success 2" in twice["Docking 'Docking undock'"]
+    assert "ran 2x: succeeded 2" in twice["Docking 'Docking undock'"]
 
 
 def test_verify_says_which_share_of_the_explored_states_a_season_reached(
@@ -114,3 +128,16 @@ class PlayContent(visit.PlayContent):
     """PlayContent as a wrong world model sees it: over in the tick it starts."""
 
     verify = Abstraction((S,), role=Role.CONTENT, rule=content)
+
+
+def test_every_outcome_coverage_shows_is_in_its_key() -> None:
+    """A run halted while running is "stopped", one a recording ended in is "still
+    running"; the key printed under the tree says what each word means."""
+    from collections import Counter
+
+    from frog_bt.verify.coverage import KEY, NodeCount, outcomes
+
+    count = NodeCount(runs=5, outcomes=Counter({"SUCCESS": 2, "FAILURE": 1, "INVALID": 1}))
+    assert outcomes(count) == "succeeded 2, failed 1, stopped 1, still running 1"
+    for word in ("succeeded", "failed", "stopped", "still running", "never run"):
+        assert f"{word} (" in KEY or f"{word}: " in KEY, word

@@ -12,7 +12,10 @@ import html
 import json
 from typing import Any
 
-from frog_bt.offline.report.intervals import Rate
+from frog_bt.offline.report import headline
+from frog_bt.offline.report.headline import rate
+from frog_bt.offline.report.intervals import TOO_FEW, Estimate, proportion, wilson
+from frog_bt.offline.report.precision import estimate, measure, places, signed
 from frog_bt.offline.report.rows import Row
 
 e = html.escape
@@ -28,26 +31,6 @@ PUBLISHED = [
 DASH = "\u2013"
 
 
-def _or_dash(x: object) -> str:
-    return DASH if x is None else str(x)
-
-
-def _n(count: int, thing: str) -> str:
-    """``1 alert``, ``2 alerts``."""
-    return f"{count} {thing}" if count == 1 else f"{count} {thing}s"
-
-
-def pct(x: float | None) -> str:
-    return "\u2013" if x is None else f"{100 * x:.1f} %"
-
-
-def rate(r: Rate) -> str:
-    """``76.0 % (152 of 200; 69.6 % to 81.4 %)``."""
-    if r["rate"] is None:
-        return "\u2013"
-    return f"{pct(r['rate'])} ({r['k']} of {r['n']}; {pct(r['low'])} to {pct(r['high'])})"
-
-
 def _table(rows: list[tuple[str, str]], ident: str) -> str:
     body = "".join(f"<tr><th>{e(k)}</th><td>{e(v)}</td></tr>" for k, v in rows)
     return f'<table class="kv" id="{ident}">{body}</table>'
@@ -59,71 +42,25 @@ def _grid(head: list[str], rows: list[list[str]], ident: str) -> str:
     return f'<table class="grid" id="{ident}"><tr>{h}</tr>{b}</table>'
 
 
+def _figures(figures: list[headline.Figure], ident: str) -> str:
+    return _table([(f.label, f.shown) for f in figures], ident)
+
+
 def summary(t: dict[str, Any]) -> str:
-    tour_min = t["tour_minutes"] or {}
-    r = t["rates"]
-    lines = [
-        ("Tours", f"{t['tours']} ({t['completed']} completed, {t['resumed']} resumed)"),
-        ("Completion rate", rate(r["completion"])),
-        ("Approach success", rate(r["approach_success"])),
-        ("Invitation acceptance", rate(r["invitation_acceptance"])),
-        ("Invitations declined", str(t["invitations_declined"])),
-        ("Visitors reached", f"{t['visitors']} ({t['visitors_lost']} lost on the way)"),
-        *((f"Part b at {poi}", rate(g)) for poi, g in t["engagement"]["by_stop"].items()),
-        (
-            "Tour length",
-            f"median {_or_dash(tour_min.get('median'))} min "
-            f"(from {_or_dash(tour_min.get('min'))} to {_or_dash(tour_min.get('max'))})",
-        ),
-        ("Distance driven", f"{t['distance_m'] / 1000:.1f} km"),
-        (
-            "Time-of-day variants",
-            ", ".join(f"{k} {n}" for k, n in sorted(t["variants"].items())) or "none",
-        ),
-    ]
-    return _table(lines, "summary")
+    return _figures(headline.summary(t), "summary")
 
 
-def reliability(rel: dict[str, Any]) -> str:
-    ack = rel["time_to_acknowledge_s"]
-    iv = rel["interventions"]
-    mtbf = rel["mean_hours_between_failures"]
-    lines = [
-        (
-            "Hours in service",
-            f"{rel['hours_in_service']:g} h over {_n(rel['robot_days'], 'robot-day')}",
-        ),
-        ("Tours per hour in service", str(rel["tours_per_hour_in_service"] or "\u2013")),
-        (
-            "Interventions per 100 tours",
-            _or_dash(rel["interventions_per_100_tours"])
-            + f" ({', '.join(f'{k} {n}' for k, n in iv.items())})",
-        ),
-        ("Failures that needed a person", str(rel["failures_needing_a_person"])),
-        (
-            "Mean operating time between them",
-            "none in the season" if mtbf is None else f"{mtbf:g} h",
-        ),
-        ("Autonomy (hours with no one needed)", pct(rel["autonomy"])),
-        (
-            "Time to acknowledge an alert",
-            "none acknowledged"
-            if ack is None
-            else f"median {ack['median']:g} s, 90th percentile {ack['p90']:g} s "
-            f"({_n(rel['acknowledged'], 'alert')})",
-        ),
-        (
-            "Distance per robot-day",
-            "\u2013" if rel["km_per_robot_day"] is None else f"{rel['km_per_robot_day']:.2f} km",
-        ),
-    ]
+def reliability(rel: dict[str, Any], tours: int) -> str:
     published = _grid(
         ["deployment", "figure", "note"],
         [list(p) for p in PUBLISHED],
         "published",
     )
     return (
-        _table(lines, "reliability") + "<p>Published figures of long deployments:</p>" + published
+        _figures(headline.reliability(rel, tours), "reliability")
+        + f'<p class="note">{e(headline.IN_SERVICE)}</p>'
+        + "<p>Published figures of long deployments:</p>"
+        + published
     )
 
 
@@ -144,9 +81,13 @@ def per_day(t: dict[str, Any], rel: dict[str, Any] | None) -> str:
         if rel is not None:
             row += (
                 [
-                    f"{r['hours_in_service']:g}",
-                    pct(r["autonomy"]),
-                    f"{(r['km_per_robot_day'] or 0):.2f}",
+                    measure(r["hours_in_service"]),
+                    next(
+                        f.shown
+                        for f in headline.reliability(r, d["tours"])
+                        if "Autonomy" in f.label
+                    ),
+                    measure(r["km_per_robot_day"] or 0.0),
                 ]
                 if r
                 else ["\u2013"] * 3
@@ -162,7 +103,13 @@ def funnel(t: dict[str, Any]) -> str:
         ["", *f],
         [
             ["visitors", *(str(n) for n in f.values())],
-            ["share", *(pct(n / start) if start else "\u2013" for n in f.values())],
+            [
+                "share",
+                *(
+                    estimate(proportion(wilson(n, start)), " %") if start else "\u2013"
+                    for n in f.values()
+                ),
+            ],
         ],
         "funnel",
     )
@@ -231,24 +178,40 @@ def provenance(p: dict[str, Any]) -> str:
     return _table(lines, "provenance") + (f'<ul class="skip">{listed}</ul>' if listed else "")
 
 
+def _moved(d: dict[str, Any]) -> tuple[str, str, str]:
+    """B - A, its interval, whether it differs: to the difference's precision (a measured
+    total's: to that of the two figures)."""
+    if d["difference"] is None:
+        return DASH, DASH, DASH
+    unit = " points" if d["unit"] == " %" else d["unit"]
+    if d["low"] is None:
+        p = max(places(d["a"]), places(d["b"]))
+        why = "measured: none" if d["how"] == "measured" else TOO_FEW
+        return signed(d["difference"], p, unit), why, DASH
+    moved_by: Estimate = {
+        "value": d["difference"],
+        "low": d["low"],
+        "high": d["high"],
+        "how": d["how"],
+    }
+    p = places(moved_by)
+    low, high = signed(d["low"], p), signed(d["high"], p)
+    return signed(d["difference"], p, unit), f"{low} to {high}", "yes" if d["significant"] else "no"
+
+
 def compare(c: dict[str, Any]) -> str:
     rows = [
-        [
-            name,
-            rate(d["a"]),
-            rate(d["b"]),
-            "\u2013" if d["difference"] is None else f"{100 * d['difference']:+.1f} points",
-            "\u2013" if d["low"] is None else f"{100 * d['low']:+.1f} to {100 * d['high']:+.1f}",
-            "yes" if d["significant"] else "no",
-        ]
-        for name, d in c["rates"].items()
+        [d["label"], d["shown"][0] or DASH, d["shown"][1] or DASH, *_moved(d)] for d in c["figures"]
     ]
     skipped = "".join(f"<li>{e(s)}</li>" for s in c["skipped_b"])
     return (
-        f"<p>{e(c['a'])} (A) beside {e(c['b'])} (B). Each rate with its 95 % interval; "
-        "the difference with the interval of B \u2212 A (Newcombe's hybrid score): it "
-        "differs when that interval leaves 0 out.</p>"
-        + _grid(["rate", "A", "B", "B \u2212 A", "95 % interval", "differs"], rows, "compare")
+        f"<p>{e(c['a'])} (A) beside {e(c['b'])} (B): every figure of the summary and the "
+        "field reliability, as each season's page shows it, and the difference B \u2212 A "
+        "with its 95 % interval (MOVER, from the two figures' intervals: Newcombe's hybrid "
+        "score for two rates, in percentage points); it differs when that interval leaves "
+        "0 out. Counts and totals measured whole (tours, visitors, hours in service, km) "
+        "have no sampling interval.</p>"
+        + _grid(["figure", "A", "B", "B \u2212 A", "95 % interval", "differs"], rows, "compare")
         + (f'<p>Skipped in B:</p><ul class="skip">{skipped}</ul>' if skipped else "")
     )
 
@@ -454,7 +417,7 @@ def page(
     data = json.dumps(t).replace("</", "<\\/")  # raw text inside <script>: no entities
     sections = [
         "<h2>Summary</h2>" + summary(t),
-        *(["<h2>Field reliability</h2>" + reliability(rel)] if rel else []),
+        *(["<h2>Field reliability</h2>" + reliability(rel, t["tours"])] if rel else []),
     ]
     return f"""<!doctype html>
 <html lang="en"><head><meta charset="utf-8">

@@ -1,8 +1,10 @@
 """Field reliability: how much the robot needed people, per season and per local day,
 from the recordings alone (each figure defined in docs/REPORT.md).
 
-* **in service**: the time the recordings cover (a robot's files, overlaps once), less
-  the time out of service (an accepted ``service_off`` to the next ``service_on``);
+* **in service**: the time the recordings cover (a robot's files, overlaps once: its
+  tours and, with ``run --record DIR``, its idle files between them), less the time
+  out of service (an accepted ``service_off`` to the next ``service_on``); **in
+  tours**: the rows' durations, the rest of it idle;
 * **interventions**: accepted operator commands by which a person acted, told apart
   (:class:`~frog_bt.offline.report.rows.Intervention`);
 * **failures that needed a person**: alerts of severity ERROR (a help request, a fault,
@@ -26,6 +28,7 @@ from frog_bt.clock import SITE_TZ
 from frog_bt.engine.operator import Command
 from frog_bt.offline.report.alerts import Episode, episodes, runs_of
 from frog_bt.offline.report.facts import HOUR, FileFacts
+from frog_bt.offline.report.intervals import mean, median
 from frog_bt.offline.report.rows import Intervention, Row, by_robot, intervention
 
 Span = tuple[float, float]
@@ -98,20 +101,25 @@ def _needed(e: Episode) -> Span:
 
 def _figures(
     tours: int,
+    tour_seconds: float,
     service: dict[tuple[str, int], float],
     needed_hours: set[tuple[str, int]],
     kinds: Counter[str],
     failures: int,
     acks: list[float],
     metres: float,
-    robot_days: int,
+    km_by_robot_day: list[float],
 ) -> dict[str, Any]:
     seconds = sum(service.values())
     hours = seconds / HOUR
     free = sum(s for h, s in service.items() if h not in needed_hours)
     count = sum(kinds.values())
+    robot_days = len(km_by_robot_day)
     return {
         "hours_in_service": round(hours, 2),
+        # of which in tours (the rows' durations), and idle between them (the rest)
+        "hours_in_tours": round(min(hours, tour_seconds / HOUR), 2),
+        "service_clock_hours": sum(s > 0 for s in service.values()),
         "tours_per_hour_in_service": None if hours == 0 else round(tours / hours, 3),
         "interventions": {k.value: kinds.get(k.value, 0) for k in Intervention},
         "interventions_per_100_tours": None if tours == 0 else round(100 * count / tours, 1),
@@ -125,8 +133,10 @@ def _figures(
             "median": round(statistics.median(acks), 1),
             "p90": round(float(np.percentile(acks, 90)), 1),
         },
+        "time_to_acknowledge": median(acks),  # the median's estimate, with its interval
         "robot_days": robot_days,
         "km_per_robot_day": None if robot_days == 0 else round(metres / 1000 / robot_days, 3),
+        "km_per_robot_day_estimate": mean(km_by_robot_day),  # over the robot-days
     }
 
 
@@ -159,6 +169,10 @@ def reliability(files: list[FileFacts], rows: list[Row]) -> dict[str, Any]:
                 metres[robot, h] = metres.get((robot, h), 0.0) + m
     day_of_hour = {h: _day(h * HOUR) for _, h in {*service, *metres}}
     robot_days = {(r, day_of_hour[h]) for (r, h), s in service.items() if s > 0}
+    km: dict[tuple[str, date], float] = dict.fromkeys(robot_days, 0.0)
+    for (robot, h), m in metres.items():
+        if (robot, day_of_hour[h]) in km:
+            km[robot, day_of_hour[h]] += m / 1000
 
     def figures(day: date | None) -> dict[str, Any]:
         def on(t: float) -> bool:
@@ -169,13 +183,14 @@ def reliability(files: list[FileFacts], rows: list[Row]) -> dict[str, Any]:
 
         return _figures(
             sum(day is None or r.day == day for r in rows),
+            sum(r.duration_s for r in rows if day is None or r.day == day),
             {key: s for key, s in service.items() if hour_on(key[1])},
             needed,
             Counter(k for t, k in kinds if on(t)),
             sum(on(t) for t in failures),
             [s for t, s in acks if on(t)],
             sum(m for (_, h), m in metres.items() if hour_on(h)),
-            sum(day is None or d == day for _, d in robot_days),
+            [k for (_, d), k in sorted(km.items()) if day is None or d == day],
         )
 
     days = sorted({d for _, d in robot_days} | {r.day for r in rows})

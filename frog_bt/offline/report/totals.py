@@ -9,7 +9,7 @@ import statistics
 from collections import Counter
 from typing import Any
 
-from frog_bt.offline.report.intervals import Rate, wilson
+from frog_bt.offline.report.intervals import Rate, median, wilson
 from frog_bt.offline.report.rows import Row, Visit
 
 
@@ -92,6 +92,7 @@ def totals(
         "gate_decisions": {poi: g["n"] for poi, g in gate.items()},
         "rates": rates,
         "tour_minutes": _spread([r.duration_s / 60 for r in rows]),
+        "tour_minutes_median": median([r.duration_s / 60 for r in rows]),  # with its interval
         "stop_seconds": {poi: _spread(v) for poi, v in per_stop.items()},
         "distance_per_day_m": distance_per_day,
         "distance_m": round(sum(r.distance_m for r in rows), 1),
