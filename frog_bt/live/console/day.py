@@ -53,11 +53,11 @@ class Day:
         self._host = host
 
     def on_event(self, event: Event) -> None:
-        kind = type(event)
-        if kind is FrontendOut:
-            self._out(event.t, event.message)  # type: ignore[union-attr]
-        elif kind is FrontendIn and isinstance(event.message, UserPositive):  # type: ignore[union-attr]
-            self.visitors += 1
+        match event:
+            case FrontendOut(t=t, message=message):
+                self._out(t, message)
+            case FrontendIn(message=UserPositive()):
+                self.visitors += 1
 
     def close(self) -> None:
         """Nothing to finish."""

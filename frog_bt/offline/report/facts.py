@@ -19,19 +19,22 @@ opening of an idle file is no tour. A piece ends at ``tour ended`` (the robot is
 docked by then), or after ``tour aborted`` once the robot has driven back and docked
 (that drive is the tour's too), or at the end of the file.
 
-Channels read, through the one decoder of recordings (:mod:`frog_bt.recordings.reader`):
-``/frontend/out`` (tour, start_poi, finish_poi, ask_tour), ``/frontend/in``
-(user_positive/negative, content_done), ``/GotoWayPoint``, ``/ApproachPeopleFar``,
+Channels read, through the one decoder of recordings (:mod:`frog_bt.recordings.reader`),
+as the executive's events it gives back: ``/frontend/out`` (tour, start_poi, finish_poi,
+ask_tour: its new commands, and the seq of each), ``/frontend/in`` (user_positive/negative,
+content_done), ``/GotoWayPoint``, ``/ApproachPeopleFar``,
 ``/FROG_response``, ``/docking/dock``, ``/docking/state``, ``/ICL_command``,
 ``/ICL_FaceDataStream``, ``/FROG_pose``, ``/diagnostic``, ``/frog_bt/operator``,
-``/frog_bt/alert`` and ``/frog_bt/primer`` (a rotated file: the front-end seqs sent just
-before it, so that a resend across the rotation is not taken for a new command). Topic
+``/frog_bt/alert`` and ``/frog_bt/primer`` (a rotated file: the reader takes the
+front-end seqs sent just before it, so that a resend across the rotation is not taken for
+a new command). Topic
 names are the site's. A message that does not decode is counted (:attr:`FileFacts.bad`)
 and read past.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import math
 from dataclasses import dataclass, field
@@ -41,6 +44,8 @@ import numpy as np
 
 from frog_bt.config import Site
 from frog_bt.engine.operator import Command as OperatorCommand
+from frog_bt.errors import DecodeError
+from frog_bt.frontend.protocol import decode_datagram
 from frog_bt.maths.engagement import decide
 from frog_bt.model.channels import (
     ALERT,
@@ -50,11 +55,18 @@ from frog_bt.model.channels import (
     PRIMER,
     SITE_METADATA,
     TREE,
+    Tree,
     from_ns,
 )
-from frog_bt.model.channels import Alert as AlertMessage
-from frog_bt.model.channels import Operator as OperatorMessage
-from frog_bt.model.channels import Tree as TreeMessage
+from frog_bt.model.events import (
+    AlertChanged,
+    Datagram,
+    FrontendIn,
+    FrontendOut,
+    OperatorDone,
+    RobotCommand,
+    RobotInput,
+)
 from frog_bt.model.frontend import (
     AskTour,
     ContentDone,
@@ -70,16 +82,7 @@ from frog_bt.model.ros import Diagnostics, FaceData, Pose
 from frog_bt.model.run import read_metadata
 from frog_bt.model.wire import SUCCEEDED, Response
 from frog_bt.recordings.mcapfile import RecordingError, open_recording
-from frog_bt.recordings.reader import (
-    FrontendIn,
-    FrontendOut,
-    Own,
-    Primed,
-    Reader,
-    Record,
-    RobotCommand,
-    RobotInput,
-)
+from frog_bt.recordings.reader import Item, Primed, Reader
 
 JUMP = 10.0  # metres: a pose step this long is a relocalisation, not a drive
 OWN = (FRONTEND_IN, FRONTEND_OUT, OPERATOR, ALERT, PRIMER, TREE)
@@ -221,9 +224,9 @@ def stop_of(site: Site) -> dict[str, str]:
 
 
 class _Pieces:
-    """A state machine over one file's records, in time order (:meth:`take` each)."""
+    """A state machine over one file's items, in time order (:meth:`take` each)."""
 
-    def __init__(self, path: str, site: Site) -> None:
+    def __init__(self, path: str, site: Site, roles: dict[str, str] | None = None) -> None:
         self.site = site
         self.path = path
         self.out: list[Piece] = []
@@ -240,12 +243,13 @@ class _Pieces:
         self.asked = False
         self.stream_on = False
         self.samples: list[tuple[float, float]] = []  # (t, level) while the stream is on
-        self.seen: set[int] = set()  # front-end seqs sent (a resend has the same one)
+        self.seq = 0  # the seq of the latest datagram out (the command after it is its)
+        self.roles = roles if roles is not None else Reader(site).roles  # topic -> role
         self.operator: list[OperatorCall] = []
         self.alerts: list[AlertChange] = []
         self.metres: dict[int, float] = {}
         self.tree = ""
-        self.last: float | None = None  # the latest record's time
+        self.last: float | None = None  # the latest item's time
         self.face_stops = {s.poi for s in site.tour.stops if s.face_stream}
         self.stop_of = stop_of(site)
         self.near = site.engagement.near
@@ -261,22 +265,40 @@ class _Pieces:
         """The pieces, but an opening one that held nothing of a tour (an idle file's)."""
         return [p for p in self.out if p.started is not None or p.of_a_tour()]
 
-    def take(self, record: Record) -> None:
-        """One record of the file (acks, ticks and bad messages tell nothing here)."""
-        self.last = record.t
-        if isinstance(record, RobotInput):
-            self.robot_input(record)
-        elif isinstance(record, RobotCommand):
-            self.robot_command(record)
-        elif isinstance(record, FrontendOut):
-            self.frontend_out(record.t, record.seq, record.message)
-        elif isinstance(record, FrontendIn):
-            self.frontend_in(record.t, record.message)
-        elif isinstance(record, Primed):
-            self.primed = True  # a rotated file: the seqs sent just before it
-            self.seen.update(record.primer.frontend_out_seqs)
-        elif isinstance(record, Own):
-            self.own(record)
+    def take(self, t: float, item: Item) -> None:
+        """One item of the file (acks, ticks and bad messages tell nothing here)."""
+        self.last = t
+        match item:
+            case RobotInput():
+                self.robot_input(t, item)
+            case RobotCommand():
+                self.robot_command(t, item)
+            case Datagram(direction="out", data=data):
+                # its seq, through the front-end protocol: a new command's follows it
+                with contextlib.suppress(DecodeError):
+                    self.seq = decode_datagram(data).seq
+            case FrontendOut(message=message):
+                self.frontend_out(t, self.seq, message)
+            case FrontendIn(message=message):
+                self.frontend_in(t, message)
+            case Primed():
+                self.primed = True  # a rotated file (the reader took its seqs sent)
+            case OperatorDone():
+                self.operator_done(t, item)
+            case AlertChanged(alert=alert):
+                self.alerts.append(
+                    AlertChange(
+                        t,
+                        alert.id,
+                        alert.kind,
+                        alert.state,
+                        alert.severity,
+                        alert.repeat,
+                        alert.subject,
+                    )
+                )
+            case Tree(xml=xml) if not self.tree:
+                self.tree = hashlib.sha256(xml.encode()).hexdigest()[:12]
 
     def _current(self, t: float) -> Piece | None:
         """The piece open now (None between a tour's end and the next start), its last
@@ -294,9 +316,7 @@ class _Pieces:
         return None
 
     def frontend_out(self, t: float, seq: int, message: FrontendMessage) -> None:
-        if seq in self.seen:
-            return  # a resend (datagram loss): not a new command
-        self.seen.add(seq)
+        """A new command (the reader tells a resend from one) and its seq."""
         if isinstance(message, Tour):
             self._tour(t, seq, message)
             return
@@ -385,10 +405,10 @@ class _Pieces:
             else:
                 piece.declined += 1
 
-    def robot_command(self, command: RobotCommand) -> None:
+    def robot_command(self, t: float, command: RobotCommand) -> None:
         # the drive back after an abort is the aborted tour's
         piece = self.back if self.back is not None else self.piece
-        t, role, value = command.t, command.role, command.value
+        role, value = command.role, command.value
         if role == "goto" and isinstance(value, Pose):
             goal, self.approach = self.site.waypoint_of(value), False
             if piece is not None:
@@ -413,9 +433,9 @@ class _Pieces:
                 self.samples = []
             self.stream_on = on
 
-    def robot_input(self, received: RobotInput) -> None:
+    def robot_input(self, t: float, received: RobotInput) -> None:
         piece = self.back if self.back is not None else self.piece
-        t, role, value = received.t, received.role, received.value
+        role, value = self.roles.get(received.topic), received.value
         if role == "pose" and isinstance(value, Pose):
             if self.pose is not None:
                 step = math.hypot(value.x - self.pose[0], value.y - self.pose[1])
@@ -469,40 +489,16 @@ class _Pieces:
                     piece.failed_goals.append(self.goal)
             self.goal = None
 
-    def own(self, record: Own) -> None:
-        """Operator commands and alert changes, in or out of a tour (rows assign them to
-        tours by time: an alert raised as a tour aborts is raised on the drive home)."""
-        message = record.message
-        if isinstance(message, OperatorMessage):
-            self.operator.append(
-                OperatorCall(
-                    record.t,
-                    message.command,
-                    message.ok,
-                    message.text,
-                    message.id,
-                    message.by,
-                )
-            )
-            piece = self.back if self.back is not None else self.piece
-            if piece is not None and message.command == OperatorCommand.SKIP and message.ok:
-                at = self._skipping()
-                if at is not None:
-                    piece.operator_skips.append(at)
-        elif isinstance(message, AlertMessage):
-            self.alerts.append(
-                AlertChange(
-                    record.t,
-                    message.id,
-                    message.kind,
-                    message.state,
-                    message.severity,
-                    message.repeat,
-                    message.subject,
-                )
-            )
-        elif isinstance(message, TreeMessage) and not self.tree:
-            self.tree = hashlib.sha256(message.xml.encode()).hexdigest()[:12]
+    def operator_done(self, t: float, done: OperatorDone) -> None:
+        """An operator command, in or out of a tour (rows assign operator commands and
+        alert changes to tours by time: an alert raised as a tour aborts is raised on the
+        drive home)."""
+        self.operator.append(OperatorCall(t, done.command, done.ok, done.text, done.id, done.by))
+        piece = self.back if self.back is not None else self.piece
+        if piece is not None and done.command == OperatorCommand.SKIP and done.ok:
+            at = self._skipping()
+            if at is not None:
+                piece.operator_skips.append(at)
 
     def _skipping(self) -> str | None:
         """The stop an operator's skip leaves: the one playing, or the one driven to."""
@@ -521,12 +517,12 @@ def read_file(path: str, site: Site) -> FileFacts:
         if FRONTEND_OUT not in recording.types:
             return FileFacts(path, error=f"not a frog-bt tour recording (no {FRONTEND_OUT})")
         reader = Reader(site, only={*(site.topic(role) for role in ROS_ROLES), *OWN})
-        pieces = _Pieces(path, site)
+        pieces = _Pieces(path, site, reader.roles)
         start = from_ns(recording.start) if recording.start or recording.end else None
         if start is not None:
             pieces.first(start)
-        for record in reader.read(recording):
-            pieces.take(record)
+        for t, item in reader.read(recording):
+            pieces.take(t, item)
         # An executive's first file: neither a tour file nor an idle file it rotated into
         # (those open with a primer); a file without our metadata is one whole run.
         kind = recording.metadata.get("frog_bt", {}).get("kind")
