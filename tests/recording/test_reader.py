@@ -7,6 +7,7 @@ reports a recording with a damaged robot input or command."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -222,7 +223,9 @@ def test_every_channel_decodes_to_the_executives_events(tmp_path: Path) -> None:
         for _, i in items
         if isinstance(i, Datagram | FrontendIn | FrontendOut)
     ]
-    datagrams = [(topic, data) for topic, _, data in messages if topic in (FRONTEND_IN, FRONTEND_OUT)]
+    datagrams = [
+        (topic, data) for topic, _, data in messages if topic in (FRONTEND_IN, FRONTEND_OUT)
+    ]
     assert frontend == [
         ("in", datagrams[0][1]),
         FrontendIn(T0 + 13, FrontendIdle()),
@@ -426,3 +429,26 @@ def test_the_report_counts_damaged_messages_and_reads_past_them(tmp_path: Path) 
     assert facts.bad_first[0].startswith(f"{SITE.topic('pose')} at +100.0 s: ")
     (piece,) = facts.pieces
     assert [(s.poi, s.waypoint) for s in piece.stops] == [("POI1", "POI1b")]
+
+
+def test_no_twins_of_the_events_remain() -> None:
+    """One family of facts: the recorder writes the events, the reader gives them back;
+    no channel Struct or reader record mirrors one of them."""
+    from frog_bt.model import events
+    from frog_bt.recordings import reader
+
+    for name in ("Tick", "Blame", "Operator", "Doubt", "Fault", "Links"):
+        assert not hasattr(channels, name), f"channels.{name} mirrors an event"
+    for name in ("Record", "Own", "FrontendAck", "OwnMessage", "RosValue"):
+        assert not hasattr(reader, name), f"reader.{name} is a record family of its own"
+    for name in ("RobotInput", "RobotCommand", "FrontendIn", "FrontendOut"):
+        assert getattr(reader, name, None) in (None, getattr(events, name))
+    names = "Tick|Blame|Operator|Doubt|Fault|Links|Own|FrontendAck|FrontendIn|FrontendOut"
+    twin = re.compile(rf"^class ({names}|Robot\w+)\((msgspec\.)?Struct\b", re.M)
+    package = Path(events.__file__).parents[1]
+    found = [
+        p
+        for p in package.rglob("*.py")
+        if p.name != "events.py" and twin.search(p.read_text(encoding="utf-8"))
+    ]
+    assert not found, found
