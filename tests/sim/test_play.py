@@ -195,8 +195,8 @@ def test_a_day_file_is_played_after_its_lead_in_and_from_its_primer(day: list[Pa
 
 def test_loop_plays_again_later_with_the_clock_and_stamps_going_forward(recorded: Path) -> None:
     """With --loop the second pass runs on after the first (the clock never goes back),
-    its stamps moved with it, its front-end events numbered after the first pass's (the
-front-end protocol's datagrams, seq from 1 over the whole play)."""
+        its stamps moved with it, its front-end events numbered after the first pass's (the
+    front-end protocol's datagrams, seq from 1 over the whole play)."""
     site = load_site()
     played = load(recorded, site)
     pose = site.topic("pose")
