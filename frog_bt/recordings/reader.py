@@ -26,8 +26,8 @@ item                            from
                                 ``doubt``, ``fault``, ``links``: the event recorded there
                                 (:data:`~frog_bt.model.events.Recorded`; a recording
                                 made before, by :mod:`frog_bt.recordings.legacy`)
-:class:`~frog_bt.model          ``/frog_bt/tree``, ``/frog_bt/restored``: their Structs
-.channels.Tree`, ``Restored``
+``Tree``, ``Restored``          ``/frog_bt/tree``, ``/frog_bt/restored``: their Structs
+                                (:mod:`frog_bt.model.channels`)
 :class:`Primed`                 ``/frog_bt/primer``: its Struct and its inputs decoded
                                 (it also primes the reader: its datagrams in and seqs out
                                 were before the file, so their resends are not new)
