@@ -11,15 +11,17 @@
   bytes;
 * ``/frog_bt/tree``: once, the tree that ran as BehaviorTree.CPP v4 XML
   (``{"format", "file", "xml"}``: Groot2 opens the XML);
-* ``/frog_bt/blame``: after each command, the tree node that sent it and the
-  blackboard values it read (``{"channel", "node", "reads"}``), for replay's
-  divergence report;
-* ``/frog_bt/tick``: one message per tick of the tree (``{"tick", "status"}``);
-* ``/frog_bt/operator``, ``/frog_bt/alert``, ``/frog_bt/links``: each operator command
-  with its answer, each alert change, each change of the links' states; and once, when
-  the executive took something up from before it (a restart), ``/frog_bt/restored``
-  (:mod:`frog_bt.model.channels`): replay rebuilds the alert book and the staff's
-  decisions from them;
+* the executive's own events, each as itself (:data:`~frog_bt.model.events.Recorded`,
+  one tagged union, encoded once: ``{"type": "Ticked", "t", ...}``) on its channel
+  (:data:`~frog_bt.model.channels.EVENT_CHANNELS`): ``/frog_bt/tick`` each tick of the
+  tree, ``/frog_bt/blame`` after each command the tree node that sent it and the
+  blackboard values it read (for replay's divergence report), ``/frog_bt/operator``,
+  ``/frog_bt/alert``, ``/frog_bt/links``, ``/frog_bt/doubt`` and ``/frog_bt/fault``
+  each operator command with its answer, alert change, change of the links' states,
+  robot answer not believed and failure of the executive's own code; replay rebuilds
+  the alert book and the staff's decisions from them;
+* once, when the executive took something up from before it (a restart),
+  ``/frog_bt/restored`` (:mod:`frog_bt.model.channels`);
 * metadata ``frog_bt_site``: ``config_sha256``, the site configuration that ran
   (:func:`frog_bt.config.fingerprint`), in every file;
 * metadata ``frog_bt_run``: ``id``, the run's UUID (drawn when the executive started
@@ -36,13 +38,14 @@ project-clock time it was received or sent; ``/clock`` with the time it carries
 is held and stamped with that first time, so a recording has no zero stamps.
 
 Each channel carries a JSON Schema (encoding ``jsonschema``), so Foxglove
-can browse and plot the fields. Writing costs one ``json.dumps`` and one
-``add_message`` per message, the latter once the event loop's current callback
-(a tick, an input) is over, in order; chunks are bounded (:data:`CHUNK_SIZE`) and
-flushed at least every :data:`FLUSH_EVERY` wall seconds, so memory stays small
-and a crash loses little. :meth:`Recorder.close` (idempotent, also run at
-interpreter exit) writes the summary and footer: a recording stays valid MCAP
-when the run command stops on SIGTERM, or on an exception.
+can browse and plot the fields. Writing costs one encoding and one
+``add_message`` per message, both once the event loop's current callback
+(a tick, an input) is over, in order (an event is kept as it is until then);
+chunks are bounded (:data:`CHUNK_SIZE`) and flushed at least every
+:data:`FLUSH_EVERY` wall seconds, so memory stays small and a crash loses little.
+:meth:`Recorder.close` (idempotent, also run at interpreter exit) writes the summary
+and footer: a recording stays valid MCAP when the run command stops on SIGTERM, or on
+an exception.
 """
 
 from __future__ import annotations
@@ -65,22 +68,18 @@ from mcap.writer import CompressionType, Writer
 from frog_bt import __version__
 from frog_bt.config import fingerprint
 from frog_bt.errors import DecodeError
+from frog_bt.frontend.protocol import decode_datagram
 from frog_bt.model import channels
 from frog_bt.model.channels import (
-    ALERT,
-    BLAME,
     DATAGRAM_TYPE,
-    DOUBT,
-    FAULT,
+    EVENT_CHANNELS,
     FRONTEND_IN,
     FRONTEND_OUT,
     LINKS,
-    OPERATOR,
     OWN_TYPES,
     PRIMER,
     RESTORED,
     SITE_METADATA,
-    TICK,
     TREE,
     from_ns,
     schema_for,
@@ -95,6 +94,7 @@ from frog_bt.model.events import (
     Faulted,
     LinksChanged,
     OperatorDone,
+    Recorded,
     RobotCommand,
     RobotInput,
     Ticked,
@@ -127,6 +127,7 @@ def _raw(msg: Any) -> bytes:
 
 
 Queued = tuple[int, int, bytes, int]  # channel id, log time (ns), data, sequence
+Incoming = tuple[str, float | None, bytes | Recorded]  # topic, time, data or the event
 
 
 def _write_queued(writer: Writer, queue: list[Queued]) -> None:
@@ -170,14 +171,14 @@ class Recorder:
         # Messages wait in _incoming until the event loop's current callback (a tick, an
         # input) is over, so that a tick pays a list append per message, not an MCAP
         # record each; _queue holds them stamped, for the writer (and the finalizer).
-        self._incoming: list[tuple[str, float | None, bytes]] = []
+        self._incoming: list[Incoming] = []
         self._queue: list[Queued] = []
         self._drain_scheduled = False
         self._flush_timer: asyncio.TimerHandle | None = None
         self._syncing = False
         self._registered: dict[str, str] = {}  # topic -> type, for the next file too
         self._last_ns = 0
-        self._held: list[tuple[str, bytes]] = []
+        self._held: list[tuple[str, bytes | Recorded]] = []
         self._ready: Callable[[], bool] = lambda: True
         self._clock_topic: str | None = None
         self._tree: bytes | None = None
@@ -188,18 +189,6 @@ class Recorder:
         self._latest_topics: frozenset[str] = frozenset()
         self._latest_raw: dict[str, tuple[float, bytes]] = {}
         self._clock_raw: bytes | None = None
-        self._handlers: dict[type, Callable[[Any], None]] = {
-            RobotInput: self._ros_in,
-            RobotCommand: self._ros_out,
-            Datagram: self._datagram,
-            Ticked: self._tick,
-            Blamed: self._blame,
-            OperatorDone: self._operator,
-            AlertChanged: self._alert,
-            Doubted: self._doubt,
-            Faulted: self._fault,
-            LinksChanged: self._links,
-        }
         self._frontend_in: deque[bytes] = deque(maxlen=PRIMER_DATAGRAMS)
         self._frontend_out_seqs: deque[int] = deque(maxlen=PRIMER_SEQS)
         self.messages = 0
@@ -252,7 +241,7 @@ class Recorder:
             self.channel(CLOCK.name, CLOCK.type)
         self.channel(FRONTEND_IN, DATAGRAM_TYPE)
         self.channel(FRONTEND_OUT, DATAGRAM_TYPE)
-        for channel in (TICK, BLAME, OPERATOR, ALERT, LINKS, DOUBT, FAULT):
+        for channel in EVENT_CHANNELS.values():
             self.channel(channel, OWN_TYPES[channel])
         clock = host.clock
         self._ready = lambda: bool(clock.ready)
@@ -269,10 +258,21 @@ class Recorder:
             self._write(RESTORED, None, channels.encode(restored))
 
     def on_event(self, event: Event) -> None:
-        """Each event its channel (tick path: a list append, see :meth:`_write`)."""
-        handler = self._handlers.get(type(event))
-        if handler is not None:
-            handler(event)
+        """Each event its channel (tick path: a list append, see :meth:`_write`): what
+        crossed a wire as it crossed, the executive's own events as themselves."""
+        match event:
+            case RobotInput():
+                self._ros_in(event)
+            case RobotCommand():
+                self._ros_out(event)
+            case Datagram():
+                self._datagram(event)
+            case LinksChanged():  # before the clock has a time: held
+                self._write(LINKS, event.t if self._ready() else None, event)
+            case Ticked() | Blamed() | OperatorDone() | AlertChanged() | Doubted() | Faulted():
+                self._write(EVENT_CHANNELS[type(event)], event.t, event)
+            case _:
+                pass  # told by the events around it (FrontendIn, FrontendOut: datagrams)
 
     def channel(self, topic: str, type_: str) -> str:
         """Register ``topic`` (and its schema) in the file on first use; the topic."""
@@ -322,10 +322,10 @@ class Recorder:
         else:
             topic = FRONTEND_OUT
             try:
-                seq = json.loads(data).get("seq")
-            except (ValueError, AttributeError):
+                seq: int | None = decode_datagram(data).seq
+            except DecodeError:
                 seq = None
-            if isinstance(seq, int) and seq not in self._frontend_out_seqs:
+            if seq is not None and seq not in self._frontend_out_seqs:
                 self._frontend_out_seqs.append(seq)
         self._write(topic, t if self._ready() else None, data)
 
@@ -342,52 +342,12 @@ class Recorder:
             return None
         return channels.encode(channels.Tree("BehaviorTree.CPP v4", str(tree_file), xml))
 
-    def _blame(self, event: Blamed) -> None:
-        self._write(
-            BLAME, event.t, channels.encode(channels.Blame(event.channel, event.node, event.reads))
-        )
-
-    def _operator(self, event: OperatorDone) -> None:
-        self._write(
-            OPERATOR,
-            event.t,
-            channels.encode(
-                channels.Operator(
-                    event.tick, event.command, event.ok, event.text, event.id, event.by
-                )
-            ),
-        )
-
-    def _alert(self, event: AlertChanged) -> None:
-        """An alert raised, cleared or acknowledged."""
-        self._write(ALERT, event.t, channels.encode(event.alert))
-
-    def _links(self, event: LinksChanged) -> None:
-        """The links' states, after one changed (before the clock has a time: held)."""
-        links = event.links
-        message = channels.Links(links.rosbridge, links.frontend, links.clock)
-        self._write(LINKS, event.t if self._ready() else None, channels.encode(message))
-
-    def _doubt(self, event: Doubted) -> None:
-        """A robot answer not believed."""
-        doubt = channels.Doubt(event.code, event.goal, event.why, event.answers)
-        self._write(DOUBT, event.t, channels.encode(doubt))
-
-    def _fault(self, event: Faulted) -> None:
-        """A failure of the executive's own code, caught."""
-        fault = channels.Fault(event.where, event.what, event.error, event.count)
-        self._write(FAULT, event.t, channels.encode(fault))
-
-    def _tick(self, event: Ticked) -> None:
-        # In order with the rest, but encoded once the tick is over (see _add): the tick
-        # itself only appends.
-        self._write(TICK, event.t, event)  # type: ignore[arg-type]
-
     # ------------------------------------------------------------ writing
 
-    def _write(self, topic: str, t: float | None, data: bytes) -> None:
-        """Take a message (``t`` None: before the clock has a time); it is stamped and
-        written once the event loop's current callback is over (at once without a loop)."""
+    def _write(self, topic: str, t: float | None, data: bytes | Recorded) -> None:
+        """Take a message (``t`` None: before the clock has a time), its bytes or the event
+        it is; it is stamped, encoded and written once the event loop's current callback
+        is over (at once without a loop)."""
         if self.closed:
             return
         self._incoming.append((topic, t, data))
@@ -418,15 +378,15 @@ class Recorder:
             self._add(topic, ns, data)
             self._last_ns = ns
 
-    def _add(self, topic: str, ns: int, data: bytes | Ticked) -> None:
-        if type(data) is Ticked:
-            data = channels.encode(channels.Tick(data.tick, data.status))
+    def _add(self, topic: str, ns: int, data: bytes | Recorded) -> None:
+        if not isinstance(data, bytes):  # an event: encoded once, as itself
+            data = channels.encode(data)
         cid = self._channels.get(topic)
         if cid is None:  # a channel of ours, first used now (or an unknown topic)
             cid = self._channels[self.channel(topic, OWN_TYPES.get(topic, "unknown"))]
         seq = self._sequence.get(cid, 0)
         self._sequence[cid] = seq + 1
-        self._queue.append((cid, ns, data, seq & 0xFFFFFFFF))  # type: ignore[arg-type]
+        self._queue.append((cid, ns, data, seq & 0xFFFFFFFF))
         self.messages += 1
 
     def _drain(self) -> None:

@@ -65,19 +65,19 @@ class TourSummary:
     def on_event(self, event: Event) -> None:
         assert self.ledger is not None
         self.ledger.feed(event)
-        kind = type(event)
-        if kind is RobotInput:
-            self._ros_in(event)  # type: ignore[arg-type]
-        elif kind is RobotCommand:
-            self._ros_out(event)  # type: ignore[arg-type]
-        elif kind is FrontendOut:
-            self._frontend_out(event.message)  # type: ignore[union-attr]
-        elif kind is FrontendIn:
-            self._frontend_in(event.message)  # type: ignore[union-attr]
-        elif kind is Ticked and self._host is not None:
-            self._tick(self._host.core)
-        elif isinstance(event, Doubted):
-            self.doubted.append(event.why)
+        match event:
+            case RobotInput():
+                self._ros_in(event)
+            case RobotCommand():
+                self._ros_out(event)
+            case FrontendOut(message=message):
+                self._frontend_out(message)
+            case FrontendIn(message=message):
+                self._frontend_in(message)
+            case Ticked() if self._host is not None:
+                self._tick(self._host.core)
+            case Doubted(why=why):
+                self.doubted.append(why)
 
     def _ros_out(self, out: RobotCommand) -> None:
         if out.role == "goto" and out.goal is not None:

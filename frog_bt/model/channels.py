@@ -1,39 +1,66 @@
-"""frog-bt's own recording channels, each message declared once as a msgspec Struct.
+"""frog-bt's own recording channels: what each holds, declared once.
 
-The recorder (:mod:`frog_bt.live.recording`) writes them, replay
-(:mod:`frog_bt.offline.replay`) reads them, and each channel's JSON Schema in the MCAP
+The recorder (:mod:`frog_bt.live.recording`) writes them and the one reader of recordings
+(:mod:`frog_bt.recordings.reader`) reads them back; each channel's JSON Schema in the MCAP
 file is derived from the same Struct (:func:`schemas`). A message that does not decode
 is a :class:`~frog_bt.errors.DecodeError` naming the field: replay counts and reports it,
 never drops it silently.
 
-=====================  ======================  ============================================
-channel                schema name             one message per
-=====================  ======================  ============================================
-``/frog_bt/tick``      ``frog_bt/Tick``        tick of the tree
-``/frog_bt/blame``     ``frog_bt/Blame``       command, right after it: who sent it
-``/frog_bt/tree``      ``frog_bt/Tree``        file: the tree that ran (BT.CPP v4 XML)
-``/frog_bt/primer``    ``frog_bt/Primer``      rotated file: what it carries from before
-``/frog_bt/operator``  ``frog_bt/Operator``    operator command, with its answer
-``/frog_bt/alert``     ``frog_bt/Alert``       alert raised, cleared or acknowledged
-``/frog_bt/doubt``     ``frog_bt/Doubt``       robot answer not believed (stale, or off)
-``/frog_bt/fault``     ``frog_bt/Fault``       failure of the executive's own code, caught
-``/frog_bt/links``     ``frog_bt/Links``       change of a link's state (the alerts read them)
-``/frog_bt/restored``  ``frog_bt/Restored``    file of a started executive: what it took up
-                                               from before it (checkpoint, staff's decisions)
-=====================  ======================  ============================================
+The channels that tell what happened hold the executive's own events
+(:mod:`frog_bt.model.events`), each as itself: one tagged msgspec union
+(:data:`~frog_bt.model.events.Recorded`, tag ``type``: the event's class name), encoded
+once by :func:`encode` and decoded in one pass by :func:`decode_event`. Three more hold
+what a file carries besides (the tree, a primer, what a restarted executive took up).
+
+=====================  ===========================  =======================================
+channel                schema name                  one message per
+=====================  ===========================  =======================================
+``/frog_bt/tick``      ``frog_bt/Ticked``           tick of the tree
+``/frog_bt/blame``     ``frog_bt/Blamed``           command, right after it: who sent it
+``/frog_bt/operator``  ``frog_bt/OperatorDone``     operator command, with its answer
+``/frog_bt/alert``     ``frog_bt/AlertChanged``     alert raised, cleared or acknowledged
+``/frog_bt/doubt``     ``frog_bt/Doubted``          robot answer not believed (stale, or off)
+``/frog_bt/fault``     ``frog_bt/Faulted``          failure of the executive's own code, caught
+``/frog_bt/links``     ``frog_bt/LinksChanged``     change of a link's state (the alerts read
+                                                    them)
+``/frog_bt/tree``      ``frog_bt/Tree``             file: the tree that ran (BT.CPP v4 XML)
+``/frog_bt/primer``    ``frog_bt/Primer``           rotated file: what it carries from before
+``/frog_bt/restored``  ``frog_bt/Restored``         file of a started executive: what it took
+                                                    up from before it (checkpoint, staff's
+                                                    decisions)
+=====================  ===========================  =======================================
+
+Recordings made before the events were recorded as themselves hold other shapes on the
+event channels (schema names ``frog_bt/Tick``, ``Blame``, ``Operator``, ``Alert``,
+``Doubt``, ``Fault``, ``Links``): the reader reads them too
+(:mod:`frog_bt.recordings.legacy`). The channels of CONTRACT §6 (one per ROS topic,
+``/frontend/in``, ``/frontend/out``) are not ours to shape: they hold what crossed the
+wire.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Any, cast
 
 import msgspec
 
 from frog_bt.codec import decoder
+from frog_bt.model.alert import Alert
+from frog_bt.model.events import (
+    AlertChanged,
+    Blamed,
+    Doubted,
+    Faulted,
+    LinksChanged,
+    OperatorDone,
+    Recorded,
+    Ticked,
+)
 from frog_bt.model.frontend import COMMANDS, EVENTS
-from frog_bt.model.links import LinkStatus
 from frog_bt.model.ros import ROS_TYPES
+
+__all__ = ["Alert"]  # (also what Carried holds; its home is frog_bt.model.alert)
 
 FRONTEND_IN = "/frontend/in"
 FRONTEND_OUT = "/frontend/out"
@@ -49,17 +76,6 @@ DOUBT = "/frog_bt/doubt"  # each robot answer not believed, and why
 FAULT = "/frog_bt/fault"  # each failure of the executive's own code, caught and counted
 LINKS = "/frog_bt/links"  # the links' states, at each change
 RESTORED = "/frog_bt/restored"  # what a started executive took up from before it
-
-
-class Tick(msgspec.Struct, frozen=True):
-    tick: int
-    status: Literal["INVALID", "RUNNING", "SUCCESS", "FAILURE"]
-
-
-class Blame(msgspec.Struct, frozen=True):
-    channel: str  # ROS topic or front-end message type
-    node: str  # the tree node that sent it, and where it is written
-    reads: dict[str, str] = {}  # the blackboard values that node read, as short text
 
 
 class Tree(msgspec.Struct, frozen=True):
@@ -80,47 +96,6 @@ class Primer(msgspec.Struct, frozen=True):
     frontend_in: list[str] = []  # recent datagrams in: their resends stay duplicates
     frontend_out_seqs: list[int] = []  # recent seqs out: resends are not new commands
     staff: Carried | None = None  # beside the tree: the staff's decisions, the alert book
-
-
-class Operator(msgspec.Struct, frozen=True):
-    tick: int  # the tick it came before: replay applies it there
-    command: str
-    ok: bool
-    text: str  # what it did, or why it was refused
-    id: str = ""  # ack_alert: the alert
-    by: str = ""  # who sent it: console, ctl, link (empty when unknown; added later)
-
-
-class Alert(msgspec.Struct, frozen=True):
-    """One alert change (``state``: raised, cleared = resolved, acknowledged by a person).
-
-    The fields after ``since`` came later, each with a default, so older recordings still
-    decode: ``severity`` in ROS diagnostics' levels (REP-107), ``key`` the stable
-    deduplication key (``frog-bt:<robot>:<kind>[:<subject>]``), ``subject`` what it is
-    about (a stop), ``answers`` the operator commands that apply, ``what`` and ``todo``
-    the two halves of ``text`` (the sentence, what to do), ``repeat`` how many times it
-    has been told again unacknowledged (escalation; 0: the first telling) and ``waited``
-    the project-clock seconds since it was raised, at that repeat."""
-
-    id: str
-    kind: str
-    text: str
-    state: Literal["raised", "cleared", "acknowledged"]
-    since: float
-    severity: Literal["WARN", "ERROR"] = "WARN"
-    key: str = ""
-    subject: str = ""
-    answers: tuple[str, ...] = ()
-    what: str = ""
-    todo: str = ""
-    repeat: int = 0
-    waited: float = 0.0
-
-    @property
-    def occurrence(self) -> str:
-        """Which raise of this alert: its raise time as text (the same through escalation,
-        clearing and acknowledgement; a later raise of the same alert has another)."""
-        return f"{self.since:.6f}"
 
 
 class CarriedIncident(msgspec.Struct, frozen=True):
@@ -147,15 +122,6 @@ class Carried(msgspec.Struct, frozen=True):
     pause_ran_out: bool = False
 
 
-class Links(msgspec.Struct, frozen=True):
-    """The links' states after one of them changed (the alerts ``rosbridge_down`` and
-    ``frontend_silent`` read them; replay takes them from here)."""
-
-    rosbridge: LinkStatus
-    frontend: LinkStatus
-    clock: LinkStatus
-
-
 class RestoredHelp(msgspec.Struct, frozen=True):
     about: str  # a HelpAbout value: undock, dock, home, fault, crashed
     since: float
@@ -178,44 +144,48 @@ class Restored(msgspec.Struct, frozen=True):
     acknowledged: list[str] = []
 
 
-class Doubt(msgspec.Struct, frozen=True):
-    code: int  # the /FROG_response code
-    goal: str  # the goal pending when it came (its target)
-    why: str  # in domain terms: "arrival at POI2 heard after the drive to SHOP: ignored"
-    answers: str = ""  # the earlier goal it is taken to answer, if known
-
-
-class Fault(msgspec.Struct, frozen=True):
-    where: str  # the node, input or observer that failed
-    what: str  # what it was doing
-    error: str  # the error, inert text
-    count: int  # failures at that place so far
-
-
-TYPES: dict[str, tuple[str, type[msgspec.Struct]]] = {
-    TICK: ("frog_bt/Tick", Tick),
-    BLAME: ("frog_bt/Blame", Blame),
-    TREE: ("frog_bt/Tree", Tree),
-    PRIMER: ("frog_bt/Primer", Primer),
-    OPERATOR: ("frog_bt/Operator", Operator),
-    ALERT: ("frog_bt/Alert", Alert),
-    DOUBT: ("frog_bt/Doubt", Doubt),
-    FAULT: ("frog_bt/Fault", Fault),
-    LINKS: ("frog_bt/Links", Links),
-    RESTORED: ("frog_bt/Restored", Restored),
+EVENT_CHANNELS: dict[type[Recorded], str] = {
+    Ticked: TICK,
+    Blamed: BLAME,
+    OperatorDone: OPERATOR,
+    AlertChanged: ALERT,
+    Doubted: DOUBT,
+    Faulted: FAULT,
+    LinksChanged: LINKS,
 }
+"""The channel each recorded event is written on."""
+
+FILE_TYPES: dict[str, type[msgspec.Struct]] = {TREE: Tree, PRIMER: Primer, RESTORED: Restored}
+"""The channels that hold what a file carries besides its events."""
+
+TYPES: dict[str, tuple[str, Any]] = {
+    **{channel: (f"frog_bt/{cls.__name__}", cls) for cls, channel in EVENT_CHANNELS.items()},
+    **{channel: (f"frog_bt/{cls.__name__}", cls) for channel, cls in FILE_TYPES.items()},
+}
+"""Every channel of ours (but the datagrams'): its schema name and its Struct."""
 
 _ENCODER = msgspec.json.Encoder()
-_DECODERS = {channel: decoder(struct) for channel, (_, struct) in TYPES.items()}
+_DECODERS = {channel: decoder(struct) for channel, struct in FILE_TYPES.items()}
+# a union is a type form, not a ``type[T]`` (no TypeForm before PEP 747): what it decodes
+_EVENT = decoder(cast("type[Recorded]", Recorded))
 
 
 def encode(message: msgspec.Struct) -> bytes:
+    """A message of one of our channels, as JSON: an event (with its tag), a file's Struct."""
     return _ENCODER.encode(message)
 
 
 def decode(channel: str, data: bytes) -> Any:
-    """The message of ``channel`` in ``data``; DecodeError with the field's path."""
-    return _DECODERS[channel](data)
+    """The message of ``channel`` in ``data`` (an event's channel: the event, whichever
+    its tag names); DecodeError with the field's path."""
+    decode_file = _DECODERS.get(channel)
+    return _EVENT(data) if decode_file is None else decode_file(data)
+
+
+def decode_event(data: bytes) -> Recorded:
+    """One recorded event, in one pass over the tagged union; DecodeError naming the
+    field (or the unknown tag)."""
+    return _EVENT(data)
 
 
 def _inline(node: Any, defs: dict[str, Any]) -> Any:

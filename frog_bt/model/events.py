@@ -25,6 +25,12 @@ event               when
 Times are project-clock seconds. Values are the wire Structs' values (what the leaves
 see); ``RobotInput.raw`` and ``RobotCommand.msg`` are the rosbridge ``msg`` as it crossed
 the wire, for the recorder.
+
+Each event is a tagged Struct (tag field ``type``, tag its class name). The recorder
+writes the executive's own events as themselves, one per message of frog-bt's channels
+(:data:`Recorded`, :mod:`frog_bt.model.channels`); what crossed a wire it writes as it
+crossed (CONTRACT §6: the rosbridge ``msg``, the datagram's bytes), and the reader
+(:mod:`frog_bt.recordings.reader`) gives back the same events from both.
 """
 
 from __future__ import annotations
@@ -33,7 +39,7 @@ from typing import Any, Literal
 
 import msgspec
 
-from frog_bt.model.channels import Alert
+from frog_bt.model.alert import Alert
 from frog_bt.model.frontend import FrontendMessage
 from frog_bt.model.goals import Goal
 from frog_bt.model.links import Links
@@ -49,6 +55,7 @@ __all__ = [
     "FrontendOut",
     "LinksChanged",
     "OperatorDone",
+    "Recorded",
     "RobotCommand",
     "RobotInput",
     "Ticked",
@@ -182,3 +189,6 @@ Event = (
     | Doubted
     | Faulted
 )
+
+Recorded = Ticked | Blamed | OperatorDone | AlertChanged | LinksChanged | Doubted | Faulted
+"""The events frog-bt's own recording channels hold, each as itself (one tagged union)."""

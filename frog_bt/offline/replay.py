@@ -2,18 +2,17 @@
 
 :class:`Replay` reads an MCAP recording (:mod:`frog_bt.live.recording`) in log-time
 order and feeds a fresh :class:`~frog_bt.engine.core.Core` on a
-:class:`~frog_bt.clock.ManualClock` that takes the recorded times: ROS inputs
-go through :data:`~frog_bt.model.ros.ROS_TYPES` (by the channel's schema name) to
-``Core.on_ros``; ``/frontend/in`` datagrams go through a fresh
-:class:`~frog_bt.frontend.protocol.Endpoint`, so duplicates are suppressed exactly
-as live, to ``Core.on_event``; ``/clock`` moves the clock (under sim time what
-arrived before the first ``/clock`` is fed with the clock not yet ready, as live).
-
-The recording is read through the one decoder of recordings
-(:class:`~frog_bt.recordings.reader.Reader`): a message that does not decode (a damaged
-robot input, command, datagram or one of our own) is counted and reported in
-:attr:`ReplayResult.bad`, never dropped silently; live, the executive did not act on it
-either.
+:class:`~frog_bt.clock.ManualClock` that takes the recorded times. The recording is read
+through the one decoder of recordings (:class:`~frog_bt.recordings.reader.Reader`), which
+gives back the executive's events: each :class:`~frog_bt.model.events.RobotInput` goes to
+``Core.on_ros``; each :class:`~frog_bt.model.events.FrontendIn` (the reader takes the
+``/frontend/in`` datagrams through the front-end protocol's
+:class:`~frog_bt.frontend.protocol.Endpoint`, so duplicates are suppressed exactly as
+live) to ``Core.on_event``; ``/clock`` moves the clock (under sim time what arrived
+before the first ``/clock`` is fed with the clock not yet ready, as live). A message
+that does not decode (a damaged robot input, command, datagram or one of our own) is
+counted and reported in :attr:`ReplayResult.bad`, never dropped silently; live, the
+executive did not act on it either.
 
 Ticks: a recording made by :class:`~frog_bt.live.recording.Recorder` has the live
 ticks (``/frog_bt/tick``), and replay ticks exactly there, in the same place
@@ -54,24 +53,36 @@ from pathlib import Path
 from typing import Any
 
 from frog_bt.clock import ManualClock
-from frog_bt.config import Site, parse_hostport
+from frog_bt.config import Site
 from frog_bt.engine.belief import Judgement
 from frog_bt.engine.core import Core
 from frog_bt.engine.operator import Command as OperatorCommand
-from frog_bt.frontend.protocol import Endpoint
-from frog_bt.model import channels, keys
+from frog_bt.model import keys
+from frog_bt.model.alert import Alert
 from frog_bt.model.channels import (
     ALERT,
-    BLAME,
     FRONTEND_IN,
     FRONTEND_OUT,
     LINKS,
     OPERATOR,
     TICK,
+    Restored,
     from_ns,
 )
-from frog_bt.model.events import AlertChanged
-from frog_bt.model.frontend import EVENTS, FrontendMessage, message_fields
+from frog_bt.model.events import (
+    AlertChanged,
+    Blamed,
+    Datagram,
+    Doubted,
+    FrontendIn,
+    FrontendOut,
+    LinksChanged,
+    OperatorDone,
+    RobotCommand,
+    RobotInput,
+    Ticked,
+)
+from frog_bt.model.frontend import FrontendMessage, message_fields
 from frog_bt.model.goals import Goal
 from frog_bt.model.links import Links
 from frog_bt.model.wire import CLOCK, OUTPUTS
@@ -84,19 +95,7 @@ from frog_bt.recordings.commands import (
     without_stamp,
 )
 from frog_bt.recordings.mcapfile import RecordingError
-from frog_bt.recordings.reader import (
-    CLOCK_ROLE,
-    Bad,
-    FrontendAck,
-    FrontendIn,
-    FrontendOut,
-    Own,
-    Primed,
-    Reader,
-    Record,
-    RobotCommand,
-    RobotInput,
-)
+from frog_bt.recordings.reader import Bad, Item, Primed, Reader
 from frog_bt.runtime import decisions
 from frog_bt.runtime.observer import Observers
 from frog_bt.runtime.staff import Staff
@@ -162,7 +161,6 @@ class Replay:
     def __init__(self, path: Path, site: Site, tree: LoadedTree) -> None:
         self.path = Path(path)
         self.site = site
-        self._peer = parse_hostport(site.links.frontend, "links.frontend")[0]
         try:
             self.files = chain(self.path)
         except RecordingError as exc:
@@ -202,14 +200,12 @@ class Replay:
         self._links_known = LINKS in self.types
         self.said = Said()  # each alert's latest change on each side, for the story
         self.reader = Reader(site)  # the one decoder; its tally counts the bad messages
-        self.endpoint = Endpoint(self._peer, EVENTS)  # the same dedup as the live link
         self._expected: deque[Command] = deque()
         self._got: deque[Command] = deque()
         self._last_expected: Command | None = None
         # observers: ("recorded" | "replayed", command) and the divergence (the viewer)
         self.on_command: list[Callable[[str, Command], None]] = []
         self.on_divergence: list[Callable[[Divergence], None]] = []
-        self._seqs: set[int] = set()
         # answers not believed, each side: (when, why); the replayed ones from the core
         self.doubts: dict[str, list[tuple[float, str]]] = {"recorded": [], "replayed": []}
         self._agreed_at = self.start  # when the last command both sides sent alike was sent
@@ -236,7 +232,7 @@ class Replay:
         self._compare()
 
     def _send(self, message: FrontendMessage) -> None:
-        payload = plain({"type": message.type, **message_fields(message)})
+        payload = _payload(message)
         self._got.append(
             Command(
                 self.clock.now(), FRONTEND_OUT, payload, self.core.blamed, self.core.blamed_reads
@@ -289,15 +285,15 @@ class Replay:
         wall0 = time.monotonic()
         result = self.result
         parted = False
-        for record in self.reader.read_all(self.files):  # a lead-in first, if any
-            if parted and not (isinstance(record, Own) and record.channel == BLAME):
+        for t, item in self.reader.read_all(self.files):  # a lead-in first, if any
+            if parted and not isinstance(item, Blamed):
                 break  # the blame of the diverging command, recorded after it, is read
-            self._on_record(record)
+            self._on_item(t, item)
             if parted:
                 break
-            result.covered = record.t
+            result.covered = t
             if progress is not None:
-                progress(record.t)
+                progress(t)
             parted = result.divergence is not None
         else:
             if not self.recovered:  # cut short: the live run neither halted nor sent more
@@ -312,73 +308,55 @@ class Replay:
         result.wall = time.monotonic() - wall0
         return result
 
-    def _on_record(self, record: Record) -> None:
-        if isinstance(record, RobotInput) and record.role == CLOCK_ROLE:
-            if self.sim_time and isinstance(record.value, float):
-                self._advance(record.value)  # /clock: the time it carries
-            return
-        if isinstance(record, Bad) and record.channel == CLOCK.name:
-            return  # live, a malformed /clock does not move the clock either
+    def _on_item(self, t: float, item: Item) -> None:
+        match item:
+            case RobotInput(topic=CLOCK.name, value=value):
+                if self.sim_time and isinstance(value, float):
+                    self._advance(value)  # /clock: the time it carries
+                return
+            case Bad(channel=CLOCK.name):
+                return  # live, a malformed /clock does not move the clock either
         if self.clock.ready or not self.sim_time:
-            self._advance(record.t)
-        if isinstance(record, RobotInput):
-            self._on_ros(record)
-        elif (datagram := _datagram_in(record)) is not None:
-            self._on_datagram(datagram)  # a bad one too: live, the link acked it if it could
-        elif isinstance(record, FrontendOut):
-            self._expect_datagram(record)
-        elif isinstance(record, RobotCommand):
-            self.result.ros_commands += 1
-            self._expect(Command(record.t, record.topic, without_stamp(record.msg)))
-        elif isinstance(record, Own):
-            self._on_own(record)
-        elif isinstance(record, Primed):
-            self._prime(record)
+            self._advance(t)
+        match item:
+            case RobotInput():
+                self.result.inputs += 1
+                if self.core.on_ros(item.topic, item.value) and not self.exact:
+                    self._tick_now()
+            case Datagram(direction="in"):
+                self.result.inputs += 1  # a bad one too: live, the link acked it if it could
+            case FrontendIn(message=message):
+                self.core.on_event(message)  # new: the reader's endpoint, as the live link's
+                if not self.exact:
+                    self._tick_now()
+            case FrontendOut(message=message):
+                self.result.frontend_commands += 1
+                self._expect(Command(t, FRONTEND_OUT, _payload(message)))
+            case RobotCommand():
+                self.result.ros_commands += 1
+                self._expect(Command(t, item.topic, without_stamp(item.msg)))
+            case Ticked():
+                if self.exact:
+                    self._tick()
+            case Blamed():
+                self._blame(item)
+            case OperatorDone():
+                self._operator(t, item)
+            case Doubted(why=why):
+                self.doubts["recorded"].append((t, why))
+            case AlertChanged(alert=alert):
+                self._expect_alert(t, alert)
+            case LinksChanged(links=links):
+                self._links(links)
+            case Restored():
+                self._restored(item)
+            case Primed():
+                self._prime(item)
 
-    def _on_own(self, record: Own) -> None:
-        message = record.message
-        if isinstance(message, channels.Tick):
-            if self.exact:
-                self._tick()
-        elif isinstance(message, channels.Blame):
-            self._blame(message)
-        elif isinstance(message, channels.Operator):
-            self._operator(record.t, message)
-        elif isinstance(message, channels.Doubt):
-            self.doubts["recorded"].append((record.t, message.why))
-        elif isinstance(message, channels.Alert):
-            self._expect_alert(record.t, message)
-        elif isinstance(message, channels.Links):
-            self._links(message)
-        elif isinstance(message, channels.Restored):
-            self._restored(message)
-
-    def _on_ros(self, record: RobotInput) -> None:
-        self.result.inputs += 1
-        if self.core.on_ros(record.topic, record.value) and not self.exact and self.clock.ready:
+    def _tick_now(self) -> None:
+        """Without recorded ticks: the tick an input calls for, once the clock runs."""
+        if self.clock.ready:
             self._tick()
-
-    def _on_datagram(self, data: bytes) -> None:
-        """A datagram in, through the live link's own protocol (its duplicates and
-        restarts are the executive's to tell, as live)."""
-        self.result.inputs += 1
-        received = self.endpoint.receive(data, self._peer, self.clock.now())
-        if received.message is not None:
-            self.core.on_event(received.message)
-            if not self.exact and self.clock.ready:
-                self._tick()
-
-    def _expect_datagram(self, record: FrontendOut) -> None:
-        if record.seq in self._seqs:
-            return  # a resend
-        self._seqs.add(record.seq)
-        self.result.frontend_commands += 1
-        message = record.message
-        self._expect(
-            Command(
-                record.t, FRONTEND_OUT, plain({"type": message.type, **message_fields(message)})
-            )
-        )
 
     def _expect(self, command: Command) -> None:
         self._last_expected = command
@@ -390,21 +368,19 @@ class Replay:
 
     def _prime(self, primed: Primed) -> None:
         """A recorded ``/frog_bt/primer``: what the live executive carried into this file
-        from before it (:mod:`frog_bt.live.rotation`)."""
-        for received in primed.inputs:  # (one that did not decode is a Bad record)
+        from before it (:mod:`frog_bt.live.rotation`; its datagrams in and seqs out primed
+        the reader: their resends are not new)."""
+        for received in primed.inputs:  # (one that did not decode is a Bad item)
             inp = self.core.table.get(received.topic)
             if inp is not None:
                 self.core.inputs.add(inp, received.value, received.t)
         primer = primed.primer
         if primer.frontend_ready:
             self.core.board.set(keys.FRONTEND_READY, True)
-        for raw in primer.frontend_in:  # seen live: their resends are duplicates
-            self.endpoint.receive(raw.encode(), self._peer, self.clock.now())
-        self._seqs.update(primer.frontend_out_seqs)
         if primer.staff is not None:  # beside the tree: decisions, the alert book
             self.staff.take_up(primer.staff)
 
-    def _blame(self, blame: channels.Blame) -> None:
+    def _blame(self, blame: Blamed) -> None:
         """A recorded ``/frog_bt/blame``: the node that sent the command just recorded."""
         last = self._last_expected
         if last is None:
@@ -415,7 +391,7 @@ class Replay:
             last.node = blame.node
             last.reads = dict(blame.reads)
 
-    def _operator(self, t: float, recorded: channels.Operator) -> None:
+    def _operator(self, t: float, recorded: OperatorDone) -> None:
         """A recorded operator command: applied again here, between the same two ticks, as
         the executive applied it (``ack_alert`` to the alert book, the others to the
         tree); a different answer is a divergence like a different command."""
@@ -449,7 +425,7 @@ class Replay:
     def _compared_alert(self, kind: str) -> bool:
         return self._alerts_compared and (self._links_known or kind not in LINK_ALERTS)
 
-    def _expect_alert(self, t: float, alert: channels.Alert) -> None:
+    def _expect_alert(self, t: float, alert: Alert) -> None:
         """A recorded alert change: compared with the replayed alert book's, in order."""
         self.said.recorded(t, alert)
         if self._compared_alert(alert.kind):
@@ -457,7 +433,7 @@ class Replay:
             self._expected.append(alert_command(t, alert))
             self._compare()
 
-    def _on_alert(self, t: float, alert: channels.Alert) -> None:
+    def _on_alert(self, t: float, alert: Alert) -> None:
         """A change of the replayed alert book: to the observers, and compared."""
         self.said.replayed(t, alert)
         if self.observers:
@@ -466,13 +442,13 @@ class Replay:
             self._got.append(alert_command(t, alert))
             self._compare()
 
-    def _links(self, recorded: channels.Links) -> None:
+    def _links(self, recorded: Links) -> None:
         """A recorded change of the links' states, noted as the executive noted it."""
-        self.recorded_links = Links(recorded.rosbridge, recorded.frontend, recorded.clock)
+        self.recorded_links = recorded
         if self.clock.ready:
             self.staff.links_changed(self.clock.now())
 
-    def _restored(self, recorded: channels.Restored) -> None:
+    def _restored(self, recorded: Restored) -> None:
         """What the recorded executive took up at start-up (a restart): its checkpoint's
         resume point and the staff's decisions, taken up here before the first tick."""
         resume, decided = decisions.taken_up(recorded)
@@ -520,13 +496,7 @@ class Replay:
         self.staff.after_tick()
 
 
-def _datagram_in(record: Record) -> bytes | None:
-    """The datagram from the front end a record is (an event, an ack, or one that did not
-    decode); None for any other record."""
-    if isinstance(record, FrontendIn) or (
-        isinstance(record, FrontendAck) and record.direction == "in"
-    ):
-        return record.raw
-    if isinstance(record, Bad) and record.channel == FRONTEND_IN:
-        return record.raw
-    return None
+def _payload(message: FrontendMessage) -> dict[str, Any]:
+    """A front-end command as replay compares it: its type and fields (``seq`` left out)."""
+    payload: dict[str, Any] = plain({"type": message.type, **message_fields(message)})
+    return payload

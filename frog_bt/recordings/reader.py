@@ -1,39 +1,48 @@
-"""The one decoder of a recording's channels: MCAP messages in, typed records out.
+"""The one decoder of a recording's channels: MCAP messages in, the executive's events out.
 
 :class:`Reader` reads recordings (:func:`~frog_bt.recordings.mcapfile.open_recording`) in
-log-time order and yields one record per message, decoded by the declaration its
-channel comes from, never by hand:
+log-time order and yields ``(t, item)`` pairs: ``t`` the message's log time in
+project-clock seconds (:func:`~frog_bt.model.channels.from_ns`), ``item`` what it holds,
+decoded by the declaration its channel comes from, never by hand. The items are the
+events observers hear live (:mod:`frog_bt.model.events`), the same Structs:
 
-==========================  ===========================================================
-record                      channel, and what decodes it
-==========================  ===========================================================
-:class:`RobotInput`         an input topic of the wire table (by the site's role) or
-                            ``/clock``: the role's :class:`~frog_bt.model.ros.RosType`
-:class:`RobotCommand`       an output topic of the wire table (goal, approach, face
-                            stream, dock): the role's RosType
-:class:`FrontendIn`         ``/frontend/in``: an event of :data:`~frog_bt.model.frontend
-                            .EVENTS`
-:class:`FrontendOut`        ``/frontend/out``: a command of :data:`~frog_bt.model.frontend
-                            .COMMANDS`
-:class:`FrontendAck`        an ack on either (``/frontend/in``: the front end acked a
-                            command; ``/frontend/out``: the executive acked an event)
-:class:`Own`                ``/frog_bt/tick``, ``blame``, ``tree``, ``operator``,
-                            ``alert``, ``links``, ``restored``: their Structs of
-                            :mod:`frog_bt.model.channels`
-:class:`Primed`             ``/frog_bt/primer``: its Struct, and its inputs decoded as
-                            :class:`RobotInput` (at the time each was received)
-:class:`Bad`                any of those that does not decode: channel and reason
-==========================  ===========================================================
+==============================  ======================================================
+item                            from
+==============================  ======================================================
+:class:`RobotInput`             an input topic of the wire table (by the site's role),
+                                or ``/clock``: its ``value`` is the role's RosType's
+                                (``/clock``'s: the time it carries), ``raw`` the ``msg``
+:class:`RobotCommand`           an output topic (goal, approach, face stream, dock):
+                                the role's value and the ``msg`` sent (``goal``: None)
+:class:`Datagram`               ``/frontend/in`` or ``/frontend/out``: every datagram,
+                                acks and resends included, as it crossed
+:class:`FrontendIn`             right after its datagram in: a new front-end event, as
+                                the executive's link took it (the front-end protocol's
+                                :class:`~frog_bt.frontend.protocol.Endpoint`: resends and
+                                duplicates are not new, a restarted peer is seen)
+:class:`FrontendOut`            right after its datagram out: a new command (a seq not
+                                sent before; a resend is not one)
+:class:`Ticked`, ...            ``/frog_bt/tick``, ``blame``, ``operator``, ``alert``,
+                                ``doubt``, ``fault``, ``links``: the event recorded there
+                                (:data:`~frog_bt.model.events.Recorded`; a recording
+                                made before, by :mod:`frog_bt.recordings.legacy`)
+``Tree``, ``Restored``          ``/frog_bt/tree``, ``/frog_bt/restored``: their Structs
+                                (:mod:`frog_bt.model.channels`)
+:class:`Primed`                 ``/frog_bt/primer``: its Struct and its inputs decoded
+                                (it also primes the reader: its datagrams in and seqs out
+                                were before the file, so their resends are not new)
+:class:`Bad`                    a message that does not decode: channel and reason
+==============================  ======================================================
 
 A message that does not decode is never dropped silently nor raised to the caller: it
-is a :class:`Bad` record, and :attr:`Reader.tally` counts it by channel (the reasons of
-the first :data:`BAD_KEPT` are kept). A channel the reader has no declaration for (a
-topic the site does not name), or one the caller did not ask for (``only``), is not
-decoded: its messages are counted in :attr:`Tally.unread`. A file damaged past reading
-(a foreign MCAP whose index lies) ends with one :class:`Bad` record on channel ``""``.
+is a :class:`Bad` item (a datagram's comes after its :class:`Datagram`), and
+:attr:`Reader.tally` counts it by channel (the reasons of the first :data:`BAD_KEPT` are
+kept). A channel the reader has no declaration for (a topic the site does not name), or
+one the caller did not ask for (``only``), is not decoded: its messages are counted in
+:attr:`Tally.unread`. A file damaged past reading (a foreign MCAP whose index lies) ends
+with one :class:`Bad` item on channel ``""``.
 
-Times are project-clock seconds (:func:`~frog_bt.model.channels.from_ns` of the log
-time). Below the engine: the simulator reads recordings through this too.
+Below the engine: the simulator reads recordings through this too.
 """
 
 from __future__ import annotations
@@ -41,138 +50,58 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Callable, Collection, Iterable, Iterator
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
 import msgspec
 
 from frog_bt.codec import decode_error
 from frog_bt.config import Site
 from frog_bt.errors import DecodeError
+from frog_bt.frontend.protocol import Endpoint
 from frog_bt.model import channels
-from frog_bt.model.channels import FRONTEND_IN, FRONTEND_OUT, PRIMER, from_ns
-from frog_bt.model.frontend import COMMANDS, EVENTS, DatagramDecoder, FrontendMessage
-from frog_bt.model.ros import (
-    ROS_TYPES,
-    Diagnostics,
-    FaceData,
-    PersonDetections,
-    Pose,
-    RosType,
-    TrackedPeople,
+from frog_bt.model.channels import (
+    EVENT_CHANNELS,
+    FILE_TYPES,
+    FRONTEND_IN,
+    FRONTEND_OUT,
+    PRIMER,
+    Primer,
+    Restored,
+    Tree,
+    from_ns,
 )
+from frog_bt.model.events import (
+    Datagram,
+    Event,
+    FrontendIn,
+    FrontendOut,
+    RobotCommand,
+    RobotInput,
+)
+from frog_bt.model.frontend import COMMANDS, EVENTS, DatagramDecoder
+from frog_bt.model.ros import ROS_TYPES, RosType
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
+from frog_bt.recordings.legacy import legacy_decoder
 from frog_bt.recordings.mcapfile import READ_ERRORS, RecordingFile
 
-__all__ = [
-    "BAD_KEPT",
-    "CLOCK_ROLE",
-    "Bad",
-    "FrontendAck",
-    "FrontendIn",
-    "FrontendOut",
-    "Own",
-    "OwnMessage",
-    "Primed",
-    "Reader",
-    "Record",
-    "RobotCommand",
-    "RobotInput",
-    "RosValue",
-    "Tally",
-]
+__all__ = ["BAD_KEPT", "CLOCK_ROLE", "Bad", "Item", "Primed", "Reader", "Tally"]
 
 BAD_KEPT = 20  # bad messages whose reasons a tally keeps (all are counted)
 CLOCK_ROLE = "clock"  # the role of /clock among the inputs (sim time only)
-
-RosValue = Pose | Diagnostics | PersonDetections | FaceData | TrackedPeople | int | float | str
-"""What a wire Struct's ``value()`` gives: what the leaves see."""
-OwnMessage = (
-    channels.Tick
-    | channels.Blame
-    | channels.Tree
-    | channels.Operator
-    | channels.Alert
-    | channels.Doubt
-    | channels.Fault
-    | channels.Links
-    | channels.Restored
-)
+PEER = "recorded"  # the front end, as the reader's endpoint knows it (all it was told)
 
 # Errors a message can make decoding raise (DecodeError from the Structs; the others
 # from a value() that computes on what it decoded): a bad message, not a crash.
 _DECODE_ERRORS = (DecodeError, ValueError, TypeError, ArithmeticError)
 
 
-class RobotInput(msgspec.Struct, frozen=True):
-    """A message on a robot input (or ``/clock``): its role in the wire table, the wire
-    Struct's value, and the rosbridge ``msg`` as recorded."""
-
-    t: float
-    topic: str
-    role: str  # the wire table's role (``pose``, ``response``, ...) or CLOCK_ROLE
-    value: RosValue
-    raw: bytes
-
-    def msg(self) -> dict[str, Any]:
-        """The ``msg`` as a JSON object, for those who send it on (``sim --play``)."""
-        return msgspec.json.decode(self.raw)  # type: ignore[no-any-return]
-
-
-class RobotCommand(msgspec.Struct, frozen=True):
-    """A command the executive sent to the robot: its role, the wire Struct's value, and
-    the ``msg`` as sent (a JSON object: commands are compared in their wire form)."""
-
-    t: float
-    topic: str
-    role: str  # ``goto``, ``approach``, ``icl``, ``dock``
-    value: RosValue
-    msg: dict[str, Any]
-    raw: bytes
-
-
-class FrontendIn(msgspec.Struct, frozen=True):
-    """A datagram from the front end carrying an event (resends included: the same seq)."""
-
-    t: float
-    seq: int
-    message: FrontendMessage
-    raw: bytes
-
-
-class FrontendOut(msgspec.Struct, frozen=True):
-    """A datagram to the front end carrying a command (resends included: the same seq)."""
-
-    t: float
-    seq: int
-    message: FrontendMessage
-    raw: bytes
-
-
-class FrontendAck(msgspec.Struct, frozen=True):
-    """An ack: ``in`` from the front end (it got a command), ``out`` from the executive."""
-
-    t: float
-    direction: Literal["in", "out"]
-    seq: int
-    raw: bytes
-
-
-class Own(msgspec.Struct, frozen=True):
-    """A message of one of frog-bt's own channels (but the primer), as its Struct."""
-
-    t: float
-    channel: str
-    message: OwnMessage
-
-
 class Primed(msgspec.Struct, frozen=True):
     """A ``/frog_bt/primer``: what a rotated file carries from before it; ``inputs`` are
-    its robot inputs decoded, each at the time it was received."""
+    its robot inputs decoded, each at the time it was received (one that does not decode
+    is a :class:`Bad` item, before this one)."""
 
-    t: float
-    primer: channels.Primer
+    primer: Primer
     inputs: tuple[RobotInput, ...]
-    bad: tuple[Bad, ...] = ()  # its inputs that did not decode (also yielded before it)
 
 
 class Bad(msgspec.Struct, frozen=True):
@@ -188,7 +117,8 @@ class Bad(msgspec.Struct, frozen=True):
         return f"{self.channel or 'the file'} at +{self.t - start:.1f} s: {self.reason}"
 
 
-Record = RobotInput | RobotCommand | FrontendIn | FrontendOut | FrontendAck | Own | Primed | Bad
+Item = Event | Tree | Restored | Primed | Bad
+"""What the reader yields (with the message's time): an event, a file's Struct, a bad one."""
 
 
 @dataclass(slots=True)
@@ -212,19 +142,20 @@ class Tally:
         return [bad.line(start) for bad in self.first]
 
 
-_EVENTS = DatagramDecoder(EVENTS)
 _COMMANDS = DatagramDecoder(COMMANDS)
 _JSON = msgspec.json.Decoder()
 
-Decode = Callable[[float, bytes], Record]
+Decode = Callable[[float, bytes], tuple[Item, ...]]
 
 
 class Reader:
     """Reads recordings for one site (its topic names): :meth:`read` one file,
-    :meth:`read_all` several in turn (a lead-in, then the file that continues it).
+    :meth:`read_all` several in turn (a lead-in, then the file that continues it: one
+    reader, so a resend across them is no new datagram).
 
     ``only``: the channels to decode (the others are counted as unread, not decoded);
-    all by default. :attr:`tally` counts bad and unread messages over every file read.
+    all by default. :attr:`tally` counts bad and unread messages over every file read;
+    :attr:`roles` gives a robot topic's role in the wire table (``/clock``: ``clock``).
     """
 
     def __init__(
@@ -235,17 +166,21 @@ class Reader:
         self._inputs = {site.topic(role): role for role in INPUTS}
         self._inputs[CLOCK.name] = CLOCK_ROLE
         self._outputs = {site.topic(role): role for role in OUTPUTS}
+        self.roles: dict[str, str] = {**self._inputs, **self._outputs}
         self._codecs: dict[str, RosType[Any]] = {
             role: topic.codec for role, topic in (*INPUTS.items(), *OUTPUTS.items())
         }
         self._codecs[CLOCK_ROLE] = CLOCK.codec
+        # the front end's datagrams as the executive's link took them (CONTRACT §2)
+        self._endpoint = Endpoint(PEER, EVENTS)
+        self._sent: set[int] = set()  # seqs of commands out: a resend is no new command
 
-    def read_all(self, recordings: Iterable[RecordingFile]) -> Iterator[Record]:
+    def read_all(self, recordings: Iterable[RecordingFile]) -> Iterator[tuple[float, Item]]:
         for recording in recordings:
             yield from self.read(recording)
 
-    def read(self, recording: RecordingFile) -> Iterator[Record]:
-        """Every message of ``recording`` as a record, in log-time order."""
+    def read(self, recording: RecordingFile) -> Iterator[tuple[float, Item]]:
+        """Every message of ``recording`` as ``(t, item)`` pairs, in log-time order."""
         plan = self._plan(recording.types)
         unread = self.tally.unread
         add = self.tally.add
@@ -259,7 +194,7 @@ class Reader:
             except READ_ERRORS as exc:
                 bad = Bad(t, "", f"damaged past here: {type(exc).__name__}: {exc}"[:200])
                 add(bad)
-                yield bad
+                yield t, bad
                 return
             t = from_ns(ns)
             decode = plan.get(topic)
@@ -268,16 +203,13 @@ class Reader:
                 continue
             data = bytes(data)
             try:
-                record = decode(t, data)
+                items = decode(t, data)
             except _DECODE_ERRORS as exc:
-                record = Bad(t, topic, _reason(exc), data)
-                add(record)
-            else:
-                if isinstance(record, Primed):
-                    for bad in record.bad:
-                        add(bad)
-                        yield bad
-            yield record
+                items = (Bad(t, topic, _reason(exc), data),)
+            for item in items:
+                if type(item) is Bad:
+                    add(item)
+                yield t, item
 
     # ------------------------------------------------------------ one decoder per channel
 
@@ -295,79 +227,108 @@ class Reader:
     def _decoder(self, topic: str, schema: str) -> Decode | None:
         role = self._inputs.get(topic)
         if role is not None:
-            return self._ros(topic, schema, role, RobotInput)
+            return self._robot_input(topic, schema, role)
         role = self._outputs.get(topic)
         if role is not None:
-            return self._ros(topic, schema, role, RobotCommand)
+            return self._robot_command(topic, schema, role)
         if topic == FRONTEND_IN:
-            return _frontend_in
+            return self._frontend_in
         if topic == FRONTEND_OUT:
-            return _frontend_out
+            return self._frontend_out
         if topic == PRIMER:
             return self._primer
-        if topic in channels.TYPES:
-            return lambda t, data: Own(t, topic, channels.decode(topic, data))
+        if topic in FILE_TYPES:
+            return lambda t, data: (channels.decode(topic, data),)
+        if topic in EVENT_CHANNELS.values():
+            old = legacy_decoder(schema)
+            if old is not None:  # a recording made before: the event from its old shape
+                return lambda t, data: (old(t, data),)
+            return lambda t, data: (channels.decode_event(data),)
         return None
 
-    def _ros(
-        self, topic: str, schema: str, role: str, make: type[RobotInput | RobotCommand]
-    ) -> Decode:
-        """A robot topic's decoder: its role's RosType (what the executive decoded it
-        with live); a channel whose schema names another ROS type is all bad."""
+    def _codec(self, topic: str, schema: str, role: str) -> RosType[Any] | str:
+        """A robot topic's RosType (what the executive decoded it with live); a channel
+        whose schema names another ROS type is all bad: why."""
         codec = self._codecs[role]
         if schema in ROS_TYPES and schema != codec.name:
-            reason = f"schema {schema}, but {topic} is {codec.name} in the wire table"
+            return f"schema {schema}, but {topic} is {codec.name} in the wire table"
+        return codec
 
-            def mismatched(t: float, data: bytes) -> Record:
-                raise DecodeError(reason)
+    def _robot_input(self, topic: str, schema: str, role: str) -> Decode:
+        codec = self._codec(topic, schema, role)
+        if isinstance(codec, str):
+            return _all_bad(codec)
+        value = codec.decode
 
-            return mismatched
-        if make is RobotInput:
-            value = codec.decode
+        def robot_input(t: float, data: bytes) -> tuple[Item, ...]:
+            return (RobotInput(t, topic, value(data), msgspec.Raw(data)),)
 
-            def robot_input(t: float, data: bytes) -> Record:
-                return RobotInput(t, topic, role, value(data), data)
+        return robot_input
 
-            return robot_input
+    def _robot_command(self, topic: str, schema: str, role: str) -> Decode:
+        codec = self._codec(topic, schema, role)
+        if isinstance(codec, str):
+            return _all_bad(codec)
         convert = codec.convert
 
-        def robot_command(t: float, data: bytes) -> Record:
+        def robot_command(t: float, data: bytes) -> tuple[Item, ...]:
             try:
                 msg = _JSON.decode(data)
             except msgspec.MsgspecError as exc:
                 raise decode_error(exc) from None
-            return RobotCommand(t, topic, role, convert(msg), msg, data)
+            return (RobotCommand(t, role, topic, convert(msg), msg),)
 
         return robot_command
 
-    def _primer(self, t: float, data: bytes) -> Primed:
-        primer: channels.Primer = channels.decode(PRIMER, data)
+    def _frontend_in(self, t: float, data: bytes) -> tuple[Item, ...]:
+        """A datagram in, through the front-end protocol as the executive's link took it:
+        a new event after it, a duplicate or an ack nothing more, a bad one a Bad."""
+        datagram = Datagram(t, "in", data)
+        received = self._endpoint.receive(data, PEER, t)
+        if received.message is not None:
+            return datagram, FrontendIn(t, received.message)
+        if received.error is not None:
+            return datagram, Bad(t, FRONTEND_IN, _reason(received.error), data)
+        return (datagram,)
+
+    def _frontend_out(self, t: float, data: bytes) -> tuple[Item, ...]:
+        """A datagram out: a new command after it (a resend has a seq sent before)."""
+        datagram = Datagram(t, "out", data)
+        try:
+            seq, message = _COMMANDS.decode(data)
+        except DecodeError as exc:
+            return datagram, Bad(t, FRONTEND_OUT, _reason(exc), data)
+        if message is None or seq in self._sent:
+            return (datagram,)
+        self._sent.add(seq)
+        return datagram, FrontendOut(t, message)
+
+    def _primer(self, t: float, data: bytes) -> tuple[Item, ...]:
+        primer: Primer = channels.decode(PRIMER, data)
+        for text in primer.frontend_in:  # seen live before the file: their resends not new
+            self._endpoint.receive(text.encode(), PEER, t)
+        self._sent.update(primer.frontend_out_seqs)
         inputs: list[RobotInput] = []
-        bad: list[Bad] = []
+        bad: list[Item] = []
         for i, entry in enumerate(primer.inputs):
             role = self._inputs.get(entry.topic)
             if role is None or role == CLOCK_ROLE:
                 continue  # not an input of this site's table: nothing to prime
             raw = bytes(entry.msg)
             try:
-                inputs.append(
-                    RobotInput(entry.t, entry.topic, role, self._codecs[role].decode(raw), raw)
-                )
+                value = self._codecs[role].decode(raw)
             except _DECODE_ERRORS as exc:
                 bad.append(Bad(t, PRIMER, f"inputs[{i}] ({entry.topic}): {_reason(exc)}", raw))
-        return Primed(t, primer, tuple(inputs), tuple(bad))
+            else:
+                inputs.append(RobotInput(entry.t, entry.topic, value, entry.msg))
+        return *bad, Primed(primer, tuple(inputs))
 
 
-def _frontend_in(t: float, data: bytes) -> FrontendIn | FrontendAck:
-    seq, message = _EVENTS.decode(data)
-    return FrontendAck(t, "in", seq, data) if message is None else FrontendIn(t, seq, message, data)
+def _all_bad(reason: str) -> Decode:
+    def mismatched(t: float, data: bytes) -> tuple[Item, ...]:
+        raise DecodeError(reason)
 
-
-def _frontend_out(t: float, data: bytes) -> FrontendOut | FrontendAck:
-    seq, message = _COMMANDS.decode(data)
-    return (
-        FrontendAck(t, "out", seq, data) if message is None else FrontendOut(t, seq, message, data)
-    )
+    return mismatched
 
 
 def _reason(exc: Exception) -> str:

@@ -3,10 +3,11 @@ tour's robot-side inputs served over rosbridge on the recording's own clock, and
 front-end events sent over UDP, open loop.
 
 :func:`load` reads a recording into a :class:`Played`, through the one decoder of
-recordings (:class:`~frog_bt.recordings.reader.Reader`): the inputs (every topic the
-executive subscribes to), the front end's events (``/frontend/in`` without its acks) and
-the commands the recorded executive sent (ROS outputs; ``/frontend/out`` without acks
-and resends). A message that does not decode is not played: it is counted, and the
+recordings (:class:`~frog_bt.recordings.reader.Reader`), as the executive's events it
+gives back: the inputs (every topic the executive subscribes to), the front end's new
+events (what the recorded executive's link took as new: no acks, no resends) and the
+commands the recorded executive sent (ROS outputs; new front-end commands: no acks, no
+resends). A message that does not decode is not played: it is counted, and the
 summary says how many and the first few. A tour file of ``--record DIR`` is read after
 the idle file it continues (its ``lead_in``, as replay does); a first file that starts
 with a ``/frog_bt/primer`` (an idle file of ``--record DIR``) gives its inputs first, at
@@ -15,10 +16,13 @@ publishes on change would not send again. The primer's datagrams are not played 
 live executive had them; a new one never asked for them).
 
 :class:`Player` is the I/O: the built-in rosbridge server, the front end's UDP socket
-(it acks every command, as a front end does: an ack is the protocol, not the content)
-and the time loop. The commands received go to a
-:class:`~frog_bt.sim.comparison.Comparison` (sans-I/O), which holds them against the
-recorded ones and tells the first difference in replay's domain terms.
+and the time loop. The datagrams are the front-end protocol's
+(:mod:`frog_bt.frontend.protocol`): each event is sent once, numbered from 1 over the
+whole play (a later pass of ``--loop`` goes on numbering); each command is taken by the
+front end's :class:`~frog_bt.frontend.protocol.Endpoint`, which acks it, as a front end
+does (an ack is the protocol, not the content), and tells a resend from a new one. The
+commands received go to a :class:`~frog_bt.sim.comparison.Comparison` (sans-I/O), which
+holds them against the recorded ones and tells the first difference in replay's domain terms.
 
 Open loop: nothing reacts to the commands. A new executive that acts as the recorded
 one did sees the same world; one that acts otherwise sees it anyway (a goal it sends
@@ -30,28 +34,25 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import json
+import itertools
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import msgspec
+
 import frog_bt.sim.msgs as msgs
 from frog_bt.config import Site
 from frog_bt.errors import FrogError
+from frog_bt.frontend.protocol import Endpoint, encode_datagram
 from frog_bt.model.channels import FRONTEND_IN, FRONTEND_OUT, PRIMER, from_ns
-from frog_bt.model.frontend import message_fields
+from frog_bt.model.events import FrontendIn, FrontendOut, RobotCommand, RobotInput
+from frog_bt.model.frontend import COMMANDS, FrontendMessage, message_fields
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.recordings.commands import Command, chain, plain, without_stamp
-from frog_bt.recordings.reader import (
-    FrontendIn,
-    FrontendOut,
-    Primed,
-    Reader,
-    RobotCommand,
-    RobotInput,
-)
+from frog_bt.recordings.reader import Primed, Reader
 from frog_bt.sim.comparison import Comparison
 from frog_bt.sim.frontend_udp import Address, FrontendSocket
 from frog_bt.sim.rosbridge_protocol import BridgeServer, Incoming
@@ -63,9 +64,9 @@ DT = 0.1  # simulated seconds per step of the time loop (a /clock each)
 WAIT_POLL = 0.01  # wall seconds between looks for an executive's first subscription
 SUBSCRIBE_GRACE = 0.3  # wall seconds for its other subscriptions, after the first
 WAIT_MAX = 60.0  # wall seconds waiting for a rosbridge client before playing anyway
-SEQ_PER_PASS = 1_000_000  # --loop: front-end seqs of pass n are the recorded ones + n x this
 PASS_TAIL = 5.0  # recording seconds of /clock after its end before a pass counts as over
 BAD_TOLD = 3  # bad messages whose reasons the summary tells (all are counted)
+EXECUTIVE = "executive"  # the peer of the player's endpoint: whoever sends to its socket
 
 
 class PlayError(FrogError):
@@ -81,7 +82,7 @@ class Played:
     start: float
     end: float
     inputs: list[tuple[float, str, dict[str, Any]]]  # (t, topic, msg), in time order
-    events: list[tuple[float, bytes]]  # front-end datagrams to the executive
+    events: list[tuple[float, FrontendMessage]]  # front-end events to the executive
     commands: list[Command]  # what the recorded executive sent
     types: dict[str, str]  # the served topics' ROS types
     bad: int = 0  # recorded messages that did not decode: not played
@@ -99,30 +100,23 @@ def load(path: Path, site: Site) -> Played:
     commands_on = {site.topic(role) for role in OUTPUTS}
     reader = Reader(site, only={*served, *commands_on, FRONTEND_IN, FRONTEND_OUT, PRIMER})
     inputs: list[tuple[float, str, dict[str, Any]]] = []
-    events: list[tuple[float, bytes]] = []
+    events: list[tuple[float, FrontendMessage]] = []
     commands: list[Command] = []
-    seqs: set[int] = set()
     for recording in recordings:
-        for record in reader.read(recording):
-            if isinstance(record, RobotInput):
-                inputs.append((record.t, record.topic, record.msg()))
-            elif isinstance(record, RobotCommand):
-                commands.append(Command(record.t, record.topic, without_stamp(record.msg)))
-            elif isinstance(record, FrontendIn):
-                events.append((record.t, record.raw))
-            elif isinstance(record, FrontendOut) and record.seq not in seqs:  # not a resend
-                seqs.add(record.seq)
-                message = record.message
-                commands.append(
-                    Command(
-                        record.t,
-                        FRONTEND_OUT,
-                        plain({"type": message.type, **message_fields(message)}),
-                    )
-                )
-            elif isinstance(record, Primed) and recording is recordings[0] and not inputs:
-                # the inputs' latest messages from before the file, given at its start
-                inputs.extend((record.t, i.topic, i.msg()) for i in record.inputs)
+        for t, item in reader.read(recording):
+            match item:
+                case RobotInput():
+                    inputs.append((t, item.topic, _msg(item)))
+                case RobotCommand():
+                    commands.append(Command(t, item.topic, without_stamp(item.msg)))
+                case FrontendIn(message=message):
+                    events.append((t, message))
+                case FrontendOut(message=message):
+                    fields = plain({"type": message.type, **message_fields(message)})
+                    commands.append(Command(t, FRONTEND_OUT, fields))
+                case Primed() if recording is recordings[0] and not inputs:
+                    # the inputs' latest messages from before the file, given at its start
+                    inputs.extend((t, i.topic, _msg(i)) for i in item.inputs)
     if not inputs:
         raise PlayError(f"{path}: no robot-side inputs in it (is it a frog-bt recording?)")
     tally = reader.tally
@@ -187,7 +181,9 @@ class Player:
         self.passes = 0  # times the recording was played to its end
         self.over = asyncio.Event()  # set at the recording's end (the first time)
         self.executive_seen = asyncio.Event()  # a client subscribed to /clock: playing
-        self._seqs: set[Any] = set()
+        # the front end's side of the link: commands in (acked, resends told), events out
+        self.endpoint = Endpoint(EXECUTIVE, COMMANDS)
+        self._seqs = itertools.count(1)  # the events' seqs, over every pass
         self._task: asyncio.Task[None] | None = None
 
     async def start(self) -> None:
@@ -261,7 +257,7 @@ class Player:
                     self.inputs_sent += 1
                     i += 1
                 while j < len(played.events) and played.events[j][0] <= t:
-                    self.udp.send(self._numbered(played.events[j][1]))
+                    self.udp.send(self._datagram(played.events[j][1]))
                     self.events_sent += 1
                     j += 1
                 if t > played.end + PASS_TAIL:
@@ -281,17 +277,10 @@ class Player:
             offset += length  # the next pass starts where this one ended
             self.comparison.next_pass(offset)
 
-    def _numbered(self, data: bytes) -> bytes:
-        """A front-end event of a later pass numbered after the earlier ones (the same seq
-        again would be taken for a resend)."""
-        if not self.passes:
-            return data
-        try:
-            msg = json.loads(data)
-            msg["seq"] = int(msg["seq"]) + SEQ_PER_PASS * self.passes
-        except (ValueError, KeyError, TypeError):
-            return data
-        return json.dumps(msg).encode()
+    def _datagram(self, message: FrontendMessage) -> bytes:
+        """A front-end event's datagram, numbered after every one sent before (a later
+        pass's too: the same seq again would be taken for a resend)."""
+        return encode_datagram(message.type, next(self._seqs), message_fields(message))
 
     async def _clock_on(self, t: float) -> None:
         loop = asyncio.get_running_loop()
@@ -308,24 +297,27 @@ class Player:
         self._take(command)
 
     def _on_datagram(self, data: bytes, addr: Address) -> None:
-        try:
-            msg = json.loads(data)
-        except ValueError:
-            return
-        if not isinstance(msg, dict) or msg.get("type") == "ack":
-            return
-        seq = msg.pop("seq", None)
-        if isinstance(seq, int):
-            self.udp.send(json.dumps({"type": "ack", "seq": seq}).encode())
-            if seq in self._seqs:
-                return  # a resend: acked again, compared once
-            self._seqs.add(seq)
-        self._take(Command(self.now, FRONTEND_OUT, msg))
+        """A datagram from the executive, through the front end's endpoint: acked, and a
+        new command compared (a resend is acked again, compared once)."""
+        received = self.endpoint.receive(data, EXECUTIVE, self.now)
+        if received.reply is not None:
+            self.udp.send(received.reply)
+        message = received.message
+        if message is not None:
+            fields = plain({"type": message.type, **message_fields(message)})
+            self._take(Command(self.now, FRONTEND_OUT, fields))
 
     def _take(self, command: Command) -> None:
         text = self.comparison.got(command)
         if text is not None and self.comparison.differ == 1 and self.on_difference:
             self.on_difference(self.comparison.first)
+
+
+def _msg(received: RobotInput) -> dict[str, Any]:
+    """The rosbridge ``msg`` of a recorded input, as a JSON object (to send it on)."""
+    raw = received.raw
+    msg: dict[str, Any] = msgspec.json.decode(raw) if raw is not None else {}
+    return msg
 
 
 def restamped(msg: dict[str, Any], offset: float) -> dict[str, Any]:

@@ -290,8 +290,8 @@ class Real:
         node = self.core.trace.current()
         at = self.index.get(id(node), 0) if node is not None else 0
         self.events.append((kind, at, self.world_view()))
-        if kind is VEvent.DRIVE and event.goal is not None:  # type: ignore[union-attr]
-            self._drove_to = event.goal.target  # type: ignore[union-attr]
+        if kind is VEvent.DRIVE and isinstance(event, RobotCommand) and event.goal is not None:
+            self._drove_to = event.goal.target
         self._sent.append(kind)
 
     def _after_tick(self) -> None:

@@ -18,6 +18,7 @@ from frog_bt.live.console.acklink import Verdict, link_key, verify
 from frog_bt.live.console.alertbodies import HOLD, rfc3339, waited
 from frog_bt.live.console.webhooks import Webhooks
 from frog_bt.model import channels
+from frog_bt.model.events import AlertChanged
 from frog_bt.model.help import Help, HelpAbout
 from frog_bt.runtime.alerts import AlertBook, Facts, dedup_key
 
@@ -304,8 +305,11 @@ def test_waited_in_plain_words(seconds: float, words: str) -> None:
 
 
 def test_an_alert_recorded_before_these_fields_still_decodes() -> None:
-    old = b'{"id":"fault","kind":"fault","text":"x","state":"raised","since":1.0}'
-    alert = channels.decode(channels.ALERT, old)
+    old = b'{"type":"AlertChanged","t":1.0,"alert":{"id":"fault","kind":"fault","text":"x",'
+    old += b'"state":"raised","since":1.0}}'
+    changed = channels.decode(channels.ALERT, old)
+    assert isinstance(changed, AlertChanged)
+    alert = changed.alert
     assert (alert.severity, alert.key, alert.answers, alert.repeat) == ("WARN", "", (), 0)
-    new = AlertBook(AlertsCfg()).update(Facts(now=1.0, faults=("x",)))[0]
+    new = AlertChanged(1.0, AlertBook(AlertsCfg()).update(Facts(now=1.0, faults=("x",)))[0])
     assert channels.decode(channels.ALERT, channels.encode(new)) == new

@@ -1,6 +1,7 @@
-"""frog-bt's own channels: operator commands are recorded and applied again by replay at
-the same tick (identical), and a bad message of our channels is counted and reported with
-its reason, never dropped silently."""
+"""frog-bt's own channels: they hold the executive's events as themselves (one tagged
+union); operator commands are recorded and applied again by replay at the same tick
+(identical), and a bad message of our channels is counted and reported with its reason,
+never dropped silently."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import asyncio
 import shutil
 from pathlib import Path
 
+import msgspec
 import pytest
 from mcap.reader import make_reader
 from mcap.writer import Writer
@@ -20,7 +22,10 @@ from frog_bt.config import load_site
 from frog_bt.engine.operator import Command
 from frog_bt.live.recording import Recorder
 from frog_bt.model import channels
+from frog_bt.model.events import Blamed, OperatorDone, Recorded, Ticked
 from frog_bt.offline.replay import Replay
+from frog_bt.recordings.mcapfile import open_recording
+from frog_bt.recordings.reader import Reader
 from frog_bt.rehearsal import Rehearsal
 from frog_bt.runtime.observer import attach_all
 
@@ -97,6 +102,37 @@ def test_without_the_skip_handler_the_replayed_answer_differs(
     assert div.got.payload["ok"] is False
 
 
+def test_our_channels_hold_the_events_as_themselves(commanded: Path) -> None:
+    """Each message of an event channel is one of the executive's events, as it told it:
+    its raw bytes decode with the union's decoder (msgspec's tagged union), under the
+    event's own schema name; the reader gives back the same events."""
+    union = msgspec.json.Decoder(Recorded)
+    got: dict[str, list[Recorded]] = {}
+    told: list[Recorded] = []  # in log-time order
+    with commanded.open("rb") as f:
+        for schema, chan, message in make_reader(f).iter_messages():
+            if chan.topic in channels.EVENT_CHANNELS.values():
+                event = union.decode(message.data)
+                assert schema is not None and schema.name == f"frog_bt/{type(event).__name__}"
+                assert channels.EVENT_CHANNELS[type(event)] == chan.topic
+                assert channels.to_ns(event.t) <= message.log_time  # stamped when told
+                got.setdefault(chan.topic, []).append(event)
+                told.append(event)
+    operator = [e for e in got[channels.OPERATOR] if isinstance(e, OperatorDone)]
+    assert [(e.command, e.ok) for e in operator] == [
+        ("skip", True),
+        ("pause", True),
+        ("pause", False),
+        ("resume", True),
+    ]
+    ticks = [e.tick for e in got[channels.TICK] if isinstance(e, Ticked)]
+    assert ticks == list(range(1, len(got[channels.TICK]) + 1))
+    assert all(isinstance(e, Blamed) for e in got[channels.BLAME])
+    site = load_site()
+    read = [e for _, e in Reader(site).read(open_recording(commanded)) if isinstance(e, Recorded)]
+    assert read == told  # the reader gives back the same events
+
+
 def copy_corrupting(src: Path, dst: Path, channel: str, data: bytes, nth: int = 1) -> None:
     """``src`` rewritten to ``dst`` with the ``nth`` message of ``channel`` replaced."""
     with src.open("rb") as f_in, dst.open("wb") as f_out:
@@ -132,7 +168,8 @@ def test_a_bad_message_of_our_channels_is_counted_and_reported(
     commanded: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     bad = tmp_path / "bad.mcap"
-    copy_corrupting(commanded, bad, channels.BLAME, b'{"channel": 5, "node": "x"}', nth=3)
+    blame = b'{"type": "Blamed", "t": 1.0, "channel": 5, "node": "x"}'
+    copy_corrupting(commanded, bad, channels.BLAME, blame, nth=3)
     result = Replay(bad, load_site(), load_tree(site=load_site())).run()
     assert result.identical  # a blame only explains a command: the replay goes on
     assert result.bad_count == 1

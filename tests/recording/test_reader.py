@@ -1,10 +1,13 @@
 """The one decoder of recordings (:mod:`frog_bt.recordings.reader`): every channel decodes
-to its type; a damaged message of each kind is a Bad record counted with its reason and
-the rest of the file is still read; any bytes on any channel are a record, never an
-exception; replay reports a recording with a damaged robot input or command."""
+to the executive's events (:mod:`frog_bt.model.events`), the same Structs; the event
+channels of a recording made before (their old shapes) decode to the same events; a
+damaged message of each kind is a Bad item counted with its reason and the rest of the
+file is still read; any bytes on any channel are an item, never an exception; replay
+reports a recording with a damaged robot input or command."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -20,8 +23,24 @@ from frog_bt.behaviours import load_tree
 from frog_bt.cli import main
 from frog_bt.config import Site, load_site
 from frog_bt.model import channels
+from frog_bt.model.alert import Alert
 from frog_bt.model.channels import FRONTEND_IN, FRONTEND_OUT, OWN_TYPES, to_ns
+from frog_bt.model.events import (
+    AlertChanged,
+    Blamed,
+    Datagram,
+    Doubted,
+    Faulted,
+    FrontendIn,
+    FrontendOut,
+    LinksChanged,
+    OperatorDone,
+    RobotCommand,
+    RobotInput,
+    Ticked,
+)
 from frog_bt.model.frontend import ContentDone, FrontendIdle, StartPoi
+from frog_bt.model.links import Links, LinkStatus
 from frog_bt.model.ros import (
     DIAGNOSTICS,
     FACES,
@@ -44,19 +63,7 @@ from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.offline.replay import Replay
 from frog_bt.offline.report.facts import OWN, ROS_ROLES, read_file
 from frog_bt.recordings.mcapfile import RecordingFile, open_recording
-from frog_bt.recordings.reader import (
-    CLOCK_ROLE,
-    Bad,
-    FrontendAck,
-    FrontendIn,
-    FrontendOut,
-    Own,
-    Primed,
-    Reader,
-    Record,
-    RobotCommand,
-    RobotInput,
-)
+from frog_bt.recordings.reader import CLOCK_ROLE, Bad, Item, Primed, Reader
 
 T0 = 1_780_000_000.0  # an epoch time in 2026
 SITE = load_site()
@@ -135,14 +142,22 @@ def good_messages(site: Site) -> list[Message]:
         ),
         (FRONTEND_IN, b'{"type": "ack", "seq": 3}'),
         (FRONTEND_IN, b'{"type": "content_done", "seq": 2, "poi": "POI1", "part": "a"}'),
-        (channels.TICK, channels.encode(channels.Tick(1, "RUNNING"))),
-        (channels.BLAME, channels.encode(channels.Blame("start_poi", "tour.yaml:3 Play"))),
+        *((channel, channels.encode(event)) for channel, event in EVENTS.items()),
         (channels.TREE, channels.encode(channels.Tree("BehaviorTree.CPP v4", "t", "<r/>"))),
-        (channels.OPERATOR, channels.encode(channels.Operator(4, "skip", True, "ok"))),
-        (channels.ALERT, channels.encode(channels.Alert("a1", "fault", "x", "raised", T0))),
     ]
     return [(name, T0 + i, data) for i, (name, data) in enumerate(made)]
 
+
+LINKS = Links(LinkStatus.CONNECTED, LinkStatus.ACKING, LinkStatus.SIM)
+EVENTS = {  # one event of each kind recorded on our channels, as the executive tells it
+    channels.TICK: Ticked(T0 + 0.1, 1, "RUNNING"),
+    channels.BLAME: Blamed(T0 + 0.1, "start_poi", "tour.yaml:3 Play", {"stop": "POI1"}),
+    channels.OPERATOR: OperatorDone(T0 + 0.1, 4, "skip", True, "ok", by="console"),
+    channels.ALERT: AlertChanged(T0 + 0.1, Alert("a1", "fault", "x", "raised", T0)),
+    channels.DOUBT: Doubted(T0 + 0.1, 2, "SHOP", "arrival at POI2 heard late: ignored", "POI2"),
+    channels.FAULT: Faulted(T0 + 0.1, "node X", "its tick", "ValueError: x", 3),
+    channels.LINKS: LinksChanged(T0 + 0.1, LINKS),
+}
 
 BAD: dict[str, tuple[bytes, str]] = {  # a damaged message of each kind: data, its reason
     "pose": (b'{"pose": {"position": {"x": 1, "y": 2}}}', "pose.orientation: missing field"),
@@ -156,7 +171,10 @@ BAD: dict[str, tuple[bytes, str]] = {  # a damaged message of each kind: data, i
     "approach": (b'{"data": "seven"}', "data: expected `int`, got `str`"),
     FRONTEND_IN: (b'{"type": "user_maybe", "seq": 4}', "type"),
     FRONTEND_OUT: (b'{"type": "start_poi", "seq": 5, "poi": "POI1"}', "missing field"),
-    channels.TICK: (b'{"tick": "one", "status": "RUNNING"}', "tick: expected `int`"),
+    channels.TICK: (
+        b'{"type": "Ticked", "t": 1.0, "tick": "one", "status": "RUNNING"}',
+        "tick: expected `int`",
+    ),
     channels.ALERT: (b'{"id": "a"}', "missing field"),
     CLOCK.name: (b'{"clock": {"secs": 1}}', "clock: expected {secs, nsecs}"),
 }
@@ -166,19 +184,22 @@ def _topic(key: str) -> str:
     return SITE.topic(key) if key in INPUTS or key in OUTPUTS else key
 
 
-def test_every_channel_decodes_to_its_type(tmp_path: Path) -> None:
+def test_every_channel_decodes_to_the_executives_events(tmp_path: Path) -> None:
     types = {**_types(SITE), "/rosout": "rosgraph_msgs/Log"}
     messages = [*good_messages(SITE), ("/rosout", T0 + 99, b'{"msg": "hello"}')]
     reader = Reader(SITE)
-    records = list(reader.read(write(tmp_path / "good.mcap", messages, types)))
-    assert reader.tally.count == 0 and not any(isinstance(r, Bad) for r in records)
+    items = list(reader.read(write(tmp_path / "good.mcap", messages, types)))
+    assert reader.tally.count == 0 and not any(isinstance(i, Bad) for _, i in items)
     assert reader.tally.unread == {"/rosout": 1}  # no declaration for it: counted, unread
-    assert [r.t for r in records] == [t for _, t, _ in messages[:-1]]  # log-time order
+    times = [t for t, _ in items]
+    assert times == sorted(times)  # log-time order
+    assert sorted(set(times)) == [t for _, t, _ in messages[:-1]]  # every message
 
-    inputs = {r.role: r for r in records if isinstance(r, RobotInput)}
+    inputs = {reader.roles[i.topic]: i for _, i in items if isinstance(i, RobotInput)}
     assert set(inputs) == {*INPUTS, CLOCK_ROLE}
     assert inputs["pose"].value == POSE_VALUE
-    assert inputs["pose"].msg() == POSE.encode(POSE_VALUE)  # the msg as recorded, for sending
+    raw = inputs["pose"].raw
+    assert raw is not None and msgspec.json.decode(raw) == POSE.encode(POSE_VALUE)  # as recorded
     assert (inputs["response"].value, inputs["docking_state"].value) == (2, "undocked")
     assert inputs[CLOCK_ROLE].value == T0
     diagnostics = inputs["diagnostic"].value
@@ -190,36 +211,103 @@ def test_every_channel_decodes_to_its_type(tmp_path: Path) -> None:
     ):
         assert isinstance(inputs[role].value, kind)
 
-    commands = {r.role: r for r in records if isinstance(r, RobotCommand)}
+    commands = {i.role: i for _, i in items if isinstance(i, RobotCommand)}
     assert set(commands) == set(OUTPUTS)
     assert commands["goto"].value == POSE_VALUE
     assert commands["goto"].msg == POSE.encode(POSE_VALUE)
     assert [commands[r].value for r in ("approach", "icl", "dock")] == [3, "start", "undock"]
 
-    assert [
-        (type(r), r.seq) for r in records if isinstance(r, FrontendIn | FrontendOut | FrontendAck)
-    ] == [(FrontendIn, 1), (FrontendAck, 1), (FrontendOut, 3), (FrontendAck, 3), (FrontendIn, 2)]
-    acks = [r.direction for r in records if isinstance(r, FrontendAck)]
-    assert acks == ["out", "in"]
-    assert [r.message for r in records if isinstance(r, FrontendIn | FrontendOut)] == [
-        FrontendIdle(),
-        StartPoi("POI1", "POI1b", "a"),
-        ContentDone("POI1", "a"),
+    # every datagram as it crossed; each new event or command after its datagram
+    frontend = [
+        (i.direction, i.data) if isinstance(i, Datagram) else i
+        for _, i in items
+        if isinstance(i, Datagram | FrontendIn | FrontendOut)
+    ]
+    datagrams = [
+        (topic, data) for topic, _, data in messages if topic in (FRONTEND_IN, FRONTEND_OUT)
+    ]
+    assert frontend == [
+        ("in", datagrams[0][1]),
+        FrontendIn(T0 + 13, FrontendIdle()),
+        ("out", datagrams[1][1]),  # an ack
+        ("out", datagrams[2][1]),
+        FrontendOut(T0 + 15, StartPoi("POI1", "POI1b", "a")),
+        ("in", datagrams[3][1]),  # an ack
+        ("in", datagrams[4][1]),
+        FrontendIn(T0 + 17, ContentDone("POI1", "a")),
     ]
 
-    own = {r.channel: type(r.message) for r in records if isinstance(r, Own)}
-    assert own == {
-        channels.TICK: channels.Tick,
-        channels.BLAME: channels.Blame,
-        channels.TREE: channels.Tree,
-        channels.OPERATOR: channels.Operator,
-        channels.ALERT: channels.Alert,
-    }
-    (primed,) = [r for r in records if isinstance(r, Primed)]
+    # our channels: the events as the executive told them, each on its channel
+    own = {t: i for t, i in items if isinstance(i, tuple(type(e) for e in EVENTS.values()))}
+    assert list(own.values()) == list(EVENTS.values())
+    (tree,) = [i for _, i in items if isinstance(i, channels.Tree)]
+    assert tree.xml == "<r/>"
+    ((t, primed),) = [(t, i) for t, i in items if isinstance(i, Primed)]
     assert primed.primer.frontend_out_seqs == [1, 2] and primed.primer.frontend_ready
-    assert [(i.role, i.value, i.t) for i in primed.inputs] == [
+    assert [(reader.roles[i.topic], i.value, i.t) for i in primed.inputs] == [
         ("docking_state", "docked", T0 - 30.0)
     ]  # at the time it was received
+    assert t == T0
+
+
+OLD = {  # the same events as a recording made before recorded them (old schema, old shape)
+    channels.TICK: ("frog_bt/Tick", b'{"tick":1,"status":"RUNNING"}'),
+    channels.BLAME: (
+        "frog_bt/Blame",
+        b'{"channel":"start_poi","node":"tour.yaml:3 Play","reads":{"stop":"POI1"}}',
+    ),
+    channels.OPERATOR: (
+        "frog_bt/Operator",
+        b'{"tick":4,"command":"skip","ok":true,"text":"ok","id":"","by":"console"}',
+    ),
+    channels.ALERT: (
+        "frog_bt/Alert",
+        b'{"id":"a1","kind":"fault","text":"x","state":"raised","since":1780000000.0}',
+    ),
+    channels.DOUBT: (
+        "frog_bt/Doubt",
+        b'{"code":2,"goal":"SHOP","why":"arrival at POI2 heard late: ignored","answers":"POI2"}',
+    ),
+    channels.FAULT: (
+        "frog_bt/Fault",
+        b'{"where":"node X","what":"its tick","error":"ValueError: x","count":3}',
+    ),
+    channels.LINKS: (
+        "frog_bt/Links",
+        b'{"rosbridge":"connected","frontend":"acking","clock":"/clock"}',
+    ),
+}
+
+
+def test_an_old_recordings_event_channels_decode_to_the_same_events(tmp_path: Path) -> None:
+    """Before the events were recorded as themselves, each had a shape of its own (no time,
+    no tag) under another schema name: read as the same event, its time the log's."""
+    types = {channel: schema for channel, (schema, _) in OLD.items()}
+    messages = [(channel, T0 + 0.1, data) for channel, (_, data) in OLD.items()]
+    reader = Reader(SITE)
+    items = [i for _, i in reader.read(write(tmp_path / "old.mcap", messages, types))]
+    assert items == list(EVENTS.values()) and reader.tally.count == 0
+    damaged = [(channels.TICK, T0, b'{"tick": "one", "status": "RUNNING"}')]
+    (bad,) = [i for _, i in Reader(SITE).read(write(tmp_path / "bad.mcap", damaged, types))]
+    assert isinstance(bad, Bad) and bad.reason.startswith("tick: expected `int`")
+
+
+def test_a_recording_made_by_the_code_before_reads_and_replays_identical() -> None:
+    """A recording ``frog-bt demo --scenario undock_fails`` made before the events were
+    recorded as themselves (tests/data): it reads whole and replays identical."""
+    path = Path(__file__).parents[1] / "data" / "recorded-v0.1.0-undock_fails.mcap"
+    recording = open_recording(path)
+    assert recording.types[channels.TICK] == "frog_bt/Tick"  # the old shapes
+    reader = Reader(SITE)
+    items = [i for _, i in reader.read(recording)]
+    assert reader.tally.count == 0
+    ticks = [i for i in items if isinstance(i, Ticked)]
+    assert [i.tick for i in ticks] == list(range(1, len(ticks) + 1)) and len(ticks) > 50
+    assert {type(i) for i in items} >= {Blamed, AlertChanged, LinksChanged, FrontendOut}
+    result = Replay(path, SITE, load_tree(site=SITE)).run()
+    assert result.identical and result.exact and not result.bad_count
+    assert (result.ticks, result.ros_commands, result.frontend_commands) == (len(ticks), 3, 2)
+    assert result.alerts == 1
 
 
 def test_a_damaged_message_of_each_kind_is_counted_and_the_rest_still_read(tmp_path: Path) -> None:
@@ -238,19 +326,17 @@ def test_a_damaged_message_of_each_kind_is_counted_and_the_rest_still_read(tmp_p
     damaged.append((channels.PRIMER, T0 + 200, bad_primer))
     later = [(topic, t + 300, data) for topic, t, data in good]
     reader = Reader(SITE, keep=5)
-    records = list(
-        reader.read(write(tmp_path / "bad.mcap", [*good, *damaged, *later], _types(SITE)))
-    )
+    items = list(reader.read(write(tmp_path / "bad.mcap", [*good, *damaged, *later], _types(SITE))))
 
-    bad = [r for r in records if isinstance(r, Bad)]
+    bad = [i for _, i in items if isinstance(i, Bad)]
     assert [(b.channel, b.t) for b in bad] == [
         *((topic, t) for topic, t, _ in damaged[:-1]),
         (channels.PRIMER, T0 + 200),
     ]
-    for record, (_, reason) in zip(bad, BAD.values(), strict=False):
-        assert reason in record.reason, (record.channel, record.reason)
+    for item, (_, reason) in zip(bad, BAD.values(), strict=False):
+        assert reason in item.reason, (item.channel, item.reason)
     assert bad[-1].reason == "inputs[0] (/FROG_response): data: expected `int`, got `float`"
-    (primed,) = [r for r in records if isinstance(r, Primed) and r.t == T0 + 200]
+    (primed,) = [i for t, i in items if isinstance(i, Primed) and t == T0 + 200]
     assert [i.value for i in primed.inputs] == ["docked"]  # the good entry is kept
 
     tally = reader.tally
@@ -258,8 +344,8 @@ def test_a_damaged_message_of_each_kind_is_counted_and_the_rest_still_read(tmp_p
     assert tally.by_channel[SITE.topic("pose")] == 1 and tally.by_channel[FRONTEND_IN] == 1
     assert [b.channel for b in tally.first] == [b.channel for b in bad[:5]]  # 5 kept
     assert tally.lines(T0)[0] == f"{SITE.topic('pose')} at +{100.0:.1f} s: {bad[0].reason}"
-    good_after = [r for r in records if r.t >= T0 + 300 and not isinstance(r, Bad)]
-    assert len(good_after) == len(good)  # the rest of the file is still read
+    good_after = {t for t, i in items if t >= T0 + 300 and not isinstance(i, Bad)}
+    assert good_after == {t for _, t, _ in later}  # the rest of the file is still read
 
 
 class _Messages(RecordingFile):
@@ -296,18 +382,16 @@ TOPICS = sorted(_types(SITE))
         max_size=8,
     )
 )
-def test_any_bytes_on_any_channel_are_a_record_never_an_exception(
+def test_any_bytes_on_any_channel_are_an_item_never_an_exception(
     messages: list[tuple[str, bytes]],
 ) -> None:
     reader = Reader(SITE)
     recording = _Messages(
         _types(SITE), [(topic, T0 + i, data) for i, (topic, data) in enumerate(messages)]
     )
-    records: list[Record] = list(reader.read(recording))
-    bad = sum(isinstance(r, Bad) for r in records)
-    assert bad == reader.tally.count
-    primed_bad = sum(len(r.bad) for r in records if isinstance(r, Primed))
-    assert len(records) - primed_bad == len(messages)  # one record per message
+    items: list[tuple[float, Item]] = list(reader.read(recording))
+    assert sum(isinstance(i, Bad) for _, i in items) == reader.tally.count
+    assert {t for t, _ in items} == {T0 + i for i in range(len(messages))}  # each one read
 
 
 def test_replay_reports_a_damaged_robot_input_and_command(
@@ -345,3 +429,26 @@ def test_the_report_counts_damaged_messages_and_reads_past_them(tmp_path: Path) 
     assert facts.bad_first[0].startswith(f"{SITE.topic('pose')} at +100.0 s: ")
     (piece,) = facts.pieces
     assert [(s.poi, s.waypoint) for s in piece.stops if s.parts] == [("POI1", "POI1b")]
+
+
+def test_no_twins_of_the_events_remain() -> None:
+    """One family of facts: the recorder writes the events, the reader gives them back;
+    no channel Struct or reader record mirrors one of them."""
+    from frog_bt.model import events
+    from frog_bt.recordings import reader
+
+    for name in ("Tick", "Blame", "Operator", "Doubt", "Fault", "Links"):
+        assert not hasattr(channels, name), f"channels.{name} mirrors an event"
+    for name in ("Record", "Own", "FrontendAck", "OwnMessage", "RosValue"):
+        assert not hasattr(reader, name), f"reader.{name} is a record family of its own"
+    for name in ("RobotInput", "RobotCommand", "FrontendIn", "FrontendOut"):
+        assert getattr(reader, name, None) in (None, getattr(events, name))
+    names = "Tick|Blame|Operator|Doubt|Fault|Links|Own|FrontendAck|FrontendIn|FrontendOut"
+    twin = re.compile(rf"^class ({names}|Robot\w+)\((msgspec\.)?Struct\b", re.M)
+    package = Path(events.__file__).parents[1]
+    found = [
+        p
+        for p in package.rglob("*.py")
+        if p.name != "events.py" and twin.search(p.read_text(encoding="utf-8"))
+    ]
+    assert not found, found

@@ -213,9 +213,9 @@ def test_the_issues_tour_replays_identically_with_every_answer_and_alert(
     out = capsys.readouterr().out
     assert out.startswith("identical: ") and ", 6 operator commands" in out
     states = [
-        (m.state, m.repeat)
+        (m.alert.state, m.alert.repeat)
         for _, _, m in _messages(recorded["dock"], "/frog_bt/alert")
-        if m.id == "docking_failed"
+        if m.alert.id == "docking_failed"
     ]
     # raised, acknowledged; cleared by the retry; raised again, told again, acknowledged
     # (by link); cleared once docked by hand
@@ -242,12 +242,11 @@ def test_the_issues_tour_replays_identically_with_every_answer_and_alert(
 
 
 def _messages(path: Path, channel: str) -> list[tuple[float, str, Any]]:
-    from frog_bt.model import channels
+    """What ``channel`` holds, through the one reader: (t, channel, item)."""
+    from frog_bt.recordings.reader import Reader
 
     return [
-        (channels.from_ns(ns), topic, channels.decode(topic, data))
-        for topic, ns, data in open_recording(path).messages()
-        if topic == channel
+        (t, channel, item) for t, item in Reader(SITE, only={channel}).read(open_recording(path))
     ]
 
 
@@ -263,7 +262,9 @@ def test_a_tree_that_no_longer_asks_for_help_diverges_where_it_asked(
         home.read_text().replace("{type: AskForHelp, about: home}", "{type: GiveUp}")
     )
     path = recorded["dock"]
-    raised = min(t for t, _, m in _messages(path, "/frog_bt/alert") if m.kind == "docking_failed")
+    raised = min(
+        t for t, _, m in _messages(path, "/frog_bt/alert") if m.alert.kind == "docking_failed"
+    )
     result = replay(path, load_tree(trees / "tour.yaml", SITE))
     div = result.divergence
     assert div is not None and div.expected is not None and div.got is not None

@@ -18,14 +18,25 @@ import pytest
 
 from frog_bt.cli import main
 from frog_bt.config import load_site
+from frog_bt.frontend.protocol import encode_datagram
 from frog_bt.model import channels
-from frog_bt.model.frontend import AskTour, FinishPoi, StartPoi, Tour, UserPositive
+from frog_bt.model.events import Datagram, FrontendIn, FrontendOut
+from frog_bt.model.frontend import (
+    AskTour,
+    FinishPoi,
+    FrontendMessage,
+    StartPoi,
+    Tour,
+    UserPositive,
+    message_fields,
+)
 from frog_bt.model.ledger import StopVisit
+from frog_bt.model.outcomes import TourState
 from frog_bt.model.run import RUN_METADATA
 from frog_bt.offline.report.facts import FileFacts, Piece, _Pieces
 from frog_bt.offline.report.rows import Played, StopTime, join, rows
 from frog_bt.recordings.mcapfile import open_recording
-from frog_bt.recordings.reader import FrontendIn, FrontendOut, Primed
+from frog_bt.recordings.reader import Item, Primed
 from frog_bt.runtime.observer import attach_all
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
@@ -308,6 +319,12 @@ def test_the_pieces_of_a_tour_are_joined_into_one() -> None:
     assert first.restarts == 1 and [str(i) for i in first.incidents] == ["restart"]
 
 
+def _out(t: float, seq: int, message: FrontendMessage) -> list[tuple[float, Item]]:
+    """A new command as the reader gives it: its datagram, then the event."""
+    datagram = encode_datagram(message.type, seq, message_fields(message))
+    return [(t, Datagram(t, "out", datagram)), (t, FrontendOut(t, message))]
+
+
 def test_a_tour_file_opening_with_the_tour_befores_end_resent_is_read_whole() -> None:
     """The idle file between two tours was short: the tour before's `tour ended` (seq 5)
     is still being resent when the next tour's file opens, after its `tour started`
@@ -315,19 +332,20 @@ def test_a_tour_file_opening_with_the_tour_befores_end_resent_is_read_whole() ->
     site = load_site()
     idle = _Pieces("r/1-idle.mcap", site)
     idle.first(100.0)
-    idle.take(Primed(100.0, channels.Primer(frontend_out_seqs=[4, 5, 6]), ()))
-    idle.take(FrontendOut(101.0, 7, Tour("started", ""), b""))
+    idle.take(100.0, Primed(channels.Primer(frontend_out_seqs=[4, 5, 6]), ()))
+    for t, item in _out(101.0, 7, Tour(TourState.STARTED, "")):
+        idle.take(t, item)
     tour = _Pieces("r/2-tour.mcap", site)
     tour.first(101.1)
-    for record in (
-        FrontendOut(101.2, 5, Tour("ended", ""), b""),
-        FrontendOut(130.0, 9, AskTour(True), b""),
-        FrontendIn(131.0, 3, UserPositive(), b""),
-        FrontendOut(150.0, 10, StartPoi("POI1", "POI1a", "a"), b""),
-        FrontendOut(170.0, 11, FinishPoi("POI1"), b""),
-        FrontendOut(300.0, 20, Tour("ended", ""), b""),
+    for t, item in (
+        *_out(101.2, 5, Tour(TourState.ENDED, "")),
+        *_out(130.0, 9, AskTour(True)),
+        (131.0, FrontendIn(131.0, UserPositive())),
+        *_out(150.0, 10, StartPoi("POI1", "POI1a", "a")),
+        *_out(170.0, 11, FinishPoi("POI1")),
+        *_out(300.0, 20, Tour(TourState.ENDED, "")),
     ):
-        tour.take(record)
+        tour.take(t, item)
     files = [
         FileFacts("r/1-idle.mcap", idle.finish(), restarts=[]),
         FileFacts("r/2-tour.mcap", tour.finish()),

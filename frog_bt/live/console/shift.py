@@ -89,16 +89,15 @@ class Shift:
     # ------------------------------------------------------------ what it sees
 
     def on_event(self, event: Event) -> None:
-        kind = type(event)
-        if kind is Ticked:
-            self._look(event.t)
-            self.check(event.t)
-        elif kind is FrontendOut and isinstance(event.message, Tour):  # type: ignore[union-attr]
-            state = event.message.state  # type: ignore[union-attr]
-            counted = {"started": "started", "ended": "completed"}.get(state, "aborted")
-            self.tours[counted] += 1
-        elif kind is OperatorDone and event.ok:  # type: ignore[union-attr]
-            self._done(event)  # type: ignore[arg-type]
+        match event:
+            case Ticked(t=t):
+                self._look(t)
+                self.check(t)
+            case FrontendOut(message=Tour(state=state)):
+                counted = {"started": "started", "ended": "completed"}.get(state, "aborted")
+                self.tours[counted] += 1
+            case OperatorDone(ok=True):
+                self._done(event)
 
     def _done(self, event: OperatorDone) -> None:
         if event.command in ("retry", "done_by_hand") and self._help_since is not None:

@@ -57,7 +57,6 @@ BOARD_KEYS: tuple[Key[Any], ...] = (
     keys.TARGET,  # a stop's lane: reached (the POI driven to when a drive succeeds)
 )
 _status = operator.attrgetter("status")
-MARKS = frozenset({OperatorDone, AlertChanged, Doubted, Faulted})  # bookmarks on the timeline
 Behaviour = py_trees.behaviour.Behaviour
 
 
@@ -155,21 +154,21 @@ class Rows:
 
     def on_event(self, event: Event) -> None:
         """One event of the host: a row for it, or the tree's changes after a tick."""
-        kind = type(event)
-        if kind is RobotInput:
-            self.ros_in(event)  # type: ignore[arg-type]
-        elif kind is Ticked:
-            core = self.core
-            if core is not None:
-                self.tick(core)
-        elif kind is RobotCommand:
-            self.ros_out(event)  # type: ignore[arg-type]
-        elif kind is FrontendOut:
-            self.frontend_out(event)  # type: ignore[arg-type]
-        elif kind is FrontendIn:
-            self.frontend_in(event)  # type: ignore[arg-type]
-        elif kind in MARKS:
-            self.mark(event)
+        match event:
+            case RobotInput():
+                self.ros_in(event)
+            case Ticked():
+                core = self.core
+                if core is not None:
+                    self.tick(core)
+            case RobotCommand():
+                self.ros_out(event)
+            case FrontendOut():
+                self.frontend_out(event)
+            case FrontendIn():
+                self.frontend_in(event)
+            case OperatorDone() | AlertChanged() | Doubted() | Faulted():
+                self.mark(event)
 
     def mark(self, event: Event) -> None:
         """A bookmark: staff acted (a command, an alert raised for help, acknowledged), a

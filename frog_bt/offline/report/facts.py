@@ -23,25 +23,29 @@ What a piece counts (stops reached, played and skipped, goals, visitors, ...) is
 count of tours, :class:`~frog_bt.model.ledger.TourLedger`, fed the file's events; the
 piece boundaries above are the ledger's rows.
 
-Channels read, through the one decoder of recordings (:mod:`frog_bt.recordings.reader`):
-``/frontend/out`` (tour, start_poi, finish_poi, ask_tour), ``/frontend/in``
-(user_positive/negative, content_done), ``/GotoWayPoint``, ``/ApproachPeopleFar``,
+Channels read, through the one decoder of recordings (:mod:`frog_bt.recordings.reader`),
+as the executive's events it gives back: ``/frontend/out`` (tour, start_poi, finish_poi,
+ask_tour: its new commands, and the seq of each), ``/frontend/in`` (user_positive/negative,
+content_done), ``/GotoWayPoint``, ``/ApproachPeopleFar``,
 ``/FROG_response``, ``/docking/dock``, ``/docking/state``, ``/ICL_command``,
 ``/ICL_FaceDataStream``, ``/FROG_pose``, ``/diagnostic``, ``/frog_bt/operator``,
-``/frog_bt/alert``, ``/frog_bt/doubt`` and ``/frog_bt/primer`` (a rotated file: the
-front-end seqs sent just before it, so that a resend across the rotation is not taken
-for a new command). Topic
+``/frog_bt/alert``, ``/frog_bt/doubt`` and ``/frog_bt/primer`` (a rotated file: the reader
+takes the front-end seqs sent just before it, so that a resend across the rotation is not
+taken for a new command). Topic
 names are the site's. A message that does not decode is counted (:attr:`FileFacts.bad`)
 and read past.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from frog_bt.config import Site
+from frog_bt.errors import DecodeError
+from frog_bt.frontend.protocol import decode_datagram
 from frog_bt.model.channels import (
     ALERT,
     DOUBT,
@@ -51,19 +55,24 @@ from frog_bt.model.channels import (
     PRIMER,
     SITE_METADATA,
     TREE,
+    Tree,
     from_ns,
 )
-from frog_bt.model.channels import Alert as AlertMessage
-from frog_bt.model.channels import Operator as OperatorMessage
-from frog_bt.model.channels import Tree as TreeMessage
+from frog_bt.model.events import (
+    AlertChanged,
+    Datagram,
+    Event,
+    FrontendOut,
+    OperatorDone,
+    RobotInput,
+)
 from frog_bt.model.frontend import Tour
 from frog_bt.model.ledger import TourLedger, TourRow, step
 from frog_bt.model.outcomes import TourState
 from frog_bt.model.ros import Pose
 from frog_bt.model.run import read_metadata
-from frog_bt.offline.record_events import as_event
 from frog_bt.recordings.mcapfile import RecordingError, open_recording
-from frog_bt.recordings.reader import FrontendOut, Own, Primed, Reader, Record, RobotInput
+from frog_bt.recordings.reader import Item, Primed, Reader
 
 OWN = (FRONTEND_IN, FRONTEND_OUT, OPERATOR, ALERT, DOUBT, PRIMER, TREE)
 HOUR = 3600.0  # distance is summed per clock hour (cheap), then per local day
@@ -143,7 +152,7 @@ def stop_of(site: Site) -> dict[str, str]:
 
 
 class _Pieces:
-    """One file's records, in time order (:meth:`take` each): its tours counted by the
+    """One file's items, in time order (:meth:`take` each): its tours counted by the
     one ledger (:class:`~frog_bt.model.ledger.TourLedger`), and what the file holds
     besides (operator commands, alert changes, metres per hour, the tree)."""
 
@@ -151,14 +160,14 @@ class _Pieces:
         self.path = path
         self.ledger = TourLedger(site.tour_plan())
         self.primed = False  # the file opens with a /frog_bt/primer (an idle rotation)
-        self.seen: set[int] = set()  # front-end seqs sent (a resend has the same one)
+        self.seq = 0  # the seq of the latest datagram out (the command after it is its)
         self.seqs: dict[int, tuple[int, int]] = {}  # id(row) -> (started seq, end seq)
         self.pose: tuple[float, float] | None = None
         self.operator: list[OperatorCall] = []
         self.alerts: list[AlertChange] = []
         self.metres: dict[int, float] = {}
         self.tree = ""
-        self.last: float | None = None  # the latest record's time
+        self.last: float | None = None  # the latest item's time
         self.pose_topic = site.topic("pose")
 
     def first(self, t: float) -> None:
@@ -173,28 +182,43 @@ class _Pieces:
             out.append(Piece(**vars(row), file=self.path, started_seq=started, end_seq=ended))
         return out
 
-    def take(self, record: Record) -> None:
-        """One record of the file (acks, ticks and bad messages tell nothing here)."""
-        self.last = record.t
-        if isinstance(record, FrontendOut):
-            if record.seq in self.seen:
-                return  # a resend (datagram loss): not a new command
-            self.seen.add(record.seq)
-        elif isinstance(record, Primed):
-            self.primed = True  # a rotated file: the seqs sent just before it
-            self.seen.update(record.primer.frontend_out_seqs)
-            return
-        elif isinstance(record, RobotInput) and record.topic == self.pose_topic:
-            self._pose(record.t, record.value)
-        elif isinstance(record, Own):
-            self.own(record)
-        event = as_event(record)  # TEMPORARY: until the reader yields the events
-        if event is None:
+    def take(self, t: float, item: Item) -> None:
+        """One item of the file, in time order: every event to the ledger; besides, the
+        seq of each datagram out (the new command the reader gives after it is its),
+        metres driven, operator commands, alert changes and the tree."""
+        self.last = t
+        match item:
+            case Datagram(direction="out", data=data):
+                with contextlib.suppress(DecodeError):
+                    self.seq = decode_datagram(data).seq
+            case Primed():
+                self.primed = True  # a rotated file (the reader took its seqs sent)
+            case RobotInput(topic=topic, value=value) if topic == self.pose_topic:
+                self._pose(t, value)
+            case OperatorDone():
+                self.operator.append(
+                    OperatorCall(t, item.command, item.ok, item.text, item.id, item.by)
+                )
+            case AlertChanged(alert=alert):
+                self.alerts.append(
+                    AlertChange(
+                        t,
+                        alert.id,
+                        alert.kind,
+                        alert.state,
+                        alert.severity,
+                        alert.repeat,
+                        alert.subject,
+                    )
+                )
+            case Tree(xml=xml) if not self.tree:
+                self.tree = hashlib.sha256(xml.encode()).hexdigest()[:12]
+        if not isinstance(item, Event):
             return
         before = self.ledger.current
-        self.ledger.feed(event)
-        if isinstance(record, FrontendOut) and isinstance(record.message, Tour):
-            self._seq(record.seq, record.message, before)
+        self.ledger.feed(item)
+        if isinstance(item, FrontendOut) and isinstance(item.message, Tour):
+            self._seq(self.seq, item.message, before)
 
     def _seq(self, seq: int, message: Tour, before: TourRow | None) -> None:
         """Note the seq of a tour's start or end on its row."""
@@ -217,36 +241,6 @@ class _Pieces:
                 self.metres[hour] = self.metres.get(hour, 0.0) + metres
         self.pose = (value.x, value.y)
 
-    def own(self, record: Own) -> None:
-        """Operator commands and alert changes, in or out of a tour (rows assign them to
-        tours by time: an alert raised as a tour aborts is raised on the drive home)."""
-        message = record.message
-        if isinstance(message, OperatorMessage):
-            self.operator.append(
-                OperatorCall(
-                    record.t,
-                    message.command,
-                    message.ok,
-                    message.text,
-                    message.id,
-                    message.by,
-                )
-            )
-        elif isinstance(message, AlertMessage):
-            self.alerts.append(
-                AlertChange(
-                    record.t,
-                    message.id,
-                    message.kind,
-                    message.state,
-                    message.severity,
-                    message.repeat,
-                    message.subject,
-                )
-            )
-        elif isinstance(message, TreeMessage) and not self.tree:
-            self.tree = hashlib.sha256(message.xml.encode()).hexdigest()[:12]
-
 
 def read_file(path: str, site: Site) -> FileFacts:
     """The tour pieces in one recording; any failure is an unreadable file, never a crash."""
@@ -259,8 +253,8 @@ def read_file(path: str, site: Site) -> FileFacts:
         start = from_ns(recording.start) if recording.start or recording.end else None
         if start is not None:
             pieces.first(start)
-        for record in reader.read(recording):
-            pieces.take(record)
+        for t, item in reader.read(recording):
+            pieces.take(t, item)
         # An executive's first file: neither a tour file nor an idle file it rotated into
         # (those open with a primer); a file without our metadata is one whole run.
         kind = recording.metadata.get("frog_bt", {}).get("kind")
