@@ -10,7 +10,7 @@ from bench import Bench, write_tree
 
 from frog_bt.live.telemetry import Telemetry
 from frog_bt.live.telemetry.layout import TreeIndex
-from frog_bt.live.telemetry.rows import Rows
+from frog_bt.live.telemetry.rows import CODES, Rows
 from frog_bt.model.frontend import FrontendIdle
 from frog_bt.model.outcomes import IncidentKind, Level
 from frog_bt.runtime.observer import attach_all
@@ -40,13 +40,14 @@ def rows_on(bench: Bench, **kwargs: object) -> Rows:
 
 
 def test_rows_belong_to_the_tick_that_consumes_or_produces_them(bench: Bench):
+    run, invalid = CODES[S.RUNNING], CODES[S.INVALID]
     rows = rows_on(bench)
     t0 = bench.clock.now()
     bench.pose(1.0, 2.0)
     assert rows.batch.poses == [(1, t0, 1.0, 2.0, 0.0)]  # consumed by tick 1
     bench.tick()
     # the first row has every node, later ones only the nodes whose status changed
-    first = ((0, S.RUNNING), (1, S.RUNNING), (2, S.INVALID), (3, S.INVALID))
+    first = ((0, run), (1, run), (2, invalid), (3, invalid))  # as codes: CODES[status]
     assert rows.batch.statuses == [(1, t0, first)]
     bench.advance(0.1)
     bench.tick()
@@ -55,7 +56,7 @@ def test_rows_belong_to_the_tick_that_consumes_or_produces_them(bench: Bench):
     bench.advance(0.1)
     bench.tick()  # tick 3: the front end is ready, the goal goes out
     t3 = bench.clock.now()
-    assert rows.batch.statuses[-1] == (3, t3, ((1, S.SUCCESS), (2, S.RUNNING)))
+    assert rows.batch.statuses[-1] == (3, t3, ((1, CODES[S.SUCCESS]), (2, run)))
     assert rows.batch.events == [(3, t0 + 0.1, "frontend_idle", FrontendIdle())]
     [(tick, t, side, topic, _)] = rows.batch.outputs
     assert (tick, t, side, topic) == (3, t3, "ros", bench.site.topic("goto"))

@@ -57,6 +57,12 @@ BOARD_KEYS: tuple[Key[Any], ...] = (
     keys.TARGET,  # a stop's lane: reached (the POI driven to when a drive succeeds)
 )
 _status = operator.attrgetter("status")
+# A status as a small int in the rows (an int pickles at a fraction of an enum's cost, and
+# a tuple of ints is dropped from the collector's books): its index here.
+CODES = {
+    s: i for i, s in enumerate((Status.RUNNING, Status.SUCCESS, Status.FAILURE, Status.INVALID))
+}
+STATES = tuple(s.name for s in CODES)  # code -> the name a status lane shows
 MARKS = frozenset({OperatorDone, AlertChanged, Doubted, Faulted})  # bookmarks on the timeline
 Behaviour = py_trees.behaviour.Behaviour
 
@@ -70,12 +76,24 @@ class Batch:
     outputs: list[tuple[int, float, str, str, Any]] = field(default_factory=list)
     # ^ side ("ros" | "frontend"), channel (topic | message type), payload
     events: list[tuple[int, float, str, Any]] = field(default_factory=list)  # type, message
-    statuses: list[tuple[int, float, tuple[tuple[int, Status], ...]]] = field(default_factory=list)
-    # ^ the nodes whose status changed in that tick: (pre-order number, status), in order
+    statuses: list[tuple[int, float, tuple[tuple[int, int], ...]]] = field(default_factory=list)
+    # ^ the nodes whose status changed in that tick: (pre-order number, CODES[status])
     notes: list[tuple[int, float, str, Level]] = field(default_factory=list)
     blackboard: list[tuple[int, float, str, Any]] = field(default_factory=list)  # key, value
     marks: list[tuple[int, float, str, str, str]] = field(default_factory=list)
     # ^ bookmarks: kind ("staff" | "doubted" | "fault"), level, text
+
+    def extend(self, later: Batch) -> None:
+        """Append the rows of a later batch (a writer merging batches, see
+        :mod:`frog_bt.live.telemetry.process`)."""
+        self.poses.extend(later.poses)
+        self.inputs.extend(later.inputs)
+        self.outputs.extend(later.outputs)
+        self.events.extend(later.events)
+        self.statuses.extend(later.statuses)
+        self.notes.extend(later.notes)
+        self.blackboard.extend(later.blackboard)
+        self.marks.extend(later.marks)
 
     def restamp(self, t: float) -> None:
         """Give rows that arrived before the clock had a time (NaN) the time ``t``."""
@@ -266,12 +284,12 @@ class Rows:
             if self._unstamped:
                 batch.restamp(t)
                 self._unstamped = False
-            changes: list[tuple[int, Status]] = []
+            changes: list[tuple[int, int]] = []
             for node, status in zip(nodes, statuses, strict=True):
                 i = position.get(node)
                 if i is not None and current[i] is not status:
                     current[i] = status
-                    changes.append((i, status))
+                    changes.append((i, CODES[status]))
             if changes:
                 batch.statuses.append((tick, t, tuple(changes)))
             notes = core.journal.notes

@@ -20,7 +20,7 @@ import rerun as rr
 
 from frog_bt.config import Site
 from frog_bt.live.telemetry.layout import TICK, TIME, TreeIndex, status_path, tidy_layout
-from frog_bt.live.telemetry.rows import Batch
+from frog_bt.live.telemetry.rows import CODES, STATES, Batch
 from frog_bt.live.telemetry.site_map import poi_marks, tour_routes, zone_outlines
 from frog_bt.model.frontend import message_fields
 from frog_bt.model.links import Health, LinkStatus
@@ -33,15 +33,13 @@ if TYPE_CHECKING:
 
 Status = py_trees.common.Status
 
-STATES = ("RUNNING", "SUCCESS", "FAILURE", "INVALID")
 STATUS_COLORS = {
     Status.RUNNING: 0xF5B400FF,
     Status.SUCCESS: 0x2EA043FF,
     Status.FAILURE: 0xE5484DFF,
     Status.INVALID: 0x8B949EFF,
 }
-CODES = {status: i for i, status in enumerate(STATUS_COLORS)}  # a status as a small int
-COLOR_TABLE = np.array(list(STATUS_COLORS.values()), dtype=np.uint32)  # code -> colour
+COLOR_TABLE = np.array([STATUS_COLORS[s] for s in CODES], dtype=np.uint32)  # code -> colour
 ROUTE_COLORS = (0xA371F7AA, 0x39C5CFAA, 0xDB61A2AA, 0x8B949EAA)  # one per period of the day
 ZONE_COLORS = {"volume": 0x3FB95099, "special": 0xDB61A299}
 FACING, NOT_FACING, TRACKED = 0x3FB950FF, 0xFF8C42FF, 0x8B949E66
@@ -343,7 +341,7 @@ class Writer:
             )
 
     def _write_statuses(
-        self, rows: list[tuple[int, float, tuple[tuple[int, Status], ...]]]
+        self, rows: list[tuple[int, float, tuple[tuple[int, int], ...]]]
     ) -> Iterator[None]:
         # Each row holds the changes of one tick; the graph needs every node's colour per
         # row: the codes of all nodes are kept here and a row's colours read off them.
@@ -356,9 +354,9 @@ class Writer:
         paths: list[tuple[int, float, tuple[int, ...] | None, np.ndarray]] = []
         for start in range(0, len(rows), per_step):
             for n, (tick, t, changes) in enumerate(rows[start : start + per_step], start):
-                for i, status in changes:
-                    codes[i] = CODES[status]
-                    lanes.setdefault(i, []).append((tick, t, status.name))
+                for i, code in changes:
+                    codes[i] = code
+                    lanes.setdefault(i, []).append((tick, t, STATES[code]))
                 colors[n] = COLOR_TABLE[codes]
                 shown = self._running_path(codes)
                 if shown != self._path or any(
