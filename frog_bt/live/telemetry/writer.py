@@ -19,7 +19,15 @@ import py_trees
 import rerun as rr
 
 from frog_bt.config import Site
-from frog_bt.live.telemetry.layout import TICK, TIME, TreeIndex, status_path, tidy_layout
+from frog_bt.live.telemetry.layout import (
+    TICK,
+    TIME,
+    TreeIndex,
+    site_ns,
+    site_offset,
+    status_path,
+    tidy_layout,
+)
 from frog_bt.live.telemetry.rows import CODES, STATES, Batch
 from frog_bt.live.telemetry.site_map import poi_marks, tour_routes, zone_outlines
 from frog_bt.model.frontend import message_fields
@@ -84,8 +92,12 @@ def link_path(name: str) -> str:
 
 def _times(rows: Sequence[tuple[Any, ...]]) -> list[rr.TimeColumn]:
     # Nanoseconds as rerun rounds them one by one (round(1e9 * t)), but in one numpy pass:
-    # a list of floats costs rerun a Python conversion per row.
-    ns = np.round(np.array([r[1] for r in rows], dtype=np.float64) * 1e9).astype(np.int64)
+    # a list of floats costs rerun a Python conversion per row. On the site's clock
+    # (layout.site_offset): one offset for the batch, unless summer time began or ended.
+    t = np.array([r[1] for r in rows], dtype=np.float64)
+    first, last = site_offset(t[0]), site_offset(t[-1])
+    shift = first if first == last else np.array([site_offset(x) for x in t])
+    ns = np.round((t + shift) * 1e9).astype(np.int64)
     return [
         rr.TimeColumn(TICK, sequence=[r[0] for r in rows]),
         rr.TimeColumn(TIME, timestamp=ns.astype("datetime64[ns]")),
@@ -290,7 +302,7 @@ class Writer:
         rec.set_time(TICK, sequence=tick)
         if t > 0:  # before the clock has a time (sim time, no /clock yet): the tick only,
             # not 1970 on the tour's clock (the timeline would open on 56 years)
-            rec.set_time(TIME, timestamp=np.datetime64(round(t * 1e9), "ns"))
+            rec.set_time(TIME, timestamp=np.datetime64(site_ns(t), "ns"))
         for name, state in changes:
             rec.log(link_path(name), rr.StateChange(state=state.value))
         level = "WARN" if any(s.health in (Health.WAIT, Health.BAD) for _, s in changes) else "INFO"
@@ -658,7 +670,7 @@ class Writer:
 
     def _set_time(self, tick: int, t: float) -> None:
         self.rec.set_time(TICK, sequence=tick)
-        self.rec.set_time(TIME, timestamp=t)
+        self.rec.set_time(TIME, timestamp=np.datetime64(site_ns(t), "ns"))
 
     def _log_goal(self, tick: int, t: float, goal: Goal | None) -> None:
         rec = self.rec
