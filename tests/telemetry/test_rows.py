@@ -167,3 +167,20 @@ def test_rows_that_never_got_a_time_are_dropped(tmp_path: Path):
     bench.pose(1.0, 2.0)
     assert len(rows.batch.poses) == 1
     assert len(rows.drain()) == 0
+
+
+def test_a_stop_given_up_within_one_tick_still_reaches_its_lane(bench: Bench):
+    """/skipped is written and cleared (the next stop's scope) inside one tick, so the
+    end-of-tick blackboard never shows it: the stop's lane reads the journal's incidents."""
+    rows = rows_on(bench)
+    bench.tick()
+    bench.core.journal.note(
+        "skipped POI2: navigation kept failing", IncidentKind.STOP_SKIPPED, subject="POI2"
+    )
+    bench.core.journal.note("skipped POI3: the operator asked", IncidentKind.STOP_LEFT, "POI3")
+    bench.core.journal.note("arrived at POI0")
+    bench.tick()
+    left = [row for row in rows.batch.blackboard if row[2] == "/skipped"]
+    assert [(tick, poi) for tick, _, _, poi in left] == [(2, "POI2"), (2, "POI3")]
+    bench.tick()
+    assert len([row for row in rows.batch.blackboard if row[2] == "/skipped"]) == 2  # once

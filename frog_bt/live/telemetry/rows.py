@@ -40,22 +40,23 @@ from frog_bt.model.events import (
     Ticked,
 )
 from frog_bt.model.key import Key
-from frog_bt.model.outcomes import Level
+from frog_bt.model.outcomes import IncidentKind, Level
 from frog_bt.model.wire import INPUTS
 
 if TYPE_CHECKING:
     from frog_bt.config import Site
     from frog_bt.engine.core import Core
-    from frog_bt.engine.journal import Note
+    from frog_bt.engine.journal import Journal, Note
     from frog_bt.runtime.observer import Host
 
 Status = py_trees.common.Status
 BOARD_KEYS: tuple[Key[Any], ...] = (
     keys.ENGAGEMENT_METER,
     keys.ENGAGEMENT_DECISION,
-    keys.SKIPPED,  # a stop's lane: skipped
     keys.TARGET,  # a stop's lane: reached (the POI driven to when a drive succeeds)
 )
+SKIPPED = keys.SKIPPED.name  # a stop's lane: skipped (from the journal's incidents)
+LEFT = frozenset({IncidentKind.STOP_SKIPPED, IncidentKind.STOP_LEFT})
 _status = operator.attrgetter("status")
 # A status as a small int in the rows (an int pickles at a fraction of an enum's cost, and
 # a tuple of ints is dropped from the collector's books): its index here.
@@ -146,6 +147,8 @@ class Rows:
         self._current: list[Status | None] = [None] * len(self._behaviours)
         self._scan_all = True  # read every node's status at the next tick
         self._last_note: Note | None = None
+        self._journal: Journal | None = None
+        self._incidents = 0  # incidents of that journal already seen
         self._blackboard: dict[str, Any] = {}
         self._ticks_since_drain = 0
         self._unstamped = False
@@ -299,6 +302,17 @@ class Rows:
                     i -= 1
                 batch.notes.extend((tick, n.at, n.text, n.level) for n in notes[i + 1 :])
                 self._last_note = notes[-1]
+            journal = core.journal
+            if journal is not self._journal:  # another core (a reload): its own journal
+                self._journal, self._incidents = journal, 0
+            if journal.incident_total != self._incidents:
+                # A stop given up on: its lane says skipped. Read off the incidents, not
+                # the blackboard: /skipped is written and cleared (the next stop's scope)
+                # within one tick.
+                for incident in journal.incidents_since(self._incidents):
+                    if incident.kind in LEFT and incident.subject:
+                        batch.blackboard.append((tick, incident.at, SKIPPED, incident.subject))
+                self._incidents = journal.incident_total
             for key in BOARD_KEYS:
                 value = core.board.get(key)
                 if value is not self._blackboard.get(key.name):
