@@ -93,6 +93,7 @@ def gaps(root: Behaviour) -> list[Gap]:
             outs = [visit(child, have, lost) for child in children]
             return _all(outs, have)
         if py_trees.composites.Parallel in mro:
+            assert isinstance(node, py_trees.composites.Parallel)  # (cached by now)
             outs = [visit(child, have, lost) for child in children]
             policy = node.policy
             if isinstance(policy, py_trees.common.ParallelPolicy.SuccessOnAll):
