@@ -7,7 +7,9 @@ queue to a child process that owns the rerun recording stream
 (:class:`~frog_bt.live.telemetry.Telemetry` there) and does all the formatting and
 logging. So:
 
-* the tick never waits for rerun (the queue's feeder thread pickles the batch);
+* the tick never waits for rerun (the batch is pickled once the tick is over, the
+  queue's feeder thread only copies bytes); the child merges batches for a file
+  (:class:`_Pending`: fewer, larger rerun chunks, a smaller file);
 * the rerun SDK's own memory, which grows with every row it has logged (see
   docs/PERFORMANCE.md), is the child's, not the executive's; and the child is
   replaced by a fresh one every :data:`RECYCLE_ROWS` rows, which gives that
