@@ -11,10 +11,16 @@ from __future__ import annotations
 import hashlib
 import ipaddress
 import math
+import os
 from datetime import time as dtime
 from pathlib import Path
 from typing import Annotated, Any, Literal
 from urllib.parse import urlsplit
+
+# pydantic looks for plugins in every installed distribution's entry points when it builds
+# the first model (a tenth of a second at start-up); frog-bt has none. An explicit setting
+# in the environment wins.
+os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")
 
 from pydantic import (
     AfterValidator,

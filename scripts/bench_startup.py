@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import os
 import signal
 import subprocess
 import sys
@@ -34,7 +35,9 @@ from bench_support import (
 )
 
 
-async def startup_runs(runs: int, extra: list[str]) -> dict[str, Any]:
+async def startup_runs(
+    runs: int, extra: list[str], importtime: Path | None = None
+) -> dict[str, Any]:
     from frog_bt.model.wire import INPUTS
 
     server = FakeRosbridge(expect_subscriptions=len(INPUTS))
@@ -61,7 +64,8 @@ async def startup_runs(runs: int, extra: list[str]) -> dict[str, Any]:
                 "--quiet",
                 *extra,
                 stdout=subprocess.DEVNULL,
-                stderr=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL if importtime is None else importtime.open("wb"),
+                env={**os.environ, "PYTHONPROFILEIMPORTTIME": "1"} if importtime else None,
             )
             try:
                 await asyncio.wait_for(server.ready.wait(), 30)
@@ -73,6 +77,30 @@ async def startup_runs(runs: int, extra: list[str]) -> dict[str, Any]:
         frontend.close()
         await server.stop()
     return summary(times)
+
+
+def import_table(log: Path, top: int = 25) -> dict[str, Any]:
+    """What ``-X importtime`` wrote up to the subscription: the total of the top-level
+    imports (cumulative), and each package's own import time (its modules' self times
+    summed: numpy, pydantic, frog_bt ...), dearest first, in seconds."""
+    total = 0
+    own: dict[str, int] = {}
+    modules = 0
+    for line in log.read_text(errors="replace").splitlines():
+        if not line.startswith("import time:") or "cumulative" in line:
+            continue
+        self_us, cum_us, name = line.split(":", 1)[1].split("|")
+        if not name.startswith("  "):  # a top-level import has one space before its name
+            total += int(cum_us)
+        package = name.strip().split(".")[0]
+        own[package] = own.get(package, 0) + int(self_us)
+        modules += 1
+    dearest = sorted(own.items(), key=lambda kv: -kv[1])[:top]
+    return {
+        "total_s": total / 1e6,
+        "modules": modules,
+        "packages_self_s": {k: round(v / 1e6, 4) for k, v in dearest},
+    }
 
 
 def import_time() -> float:
@@ -96,8 +124,21 @@ def main() -> None:
     p.add_argument(
         "--telemetry", action="store_true", help="also time a start with --record and --rerun save:"
     )
+    p.add_argument(
+        "--importtime",
+        type=Path,
+        metavar="LOG",
+        help="instead: one start under -X importtime (telemetry on with --telemetry), its "
+        "log kept in LOG, and the top-level imports summed by package",
+    )
     p.add_argument("--out")
     args = p.parse_args()
+    if args.importtime is not None:
+        with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
+            extra = ["--record", f"{tmp}/s.mcap", "--rerun", f"save:{tmp}/s.rrd"]
+            asyncio.run(startup_runs(1, extra if args.telemetry else [], args.importtime))
+        emit(import_table(args.importtime), args.out)
+        return
     result: dict[str, Any] = {"runs": args.runs}
     result["plain"] = asyncio.run(startup_runs(args.runs, []))
     if args.telemetry:

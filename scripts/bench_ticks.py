@@ -66,6 +66,68 @@ SCENARIO: dict[str, Any] = {
 }
 
 
+class _Probe:
+    """Stands for a core's ``emit`` (the host's Observers) and times what the observers do
+    while a tick runs (``inside``): the events the tick tells them, and a last tick's end
+    still held when the next one starts (``settle``). Also the garbage collector's time
+    inside ticks. Only with ``--probe``: it adds a little to every call it times."""
+
+    def __init__(self, observers: Any, clock: Any) -> None:
+        self.observers = observers
+        self.clock = clock
+        self.inside = False
+        self.emit_ns: list[int] = []  # per tick: observers' time inside it
+        self.gc_ns: list[int] = []  # per tick: the collector's time inside it
+        self._emit = 0
+        self._gc = 0
+        self.by_kind: dict[str, int] = defaultdict(int)  # ns inside ticks: emit, settle, later
+        self.settled = 0  # ticks that began by telling a last tick's end still held
+        self._gc0 = 0
+        gc.callbacks.append(self._collecting)
+
+    def _collecting(self, phase: str, info: dict[str, Any]) -> None:
+        if not self.inside:
+            return
+        if phase == "start":
+            self._gc0 = self.clock()
+        else:
+            self._gc += self.clock() - self._gc0
+
+    def __bool__(self) -> bool:
+        return bool(self.observers)
+
+    def __call__(self, event: Any) -> None:
+        t0 = self.clock()
+        self.observers.emit(event)
+        self._count("emit", self.clock() - t0)
+
+    def settle(self) -> None:
+        held = bool(self.observers._later)
+        t0 = self.clock()
+        self.observers.settle()
+        self._count("settle", self.clock() - t0)
+        if held and self.inside:
+            self.settled += 1
+
+    def later(self, event: Any) -> None:
+        t0 = self.clock()
+        self.observers.later(event)
+        self._count("later", self.clock() - t0)
+
+    def _count(self, kind: str, ns: int) -> None:
+        if self.inside:
+            self._emit += ns
+            self.by_kind[kind] += ns
+
+    def start(self) -> None:
+        self.inside, self._emit, self._gc = True, 0, 0
+
+    def end(self) -> None:
+        self.inside = False
+        self.emit_ns.append(self._emit)
+        self.gc_ns.append(self._gc)
+
+
 class _Null:
     """An observer that hears every event and does nothing with it."""
 
@@ -98,7 +160,9 @@ def phase_of(node: Any, dock: str, recruit_at: str) -> str:
     return "other"
 
 
-async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
+async def one_tour(
+    stops: int, telemetry: str, workdir: Path, probe: bool = False
+) -> dict[str, Any]:
     from frog_bt.behaviours import load_tree
     from frog_bt.clock import SimClock
     from frog_bt.config import load_site
@@ -164,11 +228,18 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
     phases: dict[int, str] = {}
     dock, recruit_at = site.tour.dock, site.tour.recruit_at
     clock = time.thread_time_ns  # the tick thread's CPU time: not the time others took
+    probing = _Probe(core.emit, clock) if probe else None
+    if probing is not None:
+        core.emit = probing  # type: ignore[assignment]
 
     def timed_tick() -> Any:
+        if probing is not None:
+            probing.start()
         t0 = clock()
         status = inner()
         dt = clock() - t0
+        if probing is not None:
+            probing.end()
         tip = core.root.tip()
         phase = phases.get(id(tip))
         if phase is None:
@@ -229,6 +300,23 @@ async def one_tour(stops: int, telemetry: str, workdir: Path) -> dict[str, Any]:
         "telemetry_dropped_batches": getattr(observers[-1], "dropped", 0) if observers else 0,
         "file_bytes": sizes,  # the recording and the .rrd of the tour
         "gc_collections": [s["collections"] for s in gc.get_stats()],
+        **(
+            {
+                "probe": {
+                    "observers_in_tick": summary_us(probing.emit_ns),
+                    "observers_in_tick_us_per_tick": sum(probing.emit_ns) / 1e3 / len(every),
+                    "gc_in_tick": summary_us(probing.gc_ns),
+                    "gc_in_tick_us_per_tick": sum(probing.gc_ns) / 1e3 / len(every),
+                    "ticks_with_gc": sum(1 for g in probing.gc_ns if g) / len(every),
+                    "in_tick_us_per_tick_by_call": {
+                        k: v / 1e3 / len(every) for k, v in probing.by_kind.items()
+                    },
+                    "ticks_settling_a_held_end": probing.settled / len(every),
+                }
+            }
+            if probing is not None
+            else {}
+        ),
     }
 
 
@@ -241,10 +329,15 @@ def main() -> None:
         default="off",
         help="on: --record FILE and --rerun save:FILE.rrd; or either alone",
     )
+    p.add_argument(
+        "--probe",
+        action="store_true",
+        help="also time the observers' work and the garbage collector inside the ticks",
+    )
     p.add_argument("--out", help="write the JSON result here (default: stdout)")
     args = p.parse_args()
     with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
-        result = asyncio.run(one_tour(args.stops, args.telemetry, Path(tmp)))
+        result = asyncio.run(one_tour(args.stops, args.telemetry, Path(tmp), args.probe))
     emit(result, args.out)
 
 

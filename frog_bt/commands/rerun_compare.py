@@ -11,12 +11,12 @@ def compare_lanes(rec: Any, replay: Any, site: Any) -> None:
     that sent it), and a marker at the divergence (``/log/replay/divergence``)."""
     import rerun as rr
 
-    from frog_bt.live.telemetry.layout import TICK, TIME
+    from frog_bt.live.telemetry.layout import TICK, TIME, site_ns
     from frog_bt.recordings.commands import describe, differences
 
     def at(t: float) -> None:
         rec.set_time(TICK, sequence=replay.core.ticks)
-        rec.set_time(TIME, timestamp=t)
+        rec.set_time(TIME, timestamp=site_ns(t) / 1e9)
 
     def command(side: str, c: Any) -> None:
         at(c.t)

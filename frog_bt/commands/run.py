@@ -268,7 +268,6 @@ async def _main(
     from frog_bt.runtime.memory import pin_malloc_thresholds
 
     pin_malloc_thresholds()  # all day without creeping up
-    from frog_bt.live.summary import TourSummary
     from frog_bt.runtime.status import StatusLine
 
     clock = SimClock() if args.sim_time else WallClock()
@@ -288,8 +287,11 @@ async def _main(
     loop = asyncio.get_running_loop()
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)
-    summary = TourSummary(site) if args.once else None
-    if summary is not None:
+    summary = None
+    if args.once:  # the summary printed after one tour
+        from frog_bt.live.summary import TourSummary
+
+        summary = TourSummary(site)
         attach_all(executive, [summary])
     status: StatusLine | None = None
     if not args.quiet:  # on a terminal a countdown; in a journal, states only

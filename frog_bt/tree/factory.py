@@ -12,7 +12,6 @@ from pathlib import Path
 
 from frog_bt.config import Site
 from frog_bt.engine.loaded import LoadedTree
-from frog_bt.tree.btcpp import tree_xml
 from frog_bt.tree.loader import load_tree
 from frog_bt.tree.registry import NodeRegistry
 
@@ -30,4 +29,6 @@ class NodeFactory(NodeRegistry):
     def export_xml(self, path: Path, site: Site | None) -> str:
         """The tree file at ``path`` as BehaviorTree.CPP v4 XML, its node model from these
         types."""
+        from frog_bt.tree.btcpp import tree_xml  # xml.etree: not needed to run a tree
+
         return tree_xml(path, site, self)

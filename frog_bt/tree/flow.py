@@ -74,6 +74,10 @@ def gaps(root: Behaviour) -> list[Gap]:
                 )
 
     def visit(node: Behaviour, have: Keys, lost: dict[Key[Any], Scope]) -> Keys:
+        # The node's classes by their MRO, not isinstance: py_trees' Behaviour is an ABC,
+        # whose first check of each leaf class against each composite walks every subclass
+        # (a third of loading the tour tree, at start-up).
+        mro = type(node).__mro__
         scope: Scope | None = getattr(node, "scope", None)
         if scope is not None:
             gone = frozenset(k for k in have if k.scope.within(scope))
@@ -81,21 +85,23 @@ def gaps(root: Behaviour) -> list[Gap]:
             have = have - gone
         need(node, have, lost)
         children = list(node.children)
-        if isinstance(node, py_trees.composites.Sequence):
+        if py_trees.composites.Sequence in mro:
             for child in children:
                 have = visit(child, have, lost)
             return have
-        if isinstance(node, py_trees.composites.Selector):
+        if py_trees.composites.Selector in mro:
             outs = [visit(child, have, lost) for child in children]
             return _all(outs, have)
-        if isinstance(node, py_trees.composites.Parallel):
+        if py_trees.composites.Parallel in mro:
+            assert isinstance(node, py_trees.composites.Parallel)  # (cached by now)
             outs = [visit(child, have, lost) for child in children]
             policy = node.policy
             if isinstance(policy, py_trees.common.ParallelPolicy.SuccessOnAll):
                 return have.union(*outs)
             return _all(outs, have)
         own = frozenset(getattr(node, "writes", ()))
-        if isinstance(node, py_trees.decorators.Decorator):
+        if py_trees.decorators.Decorator in mro:
+            assert isinstance(node, py_trees.decorators.Decorator)  # (cached by now)
             provides: Callable[[], Iterable[Key[Any]]] | None = getattr(node, "provides", None)
             given = have | frozenset(provides() if provides is not None else ())
             after = visit(node.decorated, given, lost)

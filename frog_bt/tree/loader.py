@@ -50,7 +50,6 @@ from frog_bt.engine.observed import Observed
 from frog_bt.errors import TreeError, TreeErrors, format_path
 from frog_bt.model.key import Scope
 from frog_bt.model.keys import by_name
-from frog_bt.tree.btcpp import read_xml
 from frog_bt.tree.flow import Gap, gaps
 from frog_bt.yamlfile import load_yaml_marked, validate
 from frog_bt.yamlmarks import Marks, line_of
@@ -442,6 +441,8 @@ def load_tree(path: str | Path | None, site: Site | None, factory: NodeRegistry)
     builder = _Builder(site, factory)
     source = path
     if path.suffix.lower() == ".xml":  # BehaviorTree.CPP v4 (Groot2): its trees as documents
+        from frog_bt.tree.btcpp import read_xml  # xml.etree: only for such files
+
         builder.documents, main = read_xml(path)
         path = path.parent / main
     root, description = None, ""

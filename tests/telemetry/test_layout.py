@@ -109,3 +109,19 @@ shapes = st.recursive(
 def test_any_tree_layout_is_tidy(shape: list):
     index = TreeIndex.of(_tree(shape, [0]))
     check_layout(index, tidy_layout(index))
+
+
+def test_site_time_reads_as_the_sites_clocks_also_across_summer_time():
+    from datetime import UTC, datetime
+
+    from frog_bt.live.telemetry.layout import site_ns
+
+    def local(*utc: int) -> datetime:
+        t = datetime(*utc, tzinfo=UTC).timestamp()
+        return datetime.fromtimestamp(site_ns(t) / 1e9, UTC).replace(tzinfo=None)
+
+    assert local(2026, 1, 15, 12, 0) == datetime(2026, 1, 15, 13, 0)  # CET, +1
+    assert local(2026, 7, 1, 8, 30) == datetime(2026, 7, 1, 10, 30)  # CEST, +2
+    # summer time begins at 01:00 UTC on 29 March 2026: 01:59:59 is followed by 03:00
+    assert local(2026, 3, 29, 0, 59, 59) == datetime(2026, 3, 29, 1, 59, 59)
+    assert local(2026, 3, 29, 1, 0, 0) == datetime(2026, 3, 29, 3, 0, 0)

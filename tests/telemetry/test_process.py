@@ -6,7 +6,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from frog_bt.live.telemetry.process import _numbered
+from frog_bt.live.telemetry import process
+from frog_bt.live.telemetry.process import _numbered, _Pending, serialise
+from frog_bt.live.telemetry.rows import Batch
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -15,6 +17,44 @@ def test_recycled_writers_go_on_in_numbered_files() -> None:
     assert _numbered("save:/x/tour.rrd", 1) == "save:/x/tour.rrd"
     assert _numbered("save:/x/tour.rrd", 3) == "save:/x/tour.3.rrd"
     assert _numbered("spawn", 2) == "spawn"  # the same viewer, the same recording id
+
+
+class _Writer:
+    def __init__(self) -> None:
+        self.written: list[Batch] = []
+
+    def write(self, batch: Batch) -> None:
+        self.written.append(batch)
+
+
+class _Telemetry:
+    def __init__(self) -> None:
+        self.writer = _Writer()
+
+
+def _batch(tick: int) -> bytes:
+    return serialise(Batch(poses=[(tick, 100.0 + tick, 1.0, 2.0, 0.0)], notes=[]))
+
+
+def test_a_file_writer_merges_batches_a_live_one_writes_at_once() -> None:
+    """The child holds batches for a save: file and writes them as one (fewer, larger rerun
+    chunks), in order; for a live viewer it writes as soon as nothing more is queued."""
+    telemetry = _Telemetry()
+    pending = _Pending(telemetry, live=False)  # type: ignore[arg-type]
+    for tick in range(1, process.MERGE_BATCHES):
+        pending.add(_batch(tick))
+    assert telemetry.writer.written == [] and 0 < pending.wait(5.0) <= process.HOLD
+    pending.add(_batch(process.MERGE_BATCHES))  # the tenth: written at once, as one
+    [merged] = telemetry.writer.written
+    assert [row[0] for row in merged.poses] == list(range(1, process.MERGE_BATCHES + 1))
+    assert pending.batch is None and pending.wait(5.0) == 5.0
+
+    live = _Pending(telemetry, live=True)  # type: ignore[arg-type]
+    live.add(_batch(1))
+    live.add(_batch(2))  # already queued behind the first: merged
+    assert live.wait(5.0) == 0.0  # nothing more queued: written now
+    live.write()
+    assert [row[0] for row in telemetry.writer.written[-1].poses] == [1, 2]
 
 
 def test_a_tour_is_written_by_writers_that_take_turns(tmp_path: Path) -> None:

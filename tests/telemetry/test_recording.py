@@ -7,6 +7,8 @@ import itertools
 from rerun.chunk import RrdReader
 from telemetry_tour import Recorded
 
+from frog_bt.clock import SITE_TZ
+from frog_bt.live.telemetry.layout import TIME
 from frog_bt.live.telemetry.writer import TRAIL_EVERY
 
 
@@ -129,8 +131,11 @@ def test_each_stop_has_a_lane_reached_then_played(recorded: Recorded):
 
 
 def test_the_tours_clock_starts_with_the_tour_not_in_1970(recorded: Recorded):
-    # rows logged before sim time had a /clock (the links, connecting) carry the tick only
+    # rows logged before sim time had a /clock (the links, connecting) carry the tick only;
+    # the timeline reads as the site's clocks do: the scenario starts at 10:30 in Madrid
     import datetime
+
+    from frog_bt.sim.scenario import DEFAULT_START
 
     tour_day = datetime.datetime(2026, 1, 1)
     stamps = [
@@ -139,8 +144,11 @@ def test_the_tours_clock_starts_with_the_tour_not_in_1970(recorded: Recorded):
         for chunk in chunks
         if not chunk.is_static
         for batch in [chunk.to_record_batch()]
-        if "time" in batch.schema.names
-        for stamp in batch.column("time").to_pylist()
+        if TIME in batch.schema.names
+        for stamp in batch.column(TIME).to_pylist()
         if stamp is not None
     ]
     assert stamps and min(stamps).replace(tzinfo=None) >= tour_day
+    start = DEFAULT_START.astimezone(SITE_TZ).replace(tzinfo=None)
+    first = min(stamps).replace(tzinfo=None)
+    assert start <= first < start + datetime.timedelta(minutes=5)

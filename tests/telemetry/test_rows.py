@@ -10,7 +10,7 @@ from bench import Bench, write_tree
 
 from frog_bt.live.telemetry import Telemetry
 from frog_bt.live.telemetry.layout import TreeIndex
-from frog_bt.live.telemetry.rows import Rows
+from frog_bt.live.telemetry.rows import CODES, Rows
 from frog_bt.model.frontend import FrontendIdle
 from frog_bt.model.outcomes import IncidentKind, Level
 from frog_bt.runtime.observer import attach_all
@@ -40,13 +40,14 @@ def rows_on(bench: Bench, **kwargs: object) -> Rows:
 
 
 def test_rows_belong_to_the_tick_that_consumes_or_produces_them(bench: Bench):
+    run, invalid = CODES[S.RUNNING], CODES[S.INVALID]
     rows = rows_on(bench)
     t0 = bench.clock.now()
     bench.pose(1.0, 2.0)
     assert rows.batch.poses == [(1, t0, 1.0, 2.0, 0.0)]  # consumed by tick 1
     bench.tick()
     # the first row has every node, later ones only the nodes whose status changed
-    first = ((0, S.RUNNING), (1, S.RUNNING), (2, S.INVALID), (3, S.INVALID))
+    first = ((0, run), (1, run), (2, invalid), (3, invalid))  # as codes: CODES[status]
     assert rows.batch.statuses == [(1, t0, first)]
     bench.advance(0.1)
     bench.tick()
@@ -55,7 +56,7 @@ def test_rows_belong_to_the_tick_that_consumes_or_produces_them(bench: Bench):
     bench.advance(0.1)
     bench.tick()  # tick 3: the front end is ready, the goal goes out
     t3 = bench.clock.now()
-    assert rows.batch.statuses[-1] == (3, t3, ((1, S.SUCCESS), (2, S.RUNNING)))
+    assert rows.batch.statuses[-1] == (3, t3, ((1, CODES[S.SUCCESS]), (2, run)))
     assert rows.batch.events == [(3, t0 + 0.1, "frontend_idle", FrontendIdle())]
     [(tick, t, side, topic, _)] = rows.batch.outputs
     assert (tick, t, side, topic) == (3, t3, "ros", bench.site.topic("goto"))
@@ -166,3 +167,20 @@ def test_rows_that_never_got_a_time_are_dropped(tmp_path: Path):
     bench.pose(1.0, 2.0)
     assert len(rows.batch.poses) == 1
     assert len(rows.drain()) == 0
+
+
+def test_a_stop_given_up_within_one_tick_still_reaches_its_lane(bench: Bench):
+    """/skipped is written and cleared (the next stop's scope) inside one tick, so the
+    end-of-tick blackboard never shows it: the stop's lane reads the journal's incidents."""
+    rows = rows_on(bench)
+    bench.tick()
+    bench.core.journal.note(
+        "skipped POI2: navigation kept failing", IncidentKind.STOP_SKIPPED, subject="POI2"
+    )
+    bench.core.journal.note("skipped POI3: the operator asked", IncidentKind.STOP_LEFT, "POI3")
+    bench.core.journal.note("arrived at POI0")
+    bench.tick()
+    left = [row for row in rows.batch.blackboard if row[2] == "/skipped"]
+    assert [(tick, poi) for tick, _, _, poi in left] == [(2, "POI2"), (2, "POI3")]
+    bench.tick()
+    assert len([row for row in rows.batch.blackboard if row[2] == "/skipped"]) == 2  # once

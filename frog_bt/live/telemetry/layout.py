@@ -14,11 +14,15 @@ names never overlap at any depth.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from datetime import UTC, datetime
 
 import py_trees
+
+from frog_bt.clock import SITE_TZ
 
 Behaviour = py_trees.behaviour.Behaviour
 
@@ -179,7 +183,31 @@ def _shape(
     return _Shape(offsets, [-half, *left_edges], [half, *right_edges])
 
 
-TICK, TIME = "tick", "time"  # the timelines: tick number, project-clock time
+TICK, TIME = "tick", "site time"  # the timelines: tick number, project clock at the site
+
+
+def site_offset(t: float) -> float:
+    """Seconds the site's clocks are ahead of UTC at ``t`` (Europe/Madrid: 3600 or 7200).
+
+    The ``site time`` timeline is the project clock as the site's wall clocks read it,
+    stored as if it were UTC: rerun 0.41 shows timestamps in UTC (its *Local* setting
+    fails on Linux, rerun-io/rerun#6277), and the report and the console show site
+    time, so 10:32 in either finds 10:32 in the viewer (whose trailing ``Z`` is not UTC
+    here). Also right after a change of summer time: each row is shifted by its own
+    instant's offset."""
+    return _offset(int(t // 900))
+
+
+@functools.lru_cache(maxsize=64)
+def _offset(quarter: int) -> float:
+    # zones change their offset on a quarter of an hour: one lookup per quarter
+    offset = datetime.fromtimestamp(quarter * 900, UTC).astimezone(SITE_TZ).utcoffset()
+    return offset.total_seconds() if offset is not None else 0.0
+
+
+def site_ns(t: float) -> int:
+    """``t`` (seconds since the epoch) on the ``site time`` timeline, in nanoseconds."""
+    return round((t + site_offset(t)) * 1e9)
 
 
 def status_path(key: str, bt: str = "bt") -> str:

@@ -40,23 +40,30 @@ from frog_bt.model.events import (
     Ticked,
 )
 from frog_bt.model.key import Key
-from frog_bt.model.outcomes import Level
+from frog_bt.model.outcomes import IncidentKind, Level
 from frog_bt.model.wire import INPUTS
 
 if TYPE_CHECKING:
     from frog_bt.config import Site
     from frog_bt.engine.core import Core
-    from frog_bt.engine.journal import Note
+    from frog_bt.engine.journal import Journal, Note
     from frog_bt.runtime.observer import Host
 
 Status = py_trees.common.Status
 BOARD_KEYS: tuple[Key[Any], ...] = (
     keys.ENGAGEMENT_METER,
     keys.ENGAGEMENT_DECISION,
-    keys.SKIPPED,  # a stop's lane: skipped
     keys.TARGET,  # a stop's lane: reached (the POI driven to when a drive succeeds)
 )
+SKIPPED = keys.SKIPPED.name  # a stop's lane: skipped (from the journal's incidents)
+LEFT = frozenset({IncidentKind.STOP_SKIPPED, IncidentKind.STOP_LEFT})
 _status = operator.attrgetter("status")
+# A status as a small int in the rows (an int pickles at a fraction of an enum's cost, and
+# a tuple of ints is dropped from the collector's books): its index here.
+CODES = {
+    s: i for i, s in enumerate((Status.RUNNING, Status.SUCCESS, Status.FAILURE, Status.INVALID))
+}
+STATES = tuple(s.name for s in CODES)  # code -> the name a status lane shows
 Behaviour = py_trees.behaviour.Behaviour
 
 
@@ -69,12 +76,24 @@ class Batch:
     outputs: list[tuple[int, float, str, str, Any]] = field(default_factory=list)
     # ^ side ("ros" | "frontend"), channel (topic | message type), payload
     events: list[tuple[int, float, str, Any]] = field(default_factory=list)  # type, message
-    statuses: list[tuple[int, float, tuple[tuple[int, Status], ...]]] = field(default_factory=list)
-    # ^ the nodes whose status changed in that tick: (pre-order number, status), in order
+    statuses: list[tuple[int, float, tuple[tuple[int, int], ...]]] = field(default_factory=list)
+    # ^ the nodes whose status changed in that tick: (pre-order number, CODES[status])
     notes: list[tuple[int, float, str, Level]] = field(default_factory=list)
     blackboard: list[tuple[int, float, str, Any]] = field(default_factory=list)  # key, value
     marks: list[tuple[int, float, str, str, str]] = field(default_factory=list)
     # ^ bookmarks: kind ("staff" | "doubted" | "fault"), level, text
+
+    def extend(self, later: Batch) -> None:
+        """Append the rows of a later batch (a writer merging batches, see
+        :mod:`frog_bt.live.telemetry.process`)."""
+        self.poses.extend(later.poses)
+        self.inputs.extend(later.inputs)
+        self.outputs.extend(later.outputs)
+        self.events.extend(later.events)
+        self.statuses.extend(later.statuses)
+        self.notes.extend(later.notes)
+        self.blackboard.extend(later.blackboard)
+        self.marks.extend(later.marks)
 
     def restamp(self, t: float) -> None:
         """Give rows that arrived before the clock had a time (NaN) the time ``t``."""
@@ -127,6 +146,8 @@ class Rows:
         self._current: list[Status | None] = [None] * len(self._behaviours)
         self._scan_all = True  # read every node's status at the next tick
         self._last_note: Note | None = None
+        self._journal: Journal | None = None
+        self._incidents = 0  # incidents of that journal already seen
         self._blackboard: dict[str, Any] = {}
         self._ticks_since_drain = 0
         self._unstamped = False
@@ -265,12 +286,12 @@ class Rows:
             if self._unstamped:
                 batch.restamp(t)
                 self._unstamped = False
-            changes: list[tuple[int, Status]] = []
+            changes: list[tuple[int, int]] = []
             for node, status in zip(nodes, statuses, strict=True):
                 i = position.get(node)
                 if i is not None and current[i] is not status:
                     current[i] = status
-                    changes.append((i, status))
+                    changes.append((i, CODES[status]))
             if changes:
                 batch.statuses.append((tick, t, tuple(changes)))
             notes = core.journal.notes
@@ -280,6 +301,17 @@ class Rows:
                     i -= 1
                 batch.notes.extend((tick, n.at, n.text, n.level) for n in notes[i + 1 :])
                 self._last_note = notes[-1]
+            journal = core.journal
+            if journal is not self._journal:  # another core (a reload): its own journal
+                self._journal, self._incidents = journal, 0
+            if journal.incident_total != self._incidents:
+                # A stop given up on: its lane says skipped. Read off the incidents, not
+                # the blackboard: /skipped is written and cleared (the next stop's scope)
+                # within one tick.
+                for incident in journal.incidents_since(self._incidents):
+                    if incident.kind in LEFT and incident.subject:
+                        batch.blackboard.append((tick, incident.at, SKIPPED, incident.subject))
+                self._incidents = journal.incident_total
             for key in BOARD_KEYS:
                 value = core.board.get(key)
                 if value is not self._blackboard.get(key.name):

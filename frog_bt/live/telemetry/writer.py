@@ -19,8 +19,16 @@ import py_trees
 import rerun as rr
 
 from frog_bt.config import Site
-from frog_bt.live.telemetry.layout import TICK, TIME, TreeIndex, status_path, tidy_layout
-from frog_bt.live.telemetry.rows import Batch
+from frog_bt.live.telemetry.layout import (
+    TICK,
+    TIME,
+    TreeIndex,
+    site_ns,
+    site_offset,
+    status_path,
+    tidy_layout,
+)
+from frog_bt.live.telemetry.rows import CODES, STATES, Batch
 from frog_bt.live.telemetry.site_map import poi_marks, tour_routes, zone_outlines
 from frog_bt.model.frontend import message_fields
 from frog_bt.model.links import Health, LinkStatus
@@ -33,15 +41,13 @@ if TYPE_CHECKING:
 
 Status = py_trees.common.Status
 
-STATES = ("RUNNING", "SUCCESS", "FAILURE", "INVALID")
 STATUS_COLORS = {
     Status.RUNNING: 0xF5B400FF,
     Status.SUCCESS: 0x2EA043FF,
     Status.FAILURE: 0xE5484DFF,
     Status.INVALID: 0x8B949EFF,
 }
-CODES = {status: i for i, status in enumerate(STATUS_COLORS)}  # a status as a small int
-COLOR_TABLE = np.array(list(STATUS_COLORS.values()), dtype=np.uint32)  # code -> colour
+COLOR_TABLE = np.array([STATUS_COLORS[s] for s in CODES], dtype=np.uint32)  # code -> colour
 ROUTE_COLORS = (0xA371F7AA, 0x39C5CFAA, 0xDB61A2AA, 0x8B949EAA)  # one per period of the day
 ZONE_COLORS = {"volume": 0x3FB95099, "special": 0xDB61A299}
 FACING, NOT_FACING, TRACKED = 0x3FB950FF, 0xFF8C42FF, 0x8B949E66
@@ -86,8 +92,12 @@ def link_path(name: str) -> str:
 
 def _times(rows: Sequence[tuple[Any, ...]]) -> list[rr.TimeColumn]:
     # Nanoseconds as rerun rounds them one by one (round(1e9 * t)), but in one numpy pass:
-    # a list of floats costs rerun a Python conversion per row.
-    ns = np.round(np.array([r[1] for r in rows], dtype=np.float64) * 1e9).astype(np.int64)
+    # a list of floats costs rerun a Python conversion per row. On the site's clock
+    # (layout.site_offset): one offset for the batch, unless summer time began or ended.
+    t = np.array([r[1] for r in rows], dtype=np.float64)
+    first, last = site_offset(t[0]), site_offset(t[-1])
+    shift = first if first == last else np.array([site_offset(x) for x in t])
+    ns = np.round((t + shift) * 1e9).astype(np.int64)
     return [
         rr.TimeColumn(TICK, sequence=[r[0] for r in rows]),
         rr.TimeColumn(TIME, timestamp=ns.astype("datetime64[ns]")),
@@ -292,7 +302,7 @@ class Writer:
         rec.set_time(TICK, sequence=tick)
         if t > 0:  # before the clock has a time (sim time, no /clock yet): the tick only,
             # not 1970 on the tour's clock (the timeline would open on 56 years)
-            rec.set_time(TIME, timestamp=np.datetime64(round(t * 1e9), "ns"))
+            rec.set_time(TIME, timestamp=np.datetime64(site_ns(t), "ns"))
         for name, state in changes:
             rec.log(link_path(name), rr.StateChange(state=state.value))
         level = "WARN" if any(s.health in (Health.WAIT, Health.BAD) for _, s in changes) else "INFO"
@@ -343,7 +353,7 @@ class Writer:
             )
 
     def _write_statuses(
-        self, rows: list[tuple[int, float, tuple[tuple[int, Status], ...]]]
+        self, rows: list[tuple[int, float, tuple[tuple[int, int], ...]]]
     ) -> Iterator[None]:
         # Each row holds the changes of one tick; the graph needs every node's colour per
         # row: the codes of all nodes are kept here and a row's colours read off them.
@@ -356,9 +366,9 @@ class Writer:
         paths: list[tuple[int, float, tuple[int, ...] | None, np.ndarray]] = []
         for start in range(0, len(rows), per_step):
             for n, (tick, t, changes) in enumerate(rows[start : start + per_step], start):
-                for i, status in changes:
-                    codes[i] = CODES[status]
-                    lanes.setdefault(i, []).append((tick, t, status.name))
+                for i, code in changes:
+                    codes[i] = code
+                    lanes.setdefault(i, []).append((tick, t, STATES[code]))
                 colors[n] = COLOR_TABLE[codes]
                 shown = self._running_path(codes)
                 if shown != self._path or any(
@@ -660,7 +670,7 @@ class Writer:
 
     def _set_time(self, tick: int, t: float) -> None:
         self.rec.set_time(TICK, sequence=tick)
-        self.rec.set_time(TIME, timestamp=t)
+        self.rec.set_time(TIME, timestamp=np.datetime64(site_ns(t), "ns"))
 
     def _log_goal(self, tick: int, t: float, goal: Goal | None) -> None:
         rec = self.rec
