@@ -40,13 +40,15 @@ from frog_bt.tree.world import world_of
 Behaviour = py_trees.behaviour.Behaviour
 RUNNING = py_trees.common.Status.RUNNING
 # what the operator reads of the board (engine/operator.py) besides the tree's nodes
-OPERATOR_READS = frozenset(
-    {keys.TOUR_STATE, keys.HOME, keys.ABORT_REASON, keys.PAUSED, keys.IN_SERVICE, keys.SKIP}
-    | {keys.HELP, keys.HELP_ANSWER, keys.DOCKING}
+_OPERATOR: tuple[Key[Any], ...] = (
+    *(keys.TOUR_STATE, keys.HOME, keys.ABORT_REASON, keys.PAUSED, keys.IN_SERVICE, keys.SKIP),
+    *(keys.HELP, keys.HELP_ANSWER, keys.DOCKING),
 )
+OPERATOR_READS: frozenset[Key[Any]] = frozenset(_OPERATOR)
 
 
-PRESENCE = frozenset({keys.HOME, keys.ABORT_REASON})  # the operator asks only: set?
+# the operator asks of these only whether they are set
+PRESENCE: frozenset[Key[Any]] = frozenset({keys.HOME, keys.ABORT_REASON})
 
 
 class Liveness:
@@ -74,7 +76,7 @@ class Liveness:
         self.operator = OPERATOR_READS - PRESENCE - set(derived)
         # keys every reader reads only as true or false (declared: ``World.truthy``)
         truthy: dict[Key[Any], bool] = {}
-        for i, node in enumerate(nodes):
+        for node in nodes:
             world = world_of(type(node))
             said = set(world.truthy) if world is not None else set()
             for key in (*getattr(node, "reads", ()), *getattr(node, "optional_reads", ())):

@@ -156,7 +156,8 @@ class Real:
         self.robot = Robot(self.dock)
         # the keys some node or the operator reads: a value nothing reads is not state;
         # an input the snapshot writes anew before every tick is the world's (derived)
-        derived = {inp.key for inp in self.core.table.values()} | {keys.NOW, keys.EVENTS}
+        derived: set[Key[Any]] = {inp.key for inp in self.core.table.values()}
+        derived |= {keys.NOW, keys.EVENTS}
         derived |= {keys.GOAL, keys.RESPONSES, *LAZY}
         self.liveness = Liveness(tree, self.nodes, self.index, derived)
         self.oracle = Oracle(())
@@ -647,7 +648,8 @@ class Real:
             else (k.name, v is not None)
             for store in (core.board._values, core.standing.values)
             for k, v in store.items()
-            if k in live or k in presence
+            # a value of None reads as none written; an unset truthy key reads false
+            if v is not None and (k in live or k in presence) and (k not in truthy or v)
         )
         tail = tuple(e.message for e in log.since(oldest)) if oldest < last else ()
         actions = core.actions
