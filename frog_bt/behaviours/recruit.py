@@ -186,7 +186,7 @@ class StartIntroduction(Leaf):
     """
 
     optional_reads = (keys.ICL, keys.PAUSED)
-    world = World(inputs=(Channel.OPERATOR,), role=WorldRole.SPEAK)
+    world = World(inputs=(Channel.OPERATOR,), role=WorldRole.SPEAK, truthy=(keys.ICL.name,))
 
     def update(self) -> Status:
         if self.get(keys.PAUSED):

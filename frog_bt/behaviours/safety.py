@@ -208,7 +208,7 @@ class Checkpointed(FrogDecorator):
     writes = (keys.VISITOR, keys.RESUME, keys.PROGRESS)
     skips_child = True  # resumed: SUCCESS without the child (the data-flow check)
     _skip = False
-    world = World(state=("_skip",))
+    world = World(state=("_skip",), late=(keys.VISITOR.name,))
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
         # Resumed past this part: py_trees' plain behaviour tick (initialise, update,

@@ -16,6 +16,9 @@ abstracted. Each node type says, on its class, as ``world = World(...)``:
   docking states the robot may report to it now (``/docking/state``); ``active``: the field
   set while its action is out (a goal, content playing); ``waits``: while it runs it
   waits for a person or the front end (not for the robot);
+* ``late``: the keys a decorator reads only once its child has succeeded (whatever its
+  child's scope cleared is not read from before);
+* ``truthy``: the keys it reads only as true or false (None reads as false);
 * ``role``: what it is to the built-in properties; ``why``: where it abstracts a number
   (engagement, a distance), the reason.
 """
@@ -74,6 +77,8 @@ class World:
     waits: bool = False
     role: Role = Role.NONE
     key: Callable[[Any], Hashable] | None = None  # its own encoding of its state
+    late: tuple[str, ...] = ()  # keys it reads only once its child succeeded (a decorator)
+    truthy: tuple[str, ...] = ()  # keys it reads only as true or false (None is false)
     why: str = ""
 
 

@@ -68,6 +68,7 @@ from frog_bt.model.ros import (
 from frog_bt.model.wire import FAILED, SUCCEEDED
 from frog_bt.tree.world import Channel, World, world_of
 from frog_bt.verify.explore import MAX_STATES, Graph, TooBig
+from frog_bt.verify.liveness import Liveness
 from frog_bt.verify.model import Model, preorder
 from frog_bt.verify.tick import Choice, Oracle, Step
 from frog_bt.verify.world import By
@@ -81,11 +82,6 @@ STOP_HERE = "(stop here)"  # the goal that stops the robot where it is (not a dr
 # what py_trees and the engine change on every node (not the node type's own state)
 INTERNAL = frozenset({"status", "feedback_message", "iterator"})
 LAZY = (keys.DIAGNOSTICS, keys.PERSONS, keys.PEOPLE, keys.FACES)  # answered as read
-# what the operator reads of the board (engine/operator.py) besides the tree's nodes
-OPERATOR_READS = frozenset(
-    {keys.TOUR_STATE, keys.HOME, keys.ABORT_REASON, keys.PAUSED, keys.IN_SERVICE, keys.SKIP}
-    | {keys.HELP, keys.HELP_ANSWER, keys.DOCKING}
-)
 TIME = 1e9  # a float this large is a project-clock time (encoded relative to now)
 
 
@@ -158,15 +154,12 @@ class Real:
         ]
         self.dock = site.tour.dock
         self.robot = Robot(self.dock)
-        # the keys some node or the operator reads: a value nothing reads is not state
-        self.read = (
-            frozenset(
-                k
-                for n in self.nodes
-                for k in (*getattr(n, "reads", ()), *getattr(n, "optional_reads", ()))
-            )
-            | OPERATOR_READS
-        )
+        # the keys some node or the operator reads: a value nothing reads is not state;
+        # an input the snapshot writes anew before every tick is the world's (derived)
+        derived: set[Key[Any]] = {inp.key for inp in self.core.table.values()}
+        derived |= {keys.NOW, keys.EVENTS}
+        derived |= {keys.GOAL, keys.RESPONSES, *LAZY}
+        self.liveness = Liveness(tree, self.nodes, self.index, derived)
         self.oracle = Oracle(())
         self.step = Step()
         self.asked: dict[str, object] = {}
@@ -395,6 +388,18 @@ class Real:
         self.robot = Robot(*robot)
 
     # ------------------------------------------------------------ one tick
+
+    def positions(self) -> tuple[tuple[int, int], ...]:
+        """The running nodes, each with its current child's position (-1: none)."""
+        out = []
+        for i in self.running():
+            node = self.nodes[i]
+            current = getattr(node, "current_child", None)
+            at = -1
+            if current is not None:
+                at = next((k for k, c in enumerate(node.children) if c is current), -1)
+            out.append((i, at))
+        return tuple(out)
 
     def running(self) -> Iterator[int]:
         return (i for i, n in enumerate(self.nodes) if n.status is RUNNING)
@@ -631,11 +636,20 @@ class Real:
                     fields.append(enc(value))
             nodes.append((i, tuple(fields)))
         cooling = self.site.recruit.retry_after
+        live, presence = self.liveness.live(
+            self.positions(), self._board_get(keys.RESUME) is not None
+        )
+        truthy = self.liveness.truthy
         board = tuple(
-            (k.name, enc(v) if k is not keys.APPROACH_FAILED else _cooling(v, now, cooling))
+            (k.name, bool(v))
+            if k in truthy
+            else (k.name, enc(v) if k is not keys.APPROACH_FAILED else _cooling(v, now, cooling))
+            if k in live
+            else (k.name, v is not None)
             for store in (core.board._values, core.standing.values)
             for k, v in store.items()
-            if k in self.read and k not in (keys.NOW, keys.EVENTS, keys.RESPONSES) and k not in LAZY
+            # a value of None reads as none written; an unset truthy key reads false
+            if v is not None and (k in live or k in presence) and (k not in truthy or v)
         )
         tail = tuple(e.message for e in log.since(oldest)) if oldest < last else ()
         actions = core.actions
@@ -764,8 +778,9 @@ def _clone(value: Any, memo: dict[int, Any]) -> Any:
         out = copy.copy(value)
     elif dataclasses.is_dataclass(value) and getattr(value, "__hash__", None) is not None:
         return value  # frozen
-    elif hasattr(value, "__dict__"):
-        out = copy.deepcopy(value)
+    elif hasattr(value, "__dict__"):  # one level deeper: its lists and dicts copied
+        out = copy.copy(value)
+        out.__dict__.update({k: _clone(v, memo) for k, v in value.__dict__.items()})
     else:
         return value
     memo[id(value)] = out
