@@ -29,9 +29,10 @@ from frog_bt.model.frontend import (
     UserPositive,
 )
 from frog_bt.model.goals import Goal
-from frog_bt.model.ledger import Fate, SkipWhy, TourPlan, fold
+from frog_bt.model.ledger import fold
 from frog_bt.model.outcomes import TourState
 from frog_bt.model.ros import Pose
+from frog_bt.model.tours import Fate, SkipWhy, TourPlan
 
 STOPS = ("POI1", "POI2", "POI3")
 PLAN = TourPlan(

@@ -29,9 +29,10 @@ from frog_bt.model.events import (
     Ticked,
 )
 from frog_bt.model.frontend import FrontendMessage, StartPoi, UserPositive
-from frog_bt.model.ledger import TourLedger, TourRow
+from frog_bt.model.ledger import TourLedger
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.model.ros import POSE
+from frog_bt.model.tours import TourRow
 from frog_bt.model.wire import SUCCEEDED
 from frog_bt.runtime.observer import Host
 

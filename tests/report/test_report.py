@@ -20,8 +20,8 @@ from frog_bt.cli import main
 from frog_bt.config import load_site
 from frog_bt.model import channels
 from frog_bt.model.frontend import AskTour, FinishPoi, StartPoi, Tour, UserPositive
-from frog_bt.model.ledger import StopVisit
 from frog_bt.model.run import RUN_METADATA
+from frog_bt.model.tours import StopVisit
 from frog_bt.offline.report.facts import FileFacts, Piece, _Pieces
 from frog_bt.offline.report.rows import Played, StopTime, join, rows
 from frog_bt.recordings.mcapfile import open_recording

@@ -16,8 +16,9 @@ from typing import TYPE_CHECKING
 from frog_bt.i18n import N_, Msg, say
 from frog_bt.model.events import Event, FrontendOut
 from frog_bt.model.frontend import Tour
-from frog_bt.model.ledger import TourLedger, TourPlan, TourRow
+from frog_bt.model.ledger import TourLedger
 from frog_bt.model.outcomes import TourState
+from frog_bt.model.tours import TourPlan, TourRow
 
 if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host

@@ -57,10 +57,11 @@ from frog_bt.model.channels import Alert as AlertMessage
 from frog_bt.model.channels import Operator as OperatorMessage
 from frog_bt.model.channels import Tree as TreeMessage
 from frog_bt.model.frontend import Tour
-from frog_bt.model.ledger import TourLedger, TourRow, step
+from frog_bt.model.ledger import TourLedger, step
 from frog_bt.model.outcomes import TourState
 from frog_bt.model.ros import Pose
 from frog_bt.model.run import read_metadata
+from frog_bt.model.tours import TourRow
 from frog_bt.offline.record_events import as_event
 from frog_bt.recordings.mcapfile import RecordingError, open_recording
 from frog_bt.recordings.reader import FrontendOut, Own, Primed, Reader, Record, RobotInput
