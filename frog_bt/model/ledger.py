@@ -94,6 +94,7 @@ class TourLedger:
         self.back: TourRow | None = None  # an aborted tour's row until the robot docks
         self.opening = True  # the row open began with the fold (no `tour started` seen)
         self.said_yes = 0  # invitations accepted, over all rows
+        self.resumed = False  # a resumed tour was taken up (:meth:`resume`)
         self._roles = {topic: role for role, topic in plan.topics.items()}
         self._goal: str | None = None  # waypoint of the goal awaiting its response
         self._failed: str | None = None  # waypoint whose goal failed last
@@ -152,6 +153,25 @@ class TourLedger:
         """The fold starts at ``t`` (a recording's start): the opening row opens there."""
         if not self.rows:
             self._open(None, t)
+
+    def resume(self, kept: TourRow | None) -> None:
+        """The executive resumed a tour from its checkpoint, which kept the tour's row as
+        it was then (``kept``; None: the checkpoint kept none): the row open now, begun
+        with the fold, becomes that tour's (:meth:`TourRow.carried_on`), so the stops
+        reached and skipped, the visitors, help and commands before the restart count as
+        the report counts them over both executives' recordings. Once: later calls, and
+        a call once a tour has started in this fold, change nothing."""
+        if self.resumed:
+            return
+        self.resumed = True
+        row = self.current
+        if kept is None or row is None or not self.opening or row.started is not None:
+            return
+        joined = kept.carried_on(row)
+        at = next(i for i, r in enumerate(self.rows) if r is row)
+        self.rows[at] = self.current = joined
+        self.said_yes += kept.accepted
+        self.opening = False
 
     def feed(self, event: Event) -> None:
         """One event of the executive (those that tell nothing of tours are passed over)."""

@@ -25,9 +25,13 @@ content stops it skipped (:func:`skips`): each stop once, and never one it reach
 
 from __future__ import annotations
 
+import copy
 import enum
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
+from typing import Any
+
+import msgspec
 
 from frog_bt.model.outcomes import TourState
 from frog_bt.model.ros import Pose
@@ -208,6 +212,42 @@ class TourRow:
     def skips(self, order: Iterable[str]) -> list[tuple[str, SkipWhy]]:
         """The content stops of ``order`` this tour did not reach, and why (:func:`skips`)."""
         return skips(self.stops, list(order), self.ended)
+
+    def carried_on(self, later: TourRow) -> TourRow:
+        """This row, kept by a checkpoint (what the tour did before a restart), and
+        ``later``, what the resumed executive saw of the same tour: one row. Its start is
+        this row's, its end ``later``'s; lists are joined, counts added, a fault listed
+        once. A visit under way when the checkpoint was written is left out: the resumed
+        executive drives there again (as the report joins a visit a restart cut)."""
+        kept = copy.deepcopy(self)
+        while kept.stops and kept.stops[-1].fate is Fate.UNDER_WAY:
+            kept.stops.pop()
+        for visit in kept.stops:
+            visit.closed = True
+        joined: dict[str, Any] = {}
+        for f in fields(TourRow):
+            before, after = getattr(kept, f.name), getattr(later, f.name)
+            if f.name in ("started", "t0"):
+                joined[f.name] = before
+            elif f.name in ("t1", "ended", "reason"):
+                joined[f.name] = after
+            elif f.name == "faults":
+                joined[f.name] = list(dict.fromkeys(before + after))
+            else:  # a list or a count
+                joined[f.name] = before + after
+        return replace(later, **joined)
+
+    def to_json(self) -> dict[str, Any]:
+        """The row as JSON values (a checkpoint keeps it: :meth:`of_json`)."""
+        return msgspec.to_builtins(self)  # type: ignore[no-any-return]
+
+    @classmethod
+    def of_json(cls, data: object) -> TourRow | None:
+        """The row :meth:`to_json` wrote; None when ``data`` is not one."""
+        try:
+            return msgspec.convert(data, TourRow)
+        except msgspec.ValidationError:
+            return None
 
     def left(self, order: Iterable[str]) -> list[str]:
         """The stops of :meth:`skips` that were left (by the operator, given up, or their

@@ -27,9 +27,9 @@ from frog_bt.i18n import Msg
 from frog_bt.live.console.handover import Asked, Handover, OpenAlert, Period, who
 from frog_bt.model import keys
 from frog_bt.model.events import Event, OperatorDone, Ticked
-from frog_bt.model.ledger import TourLedger
 from frog_bt.model.links import LinkStatus
 from frog_bt.model.tours import TourPlan
+from frog_bt.runtime.resuming import ResumingLedger
 
 if TYPE_CHECKING:
     from frog_bt.model.channels import Alert
@@ -74,7 +74,7 @@ class Shift:
         self.last: Handover | None = None
         self.since: float | None = None  # the shift's start (the console's, or the last handover)
         self.due: float | None = None  # the next scheduled handover
-        self.ledger = TourLedger(TourPlan())  # the one count of tours: the site's once attached
+        self.ledger = ResumingLedger(TourPlan())  # the one count of tours: the site's once attached
         self._before = self._counts()  # the ledger's counts when this shift began
         self.asked: list[Asked] = []
         self.periods: list[Period] = []
@@ -86,7 +86,8 @@ class Shift:
 
     def attach(self, host: Host) -> None:
         self._host = host
-        self.ledger = TourLedger(host.site.tour_plan())
+        self.ledger = ResumingLedger(host.site.tour_plan())
+        self.ledger.attach(host)
         self._before = self._counts()
 
     def _counts(self) -> dict[str, int]:
@@ -110,7 +111,7 @@ class Shift:
     # ------------------------------------------------------------ what it sees
 
     def on_event(self, event: Event) -> None:
-        self.ledger.feed(event)
+        self.ledger.on_event(event)
         match event:
             case Ticked(t=t):
                 self._look(t)
