@@ -34,8 +34,8 @@ from pydantic import (
 
 from frog_bt import resources
 from frog_bt.errors import ConfigError, UsageError
-from frog_bt.model.ledger import TourPlan
 from frog_bt.model.ros import Pose
+from frog_bt.model.tours import TourPlan
 from frog_bt.model.wire import (
     DEFAULT_FRONTEND,
     DEFAULT_LISTEN,

@@ -9,6 +9,7 @@ import uuid
 import pytest
 
 from frog_bt.errors import UsageError
+from frog_bt.model.tours import StopVisit, TourRow
 from frog_bt.runtime.checkpoint import Progress, Resume, claim, default_path, load, save
 
 
@@ -37,6 +38,22 @@ def test_the_checkpoint_keeps_the_run_id_of_the_executive_that_wrote_it(tmp_path
         path.write_text(json.dumps({**data, **foreign}))
         resume = load(path)
         assert resume is not None and resume.run == ""
+
+
+def test_the_checkpoint_keeps_the_tours_row_as_counted(tmp_path):
+    """The tour so far (the one count of tours' row) goes with the progress, so that a
+    resumed executive counts the stops before the restart; one not kept, or not a row,
+    resumes without it."""
+    path = tmp_path / "checkpoint.json"
+    row = TourRow(started=5.0, stops=[StopVisit("POI1", arrived=True, a_end=9.0)], accepted=1)
+    save(path, Progress().complete("start").complete("stop 0"), tour=row)
+    resume = load(path)
+    assert resume is not None and resume.tour == row and resume.order == ("start", "stop 0")
+    data = json.loads(path.read_text())
+    for tour in ({"stops": "POI1"}, None):
+        path.write_text(json.dumps({**data, "tour": tour}))
+        resume = load(path)
+        assert resume is not None and resume.tour is None and resume.order
 
 
 def test_running_a_checkpoint_again_drops_it_and_everything_after():

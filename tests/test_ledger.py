@@ -4,6 +4,7 @@ stop both skipped and reached, or played without being reached."""
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
 from hypothesis import given, settings
@@ -29,9 +30,10 @@ from frog_bt.model.frontend import (
     UserPositive,
 )
 from frog_bt.model.goals import Goal
-from frog_bt.model.ledger import Fate, SkipWhy, TourPlan, fold
+from frog_bt.model.ledger import fold
 from frog_bt.model.outcomes import TourState
 from frog_bt.model.ros import Pose
+from frog_bt.model.tours import Fate, SkipWhy, TourPlan, TourRow
 
 STOPS = ("POI1", "POI2", "POI3")
 PLAN = TourPlan(
@@ -193,6 +195,37 @@ def test_a_resent_start_is_the_same_tour() -> None:
     s = Script().tour("started").recruit().tour("started").visit("POI1").tour("ended")
     ledger = fold(PLAN, s.events)
     assert len(ledger.tours) == 1 and ledger.tours[0].reached == ["POI1"]
+
+
+def test_a_resumed_tour_carries_on_the_row_its_checkpoint_kept() -> None:
+    """A restart: the first executive's row (as the checkpoint keeps it, through JSON) is
+    carried on by the resumed executive's fold, once, as the report joins the files."""
+    before = Script().tour("started").recruit().visit("POI1")
+    before.goto("POI2").answer(2).out(StartPoi("POI2", "POI2", "a")).skip()
+    before.goto("POI3")  # under way when the checkpoint was written: made again after
+    first = fold(PLAN, before.events)
+    assert first.current is not None
+    kept = TourRow.of_json(json.loads(json.dumps(first.current.to_json())))
+    assert kept == first.current
+    after = Script()
+    after.t = before.t
+    after.goto("POI3").answer(2)  # what the resumed executive saw before the take-up
+    ledger = fold(PLAN, after.events)
+    ledger.resume(kept)
+    ledger.resume(kept)  # once
+    for event in after.play("POI3").goto("DOCK").answer(2).tour("ended").events[2:]:
+        ledger.feed(event)
+    (row,) = ledger.tours
+    assert row.started == 1.0 and row.ended == "ended" and ledger.started == 1
+    assert row.reached == row.played == ["POI1", "POI3"]
+    assert row.skips(PLAN.content) == [("POI2", SkipWhy.OPERATOR)]
+    assert [c.command for c in row.commands] == ["skip"]
+    assert (row.accepted, ledger.said_yes, row.visitors) == (1, 1, [7])
+    # nothing kept, or a fold that saw a tour start: nothing to carry on
+    assert TourRow.of_json({"stops": [{"poi": 3}]}) is None
+    fresh = fold(PLAN, Script().tour("started").events)
+    fresh.resume(kept)
+    assert fresh.tours[0].reached == [] and fresh.tours[0].commands == []
 
 
 # ------------------------------------------------------------ any stream of events

@@ -5,8 +5,9 @@ the goals sent and answered, the content started, the visitors approached and
 recruited, and reads the incidents from the one tally
 (:class:`~frog_bt.engine.tally.Tally`). Its tours, their stops (reached, played,
 skipped and why) and its verdict are the one count of tours'
-(:class:`~frog_bt.model.ledger.TourLedger`), the same fold the console and the report
-read.
+(:class:`~frog_bt.model.ledger.TourLedger`; a tour the executive resumed is carried on
+from its checkpoint, :mod:`frog_bt.runtime.resuming`), the same fold the console and the
+report read.
 """
 
 from __future__ import annotations
@@ -29,11 +30,12 @@ from frog_bt.model.events import (
     Ticked,
 )
 from frog_bt.model.frontend import FrontendMessage, StartPoi, UserPositive
-from frog_bt.model.ledger import TourLedger, TourRow
 from frog_bt.model.outcomes import IncidentKind
 from frog_bt.model.ros import POSE
+from frog_bt.model.tours import TourRow
 from frog_bt.model.wire import SUCCEEDED
 from frog_bt.runtime.observer import Host
+from frog_bt.runtime.resuming import ResumingLedger
 
 if TYPE_CHECKING:
     from frog_bt.engine.core import Core
@@ -54,17 +56,17 @@ class TourSummary:
     _last_decision: Any = None
     _seen_incidents: int = 0
     _host: Host | None = None
-    ledger: TourLedger | None = None  # the one count of tours, the site's plan
+    ledger: ResumingLedger | None = None  # the one count of tours, the site's plan
 
     def __post_init__(self) -> None:
-        self.ledger = TourLedger(self.site.tour_plan())
+        self.ledger = ResumingLedger(self.site.tour_plan())
 
     def waypoint_of(self, msg: dict[str, Any]) -> str:
         return self.site.waypoint_of(POSE.convert(msg))
 
     def on_event(self, event: Event) -> None:
         assert self.ledger is not None
-        self.ledger.feed(event)
+        self.ledger.on_event(event)
         match event:
             case RobotInput():
                 self._ros_in(event)
@@ -150,6 +152,8 @@ class TourSummary:
 
     def attach(self, host: Host) -> None:
         self._host = host
+        assert self.ledger is not None
+        self.ledger.attach(host)
 
     def close(self) -> None:
         """Nothing to finish: the summary is read from its fields."""

@@ -8,8 +8,10 @@ checkpoint file whenever a tick leaves a new value there
 after it (a lost visitor: recruit again, then every stop again).
 
 :class:`Resume` is what a restarted executive skips (each name once), the visitor it
-restores (:data:`frog_bt.model.keys.RESUME`) and the run it carries on
-(:mod:`frog_bt.model.run`).
+restores (:data:`frog_bt.model.keys.RESUME`), the run it carries on
+(:mod:`frog_bt.model.run`) and the tour's row so far, as the one count of tours had it
+when the checkpoint was written (:class:`~frog_bt.model.tours.TourRow`: the resumed
+executive's count carries it on, :meth:`~frog_bt.model.ledger.TourLedger.resume`).
 """
 
 from __future__ import annotations
@@ -17,6 +19,8 @@ from __future__ import annotations
 import re
 import time
 from dataclasses import dataclass, replace
+
+from frog_bt.model.tours import TourRow
 
 VERSION = 1
 
@@ -59,6 +63,7 @@ class Resume:
     run: str = ""  # the run id of the executive that wrote it ("": not recorded)
     resumed: int = 0  # starts that resumed it and then stopped before any progress
     crashed: str = ""  # why the executive that ran it crashed (empty: it did not)
+    tour: TourRow | None = None  # the tour so far, as counted then (None: not kept)
 
     def without(self, name: str) -> Resume:
         """This resume point once ``name`` has been skipped."""

@@ -7,8 +7,11 @@ atomically (write a temporary file, fsync, rename) whenever progress changes,
 and deletes it when a tour ends or is aborted.
 
 On start-up, :func:`load` gives a :class:`Resume`: the checkpoints a resumed
-tour skips, once each, the visitor to restore, and the run id of the executive that
-wrote it, which the resumed executive's recordings keep (:mod:`frog_bt.model.run`).
+tour skips, once each, the visitor to restore, the run id of the executive that
+wrote it, which the resumed executive's recordings keep (:mod:`frog_bt.model.run`), and
+the tour's row as the one count of tours had it (``tour``: its stops reached, played and
+skipped, visitors, help and commands so far), which the resumed executive's count
+carries on, so that it counts the tour as the report does over both executives' files.
 
 No crash loop: a checkpoint says how often it was resumed without progress since
 (:func:`mark_resumed`, reset by the next :func:`save`) and why the executive that ran it
@@ -40,6 +43,7 @@ from typing import IO
 from frog_bt.errors import UsageError
 from frog_bt.model.progress import VERSION, Progress, Resume
 from frog_bt.model.run import valid_id
+from frog_bt.model.tours import TourRow
 from frog_bt.text import LINE, inert
 
 STATE_DIR = Path(os.environ.get("XDG_STATE_HOME", Path.home() / ".local" / "state")) / "frog-bt"
@@ -105,10 +109,13 @@ def claim(path: Path, option: str = "--checkpoint") -> IO[str]:
     return handle
 
 
-def save(path: Path, progress: Progress, run: str = "") -> None:
-    """Write ``progress`` of run ``run`` (its id) atomically; an empty progress removes
-    the file."""
-    write_json(path, {**progress.to_json(time.time()), "run": run} if progress.done else None)
+def save(path: Path, progress: Progress, run: str = "", tour: TourRow | None = None) -> None:
+    """Write ``progress`` of run ``run`` (its id) and the ``tour``'s row so far (the one
+    count of tours') atomically; an empty progress removes the file."""
+    data = {**progress.to_json(time.time()), "run": run}
+    if tour is not None:
+        data["tour"] = tour.to_json()
+    write_json(path, data if progress.done else None)
 
 
 def write_json(path: Path, data: object | None) -> None:
@@ -163,6 +170,7 @@ def load(path: Path, max_age: float = math.inf) -> Resume | None:
         valid_id(data.get("run")),
         resumed,
         crashed,
+        TourRow.of_json(data["tour"]) if "tour" in data else None,
     )
 
 

@@ -31,7 +31,6 @@ from frog_bt.model.channels import Alert
 from frog_bt.model.events import AlertChanged, Datagram, Event, LinksChanged
 from frog_bt.model.frontend import EVENTS, FrontendMessage
 from frog_bt.model.help import Help, HelpAbout
-from frog_bt.model.ledger import TourLedger
 from frog_bt.model.links import Links, states
 from frog_bt.model.outcomes import DockingState, IncidentKind, TourState
 from frog_bt.model.progress import EMPTY, Progress, Resume
@@ -45,6 +44,7 @@ from frog_bt.runtime.checkpoint import load as load_checkpoint
 from frog_bt.runtime.checkpoint import save as save_checkpoint
 from frog_bt.runtime.notify import Notifier
 from frog_bt.runtime.observer import Observers
+from frog_bt.runtime.resuming import ResumingLedger
 from frog_bt.runtime.staff import Staff
 from frog_bt.runtime.status import link_line, status_line
 from frog_bt.runtime.warm import warm
@@ -91,7 +91,7 @@ class Executive:
         self.once = once
         self.outcome = Outcome()
         self.observers = Observers()  # every observer, told each event (on_event)
-        self.ledger = TourLedger(site.tour_plan())  # the one count of tours, told first
+        self.ledger = ResumingLedger(site.tour_plan())  # the one count of tours, told first
         self.observers.attach(self, [self.ledger])
         self.client = RosbridgeClient(
             rosbridge_url, secret=secret, on_input=self._on_ros, on_link=self._on_link
@@ -412,7 +412,9 @@ class Executive:
         if self.checkpoint is not None and progress != self._saved:
             self._saved = progress
             try:
-                save_checkpoint(self.checkpoint, progress, self.standing.run.id)
+                save_checkpoint(
+                    self.checkpoint, progress, self.standing.run.id, self.ledger.current
+                )
             except OSError as exc:  # a full disk must not stop the tour; warn once a minute
                 self._checkpoint_warnings.warn(
                     "checkpoint",

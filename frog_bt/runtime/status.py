@@ -1,7 +1,8 @@
 """The live one-line status: phase, POI, stops, tree tip, visitor, battery — or the links.
 
 The stops (``stops 2 of 6``: reached of the tour's content stops) are the one count of
-tours' (:class:`~frog_bt.model.ledger.TourLedger`), as the console and the report count.
+tours' (:class:`~frog_bt.model.ledger.TourLedger`), as the console and the report count
+(a resumed tour's stops before the restart too: :mod:`frog_bt.runtime.resuming`).
 
 While rosbridge is unreachable (or, on sim time, no ``/clock`` has come) the line
 says so instead of showing a tree that cannot tick::
@@ -30,6 +31,7 @@ from frog_bt.model.ledger import TourLedger
 from frog_bt.rosbridge.link import LinkState
 from frog_bt.runtime.observer import Host
 from frog_bt.runtime.phrase import doing
+from frog_bt.runtime.resuming import ResumingLedger
 
 
 def phase(core: Core) -> str:
@@ -155,16 +157,17 @@ class StatusLine:
         self._last = ""
         self._drawn_at = 0.0
         self._host: Host | None = None
-        self.ledger: TourLedger | None = None
+        self.ledger: ResumingLedger | None = None
 
     def attach(self, host: Host) -> None:
         """Redraw after each tick (``frog-bt run`` also refreshes it while nothing ticks)."""
         self._host = host
-        self.ledger = TourLedger(host.site.tour_plan())
+        self.ledger = ResumingLedger(host.site.tour_plan())
+        self.ledger.attach(host)
 
     def on_event(self, event: Event) -> None:
         if self.ledger is not None:
-            self.ledger.feed(event)
+            self.ledger.on_event(event)
         if isinstance(event, Ticked) and self._host is not None:
             self.update(self._host.core)
 

@@ -1,20 +1,25 @@
 """One run, one count (issue 39): a tour with an operator skip during POI3's content (the
 shape of the seeded season's tour 10, which read "6 of 6" stops and also "Skipped POI3
-(operator)") and a help request (docking fails; a person docks the robot and answers
-``done_by_hand``), recorded; the demo summary, the console's ``/api/state``, the status
-line and the report's row, table cell and funnel all give the same numbers, because all
-of them read the one fold (frog_bt/model/ledger.py)."""
+(operator)"), a restart (the executive stops while POI4's content plays; a second one
+resumes the tour from the checkpoint) and a help request (docking fails; a person docks
+the robot and answers ``done_by_hand``), recorded by both executives into one directory;
+the resumed executive's demo summary, console ``/api/state`` and status count, and the
+report's row, table cell and funnel over both recordings, all give the same numbers,
+because all of them read the one fold (frog_bt/model/ledger.py), and the resumed
+executive's carries on the tour's row its checkpoint kept (frog_bt/runtime/resuming.py)."""
 
 from __future__ import annotations
 
 import asyncio
 import json
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 from frog_bt.cli import main
+from frog_bt.clock import SITE_TZ
 from frog_bt.config import load_site
 from frog_bt.engine.operator import Command
 from frog_bt.live.console.day import Day
@@ -38,18 +43,24 @@ def _poi(name: str) -> Any:
 
 async def _until(exe: Any, ok: Any, limit: float) -> None:
     """Wait on the executive's (simulated) clock until ``ok()``."""
+    await exe.clock.wait_ready()  # a restarted executive's clock: from its first /clock
     end = exe.clock.now() + limit
     while not ok():
         assert exe.clock.now() < end, "the rehearsal did not get there in time"
         await exe.clock.sleep(1.0)
 
 
-async def _run(directory: Path) -> dict[str, Any]:
+async def _run(directory: Path, checkpoint: Path) -> dict[str, Any]:
     site = load_site()
     data = {**FAST_TOURS, "start_time": START}
     data["docking"] = {**data.get("docking", {}), "dock_failures": 3}
+    before = RecordingDir(directory, 10**12)  # the first executive's --record DIR
+    recordings = RecordingDir(directory, 10**12)  # the restarted one's, the same DIR
     summary, day = TourSummary(site), Day("en")
-    recordings = RecordingDir(directory, 10**12)
+    handed: Any = None  # the simulator, once the first executive has left it running
+
+    def first_prepare(exe: Any) -> None:
+        attach_all(exe, [before])
 
     def prepare(exe: Any) -> None:
         attach_all(exe, [recordings, summary, day])
@@ -57,11 +68,29 @@ async def _run(directory: Path) -> dict[str, Any]:
 
     try:
         async with Rehearsal(
-            scenario_from("default", data), site=site, prepare=prepare, once=False
-        ) as r:
-            exe, sim = r.executive, r.sim
+            scenario_from("default", data),
+            site=site,
+            prepare=first_prepare,
+            once=False,
+            checkpoint=checkpoint,
+        ) as first:
+            sim, where, killed = first.sim, first.listen, first.executive
             await sim.wait_for(_poi("POI3"), 60)
-            assert (await exe.staff.submit(Command.SKIP, by="console")).ok
+            assert (await killed.staff.submit(Command.SKIP, by="console")).ok
+            # the executive stops while POI4's content plays: a restart resumes there
+            await sim.wait_for(_poi("POI4"), 60)
+            first.own_sim, handed = False, sim
+        before.close()
+        async with Rehearsal(
+            None,
+            site=site,
+            sim=sim,
+            listen=where,
+            prepare=prepare,
+            once=False,
+            checkpoint=checkpoint,
+        ) as r:
+            exe = r.executive
             await _until(exe, lambda: "docking_failed" in exe.staff.book.active, 1800)
             docking = sim.world.docking  # a person puts the robot on its charger
             docking.state, docking.docked = "docked", True
@@ -75,14 +104,24 @@ async def _run(directory: Path) -> dict[str, Any]:
             await r.finish(120.0)
             api = state(exe, day, LogLines(owner=exe), StopClock())
     finally:
+        before.close()
         recordings.close()
-    return {"summary": summary, "day": day, "api": api, "ledger": exe.ledger, "exe": exe}
+        if handed is not None:
+            await handed.stop()
+    return {
+        "summary": summary,
+        "day": day,
+        "api": api,
+        "ledger": exe.ledger,
+        "exe": exe,
+        "killed": killed.ledger,
+    }
 
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], dict[str, Any]]:
     directory = tmp_path_factory.mktemp("one") / "frog1"
-    live = asyncio.run(_run(directory))
+    live = asyncio.run(_run(directory, directory.parent / "checkpoint.json"))
     target = directory.parent / "report.json"
     assert main(["report", str(directory), "--json", str(target), "--quiet"]) == 0
     return live, json.loads(target.read_text())
@@ -94,6 +133,16 @@ def test_the_demo_summary_the_console_and_the_report_agree(run) -> None:
     order = list(load_site().tour_plan().content)
     ledger, summary, api = live["ledger"], live["summary"], live["api"]
     (tour,) = ledger.tours
+    # the restart: the report joins the two executives' files into one resumed tour; the
+    # resumed executive's count carried on the row its checkpoint kept (POI1, POI2 and
+    # the skip of POI3 happened before the restart, the help request after it)
+    assert row["resumed"] is True and row["restarts"] == 1
+    (cut,) = live["killed"].tours
+    assert cut.ended == "" and cut.operator_skips == ["POI3"]
+    assert tour.started == cut.started is not None
+    assert row["start"] == datetime.fromtimestamp(tour.started, SITE_TZ).isoformat(
+        timespec="seconds"
+    )
     # the fold, live: POI3 left during its content is neither reached nor played
     assert tour.reached == tour.played == ["POI1", "POI2", "POI4", "POI5", "END"]
     assert tour.skips(order) == [("POI3", "operator")]
@@ -125,5 +174,6 @@ def test_the_demo_summary_the_console_and_the_report_agree(run) -> None:
     assert api["day"]["skipped"] == len(row["stops_skipped"]) == 1
     assert api["day"]["visitors"] == row["invitations_accepted"]
     assert "5 stops; skipped POI3" in api["day"]["last"][0]
-    # the executive's outcome
+    # the executive's outcome, and its status line's count of stops (its own ledger)
     assert live["exe"].outcome.tours == report["totals"]["completed"] == 1
+    assert live["exe"].ledger.tours[-1].reached == tour.reached

@@ -30,9 +30,9 @@ from frog_bt.model.frontend import (
     UserPositive,
     message_fields,
 )
-from frog_bt.model.ledger import StopVisit
 from frog_bt.model.outcomes import TourState
 from frog_bt.model.run import RUN_METADATA
+from frog_bt.model.tours import StopVisit
 from frog_bt.offline.report.facts import FileFacts, Piece, _Pieces
 from frog_bt.offline.report.rows import Played, StopTime, join, rows
 from frog_bt.recordings.mcapfile import open_recording

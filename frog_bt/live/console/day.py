@@ -2,9 +2,10 @@
 recruited, stops skipped, and the last tours in one line each.
 
 An :class:`~frog_bt.runtime.observer.Observer`: every figure is read from the one count of
-tours (:class:`~frog_bt.model.ledger.TourLedger`, fed each event), the same fold the demo
-summary, the status line and the report read; it keeps no more than :data:`LAST_TOURS`
-lines.
+tours (:class:`~frog_bt.model.ledger.TourLedger`, fed each event; a tour the executive
+resumed is carried on from its checkpoint, :mod:`frog_bt.runtime.resuming`), the same
+fold the demo summary, the status line and the report read; it keeps no more than
+:data:`LAST_TOURS` lines.
 """
 
 from __future__ import annotations
@@ -16,8 +17,9 @@ from typing import TYPE_CHECKING
 from frog_bt.i18n import N_, Msg, say
 from frog_bt.model.events import Event, FrontendOut
 from frog_bt.model.frontend import Tour
-from frog_bt.model.ledger import TourLedger, TourPlan, TourRow
 from frog_bt.model.outcomes import TourState
+from frog_bt.model.tours import TourPlan, TourRow
+from frog_bt.runtime.resuming import ResumingLedger
 
 if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host
@@ -42,17 +44,18 @@ class Day:
 
     def __init__(self, language: str = "en") -> None:
         self.language = language
-        self.ledger = TourLedger(TourPlan())  # the site's plan once attached
+        self.ledger = ResumingLedger(TourPlan())  # the site's plan once attached
         self.last: deque[str] = deque(maxlen=LAST_TOURS)
         self._host: Host | None = None
 
     def attach(self, host: Host) -> None:
         self._host = host
-        self.ledger = TourLedger(host.site.tour_plan())
+        self.ledger = ResumingLedger(host.site.tour_plan())
+        self.ledger.attach(host)
 
     def on_event(self, event: Event) -> None:
         before = self.ledger.current
-        self.ledger.feed(event)
+        self.ledger.on_event(event)
         match event:
             case FrontendOut(t=t, message=Tour(state=state)) if state != TourState.STARTED:
                 if before is not None and before.ended:

@@ -1,17 +1,19 @@
 """The shift so far, and its handover to the next one (``staff.handover``).
 
 :class:`Shift` is an :class:`~frog_bt.runtime.observer.Observer` of the executive. It
-reads the ``tour`` messages to the front end (tours started, completed, ended early), the
-operator commands (who answered a help request, who put the robot out of service and
-back) and, after each tick, the board's ``help`` and ``in_service`` (when a help request
-began and ended, the out-of-service periods). At each time of ``staff.handover`` (local,
-the site's clock; project time, so sim time in a rehearsal) — looked at after every tick
-and by the console between ticks (:meth:`Shift.check`, a robot out of reach does not
-tick) — and when someone asks (:meth:`Shift.hand_over`), it composes a
-:class:`~frog_bt.live.console.handover.Handover` of what it saw since the last one, plus
-what is still open (the alerts up, what the robot waits for), gives it to ``tell`` (the
-webhooks) and keeps it (:attr:`Shift.last`, the page's *Relevo*). A help request or an
-out-of-service period still open is carried into the next shift.
+counts the tours (started, completed, ended early) with the one count of tours
+(:class:`~frog_bt.model.ledger.TourLedger`, fed each event: the console's day's numbers,
+for the shift's span), and reads the operator commands (who answered a help request, who
+put the robot out of service and back) and, after each tick, the board's ``help`` and
+``in_service`` (when a help request began and ended, the out-of-service periods). At
+each time of ``staff.handover`` (local, the site's clock; project time, so sim time in a
+rehearsal) — looked at after every tick and by the console between ticks
+(:meth:`Shift.check`, a robot out of reach does not tick) — and when someone asks
+(:meth:`Shift.hand_over`), it composes a :class:`~frog_bt.live.console.handover.Handover`
+of what it saw since the last one, plus what is still open (the alerts up, what the
+robot waits for), gives it to ``tell`` (the webhooks) and keeps it (:attr:`Shift.last`,
+the page's *Relevo*). A help request or an out-of-service period still open is carried
+into the next shift.
 """
 
 from __future__ import annotations
@@ -24,9 +26,10 @@ from typing import TYPE_CHECKING
 from frog_bt.i18n import Msg
 from frog_bt.live.console.handover import Asked, Handover, OpenAlert, Period, who
 from frog_bt.model import keys
-from frog_bt.model.events import Event, FrontendOut, OperatorDone, Ticked
-from frog_bt.model.frontend import Tour
+from frog_bt.model.events import Event, OperatorDone, Ticked
 from frog_bt.model.links import LinkStatus
+from frog_bt.model.tours import TourPlan
+from frog_bt.runtime.resuming import ResumingLedger
 
 if TYPE_CHECKING:
     from frog_bt.model.channels import Alert
@@ -71,7 +74,8 @@ class Shift:
         self.last: Handover | None = None
         self.since: float | None = None  # the shift's start (the console's, or the last handover)
         self.due: float | None = None  # the next scheduled handover
-        self.tours = {"started": 0, "completed": 0, "aborted": 0}
+        self.ledger = ResumingLedger(TourPlan())  # the one count of tours: the site's once attached
+        self._before = self._counts()  # the ledger's counts when this shift began
         self.asked: list[Asked] = []
         self.periods: list[Period] = []
         self._host: Host | None = None
@@ -82,6 +86,24 @@ class Shift:
 
     def attach(self, host: Host) -> None:
         self._host = host
+        self.ledger = ResumingLedger(host.site.tour_plan())
+        self.ledger.attach(host)
+        self._before = self._counts()
+
+    def _counts(self) -> dict[str, int]:
+        ledger = self.ledger
+        return {
+            "started": ledger.started,
+            "completed": ledger.completed,
+            "aborted": ledger.aborted,
+        }
+
+    @property
+    def tours(self) -> dict[str, int]:
+        """The tours of this shift: started, completed and ended early since it began
+        (the console's day's counts, less those at the last handover)."""
+        now = self._counts()
+        return {kind: now[kind] - self._before[kind] for kind in now}
 
     def close(self) -> None:
         """Nothing to finish."""
@@ -89,15 +111,15 @@ class Shift:
     # ------------------------------------------------------------ what it sees
 
     def on_event(self, event: Event) -> None:
+        self.ledger.on_event(event)
         match event:
             case Ticked(t=t):
                 self._look(t)
                 self.check(t)
-            case FrontendOut(message=Tour(state=state)):
-                counted = {"started": "started", "ended": "completed"}.get(state, "aborted")
-                self.tours[counted] += 1
             case OperatorDone(ok=True):
                 self._done(event)
+            case _:
+                pass
 
     def _done(self, event: OperatorDone) -> None:
         if event.command in ("retry", "done_by_hand") and self._help_since is not None:
@@ -155,7 +177,7 @@ class Shift:
             at=now,
             since=self.since if self.since is not None else now,
             asked_by=by,
-            tours=dict(self.tours),
+            tours=self.tours,
             asked=tuple(
                 Asked(a.about, a.what, a.since, a.answered, a.by, a.answer) for a in self.asked
             ),
@@ -167,7 +189,7 @@ class Shift:
         )
         self.last = handover
         self.since = now
-        self.tours = dict.fromkeys(self.tours, 0)
+        self._before = self._counts()
         self.asked = [a for a in self.asked if a.answered is None]
         self.periods = [p for p in self.periods if p.until is None]
         log.info(

@@ -67,10 +67,11 @@ from frog_bt.model.events import (
     RobotInput,
 )
 from frog_bt.model.frontend import Tour
-from frog_bt.model.ledger import TourLedger, TourRow, step
+from frog_bt.model.ledger import TourLedger, step
 from frog_bt.model.outcomes import TourState
 from frog_bt.model.ros import Pose
 from frog_bt.model.run import read_metadata
+from frog_bt.model.tours import TourRow
 from frog_bt.recordings.mcapfile import RecordingError, open_recording
 from frog_bt.recordings.reader import Item, Primed, Reader
 

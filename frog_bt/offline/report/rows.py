@@ -32,7 +32,7 @@ from typing import Any
 from frog_bt.clock import SITE_TZ
 from frog_bt.config import Site
 from frog_bt.engine.operator import Command
-from frog_bt.model.ledger import SkipWhy, StopVisit, skips
+from frog_bt.model.tours import SkipWhy, StopVisit, skips
 from frog_bt.offline.report.alerts import Episode, episodes, runs_of
 from frog_bt.offline.report.causes import Cause, Incident
 from frog_bt.offline.report.facts import FileFacts, OperatorCall, Piece
@@ -301,7 +301,7 @@ def visits(tour: Tour) -> list[StopVisit]:
 
 def skipped(tour: Tour, site: Site, stops: list[StopVisit], ended: str) -> list[Skip]:
     """'POI: why' for each content stop of the tour order the tour did not reach
-    (:func:`frog_bt.model.ledger.skips`): for a tour that did not end, only up to the last
+    (:func:`frog_bt.model.tours.skips`): for a tour that did not end, only up to the last
     stop it reached or skipped; ``not recorded (restart)`` for one between what the
     recordings before and after a restart hold (a killed writer loses its last second)."""
     order = [s.poi for s in site.tour.stops if s.content]

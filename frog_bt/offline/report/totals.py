@@ -25,7 +25,7 @@ def _gate(visits: list[Visit]) -> Rate:
 
 def funnel(rows: list[Row], order: list[str]) -> dict[str, int]:
     """Visitors who started a tour, reached each content stop (a skipped stop is not
-    reached: :mod:`frog_bt.model.ledger`), finished. A stop reached again in a tour is a
+    reached: :mod:`frog_bt.model.tours`), finished. A stop reached again in a tour is a
     new visitor's (one was lost on the way), so each visit counts."""
     out = {"started": sum(r.visitors for r in rows), **dict.fromkeys(order, 0), "finished": 0}
     for r in rows:
