@@ -301,7 +301,9 @@ def killed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
         exe = r.executive
         await _help(exe, HelpAbout.DOCK, "docking_failed")
         await _answer(exe, Command.ACK_ALERT, True, "docking_failed")
-        await after_ticks(exe, lambda: exe.decided() == exe._decided)  # saved
+        keeper = r.keeper
+        assert keeper is not None
+        await after_ticks(exe, keeper.kept)  # saved
         ticks = exe.core.ticks
         await after_ticks(exe, lambda: exe.core.ticks >= ticks + 5)
         await asyncio.sleep(0)  # the recorder's last drain (and flush) runs
@@ -381,7 +383,7 @@ def test_a_day_of_files_carries_the_alert_book_across_rotation(tmp_path: Path) -
 
         def prepare(exe: Executive) -> None:
             attach_all(exe, [day])
-            listen(exe, lambda _e: exe.outcome.tours >= 2 and two.set(), Ticked)
+            listen(exe, lambda _e: rehearsal.rules.tours >= 2 and two.set(), Ticked)
 
         rehearsal = Rehearsal(
             scenario_from("default", data), site=SITE, prepare=prepare, once=False
@@ -389,7 +391,7 @@ def test_a_day_of_files_carries_the_alert_book_across_rotation(tmp_path: Path) -
         async with rehearsal:
             exe = rehearsal.executive
             await after_ticks(
-                exe, lambda: exe.outcome.tours >= 1 and alert in exe.staff.book.active
+                exe, lambda: rehearsal.rules.tours >= 1 and alert in exe.staff.book.active
             )
             await _answer(exe, Command.ACK_ALERT, True, alert)
             await after_ticks(exe, lambda: alert not in exe.staff.book.active)  # next tour
