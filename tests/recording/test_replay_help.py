@@ -53,7 +53,7 @@ async def _record(path: Path, script: Script, rehearsal: Rehearsal, **recorder: 
 
 
 def _rehearsal(data: dict[str, Any], **kwargs: Any) -> Rehearsal:
-    return Rehearsal(scenario(data), site=SITE, once=False, **kwargs)
+    return Rehearsal(scenario(data), site=SITE, once=False, memory=True, **kwargs)
 
 
 async def _help(exe: Executive, about: HelpAbout, alert: str) -> None:
@@ -386,7 +386,7 @@ def test_a_day_of_files_carries_the_alert_book_across_rotation(tmp_path: Path) -
             listen(exe, lambda _e: rehearsal.rules.tours >= 2 and two.set(), Ticked)
 
         rehearsal = Rehearsal(
-            scenario_from("default", data), site=SITE, prepare=prepare, once=False
+            scenario_from("default", data), site=SITE, prepare=prepare, once=False, memory=True
         )
         async with rehearsal:
             exe = rehearsal.executive
