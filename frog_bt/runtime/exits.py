@@ -51,9 +51,9 @@ class ExitRules:
         """Nothing to finish."""
 
     def on_link(self, state: LinkState) -> None:
-        """The robot's link changed: three refusals in a row end a ``once`` run."""
+        """The robot's link changed: three refusals in a row end a ``once`` run (a refused
+        connection goes up, then down at once: only a loss that was no refusal resets)."""
         if state.connected:
-            self._refusals = 0
             return
         self._refusals = self._refusals + 1 if state.refused else 0
         if self._refusals >= REFUSALS and self.once and self._host is not None:

@@ -99,7 +99,8 @@ def test_three_refused_connections_end_a_once_run() -> None:
     for once in (False, True):
         exe, robot, _ = executive()
         attach_all(exe, [ExitRules(once)])
-        for _ in range(3):
+        for _ in range(3):  # each goes up, then is closed at once
+            robot.connect()
             robot._link = LinkState(connected=False, since=0.0, refused=True)
             robot.on_link(robot.link)  # as the client tells the executive
         assert exe._stopping.is_set() is once
