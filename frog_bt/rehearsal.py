@@ -19,7 +19,6 @@ from __future__ import annotations
 import asyncio
 import socket
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -156,8 +155,7 @@ class Rehearsal:
         """The executive's outcome (with ``once``: after one tour); TimeoutError after
         ``timeout`` wall seconds."""
         assert self.task is not None
-        outcome = await asyncio.wait_for(asyncio.shield(self.task), timeout)
-        return replace(outcome, tours=self.rules.tours)
+        return await asyncio.wait_for(asyncio.shield(self.task), timeout)
 
     async def __aexit__(self, *exc: object) -> None:
         try:

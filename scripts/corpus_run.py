@@ -271,7 +271,7 @@ def record(tour: Seeded, directory: str, fast: dict[str, Any] | None = None) -> 
                 if not once:
                     listen(
                         exe,
-                        lambda _e: r.rules.tours >= 1 and exe.stop("tour ended docked", 0),
+                        lambda _e: exe.outcome.tours >= 1 and exe.stop("tour ended docked", 0),
                         Ticked,
                     )
 

@@ -60,8 +60,8 @@ ROSBRIDGE_FLUSH = 0.5  # wall seconds for the last frames to the robot (of the s
 @dataclass(slots=True)
 class Outcome:
     """Why :meth:`Executive.run` returned: exit code and one-line reason (the first
-    :meth:`Executive.stop`'s); ``tours``: completed, as the exit rules counted them
-    (:class:`~frog_bt.runtime.exits.ExitRules`, filled in by whoever attached them)."""
+    :meth:`Executive.stop`'s); ``tours``: completed, as the exit rules count them
+    (:class:`~frog_bt.runtime.exits.ExitRules`; 0 without them)."""
 
     code: int = 0
     reason: str = ""

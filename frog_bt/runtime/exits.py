@@ -12,7 +12,8 @@ code and the one-line reason CONTRACT §5 asks for:
   for a person, CONTRACT §7);
 * with ``once``: rosbridge refused the authentication three times in a row: exit 1.
 
-It counts the tours completed (:attr:`ExitRules.tours`).
+It counts the tours completed (:attr:`ExitRules.tours`, and the run's
+:attr:`~frog_bt.runtime.executive.Outcome.tours`).
 """
 
 from __future__ import annotations
@@ -76,6 +77,7 @@ class ExitRules:
                     host.stop(reason, 1)
                 return
             self.tours += 1
+            host.outcome.tours = self.tours
             if self.once:
                 host.stop("tour ended docked", 0)
         elif status == "FAILURE":

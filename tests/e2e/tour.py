@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import asyncio
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 from frog_bt.config import Site, load_site
@@ -133,7 +133,7 @@ class Running(Rehearsal):
         return Tour(
             self.sim,
             self.executive,
-            replace(self.executive.outcome, tours=self.rules.tours),
+            self.executive.outcome,
             self.summary,
             self.site,
             self.sent,

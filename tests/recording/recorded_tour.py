@@ -105,7 +105,7 @@ def record_day(directory: Path, tours: int, max_bytes: int) -> RecordingDir:
 
         def prepare(executive: Any) -> None:
             attach_all(executive, [recordings])
-            listen(executive, lambda _e: rehearsal.rules.tours >= tours and enough.set(), Ticked)
+            listen(executive, lambda _e: executive.outcome.tours >= tours and enough.set(), Ticked)
 
         rehearsal = Rehearsal(
             scenario_from("default", FAST_TOURS),

@@ -383,7 +383,7 @@ def test_a_day_of_files_carries_the_alert_book_across_rotation(tmp_path: Path) -
 
         def prepare(exe: Executive) -> None:
             attach_all(exe, [day])
-            listen(exe, lambda _e: rehearsal.rules.tours >= 2 and two.set(), Ticked)
+            listen(exe, lambda _e: exe.outcome.tours >= 2 and two.set(), Ticked)
 
         rehearsal = Rehearsal(
             scenario_from("default", data), site=SITE, prepare=prepare, once=False, memory=True
@@ -391,7 +391,7 @@ def test_a_day_of_files_carries_the_alert_book_across_rotation(tmp_path: Path) -
         async with rehearsal:
             exe = rehearsal.executive
             await after_ticks(
-                exe, lambda: rehearsal.rules.tours >= 1 and alert in exe.staff.book.active
+                exe, lambda: exe.outcome.tours >= 1 and alert in exe.staff.book.active
             )
             await _answer(exe, Command.ACK_ALERT, True, alert)
             await after_ticks(exe, lambda: alert not in exe.staff.book.active)  # next tour
