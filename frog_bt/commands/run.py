@@ -197,7 +197,7 @@ def banner(args: argparse.Namespace, settings: Settings) -> list[str]:
     ]
 
 
-__all__ = ["add_arguments", "attach_observers", "read_secret", "run"]
+__all__ = ["add_arguments", "attach_observers", "build", "read_secret", "run"]
 
 
 def attach_observers(
