@@ -327,8 +327,9 @@ def killed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
             first, until_killed, _rehearsal(DOCK_FAILS, checkpoint=checkpoint), flush_every=0.0
         )
         sim = kept["sim"]
-        again = Rehearsal(None, sim=sim, listen=kept["listen"], site=SITE, checkpoint=checkpoint)
-        again.executive_kwargs["once"] = False
+        again = Rehearsal(
+            None, sim=sim, listen=kept["listen"], site=SITE, checkpoint=checkpoint, once=False
+        )
         try:
             await _record(second, resumed, again)
         finally:
