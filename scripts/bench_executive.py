@@ -40,21 +40,21 @@ async def serve(args: argparse.Namespace) -> None:
     from frog_bt.clock import SimClock, WallClock
     from frog_bt.commands.run import attach_observers
     from frog_bt.config import load_site, parse_hostport
+    from frog_bt.frontend.link import FrontendLink
+    from frog_bt.rosbridge.client import RosbridgeClient
     from frog_bt.runtime.executive import Executive
+    from frog_bt.runtime.exits import ExitRules
     from frog_bt.runtime.memory import pin_malloc_thresholds
 
     pin_malloc_thresholds()  # as frog-bt run does
     site = load_site(args.config)
     tree = load_tree(site=site)
-    executive = Executive(
-        site,
-        tree,
-        SimClock() if args.sim_time else WallClock(),
-        rosbridge_url=args.rosbridge,
-        frontend=parse_hostport(args.frontend),
-        listen=parse_hostport(args.listen),
-        sim_time=args.sim_time,
-    )
+    clock = SimClock() if args.sim_time else WallClock()
+    client = RosbridgeClient(args.rosbridge)
+    link = FrontendLink(parse_hostport(args.listen), parse_hostport(args.frontend), clock)
+    executive = Executive(site, tree, clock, client, link, sim_time=args.sim_time)
+    rules = ExitRules()
+    executive.observers.attach(executive, [rules])
     observers = attach_observers(executive, record=args.record, rerun=args.rerun)
     tours = 0
     plain_tick = executive.tick
@@ -62,8 +62,8 @@ async def serve(args: argparse.Namespace) -> None:
     def tick() -> None:
         nonlocal tours
         plain_tick()
-        if executive.outcome.tours != tours:
-            tours = executive.outcome.tours
+        if rules.tours != tours:
+            tours = rules.tours
             say(
                 "tour",
                 tours=tours,

@@ -41,7 +41,9 @@ async def record(path: Path, minutes: float, speed: float) -> dict[str, Any]:
     from frog_bt.clock import SimClock
     from frog_bt.config import load_site
     from frog_bt.live.recording import Recorder
+    from frog_bt.rehearsal import links_to
     from frog_bt.runtime.executive import Executive
+    from frog_bt.runtime.exits import ExitRules
     from frog_bt.runtime.observer import attach_all
     from frog_bt.sim import Simulator
 
@@ -50,17 +52,13 @@ async def record(path: Path, minutes: float, speed: float) -> dict[str, Any]:
     sim = Simulator(scenario({"speed": speed}), rosbridge_port=0, frontend_port=0, executive=listen)
     small_log(sim)
     await sim.start()
+    clock = SimClock()
     executive = Executive(
-        site,
-        load_tree(site=site),
-        SimClock(),
-        rosbridge_url=f"ws://{LOOPBACK}:{sim.rosbridge_port}",
-        frontend=(LOOPBACK, sim.frontend_port),
-        listen=listen,
-        sim_time=True,
+        site, load_tree(site=site), clock, *links_to(sim, listen, clock), sim_time=True
     )
+    rules = ExitRules()
     recorder = Recorder(path)
-    attach_all(executive, [recorder])
+    attach_all(executive, [rules, recorder])
     end = sim.clock.now() + minutes * 60.0
     wall0 = time.monotonic()
 
@@ -71,13 +69,13 @@ async def record(path: Path, minutes: float, speed: float) -> dict[str, Any]:
 
     stopper = asyncio.ensure_future(until_end())
     try:
-        outcome = await executive.run()
+        await executive.run()
     finally:
         stopper.cancel()
         await sim.stop()
         recorder.close()
     return {
-        "tours": outcome.tours,
+        "tours": rules.tours,
         "sim_s": minutes * 60.0,
         "wall_s": time.monotonic() - wall0,
         "messages": recorder.messages,

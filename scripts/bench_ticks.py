@@ -166,7 +166,9 @@ async def one_tour(
     from frog_bt.behaviours import load_tree
     from frog_bt.clock import SimClock
     from frog_bt.config import load_site
+    from frog_bt.rehearsal import links_to
     from frog_bt.runtime.executive import Executive
+    from frog_bt.runtime.exits import ExitRules
     from frog_bt.sim import Simulator
     from frog_bt.sim.site import load_pois
 
@@ -184,16 +186,10 @@ async def one_tour(
     )
     small_log(sim)
     await sim.start()
-    executive = Executive(
-        site,
-        tree,
-        SimClock(),
-        rosbridge_url=f"ws://127.0.0.1:{sim.rosbridge_port}",
-        frontend=("127.0.0.1", sim.frontend_port),
-        listen=listen,
-        sim_time=True,
-        once=True,
-    )
+    clock = SimClock()
+    executive = Executive(site, tree, clock, *links_to(sim, listen, clock), sim_time=True)
+    rules = ExitRules(once=True)
+    executive.observers.attach(executive, [rules])
     observers: list[Any] = []
     writes: list[int] = []
     if telemetry == "null":  # an observer that does nothing: what listening alone costs
@@ -288,7 +284,7 @@ async def one_tour(
         "telemetry": telemetry,
         "nodes": nodes,
         "outcome": outcome.reason,
-        "tours": outcome.tours,
+        "tours": rules.tours,
         "sim_s": sim.clock.now() - sim0,
         "wall_s": wall,
         "observers_close_s": close_s if observers else 0.0,

@@ -147,7 +147,8 @@ def test_no_import_inside_a_function_hides_a_cycle():
 
 
 def test_the_scan_finds_a_cycle_hidden_in_a_function(tmp_path: Path):
-    """The scan sees through a late import: a factory that loads lazily what imports it."""
+    """The scan sees through a late import: a factory that loads lazily what imports it, a
+    module that imports under TYPE_CHECKING what imports it."""
     pkg = tmp_path / "pkg"
     pkg.mkdir()
     (pkg / "__init__.py").write_text("")
@@ -157,5 +158,12 @@ def test_the_scan_finds_a_cycle_hidden_in_a_function(tmp_path: Path):
         "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from . import loader\n"
     )
     (pkg / "ok.py").write_text("def f():\n    from pkg import types\n")
+    (pkg / "host.py").write_text(  # a protocol's module that names its host for the types
+        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from pkg.staff import Staff\n"
+    )
+    (pkg / "staff.py").write_text("from pkg import host\n")
     found = hidden_cycles(import_graph(tmp_path, "pkg"))
-    assert found == ["pkg.factory:2 imports pkg.loader late, and pkg.loader -> pkg.factory"]
+    assert found == [
+        "pkg.factory:2 imports pkg.loader late, and pkg.loader -> pkg.factory",
+        "pkg.host:3 imports pkg.staff late, and pkg.staff -> pkg.host",
+    ]

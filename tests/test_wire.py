@@ -17,6 +17,7 @@ from typing import ClassVar
 import msgspec
 import pytest
 from bench import Bench, write_tree
+from links import FakeFrontend, FakeRobot
 
 from frog_bt.behaviours import FACTORY, load_tree
 from frog_bt.clock import WallClock
@@ -90,16 +91,10 @@ def test_a_new_input_reaches_its_leaf_through_the_table_alone(
 def test_a_new_input_is_subscribed_recorded_and_simulated(corridor: Input, tmp_path: Path) -> None:
     site = load_site()
     tree = load_tree(write_tree(tmp_path, "root: {type: CorridorClear}"), site)
-    executive = Executive(
-        site,
-        tree,
-        WallClock(),
-        rosbridge_url="ws://127.0.0.1:9",
-        frontend=("127.0.0.1", 9),
-        listen=("127.0.0.1", 0),
-    )
+    robot = FakeRobot()
+    executive = Executive(site, tree, WallClock(), robot, FakeFrontend())
     executive.setup_wire()
-    assert executive.client.session.subscriptions["/lidar/corridor"].type == ("frog_msgs/Corridor")
+    assert robot.subscribed["/lidar/corridor"] == "frog_msgs/Corridor"
     schema = schema_for(corridor.type)
     assert schema["title"] == "frog_msgs/Corridor"
     assert schema["properties"]["clear"] == {"type": "boolean"}

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 from frog_bt import __version__, resources
 from frog_bt.behaviours import load_tree
-from frog_bt.clock import SimClock, WallClock
+from frog_bt.clock import Clock, SimClock, WallClock
 from frog_bt.commands import logs
 from frog_bt.commands.console_options import (
     ConsoleSettings,
@@ -197,7 +197,7 @@ def banner(args: argparse.Namespace, settings: Settings) -> list[str]:
     ]
 
 
-__all__ = ["add_arguments", "attach_observers", "read_secret", "run"]
+__all__ = ["add_arguments", "attach_observers", "build", "read_secret", "run"]
 
 
 def attach_observers(
@@ -264,26 +264,21 @@ async def _main(
     settings: Settings,
     console: ConsoleSettings | None = None,
 ) -> int:
-    from frog_bt.runtime.executive import Executive
     from frog_bt.runtime.memory import pin_malloc_thresholds
 
     pin_malloc_thresholds()  # all day without creeping up
+    from frog_bt.live.summary import TourSummary
+    from frog_bt.runtime.exits import ExitRules
+    from frog_bt.runtime.keeper import Keeper
     from frog_bt.runtime.status import StatusLine
 
     clock = SimClock() if args.sim_time else WallClock()
-    executive = Executive(
-        site,
-        tree,
-        clock,
-        rosbridge_url=settings.url,
-        frontend=settings.frontend,
-        listen=settings.listen,
-        sim_time=args.sim_time,
-        secret=settings.secret,
-        once=args.once,
-        fresh=args.fresh,
-        checkpoint=settings.checkpoint,
-    )
+    executive = build(site, tree, clock, settings, sim_time=args.sim_time)
+    # first: what the keeper takes up from before a restart is recorded by the recorder
+    keeper = Keeper(settings.checkpoint, fresh=args.fresh) if settings.checkpoint else None
+    if keeper is not None:
+        attach_all(executive, [keeper])
+    attach_all(executive, [ExitRules(once=args.once)])  # --once, and the tree giving up
     loop = asyncio.get_running_loop()
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)
@@ -317,6 +312,12 @@ async def _main(
         watcher = asyncio.create_task(watch.run())
     try:
         outcome = await executive.run()
+    except (asyncio.CancelledError, KeyboardInterrupt):
+        raise
+    except BaseException as exc:  # a crash: the next start must not loop into it
+        if keeper is not None:
+            keeper.crashed(exc)
+        raise
     finally:
         if watcher is not None:
             watcher.cancel()
@@ -331,6 +332,21 @@ async def _main(
     if outcome.code:
         print(f"frog-bt: {outcome.reason}", file=sys.stderr)
     return outcome.code
+
+
+def build(
+    site: Site, tree: Any, clock: Clock, settings: Settings, *, sim_time: bool = False
+) -> Executive:
+    """The executive, handed its links: a rosbridge client of ``settings.url`` and the UDP
+    link listening on ``settings.listen`` for the front end at ``settings.frontend``."""
+    from frog_bt.frontend.link import FrontendLink
+    from frog_bt.model.frontend import EVENTS
+    from frog_bt.rosbridge.client import RosbridgeClient
+    from frog_bt.runtime.executive import Executive
+
+    client = RosbridgeClient(settings.url, secret=settings.secret)
+    link = FrontendLink(settings.listen, settings.frontend, clock, inbound=EVENTS)
+    return Executive(site, tree, clock, client, link, sim_time=sim_time)
 
 
 async def _refresh(status: Any, interval: float = 0.5) -> None:

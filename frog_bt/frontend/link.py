@@ -27,6 +27,7 @@ import ipaddress
 import logging
 import socket
 from collections.abc import Callable
+from typing import Any, Protocol
 
 from frog_bt.clock import Clock
 from frog_bt.frontend.protocol import MAX_DATAGRAM, Endpoint, LinkStats
@@ -40,6 +41,39 @@ Address = tuple[str, int]
 SockAddr = tuple[str, int, *tuple[int, ...]]
 # (direction "in" | "out", datagram, clock time): a tap for recordings (CONTRACT §6).
 DatagramTap = Callable[[str, bytes, float], None]
+
+
+class DatagramNetwork(Protocol):
+    """Where datagram endpoints come from: the event loop (sockets), or a
+    :class:`~frog_bt.frontend.memory.MemoryNet` in tests."""
+
+    async def create_datagram_endpoint(
+        self, protocol_factory: Callable[[], Any], local_addr: Address | None = None
+    ) -> tuple[Any, Any]: ...
+
+
+class FrontendPort(Protocol):
+    """What the executive needs of its front-end link, handed to it ready-made: a
+    :class:`FrontendLink` (over UDP, or over a :class:`~frog_bt.frontend.memory.MemoryNet`
+    in tests), or any fake with this shape. The executive sets ``on_message`` (each new
+    event) and ``on_datagram`` (each datagram in or out) before it calls :meth:`start`."""
+
+    on_message: Callable[[FrontendMessage], None] | None
+    on_datagram: DatagramTap | None
+    last_heard: float | None
+
+    @property
+    def stats(self) -> LinkStats: ...
+    @property
+    def pending(self) -> int: ...
+    @property
+    def oldest_pending(self) -> float | None: ...
+
+    def send(self, message: FrontendMessage) -> None: ...
+    async def start(self) -> None: ...
+    async def drain(self, timeout: float) -> bool: ...
+    def close(self) -> None: ...
+    async def wait_closed(self) -> None: ...
 
 
 class AddressError(OSError):
@@ -82,6 +116,8 @@ class FrontendLink:
     ones included; datagrams from other hosts are dropped and counted, never
     shown, so a recording holds nothing a replay must not act on) or sent
     (``"out"``, acks and resends included), stamped with the clock's time.
+    ``network`` makes the endpoint (default: the event loop, a UDP socket; a
+    :class:`~frog_bt.frontend.memory.MemoryNet` runs the same link with no socket).
     """
 
     def __init__(
@@ -96,6 +132,7 @@ class FrontendLink:
         max_sends: int = 8,
         dedup_window: float = 10.0,
         on_datagram: DatagramTap | None = None,
+        network: DatagramNetwork | None = None,
     ) -> None:
         if not resend_after > 0:
             raise ValueError(f"resend_after must be > 0, got {resend_after}")
@@ -106,6 +143,7 @@ class FrontendLink:
         self.clock = clock
         self.on_message = on_message
         self.on_datagram = on_datagram
+        self.network = network
         self._endpoint = Endpoint(peer[0], inbound, resend_after, max_sends, dedup_window)
         self._peer_addr: Address = self.peer
         self._transport: asyncio.DatagramTransport | None = None
@@ -125,15 +163,18 @@ class FrontendLink:
         if self._transport is not None or self._closing:
             raise RuntimeError("FrontendLink already started or closed")
         loop = asyncio.get_running_loop()
+        network: DatagramNetwork = self.network or loop
         try:
-            transport, _ = await loop.create_datagram_endpoint(
+            transport, _ = await network.create_datagram_endpoint(
                 lambda: _DatagramProtocol(self), local_addr=self.listen
             )
         except OSError as exc:
             raise AddressError("listen", self.listen, "cannot listen there: " + _why(exc)) from exc
         self._transport = transport
+        sock = transport.get_extra_info("socket")
+        family = sock.family if sock is not None else socket.AF_INET
         try:
-            host = await _resolve(loop, self.peer, transport.get_extra_info("socket").family)
+            host = await _resolve(loop, self.peer, family)
         except OSError as exc:
             self.close()
             raise AddressError("peer", self.peer, "cannot resolve the host: " + _why(exc)) from exc

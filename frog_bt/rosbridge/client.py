@@ -29,6 +29,7 @@ import logging
 import time
 from collections import deque
 from collections.abc import Callable, Iterator
+from contextlib import AbstractAsyncContextManager
 from dataclasses import replace
 from typing import Any
 
@@ -59,6 +60,15 @@ FRAME_TOPIC = "<frame>"  # stats/warning key for frames too broken to name a top
 _MAX_WS_MESSAGE = 4 * MAX_FRAME_BYTES
 
 
+# Opens one connection to a URL, as an async context manager: websockets' ``connect`` by
+# default, or an in-memory wire's (frog_bt.rosbridge.memory) in tests.
+Connect = Callable[[str], AbstractAsyncContextManager[Any]]
+
+
+def _websocket(url: str) -> AbstractAsyncContextManager[ClientConnection]:
+    return connect(url, proxy=None, max_size=_MAX_WS_MESSAGE, open_timeout=10, close_timeout=2)
+
+
 class RosbridgeClient:
     """rosbridge v2 client with reconnect; see the module docstring.
 
@@ -71,6 +81,10 @@ class RosbridgeClient:
 
     The auth frame (sent first on each connection when ``secret`` is set) is
     stamped with the wall clock: rosauth compares it with the server's time.
+
+    ``connect`` opens the connections (default: a WebSocket to ``url``); a
+    :class:`~frog_bt.rosbridge.memory.MemoryWire`'s ``connect`` runs the same client
+    with no socket.
     """
 
     def __init__(
@@ -86,11 +100,13 @@ class RosbridgeClient:
         on_link: Callable[[LinkState], None] | None = None,
         on_raw: Callable[[str, Any], None] | None = None,
         on_input: Callable[[str, object, Any], None] | None = None,
+        connect: Connect | None = None,
     ) -> None:
-        try:
-            parse_uri(url)
-        except InvalidURI as exc:
-            raise ValueError(f"rosbridge URL {url!r}: {exc}") from None
+        if connect is None:
+            try:
+                parse_uri(url)
+            except InvalidURI as exc:
+                raise ValueError(f"rosbridge URL {url!r}: {exc}") from None
         if queue_limit < 1:
             raise ValueError(f"queue_limit must be >= 1, got {queue_limit}")
         if not 0 < backoff_initial <= backoff_max:
@@ -107,6 +123,7 @@ class RosbridgeClient:
         self.on_link = on_link
         self.on_raw = on_raw  # (topic, msg JSON) of every publish on a subscribed topic
         self.on_input = on_input
+        self._connect: Connect = connect or _websocket
         self.session = Session(queue_limit=queue_limit, secret=secret)
         self.stats = ClientStats()
         self._link = LinkState(connected=False, since=time.monotonic())
@@ -119,7 +136,7 @@ class RosbridgeClient:
         self._closing = False
         self._loop_task: asyncio.Task[None] | None = None
         self._run_task: asyncio.Task[None] | None = None
-        self._ws: ClientConnection | None = None  # the current connection
+        self._ws: Any = None  # the current connection (ClientConnection over a socket)
         self._heard = 0
 
     # ------------------------------------------------------------ program side
@@ -162,6 +179,15 @@ class RosbridgeClient:
         dropped = self.session.dropped
         self._enqueue(self.session.publish(topic, msg))
         self._note_dropped(dropped)
+
+    def leave(self) -> None:
+        """Unsubscribe from every topic and unadvertise every one, so that the server is
+        left tidy (only while connected: nothing is queued for a later connection)."""
+        if self._link.connected:
+            for topic in list(self.session.subscriptions):
+                self.unsubscribe(topic)
+            for topic in list(self.session.advertised):
+                self.unadvertise(topic)
 
     # ------------------------------------------------------------ lifecycle
 
@@ -242,9 +268,7 @@ class RosbridgeClient:
             up_at: float | None = None
             delay = 0.0
             try:
-                async with connect(
-                    self.url, proxy=None, max_size=_MAX_WS_MESSAGE, open_timeout=10, close_timeout=2
-                ) as ws:
+                async with self._connect(self.url) as ws:
                     up_at = time.monotonic()
                     self._on_up(ws)
                     error = await self._serve(ws)
@@ -282,7 +306,7 @@ class RosbridgeClient:
                 return
             await asyncio.sleep(delay)
 
-    async def _serve(self, ws: ClientConnection) -> str:
+    async def _serve(self, ws: Any) -> str:
         """Run reader and writer until the connection ends; say why it ended."""
         reader = asyncio.create_task(self._read_loop(ws))
         writer = asyncio.create_task(self._write_loop(ws))
@@ -299,11 +323,11 @@ class RosbridgeClient:
         code = ws.close_code if ws.close_code is not None else 1006
         return f"connection closed (code {code}{', ' + ws.close_reason if ws.close_reason else ''})"
 
-    async def _read_loop(self, ws: ClientConnection) -> None:
+    async def _read_loop(self, ws: Any) -> None:
         async for frame in ws:
             self._on_frame(frame)
 
-    async def _write_loop(self, ws: ClientConnection) -> None:
+    async def _write_loop(self, ws: Any) -> None:
         out = self._outbox
         while True:
             if not out:
@@ -322,7 +346,7 @@ class RosbridgeClient:
             self._outbox.extend(frames)
             self._wake.set()
 
-    def _on_up(self, ws: ClientConnection) -> None:
+    def _on_up(self, ws: Any) -> None:
         with contextlib.suppress(Exception):  # addresses only feed the auth MAC
             self.session.client_addr = str(ws.local_address[0])
             self.session.dest_addr = str(ws.remote_address[0])

@@ -3,13 +3,16 @@
 :class:`LinkState` is the value the client hands to its ``on_link`` callback
 and exposes as ``client.link``; :class:`ClientStats` are its counters. Both are
 plain data so that the tree, telemetry and tests can use them without pulling in
-the network adapter.
+the network adapter. :class:`RobotLink` is what the executive needs of the link
+(the client, or a fake handed in instead).
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any, Protocol
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,3 +73,38 @@ class ClientStats:
     sent: int = 0
     connect_failures: int = 0
     malformed_by_topic: dict[str, int] = field(default_factory=dict)
+
+
+class RobotLink(Protocol):
+    """What the executive needs of its link to the robot, handed to it ready-made:
+    :class:`~frog_bt.rosbridge.client.RosbridgeClient` (over a socket, or over a
+    :class:`~frog_bt.rosbridge.memory.MemoryWire` in tests), or any fake with this shape.
+
+    The executive sets ``on_input(topic, value, msg)`` (every message on a subscribed
+    topic; ``value`` None when it did not decode) and ``on_link(state)`` (each change of
+    :attr:`link`) before it calls :meth:`start`. The calls that send never block.
+    """
+
+    url: str
+    on_input: Callable[[str, object, Any], None] | None
+    on_link: Callable[[LinkState], None] | None
+
+    @property
+    def link(self) -> LinkState: ...
+    @property
+    def stats(self) -> ClientStats: ...
+
+    def advertise(self, topic: str, type: str) -> None: ...
+    def subscribe(
+        self, topic: str, type: str, throttle_rate: int = 0, queue_length: int = 0
+    ) -> None: ...
+    def publish(self, topic: str, msg: Any) -> None: ...
+    def leave(self) -> None:
+        """Unsubscribe and unadvertise everything (while connected)."""
+
+    def start(self) -> object:
+        """Connect (and reconnect for ever) in a task of its own."""
+
+    async def wait_connected(self, timeout: float | None = None) -> bool: ...
+    async def flush(self, timeout: float) -> bool: ...
+    async def close(self) -> None: ...

@@ -1,4 +1,13 @@
-"""The online executive: rosbridge and UDP links around a :class:`~frog_bt.engine.core.Core`.
+"""The online executive: a :class:`~frog_bt.engine.core.Core` between the robot's link
+and the front end's, ticked.
+
+The executive is handed its two links ready-made (:class:`~frog_bt.rosbridge.link.RobotLink`:
+the rosbridge client; :class:`~frog_bt.frontend.link.FrontendPort`: the UDP link): the
+command that runs it builds them (``frog-bt run``, :mod:`frog_bt.rehearsal`), tests may hand
+in links over memory (:mod:`frog_bt.rosbridge.memory`, :mod:`frog_bt.frontend.memory`). It
+does not decide when a run ends, nor keep anything on disk: those are observers the
+command attaches (:mod:`frog_bt.runtime.exits`, :mod:`frog_bt.runtime.keeper`), and the
+command calls :meth:`Executive.stop`.
 
 Ticks are event-driven — a tick follows any relevant input (a navigation
 response, a docking state, a front-end event, detections, diagnostics, a link
@@ -15,8 +24,8 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
-from dataclasses import dataclass, replace
-from pathlib import Path
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import py_trees
@@ -25,23 +34,16 @@ from frog_bt.clock import Clock, ManualClock
 from frog_bt.config import Site
 from frog_bt.engine.core import Core
 from frog_bt.engine.standing import Standing
-from frog_bt.frontend.link import FrontendLink
+from frog_bt.frontend.link import FrontendPort
 from frog_bt.model import keys
-from frog_bt.model.channels import Alert
+from frog_bt.model.channels import Alert, Restored
 from frog_bt.model.events import AlertChanged, Datagram, Event, LinksChanged
-from frog_bt.model.frontend import EVENTS, FrontendMessage
-from frog_bt.model.help import Help, HelpAbout
+from frog_bt.model.frontend import FrontendMessage
 from frog_bt.model.links import Links, states
 from frog_bt.model.outcomes import DockingState, IncidentKind, TourState
-from frog_bt.model.progress import EMPTY, Progress, Resume
-from frog_bt.model.run import RunId
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
-from frog_bt.rosbridge.client import RosbridgeClient
-from frog_bt.rosbridge.link import LinkState
-from frog_bt.runtime import decisions, logctx
-from frog_bt.runtime.checkpoint import crash_loop, mark_crashed, mark_resumed
-from frog_bt.runtime.checkpoint import load as load_checkpoint
-from frog_bt.runtime.checkpoint import save as save_checkpoint
+from frog_bt.rosbridge.link import LinkState, RobotLink
+from frog_bt.runtime import logctx
 from frog_bt.runtime.notify import Notifier
 from frog_bt.runtime.observer import Observers
 from frog_bt.runtime.resuming import ResumingLedger
@@ -49,7 +51,6 @@ from frog_bt.runtime.staff import Staff
 from frog_bt.runtime.status import link_line, status_line
 from frog_bt.runtime.warm import warm
 from frog_bt.tree.loader import LoadedTree
-from frog_bt.warning_limit import WarningLimiter
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
@@ -59,8 +60,10 @@ ROSBRIDGE_FLUSH = 0.5  # wall seconds for the last frames to the robot (of the s
 
 @dataclass(slots=True)
 class Outcome:
-    """Why :meth:`Executive.run` returned: exit code, one-line reason, tours completed
-    (the one count of tours': :attr:`Executive.ledger`)."""
+    """Why :meth:`Executive.run` returned: exit code and one-line reason (the first
+    :meth:`Executive.stop`'s); ``tours``: completed, as the one count of tours has them
+    (:attr:`Executive.ledger`, set by the exit rules: :class:`~frog_bt.runtime.exits.ExitRules`;
+    0 without them)."""
 
     code: int = 0
     reason: str = ""
@@ -68,106 +71,47 @@ class Outcome:
 
 
 class Executive:
+    """The tree, ticked between ``client`` (the robot) and ``link`` (the front end)."""
+
     def __init__(
         self,
         site: Site,
         tree: LoadedTree,
         clock: Clock,
+        client: RobotLink,
+        link: FrontendPort,
         *,
-        rosbridge_url: str,
-        frontend: tuple[str, int],
-        listen: tuple[str, int],
         sim_time: bool = False,
-        secret: str | None = None,
-        once: bool = False,
-        checkpoint: Path | None = None,
-        fresh: bool = False,
     ) -> None:
         if sim_time and not isinstance(clock, ManualClock):
             raise ValueError("sim time needs a ManualClock (SimClock)")
         self.site = site
         self.clock = clock
         self.sim_time = sim_time
-        self.once = once
         self.outcome = Outcome()
         self.observers = Observers()  # every observer, told each event (on_event)
         self.ledger = ResumingLedger(site.tour_plan())  # the one count of tours, told first
         self.observers.attach(self, [self.ledger])
-        self.client = RosbridgeClient(
-            rosbridge_url, secret=secret, on_input=self._on_ros, on_link=self._on_link
-        )
-        self.link = FrontendLink(
-            listen,
-            frontend,
-            clock,
-            inbound=EVENTS,
-            on_message=self._on_event,
-            on_datagram=self._on_datagram,
-        )
+        self.client = client
+        client.on_input, client.on_link = self._on_ros, self._on_link
+        self.link = link
+        link.on_message, link.on_datagram = self._on_event, self._on_datagram
+        self.link_listeners: list[Callable[[LinkState], None]] = []  # each robot link change
         self.standing = Standing(clock)  # what outlives a tree: each core gets it
         self.core = self._core(site, tree)
-        self.checkpoint = checkpoint
-        self._saved: Progress = EMPTY
-        self._decided = decisions.NONE  # what staff decided, as last saved
-        self._crash_loop: Help | None = None  # a tour not resumed, to not fail the same way
-        resume = None
-        if checkpoint is not None and not fresh:
-            resume = self._resume_or_hold(checkpoint, site.checkpoint.max_age)
         self._wake = asyncio.Event()
         self._stopping = asyncio.Event()
         self._pending_at_loss: object = None
-        self._refusals = 0  # consecutive connections refused (auth)
         self._peer_restarts = 0
-        self._checkpoint_warnings = WarningLimiter(60.0, logger=log)
         self._swap: tuple[Site, LoadedTree] | None = None  # a checked tree, for the next idle
         self.was_connected = False  # to rosbridge, at some point: a loss is a reconnect
         self._link_states = states(self)
         self.swaps = 0
         self.staff = Staff(self)  # operator commands and alerts
-        if checkpoint is not None and not fresh:
-            self._decided = decisions.load(decisions.path_for(checkpoint))
-            if self._crash_loop is not None:  # it holds and asks, whatever staff decided
-                self._decided = replace(self._decided, help=self._crash_loop)
-            self.staff.restore(self._decided)
-            if self._decided != decisions.NONE:
-                log.info("restored what staff decided: %s", self._decided.to_json())
-        # what this executive took up from before it: recorded, so that replay does too
-        self.restored = decisions.restored(resume, self._decided)
+        # what this executive took up from before it (a Keeper sets it): recorded
+        self.restored: Restored | None = None
         self.staff.book.listeners.append(self._on_alert)
         self.notifier = Notifier.from_env()  # systemd: READY, STATUS, watchdog pings
-
-    def _resume_or_hold(self, checkpoint: Path, max_age: float) -> Resume | None:
-        """The resume point of ``checkpoint``, on the board (the file marked: resumed once
-        more), unless resuming it would run into the same failure again
-        (:func:`crash_loop`): then None, and the robot holds where it is and asks a person
-        (``help`` crashed, with the reason); the checkpoint is set aside, so that a further
-        start does not try it either."""
-        resume = load_checkpoint(checkpoint, max_age)
-        if resume is None:
-            return None
-        why = crash_loop(resume)
-        if why is None:
-            mark_resumed(checkpoint, resume)
-            self.core.board.set(keys.RESUME, resume)
-            if resume.run:  # the run goes on: its recordings say so
-                self.standing.run = RunId.resuming(resume.run)
-            return resume
-        log.error("not resuming the tour of %s: %s; holding for a person", checkpoint, why)
-        with contextlib.suppress(OSError):
-            checkpoint.replace(checkpoint.with_name(checkpoint.name + ".crashed"))
-        self._crash_loop = Help(HelpAbout.CRASHED, resume.written, why)
-        return None
-
-    def decided(self) -> decisions.Decisions:
-        """What staff decided now (saved beside the checkpoint whenever it changes)."""
-        board = self.core.board
-        help_ = board.get(keys.HELP) or board.get(keys.HELP_RESTORED)
-        return decisions.Decisions(
-            in_service=board.get(keys.IN_SERVICE) is not False,
-            paused=bool(board.get(keys.PAUSED)),
-            help=help_,
-            acknowledged=self.staff.acknowledged_ids(),
-        )
 
     def _core(self, site: Site, tree: LoadedTree) -> Core:
         """A core for ``tree``, on this executive's links, observers and standing state."""
@@ -217,9 +161,6 @@ class Executive:
         actions = self.core.actions
         if not state.connected:
             self._pending_at_loss = actions.pending
-            self._refusals = self._refusals + 1 if state.refused else 0
-            if self._refusals >= 3 and self.once:
-                self.stop("rosbridge refused authentication (check the secret)", 1)
         elif (
             state.reconnects > 0
             and actions.pending is not None
@@ -232,6 +173,8 @@ class Executive:
                 f"link back: re-sent {actions.pending.kind} to {actions.pending.target}"
             )
         self.check_links()
+        for listener in self.link_listeners:
+            listener(state)
         self._wake.set()
 
     def wake(self) -> None:
@@ -277,7 +220,7 @@ class Executive:
             self.client.subscribe(CLOCK.name, CLOCK.type)
 
     async def run(self) -> Outcome:
-        """Connect, tick until stopped (or one tour done with ``once``), then halt cleanly."""
+        """Connect, tick until :meth:`stop`, then halt cleanly and close the links."""
         logctx.mark(self)  # this task's log lines (and its tasks') are this executive's
         self.setup_wire()
         await self.link.start()
@@ -287,12 +230,6 @@ class Executive:
             if await self._until_stopped(self._ready_or_alive()):
                 self.core.setup()
                 await self._loop()
-        except (asyncio.CancelledError, KeyboardInterrupt):
-            raise
-        except BaseException as exc:  # a crash: the next start must not loop into it
-            if self.checkpoint is not None:
-                mark_crashed(self.checkpoint, f"{type(exc).__name__}: {exc}")
-            raise
         finally:
             self.notifier.stopping()
             await self._shutdown()
@@ -334,6 +271,8 @@ class Executive:
         return not self._stopping.is_set()
 
     def stop(self, reason: str = "", code: int = 0) -> None:
+        """End :meth:`run` (after the tick under way): the first stop's ``code`` and
+        ``reason`` are the outcome's."""
         if not self._stopping.is_set():
             self.outcome.code, self.outcome.reason = code, reason
         self._stopping.set()
@@ -355,6 +294,9 @@ class Executive:
                         self.tick()
                     except Exception as exc:
                         self.core.faults.failed("the executive", exc, "a tick")
+                    # the observers hear the tick's end (Observers.later) before the loop
+                    # goes on: an exit rule that stops the run stops it before another tick
+                    await asyncio.sleep(0)
         finally:
             periodic.cancel()
 
@@ -398,7 +340,16 @@ class Executive:
         log.warning("tree reloaded at an idle point: %s (%d nodes)", tree.file, nodes)
         core.ctx.note(f"tree reloaded: {tree.file}")
 
-    def tick(self) -> None:
+    def tick(self) -> Status:
+        """One tick of the tree, after what must happen between two ticks; its status.
+        (Observers hear it as :class:`~frog_bt.model.events.Ticked`: the exit rules, the
+        keeper of the checkpoint, the recorder.)"""
+        self._between_ticks()
+        return self.core.tick()  # the staff check the alerts at its end (_after_tick)
+
+    def _between_ticks(self) -> None:
+        """The links' states, a checked tree swapped in at an idle point, a restart of the
+        front end noted, the staff's queued commands applied."""
         self.check_links()
         if self._swap is not None and self.idle():
             self._swap_tree()
@@ -407,49 +358,6 @@ class Executive:
             self._peer_restarts = restarts
             self.core.ctx.note("front end restarted", incident=IncidentKind.FRONTEND_RESTARTED)
         self.staff.before_tick()
-        status = self.core.tick()  # the staff check the alerts at its end (_after_tick)
-        progress = self.core.board.get(keys.PROGRESS) or EMPTY
-        if self.checkpoint is not None and progress != self._saved:
-            self._saved = progress
-            try:
-                save_checkpoint(
-                    self.checkpoint, progress, self.standing.run.id, self.ledger.current
-                )
-            except OSError as exc:  # a full disk must not stop the tour; warn once a minute
-                self._checkpoint_warnings.warn(
-                    "checkpoint",
-                    f"cannot write the checkpoint {self.checkpoint}: {exc.strerror or exc}",
-                )
-        decided = self.decided()
-        if self.checkpoint is not None and decided != self._decided:
-            self._decided = decided
-            try:
-                decisions.save(decisions.path_for(self.checkpoint), decided)
-            except OSError as exc:
-                self._checkpoint_warnings.warn(
-                    "decisions", f"cannot keep what staff decided: {exc.strerror or exc}"
-                )
-        help_ = self.core.board.get(keys.HELP)
-        if help_ is not None and self.once:  # CONTRACT §5: --once exits with the reason
-            self.stop(f"needs help: {help_.what}", 1)
-            return
-        if status == Status.SUCCESS:
-            board = self.core.board
-            if board.get(keys.TOUR_STATE) is TourState.ABORTED:
-                reason = f"tour aborted: {board.get(keys.TOUR_REASON) or 'no reason given'}"
-                log.warning("%s", reason)
-                if self.once:
-                    self.stop(reason, 1)
-                return
-            self.outcome.tours = self.ledger.completed
-            if self.once:
-                self.stop("tour ended docked", 0)
-        elif status == Status.FAILURE:
-            # the tree gave up (GiveUp told the front end): the robot cannot go on
-            gave_up = self.core.board.get(keys.GAVE_UP)
-            reason = gave_up.text if gave_up is not None else "the tour tree failed"
-            log.error("cannot go on: %s", reason)
-            self.stop(reason, 1)
 
     async def _shutdown(self) -> None:
         """Halt the tree (scopes switch the face stream off, ...) and flush the links."""
@@ -460,11 +368,7 @@ class Executive:
         await self.link.drain(FRONTEND_DRAIN)
         # Leave the robot's rosbridge tidy: the last commands out, then unsubscribe and
         # unadvertise (only sent while connected; nothing is queued for later).
-        if self.client.link.connected:
-            for topic in list(self.client.session.subscriptions):
-                self.client.unsubscribe(topic)
-            for topic in list(self.client.session.advertised):
-                self.client.unadvertise(topic)
+        self.client.leave()
         await self.client.flush(ROSBRIDGE_FLUSH)
         await self.client.close()
         self.link.close()

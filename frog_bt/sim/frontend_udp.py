@@ -1,8 +1,9 @@
 """The simulated front end's UDP socket: a thin asyncio adapter that only moves bytes.
 
 Listens on ``host:port`` (port 0: any free port, see :attr:`FrontendSocket.port`)
-and sends to the executive's address. What the datagrams mean is
-:mod:`frog_bt.sim.frontend`'s business.
+and sends to the executive's address; over a
+:class:`~frog_bt.frontend.memory.MemoryNet` (``network``) instead of a socket in tests.
+What the datagrams mean is :mod:`frog_bt.sim.frontend`'s business.
 """
 
 from __future__ import annotations
@@ -10,6 +11,8 @@ from __future__ import annotations
 import asyncio
 import logging
 from collections.abc import Callable
+
+from frog_bt.frontend.link import DatagramNetwork
 
 log = logging.getLogger(__name__)
 
@@ -37,7 +40,9 @@ class FrontendSocket:
         port: int,
         executive: Address,
         on_datagram: Callable[[bytes, Address], None],
+        network: DatagramNetwork | None = None,
     ) -> None:
+        self.network = network
         self.host = host
         self.port = port
         self.executive = executive
@@ -46,8 +51,8 @@ class FrontendSocket:
         self.send_errors = 0
 
     async def open(self) -> None:
-        loop = asyncio.get_running_loop()
-        transport, _ = await loop.create_datagram_endpoint(
+        network: DatagramNetwork = self.network or asyncio.get_running_loop()
+        transport, _ = await network.create_datagram_endpoint(
             lambda: _Protocol(self.on_datagram), local_addr=(self.host, self.port)
         )
         self._transport = transport

@@ -5,7 +5,9 @@ It accepts connections, feeds each text frame to the sans-I/O
 returns: frames go into a per-client queue drained by one writer task (frames
 stay in order; a client too slow to keep up loses the oldest, counted in
 :attr:`RosbridgeServer.dropped`), publishes from clients go to
-``on_incoming``, ``Close`` closes the connection.
+``on_incoming``, ``Close`` closes the connection. Given a
+:class:`~frog_bt.rosbridge.memory.MemoryWire`, it serves on that instead of a socket
+(clients connect with the wire's ``connect``).
 """
 
 from __future__ import annotations
@@ -16,10 +18,12 @@ import logging
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
-from websockets.asyncio.server import Server, ServerConnection, serve
+from websockets.asyncio.server import serve
 from websockets.exceptions import ConnectionClosed
 
+from frog_bt.rosbridge.memory import MemoryWire
 from frog_bt.rosbridge.protocol import MAX_FRAME_BYTES
 from frog_bt.sim.rosbridge_protocol import Action, BridgeServer, Close, Incoming, Send
 
@@ -30,7 +34,7 @@ QUEUE_LIMIT = 10_000  # frames waiting for one client
 
 @dataclass(slots=True)
 class _Connection:
-    ws: ServerConnection
+    ws: Any  # a websockets ServerConnection, or a MemoryConnection
     queue: asyncio.Queue[str | Close]
 
 
@@ -44,14 +48,16 @@ class RosbridgeServer:
         port: int,
         on_incoming: Callable[[Incoming], None],
         now: Callable[[], float],
+        wire: MemoryWire | None = None,
     ) -> None:
         self.protocol = protocol
+        self.wire = wire
         self.host = host
         self.port = port
         self.on_incoming = on_incoming
         self.now = now
         self.dropped = 0
-        self._server: Server | None = None
+        self._server: Any = None  # websockets' Server, or a MemoryServing
         self._connections: dict[int, _Connection] = {}
 
     @classmethod
@@ -75,6 +81,11 @@ class RosbridgeServer:
     async def start(self) -> None:
         """Listen (again: on the port bound the first time)."""
         if self._server is not None:
+            return
+        if self.wire is not None:
+            self._server = await self.wire.serve(self._handle)
+            self.port = self.wire.port
+            log.info("rosbridge serving in memory on %s", self.wire.url)
             return
         # No permessage-deflate: loopback needs no compression, and it costs per frame.
         self._server = await serve(
@@ -114,7 +125,7 @@ class RosbridgeServer:
             self.dropped += 1
         conn.queue.put_nowait(item)
 
-    async def _handle(self, ws: ServerConnection) -> None:
+    async def _handle(self, ws: Any) -> None:  # a ServerConnection, or a MemoryConnection
         client = self.protocol.connect()
         conn = _Connection(ws, asyncio.Queue())
         self._connections[client] = conn
@@ -141,5 +152,5 @@ class RosbridgeServer:
                     await conn.ws.close(1008, item.reason)
                     return
                 await conn.ws.send(item)
-        except ConnectionClosed:
+        except (ConnectionClosed, ConnectionResetError):  # the latter: in memory
             return

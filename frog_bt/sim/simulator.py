@@ -15,6 +15,11 @@ machine then slows the whole rehearsal down instead of changing what the
 executive sees: the same tour at any load. :meth:`pause` holds the world
 still (a test reconnecting its executive, say).
 
+With ``memory=True`` nothing binds a socket: the rosbridge server serves a
+:class:`~frog_bt.rosbridge.memory.MemoryWire` (:attr:`Simulator.wire`) and the front end
+a :class:`~frog_bt.frontend.memory.MemoryNet` (:attr:`Simulator.net`), which the
+executive's links are then built on (:mod:`frog_bt.rehearsal`).
+
 Tests can also skip the time loop (``await sim.start(run_clock=False)``) and
 move the world by hand with :meth:`Simulator.step` / :meth:`Simulator.advance`.
 """
@@ -30,7 +35,9 @@ from typing import Any
 
 import frog_bt.sim.msgs as msgs
 from frog_bt.clock import ManualClock
+from frog_bt.frontend.memory import MemoryNet
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
+from frog_bt.rosbridge.memory import MemoryWire
 from frog_bt.sim.frontend import FrontendModel
 from frog_bt.sim.frontend_udp import Address, FrontendSocket
 from frog_bt.sim.rosbridge_protocol import BridgeServer, Incoming
@@ -63,6 +70,7 @@ class Simulator:
         secret: str | None = None,
         frontend_host: str | None = None,
         via: str | None = None,
+        memory: bool = False,
     ) -> None:
         self.scenario = scenario
         self.speed = scenario.speed
@@ -77,10 +85,14 @@ class Simulator:
         types = {t.name: t.type for t in (*INPUTS.values(), *OUTPUTS.values(), CLOCK)}
         self.bridge = BridgeServer(secret, types)
         self.via = via
+        # in memory: no socket at all; the executive connects with wire.connect and
+        # binds its front-end link on net (frog_bt.rosbridge.memory, frog_bt.frontend.memory)
+        self.wire = MemoryWire(host) if memory and via is None else None
+        self.net = MemoryNet() if memory else None
         self._rosbridge: RosbridgeServer | RosbridgeVia
         if via is None:
             self._rosbridge = RosbridgeServer(
-                self.bridge, host, rosbridge_port, self._on_incoming, self.clock.now
+                self.bridge, host, rosbridge_port, self._on_incoming, self.clock.now, self.wire
             )
         else:  # the robot as a client of an existing server (secret: to authenticate)
             robot = {t.name: t.type for t in (*INPUTS.values(), CLOCK)}
@@ -90,7 +102,11 @@ class Simulator:
             scenario, executive[0], self._visitor_says_yes, self._on_frontend_traffic
         )
         self._udp = FrontendSocket(
-            frontend_host or host, frontend_port, (executive[0], executive[1]), self._on_datagram
+            frontend_host or host,
+            frontend_port,
+            (executive[0], executive[1]),
+            self._on_datagram,
+            self.net,
         )
         self._loop_task: asyncio.Task[None] | None = None
         self._dropped: dict[str, float] = {}  # topic -> simulated time its drop-out ends

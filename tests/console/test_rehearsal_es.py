@@ -57,7 +57,7 @@ def _walk(driver: webdriver.Chrome, url: str, words: str) -> str:
 
 async def _rehearse(driver: webdriver.Chrome, name: str, words: str) -> tuple[str, bool, str]:
     site = load_site()
-    rehearsal = Rehearsal(scenario_from(name, FAST), site=site, once=False)
+    rehearsal = Rehearsal(scenario_from(name, FAST), site=site, once=False, memory=True)
     async with rehearsal:
         exe = rehearsal.executive
         people = await start_people(exe, ConsoleSettings("127.0.0.1", 0, TOKEN), [])

@@ -249,7 +249,8 @@ def test_out_of_service_and_an_acknowledged_alert_survive_a_restart(
             first.sim.world.battery.percentage = 20.0
             await after_ticks(exe, lambda: "battery_low" in exe.staff.book.active)
             assert (await exe.staff.submit(Command.ACK_ALERT, "battery_low")).ok
-            await after_ticks(exe, lambda: exe.decided() == exe._decided)  # saved
+            assert first.keeper is not None
+            await after_ticks(exe, first.keeper.kept)  # saved
             sim, listen = first.sim, first.listen
             first.own_sim = False
         saved = decisions.load(decisions.path_for(checkpoint))
@@ -290,7 +291,8 @@ def test_a_pause_survives_a_restart_and_the_resumed_tour_waits(tmp_path: Path) -
                 lambda r: r.channel == "start_poi" and r.payload.get("poi") == "POI1", 60
             )
             assert (await exe.staff.submit(Command.PAUSE)).ok
-            await after_ticks(exe, lambda: exe.decided() == exe._decided)  # saved
+            assert first.keeper is not None
+            await after_ticks(exe, first.keeper.kept)  # saved
             sim, listen = first.sim, first.listen
             first.own_sim = False
         assert decisions.load(decisions.path_for(checkpoint)).paused

@@ -2,7 +2,10 @@
 
 Built on :class:`frog_bt.rehearsal.Rehearsal`; adds what tests assert on: the
 commands the simulator received, compactly, and what the executive sent to the
-front end with its own clock's times.
+front end with its own clock's times. The links run over memory
+(:class:`~frog_bt.rosbridge.memory.MemoryWire`, :class:`~frog_bt.frontend.memory.MemoryNet`:
+the same protocols, no socket) unless a test asks for sockets (``memory=False``) to test
+the wire itself.
 """
 
 from __future__ import annotations
@@ -90,7 +93,8 @@ def describe(record: Record, summary: TourSummary) -> str:
 
 class Running(Rehearsal):
     """A rehearsal of the default scenario (fast, with ``scenario_data`` on top) that
-    keeps a tour summary and the front-end commands sent; ``once`` is off unless asked."""
+    keeps a tour summary and the front-end commands sent; ``once`` is off unless asked;
+    over memory unless ``memory=False``."""
 
     def __init__(
         self,
@@ -100,13 +104,14 @@ class Running(Rehearsal):
         tree: LoadedTree | None = None,
         sim: Simulator | None = None,
         listen: tuple[str, int] | None = None,
+        once: bool = False,
+        memory: bool = True,
         **executive_kwargs: Any,
     ) -> None:
         site = site or load_site()
         self.summary = TourSummary(site)
         self.sent: list[tuple[float, Any]] = []
         self.published: list[tuple[float, str]] = []
-        executive_kwargs.setdefault("once", False)
         super().__init__(
             None if sim is not None else fast(scenario_data),
             site=site,
@@ -114,6 +119,8 @@ class Running(Rehearsal):
             sim=sim,
             listen=listen,
             prepare=self._prepare,
+            once=once,
+            memory=memory,
             **executive_kwargs,
         )
 

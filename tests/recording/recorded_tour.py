@@ -50,7 +50,11 @@ async def _record(
     site = site or load_site()
     recorder = Recorder(path)
     rehearsal = Rehearsal(
-        scenario(data), site=site, tree=tree, prepare=lambda exe: attach_all(exe, [recorder])
+        scenario(data),
+        site=site,
+        tree=tree,
+        prepare=lambda exe: attach_all(exe, [recorder]),
+        memory=True,
     )
     start = rehearsal.sim.clock.now()
     try:
@@ -104,7 +108,11 @@ def record_day(directory: Path, tours: int, max_bytes: int) -> RecordingDir:
             listen(executive, lambda _e: executive.outcome.tours >= tours and enough.set(), Ticked)
 
         rehearsal = Rehearsal(
-            scenario_from("default", FAST_TOURS), site=load_site(), prepare=prepare, once=False
+            scenario_from("default", FAST_TOURS),
+            site=load_site(),
+            prepare=prepare,
+            once=False,
+            memory=True,
         )
         async with rehearsal:
             await asyncio.wait_for(enough.wait(), 60)

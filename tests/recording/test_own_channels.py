@@ -41,7 +41,9 @@ def is_(channel: str, **fields: object):  # type: ignore[no-untyped-def]
 async def _record_with_commands(path: Path) -> list[tuple[bool, str]]:
     site = load_site()
     recorder = Recorder(path)
-    rehearsal = Rehearsal(scenario(), site=site, prepare=lambda exe: attach_all(exe, [recorder]))
+    rehearsal = Rehearsal(
+        scenario(), site=site, prepare=lambda exe: attach_all(exe, [recorder]), memory=True
+    )
     answers = []
     try:
         async with rehearsal:

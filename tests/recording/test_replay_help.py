@@ -53,7 +53,7 @@ async def _record(path: Path, script: Script, rehearsal: Rehearsal, **recorder: 
 
 
 def _rehearsal(data: dict[str, Any], **kwargs: Any) -> Rehearsal:
-    return Rehearsal(scenario(data), site=SITE, once=False, **kwargs)
+    return Rehearsal(scenario(data), site=SITE, once=False, memory=True, **kwargs)
 
 
 async def _help(exe: Executive, about: HelpAbout, alert: str) -> None:
@@ -302,7 +302,9 @@ def killed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
         exe = r.executive
         await _help(exe, HelpAbout.DOCK, "docking_failed")
         await _answer(exe, Command.ACK_ALERT, True, "docking_failed")
-        await after_ticks(exe, lambda: exe.decided() == exe._decided)  # saved
+        keeper = r.keeper
+        assert keeper is not None
+        await after_ticks(exe, keeper.kept)  # saved
         ticks = exe.core.ticks
         await after_ticks(exe, lambda: exe.core.ticks >= ticks + 5)
         await asyncio.sleep(0)  # the recorder's last drain (and flush) runs
@@ -326,8 +328,9 @@ def killed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
             first, until_killed, _rehearsal(DOCK_FAILS, checkpoint=checkpoint), flush_every=0.0
         )
         sim = kept["sim"]
-        again = Rehearsal(None, sim=sim, listen=kept["listen"], site=SITE, checkpoint=checkpoint)
-        again.executive_kwargs["once"] = False
+        again = Rehearsal(
+            None, sim=sim, listen=kept["listen"], site=SITE, checkpoint=checkpoint, once=False
+        )
         try:
             await _record(second, resumed, again)
         finally:
@@ -385,7 +388,7 @@ def test_a_day_of_files_carries_the_alert_book_across_rotation(tmp_path: Path) -
             listen(exe, lambda _e: exe.outcome.tours >= 2 and two.set(), Ticked)
 
         rehearsal = Rehearsal(
-            scenario_from("default", data), site=SITE, prepare=prepare, once=False
+            scenario_from("default", data), site=SITE, prepare=prepare, once=False, memory=True
         )
         async with rehearsal:
             exe = rehearsal.executive

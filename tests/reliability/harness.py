@@ -74,14 +74,7 @@ class TourRun(Rehearsal):
             lambda out: self._add(Published(out.t, out.topic, out.msg, exe.client.link.connected)),
             RobotCommand,
         )
-        on_link = exe.client.on_link
-
-        def link_changed(state: LinkState) -> None:
-            if on_link is not None:
-                on_link(state)  # the executive's own handler first (it re-sends the goal)
-            self._add(state)
-
-        exe.client.on_link = link_changed
+        exe.link_listeners.append(self._add)  # after the executive's own (it re-sends the goal)
 
     # ------------------------------------------------------------ records and waits
 

@@ -36,6 +36,7 @@ from garbage import (
 )
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from links import over_sockets
 from rosmsgs import DECODERS, encode_clock
 from websockets.asyncio.server import ServerConnection, serve
 
@@ -47,7 +48,6 @@ from frog_bt.frontend.protocol import Endpoint, decode_datagram, encode_datagram
 from frog_bt.model import frontend as fm
 from frog_bt.rehearsal import free_udp_port
 from frog_bt.rosbridge.protocol import Publish, decode_frame
-from frog_bt.runtime.executive import Executive
 from frog_bt.warning_limit import WARN_INTERVAL
 
 ROS_FRAMES = 70_000  # through decode_frame and the message decoders
@@ -207,11 +207,11 @@ def test_running_executive_survives_a_flood_of_bad_input(caplog: pytest.LogCaptu
         async with serve(handler, "127.0.0.1", 0) as server:
             port = server.sockets[0].getsockname()[1]
             listen = ("127.0.0.1", free_udp_port())
-            exe = Executive(
+            exe = over_sockets(
                 site,
                 load_tree(site=site),
                 SimClock(),
-                rosbridge_url=f"ws://127.0.0.1:{port}",
+                url=f"ws://127.0.0.1:{port}",
                 frontend=front_end.getsockname(),
                 listen=listen,
                 sim_time=True,

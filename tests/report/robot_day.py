@@ -181,6 +181,7 @@ async def _tour(directory: Path, kind: str) -> Seen:
         scenario_from(name, data),
         site=site,
         prepare=lambda exe: (attach_all(exe, [recordings]), hear(exe, seen)),
+        memory=True,
     )
     try:
         async with run:
@@ -209,6 +210,7 @@ async def _resumed(directory: Path, checkpoint: Path) -> Seen:
         prepare=lambda exe: (attach_all(exe, [first]), hear(exe, seen)),
         checkpoint=checkpoint,
         once=False,
+        memory=True,
     )
     try:
         async with run:

@@ -409,6 +409,7 @@ def test_a_tour_resumed_by_a_restarted_executive_is_one_resumed_row(tmp_path) ->
             prepare=lambda exe: attach_all(exe, [first_files]),
             checkpoint=checkpoint,
             once=False,
+            memory=True,
         )
         async with first:
             await first.sim.wait_for(

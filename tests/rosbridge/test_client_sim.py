@@ -1,9 +1,11 @@
-"""RosbridgeClient against the built-in simulator on loopback: the real pair, end to end."""
+"""RosbridgeClient against the built-in simulator: the real pair, end to end, on loopback
+and over an in-memory wire (frog_bt/rosbridge/memory.py), which must behave the same."""
 
 from __future__ import annotations
 
 import asyncio
 
+import pytest
 from rosmsgs import encode_pose
 
 from frog_bt.model.ros import Pose
@@ -11,11 +13,12 @@ from frog_bt.rosbridge.client import RosbridgeClient
 from frog_bt.sim import Simulator, parse_scenario
 
 
-async def _drive_and_reconnect() -> tuple[list[int], int, int, int]:
+async def _drive_and_reconnect(memory: bool) -> tuple[list[int], int, int, int]:
     sim = Simulator(
         parse_scenario({"speed": 100.0, "robot": {"docked": False}}),
         rosbridge_port=0,
         frontend_port=0,
+        memory=memory,
     )
     await sim.start()
     poses: asyncio.Queue[Pose] = asyncio.Queue()
@@ -29,7 +32,8 @@ async def _drive_and_reconnect() -> tuple[list[int], int, int, int]:
 
     down = asyncio.Event()
     client = RosbridgeClient(
-        f"ws://127.0.0.1:{sim.rosbridge_port}",
+        sim.wire.url if sim.wire else f"ws://127.0.0.1:{sim.rosbridge_port}",
+        connect=sim.wire.connect if sim.wire else None,
         on_message=on_message,
         on_link=lambda state: None if state.connected else down.set(),
         backoff_initial=0.05,
@@ -63,8 +67,9 @@ async def _drive_and_reconnect() -> tuple[list[int], int, int, int]:
         await sim.stop()
 
 
-def test_subscribe_publish_and_resubscribe_after_the_server_restarts():
-    codes, reconnects, gotos, malformed = asyncio.run(_drive_and_reconnect())
+@pytest.mark.parametrize("memory", [False, True], ids=["socket", "memory"])
+def test_subscribe_publish_and_resubscribe_after_the_server_restarts(memory: bool):
+    codes, reconnects, gotos, malformed = asyncio.run(_drive_and_reconnect(memory))
     assert codes == [1, 2, 1, 2]
     assert reconnects == 1
     assert gotos == 2

@@ -5,12 +5,13 @@ from __future__ import annotations
 import asyncio
 from typing import Any
 
+from links import over_sockets
+
 from frog_bt.behaviours import load_tree
 from frog_bt.clock import WallClock
 from frog_bt.config import load_site
 from frog_bt.model.wire import INPUTS, OUTPUTS
 from frog_bt.rehearsal import free_udp_port
-from frog_bt.runtime.executive import Executive
 
 from .conftest import FakeRosbridge
 
@@ -18,11 +19,11 @@ from .conftest import FakeRosbridge
 async def _ops() -> list[dict[str, Any]]:
     site = load_site()
     async with FakeRosbridge() as server:
-        executive = Executive(
+        executive = over_sockets(
             site,
             load_tree(site=site),
             WallClock(),
-            rosbridge_url=server.url,
+            url=server.url,
             frontend=("127.0.0.1", free_udp_port()),
             listen=("127.0.0.1", free_udp_port()),
         )

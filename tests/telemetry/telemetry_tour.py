@@ -65,7 +65,11 @@ async def _run_tour(path: Path) -> Recorded:
     tree = load_tree(site=site)
     telemetry = Telemetry.open(f"save:{path}", site, tree)
     rehearsal = Rehearsal(
-        fast(), site=site, tree=tree, prepare=lambda executive: attach_all(executive, [telemetry])
+        fast(),
+        site=site,
+        tree=tree,
+        prepare=lambda executive: attach_all(executive, [telemetry]),
+        memory=True,
     )
     try:
         async with rehearsal:
