@@ -41,6 +41,8 @@ Address = tuple[str, int]
 SockAddr = tuple[str, int, *tuple[int, ...]]
 # (direction "in" | "out", datagram, clock time): a tap for recordings (CONTRACT §6).
 DatagramTap = Callable[[str, bytes, float], None]
+DRAIN_LIMIT = 256  # datagrams read per turn of the loop beyond the first (a flood cannot hold it)
+READ_SIZE = 65536  # bytes: a whole UDP datagram, so that an oversized one is seen as such
 
 
 class DatagramNetwork(Protocol):
@@ -88,17 +90,44 @@ class AddressError(OSError):
 
 
 class _DatagramProtocol(asyncio.DatagramProtocol):
+    """Hands every datagram to the link. The event loop reads one datagram per turn, and
+    a busy loop turns slowly (a rosbridge backlog, a tick, the recording), so a fresh
+    event would wait behind every stale resend queued before it; so each turn also reads
+    whatever else waits on the socket (up to :data:`DRAIN_LIMIT`), through a duplicate of
+    the loop's socket. An endpoint with no socket (a MemoryNet's) delivers as it is."""
+
     def __init__(self, link: FrontendLink) -> None:
         self._link = link
+        self._sock: socket.socket | None = None
+
+    def connection_made(self, transport: asyncio.BaseTransport) -> None:
+        sock = transport.get_extra_info("socket")
+        if sock is not None:
+            self._sock = sock.dup()
+            self._sock.setblocking(False)
 
     def datagram_received(self, data: bytes, addr: SockAddr) -> None:
         self._link._datagram_received(data, addr)
+        for _ in range(DRAIN_LIMIT):
+            if self._sock is None or self._link._closing:
+                return
+            try:
+                data, addr = self._sock.recvfrom(READ_SIZE)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:
+                self.error_received(exc)
+                return
+            self._link._datagram_received(data, addr)
 
     def error_received(self, exc: Exception) -> None:
         # ICMP errors (peer not listening yet) are expected; resends cover them.
         self._link._warnings.warn("socket error", f"front-end link socket error: {exc}")
 
     def connection_lost(self, exc: Exception | None) -> None:
+        if self._sock is not None:
+            self._sock.close()
+            self._sock = None
         self._link._closed.set()
 
 

@@ -23,6 +23,7 @@ from frog_bt.frontend.protocol import MAX_DATAGRAM
 from frog_bt.model.frontend import (
     COMMANDS,
     ContentDone,
+    FinishIntroduction,
     FollowMe,
     FrontendMessage,
     UserPositive,
@@ -218,6 +219,32 @@ def test_ack_goes_to_the_datagram_source_not_the_configured_peer() -> None:
                 obj, addr = await within(sender.datagrams.get())
                 assert obj == {"type": "ack", "seq": 1} and addr[1] == link.listen_port
                 assert configured.datagrams.empty()
+
+    run(main)
+
+
+def test_every_datagram_waiting_is_read_at_the_next_turn_of_the_loop() -> None:
+    """A busy event loop turns slowly (a rosbridge backlog, a tick, the recording): read
+    one datagram per turn, a fresh event waited behind every stale resend queued before
+    it. In the soak (speed 300, a core busy) a ``user_positive`` was read 160 simulated
+    seconds after it came, past the answer timeout: the visitor was taken for one who
+    gave no answer, and the tour never went on. All that waits is read at once."""
+
+    async def main() -> None:
+        clock = ManualClock(T0)
+        events: list[FrontendMessage] = []
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as peer:
+            peer.bind((HOST, 0))
+            link = FrontendLink((HOST, 0), peer.getsockname(), clock, on_message=events.append)
+            async with started(link):
+                to = (HOST, link.listen_port)
+                for _ in range(50):  # the front end resends while its ack is on the way
+                    peer.sendto(b'{"type": "finish_introduction", "seq": 2}', to)
+                peer.sendto(b'{"type": "user_positive", "seq": 3}', to)
+                for _ in range(3):  # three turns of the loop, no time on any clock
+                    await asyncio.sleep(0)
+                assert events == [FinishIntroduction(), UserPositive()]
+                assert link.stats.duplicates == 49 and link.stats.received == 2
 
     run(main)
 
