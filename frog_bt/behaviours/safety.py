@@ -56,7 +56,10 @@ class MustAbort(Leaf):
     writes = (keys.ABORT_REASON,)
     world = World(
         inputs=(Channel.DIAGNOSTICS, Channel.OPERATOR),
-        why="battery: low (below safety.battery_low) or full; a fault or none",
+        truthy=(keys.ABORT_REASON.name, keys.HOME.name),
+        why="battery: low (below safety.battery_low) or full; a fault or none. Of /home "
+        "it decides on whether it is set; its words become the abort's, which only the "
+        "front end reads",
     )
 
     def update(self) -> Status:
@@ -100,7 +103,9 @@ class ClearAbort(Leaf):
 
     optional_reads = (keys.ABORT_REASON,)
     writes = (keys.ABORT_REASON, keys.ABORT_REASON_LAST, keys.HOME)
-    world = World()
+    world = World(
+        ignores=(keys.ABORT_REASON.name,), why="it keeps the reason as /abort_reason_last"
+    )
 
     def update(self) -> Status:
         self.set(keys.ABORT_REASON_LAST, self.get(keys.ABORT_REASON))
@@ -208,7 +213,12 @@ class Checkpointed(FrogDecorator):
     writes = (keys.VISITOR, keys.RESUME, keys.PROGRESS)
     skips_child = True  # resumed: SUCCESS without the child (the data-flow check)
     _skip = False
-    world = World(state=("_skip",), late=(keys.VISITOR.name,))
+    world = World(
+        state=("_skip",),
+        late=(keys.VISITOR.name,),
+        passes=True,
+        people=(keys.VISITOR.name, keys.RESUME.name, keys.PROGRESS.name),
+    )
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
         # Resumed past this part: py_trees' plain behaviour tick (initialise, update,

@@ -31,6 +31,7 @@ import copy
 import dataclasses
 import enum
 import logging
+import math
 import time
 from collections import deque
 from collections.abc import Callable, Hashable, Iterator
@@ -97,10 +98,12 @@ class Robot:
     where: str | None
     docking: DockingState = DockingState.DOCKED
     homing: bool = False
+    people: int = 0  # the persons the camera has shown so far (the next one is new)
     seen: int | None = None  # the visitor the camera sees as an approach succeeds
 
-    def key(self) -> tuple[object, ...]:
-        return (self.where, self.docking, self.homing)
+    def key(self, near: Callable[[str | None], Hashable]) -> tuple[object, ...]:
+        """Its encoding; ``near``: where it is, as the nodes tell places apart."""
+        return (near(self.where), self.docking, self.homing)
 
 
 @dataclass(slots=True)
@@ -148,12 +151,41 @@ class Real:
         self.index = {id(n): i for i, n in enumerate(self.nodes)}
         self.worlds = [world_of(type(n)) for n in self.nodes]
         self.declared = [_declared(w) | INTERNAL for w in self.worlds]
+        # the board's keys that hold people's ids (``World.people``; a node's own fields
+        # are named there too)
+        self.people = {name for w in self.worlds if w is not None for name in w.people}
+        self.approaches = [i for i, w in enumerate(self.worlds) if _role(w) == "approach"]
+        # counts on the board every reader of which reads only as a count since it began
+        counted: dict[str, set[int]] = {}
+        for i, w in enumerate(self.worlds):
+            for name, _ in w.counts if w is not None else ():
+                counted.setdefault(name, set()).add(i)
+        self.counted = {
+            name
+            for name, counters in counted.items()
+            if all(
+                i in counters
+                for i, n in enumerate(self.nodes)
+                for k in (*getattr(n, "reads", ()), *getattr(n, "optional_reads", ()))
+                if k.name == name
+            )
+        }
         self.copies = [i for i, w in enumerate(self.worlds) if w is not None and w.copy]
         self.retries = [
             i for i, n in enumerate(self.nodes) if isinstance(n, py_trees.decorators.Retry)
         ]
         self.dock = site.tour.dock
         self.robot = Robot(self.dock)
+        # the waypoints some node compares the robot's pose with (``World.places``)
+        self.places = sorted(
+            {
+                p
+                for n, w in zip(self.nodes, self.worlds, strict=True)
+                if w and w.places
+                for p in w.places(n)
+            }
+        )
+        self._nearness: dict[str | None, Hashable] = {}
         # the keys some node or the operator reads: a value nothing reads is not state;
         # an input the snapshot writes anew before every tick is the world's (derived)
         derived: set[Key[Any]] = {inp.key for inp in self.core.table.values()}
@@ -168,6 +200,7 @@ class Real:
         self._board_get = self.core.board.get
         self.core.board.get = self._get  # type: ignore[method-assign]
         self._publish_world(moved=True)
+        self._canonical()
         self.initial = self.save()
 
     # ------------------------------------------------------------ the world answers
@@ -178,6 +211,19 @@ class Real:
         value, by = options[self.oracle.pick(len(options))]
         self.step.choices.append(Choice(node, what, value, by))
         return value
+
+    def _near(self, where: str | None) -> Hashable:
+        """Where the robot is as the nodes tell places apart: for each waypoint some node
+        compares its pose with, whether it is within ``navigation.tolerance`` of it."""
+        found = self._nearness.get(where)
+        if found is None:
+            x, y = AWAY if where is None else (self.site.pois[where].x, self.site.pois[where].y)
+            tolerance = self.site.navigation.tolerance
+            found = self._nearness[where] = tuple(
+                math.hypot(x - self.site.pois[p].x, y - self.site.pois[p].y) <= tolerance
+                for p in self.places
+            )
+        return found
 
     def _here(self) -> tuple[float, float]:
         if self.robot.where is None:
@@ -214,17 +260,16 @@ class Real:
                 faults = ("motors: fault",)  # type: ignore[assignment]
             return Reading(Diagnostics(now, battery, faults), now)
         if key is keys.PERSONS:
+            # someone the robot has not seen before: a person it saw again is either
+            # passed over (as if nobody) or, after renaming, alike a new one
             who = self._choose(
-                at,
-                "camera",
-                [("nobody", By.QUIET), ("visitor 1 faces it", By.WORLD), ("visitor 2", By.WORLD)],
+                at, "camera", [("nobody", By.QUIET), ("someone new faces it", By.WORLD)]
             )
-            persons = (
-                ()
-                if who == "nobody"
-                else (PersonDetection(1 if "1" in who else 2, Point(x + 1.0, y), 180.0),)
-            )
-            return Reading(PersonDetections(now, persons), now)
+            if who == "nobody":
+                return Reading(PersonDetections(now, ()), now)
+            self.robot.people += 1
+            person = PersonDetection(self.robot.people, Point(x + 1.0, y), 180.0)
+            return Reading(PersonDetections(now, (person,)), now)
         if key is keys.PEOPLE:
             near = self._choose(at, "visitor", [("nobody near", By.WORLD), ("follows", By.WORLD)])
             people = (TrackedPerson(1, Point(x, y)),) if near == "follows" else ()
@@ -329,7 +374,7 @@ class Real:
             ),
             self.clock.now(),
             core.pause_ran_out,
-            (self.robot.where, self.robot.docking, self.robot.homing),
+            (self.robot.where, self.robot.docking, self.robot.homing, self.robot.people),
         )
         return Saved(tuple(nodes), engine)
 
@@ -426,7 +471,15 @@ class Real:
                     self.found.failed.append(line)
         step.events = self.events
         self._after(step, help_before)
+        self._canonical()
         return step
+
+    def _canonical(self) -> None:
+        """The interval since the last approach, pending whenever no approach runs: all
+        a later approach may see is that it has to wait (until the explorer lets the
+        interval run out) or not, and waiting first covers both."""
+        if not any(self.nodes[i].status is RUNNING for i in self.approaches):
+            self.core.actions.last_approach_at = self.clock.now()
 
     def _before(self, running: list[int]) -> bool:
         """The operator's command, a wait running out, or the world's answers: the
@@ -449,25 +502,13 @@ class Real:
         helping = board.get(keys.HELP)
         if helping is not None and board.get(keys.HELP_ANSWER) is None:
             options += [("retry", By.WORLD), ("done_by_hand", By.WORLD)]
-        deadlines: dict[float, int] = {}
-        now = self.clock.now()
-        for i in running:
-            w = self.worlds[i]
-            if w is not None and w.timer is not None:
-                due = w.timer(self.nodes[i])
-                if due is not None and due > now:
-                    deadlines.setdefault(due, i)
-        since = core.standing.paused_since
-        if paused and since is not None:
-            deadlines.setdefault(since + core.operator.pause_max, -1)
-        timers = sorted(deadlines.items())
-        options += [(_timer_label(self.nodes, i), By.ROBOT) for _, i in timers]
+        timers = self._timers(running, paused)
+        options += [(label, By.ROBOT) for label in timers]
         what = self._choose(-1, "operator", options)
         if what == "none":
             return self._answers(running)
-        if what.startswith("time: "):
-            due = next(d for d, i in timers if _timer_label(self.nodes, i) == what)
-            self.clock.set(due)
+        if what in timers:
+            timers[what]()
             return False
         if what == "done_by_hand" and helping is not None:  # a person did the step
             if helping.about is HelpAbout.UNDOCK:
@@ -479,6 +520,35 @@ class Real:
         if not answer.ok:
             raise Pruned(what)
         return False
+
+    def _timers(self, running: list[int], paused: bool) -> dict[str, Callable[[], None]]:
+        """The waits still ahead, each with what makes it run out now. The clock never
+        moves: a wait runs out by its own times moving back (``World.fire``), so that
+        the others stay pending; which runs out first is the explorer's choice."""
+        now = self.clock.now()
+        out: dict[str, Callable[[], None]] = {}
+        for i in running:
+            w = self.worlds[i]
+            if w is None or w.timer is None:
+                continue
+            due = w.timer(self.nodes[i])
+            if due is not None and due > now:
+                label = _timer_label(self.nodes, i)
+                out[label if label not in out else f"{label} ({i})"] = _firing(
+                    self.nodes[i], w, due - now
+                )
+        standing = self.core.standing
+        since = standing.paused_since
+        if paused and since is not None:
+            left = since + self.core.operator.pause_max - now
+            if left > 0:
+
+                def pause_runs_out() -> None:
+                    assert standing.paused_since is not None
+                    standing.paused_since -= left
+
+                out[_timer_label(self.nodes, -1)] = pause_runs_out
+        return out
 
     def _answers(self, running: list[int]) -> bool:
         """The robot answers its pending goal, the docking the running Docking asked
@@ -615,53 +685,77 @@ class Real:
         followed = {getattr(self.nodes[i], "goal", None) for i in self.running()} | {
             core.actions.pending
         }
-        enc = _Encoder(now, base, poses, {g.id for g in followed if isinstance(g, Goal)})
+        enc = _Encoder(
+            now,
+            base,
+            poses,
+            {g.id for g in followed if isinstance(g, Goal)},
+            self._board_get(keys.VISITOR),
+        )
         nodes: list[object] = []
         oldest = last
+        since: dict[str, int] = {}  # a count's value as a running node that counts it began
         for i in self.running():
             node, w = self.nodes[i], self.worlds[i]
             if w is None:
                 nodes.append(i)
                 continue
+            for name, at in w.counts:
+                since[name] = getattr(node, at, None) or 0
             if w.key is not None:
                 nodes.append((i, w.key(node)))
                 continue
             fields: list[Hashable] = []
             for name in w.state:
+                if name in w.ignores:
+                    continue
                 value = getattr(node, name, None)
                 if name in w.indexes and isinstance(value, int):
                     oldest = min(oldest, value)
                     fields.append(value - last)
+                elif name in w.people:
+                    fields.append(enc.person(value))
+                elif any(name == at for _, at in w.counts):
+                    continue  # with the count on the board: the count since it began
                 else:
                     fields.append(enc(value))
             nodes.append((i, tuple(fields)))
-        cooling = self.site.recruit.retry_after
         live, presence = self.liveness.live(
             self.positions(), self._board_get(keys.RESUME) is not None
         )
         truthy = self.liveness.truthy
-        board = tuple(
-            (k.name, bool(v))
-            if k in truthy
-            else (k.name, enc(v) if k is not keys.APPROACH_FAILED else _cooling(v, now, cooling))
-            if k in live
-            else (k.name, v is not None)
-            for store in (core.board._values, core.standing.values)
-            for k, v in store.items()
-            # a value of None reads as none written; an unset truthy key reads false
-            if v is not None and (k in live or k in presence) and (k not in truthy or v)
-        )
+        board: list[tuple[str, Hashable]] = []
+        for store in (core.board._values, core.standing.values):
+            for k, v in store.items():
+                # a value of None reads as none written; an unset truthy key reads false
+                if v is None or (k not in live and k not in presence) or (k in truthy and not v):
+                    continue
+                if k in truthy:
+                    board.append((k.name, True))
+                elif k not in live:
+                    board.append((k.name, True))  # only whether it is set
+                elif k.name in since:  # unset, or none since it began: left out alike
+                    if v != since[k.name]:
+                        board.append((k.name, v - since[k.name]))
+                elif k.name in self.counted:
+                    continue  # read only as a count since a node starts: none runs
+                elif k.name in self.people:
+                    board.append((k.name, enc.person(v)))
+                else:
+                    board.append((k.name, enc(v)))
+        board.sort(key=lambda e: e[0])
         tail = tuple(e.message for e in log.since(oldest)) if oldest < last else ()
         actions = core.actions
         engine = (
             enc(actions.pending),
             enc(latest),
-            enc(actions.before),
+            # the goal the pending one replaced while open: what a stale answer answers
+            enc(actions.before) if actions.pending is not None else None,
             enc(actions.unconfirmed),
             enc(core.standing.paused_since),
             min(round(now - actions.last_approach_at, 3), self.site.recruit.approach_interval),
         )
-        return (tuple(nodes), board, tail, engine, self.robot.key())
+        return (tuple(nodes), tuple(board), tail, engine, self.robot.key(self._near))
 
     # ------------------------------------------------------------ successors
 
@@ -708,8 +802,24 @@ class _Encoder:
     the newest goal; a goal no running node follows (and not pending) only as whether it
     is done (all that the next goal's belief reads of it)."""
 
-    def __init__(self, now: float, base: int, poses: int, followed: set[int]) -> None:
+    def __init__(
+        self, now: float, base: int, poses: int, followed: set[int], visitor: int | None
+    ) -> None:
         self.now, self.base, self.poses, self.followed = now, base, poses, followed
+        self.visitor = visitor
+
+    def person(self, value: Any) -> Hashable:
+        """A value holding people's ids (``World.people``): each id only as whether it is
+        the current visitor's (``/visitor``): people are alike."""
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value == self.visitor
+        if isinstance(value, frozenset | set):
+            return frozenset(self.person(v) for v in value)
+        if isinstance(value, dict):
+            return frozenset((self.person(k), self(v)) for k, v in value.items())
+        if dataclasses.is_dataclass(value) and not isinstance(value, type):
+            return tuple(self.person(getattr(value, f.name)) for f in dataclasses.fields(value))
+        return self(value)
 
     def __call__(self, value: Any) -> Hashable:
         if value is None or isinstance(value, bool | int | str | enum.Enum):
@@ -719,9 +829,12 @@ class _Encoder:
         if isinstance(value, Goal):
             if value.id not in self.followed:
                 return ("goal", value.done)
+            target: Hashable = value.target
+            if value.kind == "approach":  # a person's id
+                target = target.isdigit() and int(target) == self.visitor
             return (
                 value.kind,
-                value.target,
+                target,
                 value.code,
                 value.acknowledged,
                 value.id - self.base,
@@ -749,11 +862,6 @@ class _Encoder:
         except TypeError:
             return repr(value)
         return value  # type: ignore[no-any-return]
-
-
-def _cooling(failed: dict[int, float], now: float, retry_after: float) -> frozenset[int]:
-    """``/approach_failed`` as the seeker reads it: the visitors still passed over."""
-    return frozenset(pid for pid, at in failed.items() if now - at < retry_after)
 
 
 def _clone(value: Any, memo: dict[int, Any]) -> Any:
@@ -785,6 +893,21 @@ def _clone(value: Any, memo: dict[int, Any]) -> Any:
         return value
     memo[id(value)] = out
     return out
+
+
+def _firing(node: Behaviour, world: World, seconds: float) -> Callable[[], None]:
+    """What makes ``node``'s wait run out now: its ``fire``, or its ``times`` moved back."""
+
+    def fire() -> None:
+        if world.fire is not None:
+            world.fire(node, seconds)
+            return
+        for name in world.times:
+            value = getattr(node, name, None)
+            if value is not None:
+                setattr(node, name, value - seconds)
+
+    return fire
 
 
 def _timer_label(nodes: list[Behaviour], i: int) -> str:
