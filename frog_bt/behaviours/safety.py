@@ -57,7 +57,9 @@ class MustAbort(Leaf):
     world = World(
         inputs=(Channel.DIAGNOSTICS, Channel.OPERATOR),
         truthy=(keys.ABORT_REASON.name, keys.HOME.name),
-        why="battery: low (below safety.battery_low) or full; a fault or none. Of /home "
+        diagnostics=("ok", "battery low"),
+        why="battery: low (below safety.battery_low) or full; a fault or none: both abort "
+        "alike (the reason's words differ). Of /home "
         "it decides on whether it is set; its words become the abort's, which only the "
         "front end reads",
     )

@@ -30,6 +30,8 @@ abstracted. Each node type says, on its class, as ``world = World(...)``:
   unless it skips its child, resumed);
 * ``sets``: the keys it surely writes as it succeeds (what was there before is not read
   after it);
+* ``diagnostics``: the diagnostics it tells apart (``ok``, ``battery low``, ``fault``):
+  the explorer offers those when it is the first node of a tick to read them;
 * ``places``: the waypoints it compares the robot's pose with: where the robot is, is
   state only as whether it is at each waypoint some node compares with;
 * ``people``: keys (and its own fields) that hold a person's id: people are alike, so
@@ -99,6 +101,7 @@ class World:
     people: tuple[str, ...] = ()  # keys and fields holding a person's id
     sets: tuple[str, ...] = ()  # keys it surely writes as it succeeds
     passes: bool = False  # a decorator: it succeeds only when its child succeeded
+    diagnostics: tuple[str, ...] = ("ok", "battery low", "fault")
     places: Callable[[Any], tuple[str, ...]] | None = None  # waypoints it compares with
     counts: tuple[tuple[str, str], ...] = ()  # (key, field): a count since it started
     why: str = ""

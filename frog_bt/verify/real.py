@@ -32,10 +32,12 @@ import dataclasses
 import enum
 import logging
 import math
+import operator
 import time
 from collections import deque
 from collections.abc import Callable, Hashable, Iterator
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import py_trees
@@ -83,6 +85,7 @@ STOP_HERE = "(stop here)"  # the goal that stops the robot where it is (not a dr
 # what py_trees and the engine change on every node (not the node type's own state)
 INTERNAL = frozenset({"status", "feedback_message", "iterator"})
 LAZY = (keys.DIAGNOSTICS, keys.PERSONS, keys.PEOPLE, keys.FACES)  # answered as read
+DIAGNOSTICS = ("ok", "battery low", "fault")  # what a reader tells apart unless it says
 TIME = 1e9  # a float this large is a project-clock time (encoded relative to now)
 
 
@@ -151,6 +154,8 @@ class Real:
         self.index = {id(n): i for i, n in enumerate(self.nodes)}
         self.worlds = [world_of(type(n)) for n in self.nodes]
         self.declared = [_declared(w) | INTERNAL for w in self.worlds]
+        # per node, what gives its undeclared fields (to compare them at once)
+        self.watch: list[Callable[[dict[str, Any]], object] | None] = [None] * len(self.nodes)
         # the board's keys that hold people's ids (``World.people``; a node's own fields
         # are named there too)
         self.people = {name for w in self.worlds if w is not None for name in w.people}
@@ -199,6 +204,17 @@ class Real:
         self.live: list[dict[str, Any] | None] = [None] * len(self.nodes)
         self._board_get = self.core.board.get
         self.core.board.get = self._get  # type: ignore[method-assign]
+        self._blaming = False
+        note_sender = self.core._note_sender
+
+        def blame() -> None:  # what a node read, for the record: no choice of the world
+            self._blaming = True
+            try:
+                note_sender()
+            finally:
+                self._blaming = False
+
+        self.core._note_sender = blame  # type: ignore[method-assign]
         self._publish_world(moved=True)
         self._canonical()
         self.initial = self.save()
@@ -236,11 +252,11 @@ class Real:
         tick, the same for every reader), a choice of the explorer."""
         if key not in LAZY:
             return self._board_get(key)
-        reader = self.core.trace.current()
-        if reader is None:  # the pre-tick step judging an answer: what the robot sees
-            return self._board_get(key)
         if key in self.asked:
             return self.asked[key]
+        reader = self.core.trace.current()
+        if reader is None or self._blaming:  # judging an answer, or blaming: as it is
+            return self._board_get(key)
         value = self.asked[key] = self._ask(key, reader)
         return value
 
@@ -250,10 +266,10 @@ class Real:
         at = self.index.get(id(reader), -1)
         if key is keys.DIAGNOSTICS:
             low = self.site.safety.battery_low - 5.0
+            w = self.worlds[at] if at >= 0 else None
+            told = w.diagnostics if w is not None else DIAGNOSTICS
             how = self._choose(
-                -1,
-                "diagnostics",
-                [("ok", By.QUIET), ("battery low", By.WORLD), ("fault", By.WORLD)],
+                -1, "diagnostics", [(d, By.QUIET if d == "ok" else By.WORLD) for d in told]
             )
             battery, faults = (low, ()) if how == "battery low" else (100.0, ())
             if how == "fault":
@@ -453,6 +469,7 @@ class Real:
         """One tick from the restored state, with ``oracle``'s choices."""
         core, board = self.core, self.core.board
         self.oracle = oracle
+        self.fired: list[int] = []
         self.asked = {}
         self.events = []
         self._sent: list[VEvent] = []
@@ -534,8 +551,8 @@ class Real:
             due = w.timer(self.nodes[i])
             if due is not None and due > now:
                 label = _timer_label(self.nodes, i)
-                out[label if label not in out else f"{label} ({i})"] = _firing(
-                    self.nodes[i], w, due - now
+                out[label if label not in out else f"{label} ({i})"] = partial(
+                    self._fire, i, w, due - now
                 )
         standing = self.core.standing
         since = standing.paused_since
@@ -549,6 +566,18 @@ class Real:
 
                 out[_timer_label(self.nodes, -1)] = pause_runs_out
         return out
+
+    def _fire(self, i: int, world: World, seconds: float) -> None:
+        """Node ``i``'s wait runs out now: its ``fire``, or its ``times`` moved back."""
+        node = self.nodes[i]
+        self.fired.append(i)
+        if world.fire is not None:
+            world.fire(node, seconds)
+            return
+        for name in world.times:
+            value = getattr(node, name, None)
+            if value is not None:
+                setattr(node, name, value - seconds)
 
     def _answers(self, running: list[int]) -> bool:
         """The robot answers its pending goal, the docking the running Docking asked
@@ -638,10 +667,14 @@ class Real:
         declare is reported by class."""
         for node in self.touched:
             i = self.index[id(node)]
-            before = saved.nodes[i]
-            for name, value in node.__dict__.items():
-                if name in self.declared[i]:
-                    continue
+            before, now = saved.nodes[i], node.__dict__
+            watch = self.watch[i]
+            if watch is not None and now.keys() == before.keys() and watch(now) == watch(before):
+                continue  # no field it does not declare changed (compared at C speed)
+            undeclared = [name for name in now if name not in self.declared[i]]
+            self.watch[i] = operator.itemgetter(*undeclared, "status")
+            for name in undeclared:
+                value = now[name]
                 if name not in before or (before[name] is not value and before[name] != value):
                     self.found.undeclared.setdefault(type(node).__name__, set()).add(name)
 
@@ -759,8 +792,9 @@ class Real:
 
     # ------------------------------------------------------------ successors
 
-    def successors(self, saved: Saved) -> Iterator[tuple[Saved, Step]]:
-        """Every next state with the tick that led there (all choices enumerated)."""
+    def successors(self, saved: Saved) -> Iterator[tuple[Callable[[], Saved], Step]]:
+        """Every next state with the tick that led there (all choices enumerated): what
+        saves it (to call before the next one; a state already seen need not be)."""
         pending: list[list[int]] = [[]]
         while pending:
             prefix = pending.pop()
@@ -775,8 +809,10 @@ class Real:
                 ok = False
             if ok:
                 self.check_declared(saved)
-                touched = [self.index[id(n)] for n in self.touched]
-                yield self.save(saved, touched), step
+                touched = [*{self.index[id(n)]: None for n in self.touched}, *self.fired]
+                for i in touched:
+                    self.live[i] = None  # changed: restore it next time
+                yield partial(self.save, saved, touched), step
             for k in range(len(prefix), len(oracle.widths)):
                 for alt in range(1, oracle.widths[k]):
                     pending.append([*oracle.taken[:k], alt])
@@ -895,21 +931,6 @@ def _clone(value: Any, memo: dict[int, Any]) -> Any:
     return out
 
 
-def _firing(node: Behaviour, world: World, seconds: float) -> Callable[[], None]:
-    """What makes ``node``'s wait run out now: its ``fire``, or its ``times`` moved back."""
-
-    def fire() -> None:
-        if world.fire is not None:
-            world.fire(node, seconds)
-            return
-        for name in world.times:
-            value = getattr(node, name, None)
-            if value is not None:
-                setattr(node, name, value - seconds)
-
-    return fire
-
-
 def _timer_label(nodes: list[Behaviour], i: int) -> str:
     return "time: the pause runs out" if i < 0 else f"time: {nodes[i].name} runs out"
 
@@ -953,7 +974,7 @@ def _explore(
         while head < len(graph.states):
             edges: list[tuple[int, Step]] = []
             graph.edges.append(edges)
-            for nxt, step in real.successors(saved[head]):
+            for save, step in real.successors(saved[head]):
                 key = real.key()
                 dst = index.get(key)
                 if dst is None:
@@ -963,7 +984,7 @@ def _explore(
                     index[key] = dst
                     graph.states.append(real.view())
                     graph.parent.append((head, len(edges)))
-                    saved.append(nxt)
+                    saved.append(save())
                     progress = real.core.board.get(keys.PROGRESS)
                     if progress is not None and progress.done:
                         progresses[progress] = None
