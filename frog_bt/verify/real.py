@@ -202,6 +202,7 @@ class Real:
         self.asked: dict[str, object] = {}
         self.found = Found()
         self.live: list[dict[str, Any] | None] = [None] * len(self.nodes)
+        self._running: list[int] | None = None
         self._board_get = self.core.board.get
         self.core.board.get = self._get  # type: ignore[method-assign]
         self._blaming = False
@@ -395,6 +396,7 @@ class Real:
         return Saved(tuple(nodes), engine)
 
     def restore(self, saved: Saved) -> None:
+        self._running = None
         memo: dict[int, Any] = {}
         for i, node in enumerate(self.nodes):
             target = saved.nodes[i]
@@ -462,8 +464,12 @@ class Real:
             out.append((i, at))
         return tuple(out)
 
-    def running(self) -> Iterator[int]:
-        return (i for i, n in enumerate(self.nodes) if n.status is RUNNING)
+    def running(self) -> list[int]:
+        """The running nodes, pre-order (kept until a tick or a restore changes them)."""
+        found = self._running
+        if found is None:
+            found = self._running = [i for i, n in enumerate(self.nodes) if n.status is RUNNING]
+        return found
 
     def tick(self, oracle: Oracle) -> Step:
         """One tick from the restored state, with ``oracle``'s choices."""
@@ -476,11 +482,13 @@ class Real:
         self._drove_to = ""
         step = self.step = Step(started_tour=board.get(keys.TOUR_STATE) is TourState.STARTED)
         help_before = board.get(keys.HELP) is not None
-        running = list(self.running())
+        running = self.running()
         moved = self._before(running)
         self._publish_world(moved)
         faults = core.faults.total
+        self._running = None
         core.tick()
+        self._running = None
         if core.faults.total != faults:
             for seen in core.faults.seen.values():
                 line = f"{seen.where}: {seen.error}"
@@ -672,7 +680,7 @@ class Real:
             if watch is not None and now.keys() == before.keys() and watch(now) == watch(before):
                 continue  # no field it does not declare changed (compared at C speed)
             undeclared = [name for name in now if name not in self.declared[i]]
-            self.watch[i] = operator.itemgetter(*undeclared, "status")
+            self.watch[i] = operator.itemgetter(*undeclared) if undeclared else _nothing
             for name in undeclared:
                 value = now[name]
                 if name not in before or (before[name] is not value and before[name] != value):
@@ -929,6 +937,10 @@ def _clone(value: Any, memo: dict[int, Any]) -> Any:
         return value
     memo[id(value)] = out
     return out
+
+
+def _nothing(_: object) -> None:
+    return None
 
 
 def _timer_label(nodes: list[Behaviour], i: int) -> str:
