@@ -166,6 +166,9 @@ class ConfirmResume(Leaf):
         state=("started",),
         times=("started",),
         timer=lambda n: n.started + n.ctx.site.checkpoint.confirm,
+        views=((keys.RESUME.name, lambda r: True),),
+        why="of a checkpoint it decides only on whether there is one: the rest (where, how "
+        "old) is the words it announces",
     )
 
     def initialise(self) -> None:
@@ -220,6 +223,9 @@ class Checkpointed(FrogDecorator):
         late=(keys.VISITOR.name,),
         passes=True,
         people=(keys.VISITOR.name, keys.RESUME.name, keys.PROGRESS.name),
+        views=((keys.RESUME.name, lambda r: (r.done, r.visitor if r.done else None)),),
+        why="of a checkpoint to resume it reads what is still to skip and the visitor a "
+        "skip restores; the rest is words",
     )
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:

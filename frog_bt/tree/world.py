@@ -32,6 +32,8 @@ abstracted. Each node type says, on its class, as ``world = World(...)``:
   after it);
 * ``diagnostics``: the diagnostics it tells apart (``ok``, ``battery low``, ``fault``):
   the explorer offers those when it is the first node of a tick to read them;
+* ``views``: (key, view): of a key's value it decides only on ``view(value)`` (the rest
+  it only says in words): when every reader of the key says so, the views are state;
 * ``places``: the waypoints it compares the robot's pose with: where the robot is, is
   state only as whether it is at each waypoint some node compares with;
 * ``people``: keys (and its own fields) that hold a person's id: people are alike, so
@@ -102,6 +104,7 @@ class World:
     sets: tuple[str, ...] = ()  # keys it surely writes as it succeeds
     passes: bool = False  # a decorator: it succeeds only when its child succeeded
     diagnostics: tuple[str, ...] = ("ok", "battery low", "fault")
+    views: tuple[tuple[str, Callable[[Any], Hashable]], ...] = ()  # (key, what it decides on)
     places: Callable[[Any], tuple[str, ...]] | None = None  # waypoints it compares with
     counts: tuple[tuple[str, str], ...] = ()  # (key, field): a count since it started
     why: str = ""

@@ -116,6 +116,7 @@ class Saved:
 
     nodes: tuple[dict[str, Any], ...]
     engine: tuple[Any, ...]
+    running: list[int]  # the running nodes (pre-order)
 
 
 @dataclass(slots=True)
@@ -160,6 +161,21 @@ class Real:
         # are named there too)
         self.people = {name for w in self.worlds if w is not None for name in w.people}
         self.approaches = [i for i, w in enumerate(self.worlds) if _role(w) == "approach"]
+        # keys every reader of which decides only on a view of the value (``World.views``)
+        viewed: dict[str, dict[type, Callable[[Any], Hashable]]] = {}
+        for n, w in zip(self.nodes, self.worlds, strict=True):
+            for name, view in w.views if w is not None else ():
+                viewed.setdefault(name, {})[type(n)] = view
+        self.views = {
+            name: list(by_type.values())
+            for name, by_type in viewed.items()
+            if all(
+                type(n) in by_type
+                for n in self.nodes
+                for k in (*getattr(n, "reads", ()), *getattr(n, "optional_reads", ()))
+                if k.name == name
+            )
+        }
         # counts on the board every reader of which reads only as a count since it began
         counted: dict[str, set[int]] = {}
         for i, w in enumerate(self.worlds):
@@ -393,10 +409,10 @@ class Real:
             core.pause_ran_out,
             (self.robot.where, self.robot.docking, self.robot.homing, self.robot.people),
         )
-        return Saved(tuple(nodes), engine)
+        return Saved(tuple(nodes), engine, self.running())
 
     def restore(self, saved: Saved) -> None:
-        self._running = None
+        self._running = saved.running
         memo: dict[int, Any] = {}
         for i, node in enumerate(self.nodes):
             target = saved.nodes[i]
@@ -476,6 +492,7 @@ class Real:
         core, board = self.core, self.core.board
         self.oracle = oracle
         self.fired: list[int] = []
+        self.timed = False  # a wait's time was running as the tick began
         self.asked = {}
         self.events = []
         self._sent: list[VEvent] = []
@@ -528,6 +545,7 @@ class Real:
         if helping is not None and board.get(keys.HELP_ANSWER) is None:
             options += [("retry", By.WORLD), ("done_by_hand", By.WORLD)]
         timers = self._timers(running, paused)
+        self.timed = bool(timers)
         options += [(label, By.ROBOT) for label in timers]
         what = self._choose(-1, "operator", options)
         if what == "none":
@@ -644,15 +662,15 @@ class Real:
         step.ticked = []
         for node in self.touched:
             i = self.index[id(node)]
-            before = self.live_status[i]
-            if node.status is not py_trees.common.Status.INVALID or before is not RUNNING:
-                step.ticked.append((i, before is not RUNNING))
+            started = i not in self.was_running
+            if node.status is not py_trees.common.Status.INVALID or started:
+                step.ticked.append((i, started))
         if board.get(keys.HELP) is not None and not help_before:
             asking = next((i for i in self.running() if _role(self.worlds[i]) == "help"), 0)
             step.events.append((VEvent.HELP, asking, self.world_view()))
         for i in self.retries:
             retry: Any = self.nodes[i]
-            was = self.live_failures[i] if self.live_status[i] is RUNNING else 0
+            was = self.was_failures.get(i, 0)
             if retry.status is RUNNING and retry.failures > was:
                 step.events.append((VEvent.RETRY, i, self.world_view()))
         if board.get(keys.HOME) is None:
@@ -780,6 +798,9 @@ class Real:
                         board.append((k.name, v - since[k.name]))
                 elif k.name in self.counted:
                     continue  # read only as a count since a node starts: none runs
+                elif k.name in self.views:
+                    seen = tuple(view(v) for view in self.views[k.name])
+                    board.append((k.name, enc.person(seen) if k.name in self.people else enc(seen)))
                 elif k.name in self.people:
                     board.append((k.name, enc.person(v)))
                 else:
@@ -807,8 +828,10 @@ class Real:
         while pending:
             prefix = pending.pop()
             self.restore(saved)
-            self.live_status = [n.status for n in self.nodes]
-            self.live_failures = [getattr(n, "failures", 0) for n in self.nodes]
+            self.was_running = set(self.running())
+            self.was_failures = {
+                i: self.nodes[i].failures for i in self.retries if i in self.was_running
+            }
             oracle = Oracle(prefix)
             try:
                 step = self.tick(oracle)
@@ -859,6 +882,8 @@ class _Encoder:
             return value == self.visitor
         if isinstance(value, frozenset | set):
             return frozenset(self.person(v) for v in value)
+        if isinstance(value, tuple | list):
+            return tuple(self.person(v) for v in value)
         if isinstance(value, dict):
             return frozenset((self.person(k), self(v)) for k, v in value.items())
         if dataclasses.is_dataclass(value) and not isinstance(value, type):
@@ -908,10 +933,15 @@ class _Encoder:
         return value  # type: ignore[no-any-return]
 
 
+# the types whose values a tick never changes in place (learnt as met)
+_SAME: set[type] = {type(None), bool, int, float, str, tuple, frozenset}
+
+
 def _clone(value: Any, memo: dict[int, Any]) -> Any:
     """A copy of a mutable value a tick may change in place (one copy per object in a
     snapshot: the stream's samples are the board's); an immutable one as it is."""
-    if value is None or isinstance(value, bool | int | float | str | tuple | frozenset):
+    kind = type(value)
+    if kind in _SAME:
         return value
     found = memo.get(id(value))
     if found is not None:
@@ -929,7 +959,11 @@ def _clone(value: Any, memo: dict[int, Any]) -> Any:
     elif isinstance(value, dict | list | set):
         out = copy.copy(value)
     elif dataclasses.is_dataclass(value) and getattr(value, "__hash__", None) is not None:
-        return value  # frozen
+        _SAME.add(kind)  # frozen
+        return value
+    elif isinstance(value, enum.Enum | bool | int | float | str | tuple | frozenset):
+        _SAME.add(kind)
+        return value
     elif hasattr(value, "__dict__"):  # one level deeper: its lists and dicts copied
         out = copy.copy(value)
         out.__dict__.update({k: _clone(v, memo) for k, v in value.__dict__.items()})
@@ -1000,6 +1034,14 @@ def _explore(
                     progress = real.core.board.get(keys.PROGRESS)
                     if progress is not None and progress.done:
                         progresses[progress] = None
+                if (
+                    dst == head
+                    and real.timed
+                    and not any(c.value.startswith("time:") for c in step.choices)
+                ):
+                    # nothing changed while a wait's time runs: time passes (the explorer
+                    # lets it run out as a choice of its own), no loop of the robot's
+                    step.waits.append((-1, "waits for its time to run out"))
                 edges.append((dst, step))
                 if on_step is not None:
                     on_step(head, step, dst, graph.states[dst])

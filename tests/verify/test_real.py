@@ -22,7 +22,7 @@ from frog_bt.model import keys
 from frog_bt.model.frontend import StartIntroduction
 from frog_bt.tree.factory import NodeFactory
 from frog_bt.tree.leaf import RUNNING, SUCCESS, Leaf, Status
-from frog_bt.tree.world import Channel, World
+from frog_bt.tree.world import Channel, World, world_of
 from frog_bt.verify.prove import Verdict, prove
 from frog_bt.verify.report import tick_line
 
@@ -210,3 +210,11 @@ def test_verify_real_on_the_command_line(tmp_path: Path, capsys: object) -> None
         "    - {type: WaitInService}\n    - {type: WaitFrontendIdle}\n"
     )
     assert main(["verify", "--real", str(path)]) == 1  # vacuous: no tour to pause
+
+
+def test_every_registered_node_type_declares_its_world() -> None:
+    """verify --real ticks every node type as it is: each says, on its class, what of the
+    world it listens to and what it keeps (frog_bt.tree.world)."""
+    types = [*LEAF_TYPES, *DECORATOR_TYPES]
+    assert types
+    assert [t.__name__ for t in types if world_of(t) is None] == []
