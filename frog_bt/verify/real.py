@@ -10,19 +10,24 @@ each leaf's own ``update()`` run as in production.
 
 What no leaf can know is chosen per tick from a finite set (:mod:`frog_bt.tree.world`:
 each node type declares its world interface on its class): the operator's command, a
-wait running out (the clock is stepped to that node's deadline), the robot's answer to
-the pending goal (a pose at the goal with an arrival; the camera seeing the visitor with
-an approach's success), the docking state, the front end's events; and, as a node reads
-them, the diagnostics, a visitor facing the robot or following, a face. Every
-combination is explored (an :class:`~frog_bt.verify.tick.Oracle` replays a prefix of
-choices; each choice beyond it branches).
+wait running out, the robot's answer to the pending goal (a pose at the goal with an
+arrival; the camera seeing the visitor with an approach's success), the docking state,
+the front end's events; and, as a node reads them, the diagnostics, nobody or someone
+new facing the robot, someone following, a face. Every combination is explored (an
+:class:`~frog_bt.verify.tick.Oracle` replays a prefix of choices; each choice beyond it
+branches).
 
-A state is what the nodes hold (each running node's declared fields, a composite's
-current child, a retry's count) with the board, the pending goal and the world; its
-canonical encoding (:meth:`Real.key`) makes times relative to now, event indexes
-relative to the newest event and goal ids to the newest goal, so that alike states
-hash alike. Each state is kept as a snapshot (per node, its ``__dict__``; the engine's
-stores), restored before each tick from it.
+The project clock never moves: a wait runs out by its own times moving back
+(``World.fire``), so a wait is pending or run out, and which of several runs out first
+is a choice. A state is what the nodes hold (each running node's declared fields, a
+composite's current child, a retry's count) with the board's live values, the pending
+goal and the world; its canonical encoding (:meth:`Real.key`) keeps of each what some
+outcome depends on, as the classes declare it (``ignores``, ``truthy``, ``views``,
+``counts``, ``people``: ids only as whether the current visitor's; ``places``: where the
+robot is only as whether at a waypoint a node compares with), event indexes relative to
+the newest event and goal ids to the newest goal, so that alike states hash alike. Each
+new state is kept as a snapshot (per node, its ``__dict__``; the engine's stores),
+restored before each tick from it.
 """
 
 from __future__ import annotations
