@@ -835,7 +835,9 @@ class Real:
             self.restore(saved)
             self.was_running = set(self.running())
             self.was_failures = {
-                i: self.nodes[i].failures for i in self.retries if i in self.was_running
+                i: getattr(self.nodes[i], "failures", 0)
+                for i in self.retries
+                if i in self.was_running
             }
             oracle = Oracle(prefix)
             try:
@@ -905,7 +907,7 @@ class _Encoder:
                 return ("goal", value.done)
             target: Hashable = value.target
             if value.kind == "approach":  # a person's id
-                target = target.isdigit() and int(target) == self.visitor
+                target = value.target.isdigit() and int(value.target) == self.visitor
             return (
                 value.kind,
                 target,
