@@ -6,10 +6,9 @@ stops repeated), and the model's per-property times.
 
 The model explorer (:mod:`frog_bt.verify.tick`) ticks a copy of the tree over tuples of
 ints; the real one (``verify --real``, :mod:`frog_bt.verify.real`) ticks the loader's
-nodes in a core with only the world abstracted, and stops at ``--real-limit`` states
-(its exploration of the shipped tree does not end within it yet: the state it keeps is
-the nodes' and the board's own, and values nothing reads any more still tell states
-apart; see docs/TREES.md).
+nodes in a core with only the world abstracted, from a fresh start (``--restarts``: and
+from every checkpoint the tree writes, as ``verify --real`` does), and stops at
+``--real-limit`` states.
 """
 
 from __future__ import annotations
@@ -50,12 +49,12 @@ def model_row(site: Site) -> str:
     )
 
 
-def real_row(site: Site, limit: int) -> str:
+def real_row(site: Site, limit: int, restarts: bool) -> str:
     tree = load_tree(None, site)
     model = compile_tree(tree, site, real=True)
     t0 = time.perf_counter()
     try:
-        graph, _ = explore_real(model, site, limit=limit)
+        graph, _ = explore_real(model, site, limit=limit, restarts=restarts)
     except TooBig:
         seconds = time.perf_counter() - t0
         return (
@@ -71,7 +70,10 @@ def real_row(site: Site, limit: int) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stops", type=int, nargs="+", default=[6, 30, 100])
-    parser.add_argument("--real-limit", type=int, default=20000)
+    parser.add_argument("--real-limit", type=int, default=100000)
+    parser.add_argument(
+        "--restarts", action="store_true", help="the real explorer from every checkpoint too"
+    )
     args = parser.parse_args()
     base = load_site(None)
     print(f"{'stops':>5} {'':5} {'states':>8} {'transitions':>10} {'seconds':>8} {'states/s':>8}")
@@ -79,7 +81,7 @@ def main() -> None:
         stops = [base.tour.stops[i % len(base.tour.stops)] for i in range(n)]
         site = base.model_copy(update={"tour": base.tour.model_copy(update={"stops": stops})})
         print(f"{n:>5} {model_row(site)}")
-        print(f"{n:>5} {real_row(site, args.real_limit)}")
+        print(f"{n:>5} {real_row(site, args.real_limit, args.restarts)}")
 
 
 if __name__ == "__main__":

@@ -60,6 +60,7 @@ class Docking(GoalLeaf):
             if n.sent_at is not None and not n.already and n.away is None
             else ()
         ),
+        places=lambda n: (n.ctx.site.tour.dock,) if n.params.action == "dock" else (),
         why="the robot reports the state asked for, or failed, at the next tick",
     )
 

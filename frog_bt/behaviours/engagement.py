@@ -45,6 +45,7 @@ class FaceStream(FrogDecorator):
         state=("samples", "last_face_data", "next_meter"),
         times=("last_face_data", "next_meter"),
         copy=("samples",),
+        passes=True,
         key=lambda n: tuple(float(v) for v in n.samples.levels()),
         why="engagement: one face sample per stream, engaged or not, or none; the vote "
         "over many samples is the maths' own (tests/maths). When the meter is sent "
@@ -123,7 +124,7 @@ class DecideEngagement(Leaf):
     params: Params
     optional_reads = (keys.ENGAGEMENT,)
     writes = (keys.ENGAGED, keys.ENGAGEMENT_DECISION)
-    world = World()
+    world = World(sets=(keys.ENGAGED.name, keys.ENGAGEMENT_DECISION.name))
 
     def update(self) -> Status:
         cfg = self.ctx.site.engagement

@@ -59,8 +59,10 @@ class LocationAware(FrogDecorator):
         inputs=(Channel.POSE,),
         state=("zones", "membership", "percent"),
         copy=("membership",),
-        key=lambda n: getattr(n, "percent", None),
-        why="the zone follows from where the robot is (a waypoint)",
+        passes=True,
+        key=lambda n: None,
+        why="the zone follows from where the robot is (a waypoint); the volume it sends "
+        "is all its state changes, and no node or property reads it",
     )
 
     def initialise(self) -> None:
@@ -101,8 +103,12 @@ class GuidedDrive(FrogDecorator):
     world = World(
         inputs=(Channel.POSE,),
         state=("_on", "spots"),
-        key=lambda n: n._on,
-        why="follow_me and special content follow from where the robot is (a waypoint)",
+        passes=True,
+        key=lambda n: None,
+        ignores=(keys.SPECIAL_DONE.name, keys.WAYPOINT.name),
+        why="follow_me and special content follow from where the robot is (a waypoint); "
+        "what it sends is all its state and /special_done change, and no node or "
+        "property reads that",
     )
 
     def __init__(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]

@@ -127,6 +127,7 @@ class AtPoi(Leaf):
     optional_reads = (keys.POSE,)
     world = World(
         inputs=(Channel.POSE,),
+        places=lambda n: (n.ctx.site.waypoint_for(n.params.poi, n.ctx.clock.local_time().time()),),
         why="where the robot is: at the waypoint of its last believed arrival (at the dock "
         "at first), or away from every waypoint after a failed drive",
     )

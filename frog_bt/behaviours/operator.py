@@ -37,7 +37,12 @@ class OperatorSkip(FrogDecorator):
     optional_reads = (keys.SKIP,)
     role = Role.STOP  # the core asks the running ones what a skip would leave
     _requested = False
-    world = World(inputs=(Channel.OPERATOR,), state=("skips", "_requested"))
+    world = World(
+        inputs=(Channel.OPERATOR,),
+        state=("skips", "_requested"),
+        counts=((keys.SKIP.name, "skips"),),
+        why="of /skip it reads only how many skips came since it started",
+    )
 
     def stop_poi(self) -> str:
         return self.params.poi

@@ -51,9 +51,12 @@ class Projector(FrogDecorator):
         inputs=(Channel.POSE,),
         state=("_on", "history"),
         copy=("history",),
-        key=lambda n: n._on,
+        passes=True,
+        key=lambda n: None,
+        ignores=(keys.WAYPOINT.name,),
         why="the arrival estimate needs the robot's speed over seconds, which verify leaves "
-        "out: the projector goes on within projector.radius of the stop",
+        "out: the projector goes on within projector.radius of the stop. Whether it is on "
+        "changes only what it sends, which no node or property reads",
     )
 
     def __init__(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]

@@ -69,7 +69,13 @@ class SeekVisitor(Leaf):
     world = World(
         inputs=(Channel.VISITOR, Channel.POSE),
         waits=True,
-        why="two visitors who may face the robot, or nobody: a declined one is passed over",
+        ignores=(keys.DECLINED.name, keys.APPROACH_FAILED.name),
+        people=(keys.VISITOR.name,),
+        sets=(keys.VISITOR.name,),
+        why="nobody faces the robot, or someone it has not seen before: a person seen "
+        "again is either passed over (declined, or their approach failed: as if nobody "
+        "faced it) or, people being alike, one more new person; so whom it passes "
+        "over changes none of its outcomes",
     )
 
     def update(self) -> Status:
@@ -100,6 +106,15 @@ class SeekVisitor(Leaf):
             f"({person.orientation:.0f} deg), nearest of {len(persons.value.persons)}"
         )
         return SUCCESS
+
+
+def _run_out(node: ApproachVisitor, seconds: float) -> None:
+    """verify: its wait runs out now (the approach's timeout, or before it goes out, the
+    interval since the previous approach)."""
+    if node.sent_at is not None:
+        node.sent_at -= seconds
+    else:
+        node.ctx.actions.last_approach_at -= seconds
 
 
 @register
@@ -134,10 +149,14 @@ class ApproachVisitor(GoalLeaf):
             if n.sent_at is not None
             else n.ctx.actions.last_approach_at + n.ctx.site.recruit.approach_interval
         ),
+        fire=lambda n, seconds: _run_out(n, seconds),
         active="sent_at",
         role=WorldRole.APPROACH,
+        ignores=(keys.APPROACH_FAILED.name,),
+        people=("visitor",),
         why="the robot reaches the visitor (while the camera sees them) or fails at the "
-        "next tick; the next approach waits recruit.approach_interval",
+        "next tick; the next approach waits recruit.approach_interval. It reads "
+        "/approach_failed only to add to it",
     )
 
     def default_timeout(self) -> float:
@@ -242,6 +261,8 @@ class WaitAnswer(Leaf):
         timer=lambda n: n.started + n.timeout,
         frontend=lambda n: (UserPositive(), UserNegative()),
         waits=True,
+        ignores=(keys.DECLINED.name,),
+        why="it reads /declined only to add to it",
     )
 
     def initialise(self) -> None:

@@ -56,7 +56,12 @@ class MustAbort(Leaf):
     writes = (keys.ABORT_REASON,)
     world = World(
         inputs=(Channel.DIAGNOSTICS, Channel.OPERATOR),
-        why="battery: low (below safety.battery_low) or full; a fault or none",
+        truthy=(keys.ABORT_REASON.name, keys.HOME.name),
+        diagnostics=("ok", "battery low"),
+        why="battery: low (below safety.battery_low) or full; a fault or none: both abort "
+        "alike (the reason's words differ). Of /home "
+        "it decides on whether it is set; its words become the abort's, which only the "
+        "front end reads",
     )
 
     def update(self) -> Status:
@@ -100,7 +105,9 @@ class ClearAbort(Leaf):
 
     optional_reads = (keys.ABORT_REASON,)
     writes = (keys.ABORT_REASON, keys.ABORT_REASON_LAST, keys.HOME)
-    world = World()
+    world = World(
+        ignores=(keys.ABORT_REASON.name,), why="it keeps the reason as /abort_reason_last"
+    )
 
     def update(self) -> Status:
         self.set(keys.ABORT_REASON_LAST, self.get(keys.ABORT_REASON))
@@ -159,6 +166,9 @@ class ConfirmResume(Leaf):
         state=("started",),
         times=("started",),
         timer=lambda n: n.started + n.ctx.site.checkpoint.confirm,
+        views=((keys.RESUME.name, lambda r: True),),
+        why="of a checkpoint it decides only on whether there is one: the rest (where, how "
+        "old) is the words it announces",
     )
 
     def initialise(self) -> None:
@@ -208,7 +218,15 @@ class Checkpointed(FrogDecorator):
     writes = (keys.VISITOR, keys.RESUME, keys.PROGRESS)
     skips_child = True  # resumed: SUCCESS without the child (the data-flow check)
     _skip = False
-    world = World(state=("_skip",), late=(keys.VISITOR.name,))
+    world = World(
+        state=("_skip",),
+        late=(keys.VISITOR.name,),
+        passes=True,
+        people=(keys.VISITOR.name, keys.RESUME.name, keys.PROGRESS.name),
+        views=((keys.RESUME.name, lambda r: (r.done, r.visitor if r.done else None)),),
+        why="of a checkpoint to resume it reads what is still to skip and the visitor a "
+        "skip restores; the rest is words",
+    )
 
     def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
         # Resumed past this part: py_trees' plain behaviour tick (initialise, update,

@@ -81,7 +81,10 @@ class TourStatus(Leaf):
     params: Params
     optional_reads = (keys.ABORT_REASON,)
     writes = (keys.FRONTEND_READY, keys.TOUR_STATE, keys.TOUR_REASON, keys.PROGRESS)
-    world = World()
+    world = World(
+        ignores=(keys.ABORT_REASON.name,),
+        why="of the abort's reason it sends the words to the front end: no outcome",
+    )
 
     def update(self) -> Status:
         p = self.params

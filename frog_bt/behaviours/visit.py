@@ -146,6 +146,9 @@ class PlayContent(Leaf):
         active="playing",
         waits=True,
         role=Role.CONTENT,
+        ignores=(keys.WAYPOINT.name, "waypoint"),
+        why="the waypoint (the variant driven to) goes to the front end with start_poi: "
+        "no outcome depends on it",
     )
 
     def initialise(self) -> None:

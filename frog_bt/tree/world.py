@@ -11,14 +11,33 @@ abstracted. Each node type says, on its class, as ``world = World(...)``:
   and ``indexes`` (front-end event indexes: relative to the newest event); ``copy``:
   the mutable ones, copied on snapshot and restore. A field it keeps and does not
   declare is an error verify reports by class;
-* ``timer``: when its wait runs out (project clock), the explorer may step the clock
-  there; ``frontend``: the front-end events it may be sent now; ``docking``: the
+* ``timer``: when its wait runs out (project clock): while that is ahead, the explorer
+  may make it run out (``fire``: the node's own times moved back by the seconds left,
+  by default every field in ``times``; the clock itself never moves, so the other
+  waits stay pending); ``frontend``: the front-end events it may be sent now; ``docking``: the
   docking states the robot may report to it now (``/docking/state``); ``active``: the field
   set while its action is out (a goal, content playing); ``waits``: while it runs it
   waits for a person or the front end (not for the robot);
 * ``late``: the keys a decorator reads only once its child has succeeded (whatever its
   child's scope cleared is not read from before);
 * ``truthy``: the keys it reads only as true or false (None reads as false);
+* ``ignores``: keys it reads, and fields of its ``state``, whose value changes none of
+  its outcomes under its world abstraction (``why`` says why): not state on its account;
+* ``counts``: (key, field): a count on the board it remembers in ``field`` as it starts
+  and compares with later: only the count since its start is state (and none while no
+  node that counts it runs, when every reader of the key counts it so);
+* ``passes``: a decorator that succeeds only when its child succeeded (a checkpoint:
+  unless it skips its child, resumed);
+* ``sets``: the keys it surely writes as it succeeds (what was there before is not read
+  after it);
+* ``diagnostics``: the diagnostics it tells apart (``ok``, ``battery low``, ``fault``):
+  the explorer offers those when it is the first node of a tick to read them;
+* ``views``: (key, view): of a key's value it decides only on ``view(value)`` (the rest
+  it only says in words): when every reader of the key says so, the views are state;
+* ``places``: the waypoints it compares the robot's pose with: where the robot is, is
+  state only as whether it is at each waypoint some node compares with;
+* ``people``: keys (and its own fields) that hold a person's id: people are alike, so
+  verify keeps only whether an id is the current visitor's (``/visitor``);
 * ``role``: what it is to the built-in properties; ``why``: where it abstracts a number
   (engagement, a distance), the reason.
 """
@@ -71,6 +90,7 @@ class World:
     indexes: tuple[str, ...] = ()
     copy: tuple[str, ...] = ()
     timer: Callable[[Any], float | None] | None = None
+    fire: Callable[[Any, float], None] | None = None  # (node, seconds left): run out now
     frontend: Callable[[Any], tuple[Any, ...]] | None = None
     docking: Callable[[Any], tuple[str, ...]] | None = None
     active: str = ""
@@ -79,6 +99,14 @@ class World:
     key: Callable[[Any], Hashable] | None = None  # its own encoding of its state
     late: tuple[str, ...] = ()  # keys it reads only once its child succeeded (a decorator)
     truthy: tuple[str, ...] = ()  # keys it reads only as true or false (None is false)
+    ignores: tuple[str, ...] = ()  # keys it reads whose value changes no outcome of it
+    people: tuple[str, ...] = ()  # keys and fields holding a person's id
+    sets: tuple[str, ...] = ()  # keys it surely writes as it succeeds
+    passes: bool = False  # a decorator: it succeeds only when its child succeeded
+    diagnostics: tuple[str, ...] = ("ok", "battery low", "fault")
+    views: tuple[tuple[str, Callable[[Any], Hashable]], ...] = ()  # (key, what it decides on)
+    places: Callable[[Any], tuple[str, ...]] | None = None  # waypoints it compares with
+    counts: tuple[tuple[str, str], ...] = ()  # (key, field): a count since it started
     why: str = ""
 
 

@@ -17,7 +17,13 @@ which readers can tick before a clearing start:
 * in a sequence, a child that surely cleared the key on its way to success hides the
   children after it (a selector's failed child may not have: every child counts);
 * a checkpoint that may skip its child (a resumed tour: ``/resume`` set) neither clears
-  nor hides.
+  nor hides;
+* a decorator that succeeds only with its child (``World.passes``) cleared what its
+  child surely cleared;
+* in a sequence, a child that writes the key as it succeeds (``World.sets``) hides the
+  children after it, as one that cleared it;
+* a read a node type ``ignores`` (``World.ignores``: the value changes none of its
+  outcomes under its world abstraction) is not a read.
 
 Writes are not counted (a value written before every read would be dead too):
 conservative, never unsound. The keys the pre-tick snapshot writes anew before every
@@ -40,8 +46,9 @@ from frog_bt.tree.world import world_of
 Behaviour = py_trees.behaviour.Behaviour
 RUNNING = py_trees.common.Status.RUNNING
 # what the operator reads of the board (engine/operator.py) besides the tree's nodes
+# (``/skip`` too, only to add one to it)
 _OPERATOR: tuple[Key[Any], ...] = (
-    *(keys.TOUR_STATE, keys.HOME, keys.ABORT_REASON, keys.PAUSED, keys.IN_SERVICE, keys.SKIP),
+    *(keys.TOUR_STATE, keys.HOME, keys.ABORT_REASON, keys.PAUSED, keys.IN_SERVICE),
     *(keys.HELP, keys.HELP_ANSWER, keys.DOCKING),
 )
 OPERATOR_READS: frozenset[Key[Any]] = frozenset(_OPERATOR)
@@ -69,7 +76,7 @@ class Liveness:
         for i, node in enumerate(nodes):
             world = world_of(type(node))
             late = set(world.late) if world is not None else set()
-            for key in (*getattr(node, "reads", ()), *getattr(node, "optional_reads", ())):
+            for key in _reads(node):
                 if key not in derived:
                     into = self.late if key.name in late and node.children else self.reads
                     into.setdefault(key, set()).add(i)
@@ -79,13 +86,22 @@ class Liveness:
         for node in nodes:
             world = world_of(type(node))
             said = set(world.truthy) if world is not None else set()
-            for key in (*getattr(node, "reads", ()), *getattr(node, "optional_reads", ())):
+            for key in _reads(node):
                 truthy[key] = truthy.get(key, True) and key.name in said
-        self.truthy = frozenset(k for k, only in truthy.items() if only) - OPERATOR_READS
+        self.truthy = frozenset(k for k, only in truthy.items() if only) - (
+            OPERATOR_READS - PRESENCE
+        )
         self.children = [[index[id(c)] for c in n.children] for n in nodes]
         self.memory = [bool(getattr(n, "memory", False)) for n in nodes]
         self.kind = [_kind(n) for n in nodes]
         self.skips = [bool(getattr(n, "skips_child", False)) for n in nodes]
+        # decorators that succeed only when their child did (``World.passes``)
+        self.passes = [bool(w.passes) if (w := world_of(type(n))) else False for n in nodes]
+        # the keys each node surely writes as it succeeds (``World.sets``)
+        self.sets = [
+            frozenset(w.sets) if (w := world_of(type(n))) is not None else frozenset()
+            for n in nodes
+        ]
         self._cache: dict[tuple[object, ...], tuple[frozenset[Key[Any]], frozenset[Key[Any]]]] = {}
 
     def live(
@@ -107,6 +123,14 @@ class Liveness:
             found = (frozenset(values), PRESENCE - values)
             self._cache[sig] = found
         return found
+
+
+def _reads(node: Behaviour) -> list[Key[Any]]:
+    """The keys ``node`` reads, less those its type ``ignores`` (``World.ignores``)."""
+    world = world_of(type(node))
+    ignored = set(world.ignores) if world is not None else set()
+    found = (*getattr(node, "reads", ()), *getattr(node, "optional_reads", ()))
+    return [k for k in found if k.name not in ignored]
 
 
 def _kind(node: Behaviour) -> str:
@@ -135,6 +159,9 @@ class _Walk:
     def _skips(self, i: int) -> bool:
         return self.resuming and self.of.skips[i]
 
+    def _passes(self, i: int) -> bool:
+        return self.of.passes[i] and not self._skips(i)
+
     def _clears_at(self, i: int) -> bool:
         s = self.of.scope[i]
         return (
@@ -154,17 +181,18 @@ class _Walk:
         return self._starts_clear(kids[0])
 
     def _succeeds_cleared(self, i: int) -> bool:
-        """``i`` succeeded from a fresh start: it surely cleared the key on the way."""
+        """``i`` succeeded from a fresh start: it surely cleared (or wrote) the key on the
+        way."""
         found = self._clears.get(i)
         if found is None:
             kind, kids = self.of.kind[i], self.of.children[i]
-            if self._starts_clear(i):
+            if self._starts_clear(i) or self.key.name in self.of.sets[i]:
                 found = True
             elif kind == "sequence":
                 found = any(self._succeeds_cleared(c) for c in kids)
             elif kind in ("selector", "parallel"):
                 found = bool(kids) and all(self._succeeds_cleared(c) for c in kids)
-            elif kind == "retry":
+            elif kind == "retry" or (kind == "decorator" and self._passes(i)):
                 found = self._succeeds_cleared(kids[0])
             else:
                 found = False
@@ -193,11 +221,33 @@ class _Walk:
                 return False
         return False
 
+    def _rest_clears(self, i: int) -> bool:
+        """``i`` runs now: on its way to success it surely clears (or writes) the key."""
+        if i not in self.running:
+            return self._succeeds_cleared(i)
+        kids, kind = self.of.children[i], self.of.kind[i]
+        if not kids:
+            return self.key.name in self.of.sets[i]
+        at = self.running.get(i, -1)
+        if kind == "sequence" and self.of.memory[i] and 0 <= at < len(kids):
+            current = kids[at]
+            rest = (
+                self._rest_clears(current)
+                if current in self.running
+                else self._succeeds_cleared(current)
+            )
+            return rest or any(self._succeeds_cleared(c) for c in kids[at + 1 :])
+        if kind == "decorator" and self._passes(i):
+            return self._rest_clears(kids[0])
+        return False
+
     def _on(self, i: int) -> bool:
         """``i`` runs now: may a reader under it read the value before it is cleared?"""
-        if i in self.readers or i in self.late_readers:
-            return True
         kids, kind = self.of.children[i], self.of.kind[i]
+        if i in self.readers:
+            return True
+        if i in self.late_readers and not (kids and self._rest_clears(kids[0])):
+            return True
         at = self.running.get(i, -1)
         if kind in ("sequence", "selector") and self.of.memory[i] and 0 <= at < len(kids):
             current = kids[at]
@@ -206,6 +256,8 @@ class _Walk:
             ):
                 return True
             later = kids[at + 1 :]  # the current child's own clearing is behind it
+            if kind == "sequence" and current in self.running and self._rest_clears(current):
+                return False  # it writes the key as it succeeds: the value now is dead
             if kind == "sequence":
                 return self._in_order(later)
             return any(self._fresh(c) for c in later)

@@ -10,19 +10,24 @@ each leaf's own ``update()`` run as in production.
 
 What no leaf can know is chosen per tick from a finite set (:mod:`frog_bt.tree.world`:
 each node type declares its world interface on its class): the operator's command, a
-wait running out (the clock is stepped to that node's deadline), the robot's answer to
-the pending goal (a pose at the goal with an arrival; the camera seeing the visitor with
-an approach's success), the docking state, the front end's events; and, as a node reads
-them, the diagnostics, a visitor facing the robot or following, a face. Every
-combination is explored (an :class:`~frog_bt.verify.tick.Oracle` replays a prefix of
-choices; each choice beyond it branches).
+wait running out, the robot's answer to the pending goal (a pose at the goal with an
+arrival; the camera seeing the visitor with an approach's success), the docking state,
+the front end's events; and, as a node reads them, the diagnostics, nobody or someone
+new facing the robot, someone following, a face. Every combination is explored (an
+:class:`~frog_bt.verify.tick.Oracle` replays a prefix of choices; each choice beyond it
+branches).
 
-A state is what the nodes hold (each running node's declared fields, a composite's
-current child, a retry's count) with the board, the pending goal and the world; its
-canonical encoding (:meth:`Real.key`) makes times relative to now, event indexes
-relative to the newest event and goal ids to the newest goal, so that alike states
-hash alike. Each state is kept as a snapshot (per node, its ``__dict__``; the engine's
-stores), restored before each tick from it.
+The project clock never moves: a wait runs out by its own times moving back
+(``World.fire``), so a wait is pending or run out, and which of several runs out first
+is a choice. A state is what the nodes hold (each running node's declared fields, a
+composite's current child, a retry's count) with the board's live values, the pending
+goal and the world; its canonical encoding (:meth:`Real.key`) keeps of each what some
+outcome depends on, as the classes declare it (``ignores``, ``truthy``, ``views``,
+``counts``, ``people``: ids only as whether the current visitor's; ``places``: where the
+robot is only as whether at a waypoint a node compares with), event indexes relative to
+the newest event and goal ids to the newest goal, so that alike states hash alike. Each
+new state is kept as a snapshot (per node, its ``__dict__``; the engine's stores),
+restored before each tick from it.
 """
 
 from __future__ import annotations
@@ -31,10 +36,13 @@ import copy
 import dataclasses
 import enum
 import logging
+import math
+import operator
 import time
 from collections import deque
 from collections.abc import Callable, Hashable, Iterator
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import py_trees
@@ -82,6 +90,7 @@ STOP_HERE = "(stop here)"  # the goal that stops the robot where it is (not a dr
 # what py_trees and the engine change on every node (not the node type's own state)
 INTERNAL = frozenset({"status", "feedback_message", "iterator"})
 LAZY = (keys.DIAGNOSTICS, keys.PERSONS, keys.PEOPLE, keys.FACES)  # answered as read
+DIAGNOSTICS = ("ok", "battery low", "fault")  # what a reader tells apart unless it says
 TIME = 1e9  # a float this large is a project-clock time (encoded relative to now)
 
 
@@ -97,10 +106,12 @@ class Robot:
     where: str | None
     docking: DockingState = DockingState.DOCKED
     homing: bool = False
+    people: int = 0  # the persons the camera has shown so far (the next one is new)
     seen: int | None = None  # the visitor the camera sees as an approach succeeds
 
-    def key(self) -> tuple[object, ...]:
-        return (self.where, self.docking, self.homing)
+    def key(self, near: Callable[[str | None], Hashable]) -> tuple[object, ...]:
+        """Its encoding; ``near``: where it is, as the nodes tell places apart."""
+        return (near(self.where), self.docking, self.homing)
 
 
 @dataclass(slots=True)
@@ -110,6 +121,7 @@ class Saved:
 
     nodes: tuple[dict[str, Any], ...]
     engine: tuple[Any, ...]
+    running: list[int]  # the running nodes (pre-order)
 
 
 @dataclass(slots=True)
@@ -148,12 +160,58 @@ class Real:
         self.index = {id(n): i for i, n in enumerate(self.nodes)}
         self.worlds = [world_of(type(n)) for n in self.nodes]
         self.declared = [_declared(w) | INTERNAL for w in self.worlds]
+        # per node, what gives its undeclared fields (to compare them at once)
+        self.watch: list[Callable[[dict[str, Any]], object] | None] = [None] * len(self.nodes)
+        # the board's keys that hold people's ids (``World.people``; a node's own fields
+        # are named there too)
+        self.people = {name for w in self.worlds if w is not None for name in w.people}
+        self.approaches = [i for i, w in enumerate(self.worlds) if _role(w) == "approach"]
+        # keys every reader of which decides only on a view of the value (``World.views``)
+        viewed: dict[str, dict[type, Callable[[Any], Hashable]]] = {}
+        for n, w in zip(self.nodes, self.worlds, strict=True):
+            for name, view in w.views if w is not None else ():
+                viewed.setdefault(name, {})[type(n)] = view
+        self.views = {
+            name: list(by_type.values())
+            for name, by_type in viewed.items()
+            if all(
+                type(n) in by_type
+                for n in self.nodes
+                for k in (*getattr(n, "reads", ()), *getattr(n, "optional_reads", ()))
+                if k.name == name
+            )
+        }
+        # counts on the board every reader of which reads only as a count since it began
+        counted: dict[str, set[int]] = {}
+        for i, w in enumerate(self.worlds):
+            for name, _ in w.counts if w is not None else ():
+                counted.setdefault(name, set()).add(i)
+        self.counted = {
+            name
+            for name, counters in counted.items()
+            if all(
+                i in counters
+                for i, n in enumerate(self.nodes)
+                for k in (*getattr(n, "reads", ()), *getattr(n, "optional_reads", ()))
+                if k.name == name
+            )
+        }
         self.copies = [i for i, w in enumerate(self.worlds) if w is not None and w.copy]
         self.retries = [
             i for i, n in enumerate(self.nodes) if isinstance(n, py_trees.decorators.Retry)
         ]
         self.dock = site.tour.dock
         self.robot = Robot(self.dock)
+        # the waypoints some node compares the robot's pose with (``World.places``)
+        self.places = sorted(
+            {
+                p
+                for n, w in zip(self.nodes, self.worlds, strict=True)
+                if w and w.places
+                for p in w.places(n)
+            }
+        )
+        self._nearness: dict[str | None, Hashable] = {}
         # the keys some node or the operator reads: a value nothing reads is not state;
         # an input the snapshot writes anew before every tick is the world's (derived)
         derived: set[Key[Any]] = {inp.key for inp in self.core.table.values()}
@@ -165,9 +223,22 @@ class Real:
         self.asked: dict[str, object] = {}
         self.found = Found()
         self.live: list[dict[str, Any] | None] = [None] * len(self.nodes)
+        self._running: list[int] | None = None
         self._board_get = self.core.board.get
         self.core.board.get = self._get  # type: ignore[method-assign]
+        self._blaming = False
+        note_sender = self.core._note_sender
+
+        def blame() -> None:  # what a node read, for the record: no choice of the world
+            self._blaming = True
+            try:
+                note_sender()
+            finally:
+                self._blaming = False
+
+        self.core._note_sender = blame  # type: ignore[method-assign]
         self._publish_world(moved=True)
+        self._canonical()
         self.initial = self.save()
 
     # ------------------------------------------------------------ the world answers
@@ -178,6 +249,19 @@ class Real:
         value, by = options[self.oracle.pick(len(options))]
         self.step.choices.append(Choice(node, what, value, by))
         return value
+
+    def _near(self, where: str | None) -> Hashable:
+        """Where the robot is as the nodes tell places apart: for each waypoint some node
+        compares its pose with, whether it is within ``navigation.tolerance`` of it."""
+        found = self._nearness.get(where)
+        if found is None:
+            x, y = AWAY if where is None else (self.site.pois[where].x, self.site.pois[where].y)
+            tolerance = self.site.navigation.tolerance
+            found = self._nearness[where] = tuple(
+                math.hypot(x - self.site.pois[p].x, y - self.site.pois[p].y) <= tolerance
+                for p in self.places
+            )
+        return found
 
     def _here(self) -> tuple[float, float]:
         if self.robot.where is None:
@@ -190,11 +274,11 @@ class Real:
         tick, the same for every reader), a choice of the explorer."""
         if key not in LAZY:
             return self._board_get(key)
-        reader = self.core.trace.current()
-        if reader is None:  # the pre-tick step judging an answer: what the robot sees
-            return self._board_get(key)
         if key in self.asked:
             return self.asked[key]
+        reader = self.core.trace.current()
+        if reader is None or self._blaming:  # judging an answer, or blaming: as it is
+            return self._board_get(key)
         value = self.asked[key] = self._ask(key, reader)
         return value
 
@@ -204,27 +288,26 @@ class Real:
         at = self.index.get(id(reader), -1)
         if key is keys.DIAGNOSTICS:
             low = self.site.safety.battery_low - 5.0
+            w = self.worlds[at] if at >= 0 else None
+            told = w.diagnostics if w is not None else DIAGNOSTICS
             how = self._choose(
-                -1,
-                "diagnostics",
-                [("ok", By.QUIET), ("battery low", By.WORLD), ("fault", By.WORLD)],
+                -1, "diagnostics", [(d, By.QUIET if d == "ok" else By.WORLD) for d in told]
             )
             battery, faults = (low, ()) if how == "battery low" else (100.0, ())
             if how == "fault":
                 faults = ("motors: fault",)  # type: ignore[assignment]
             return Reading(Diagnostics(now, battery, faults), now)
         if key is keys.PERSONS:
+            # someone the robot has not seen before: a person it saw again is either
+            # passed over (as if nobody) or, after renaming, alike a new one
             who = self._choose(
-                at,
-                "camera",
-                [("nobody", By.QUIET), ("visitor 1 faces it", By.WORLD), ("visitor 2", By.WORLD)],
+                at, "camera", [("nobody", By.QUIET), ("someone new faces it", By.WORLD)]
             )
-            persons = (
-                ()
-                if who == "nobody"
-                else (PersonDetection(1 if "1" in who else 2, Point(x + 1.0, y), 180.0),)
-            )
-            return Reading(PersonDetections(now, persons), now)
+            if who == "nobody":
+                return Reading(PersonDetections(now, ()), now)
+            self.robot.people += 1
+            person = PersonDetection(self.robot.people, Point(x + 1.0, y), 180.0)
+            return Reading(PersonDetections(now, (person,)), now)
         if key is keys.PEOPLE:
             near = self._choose(at, "visitor", [("nobody near", By.WORLD), ("follows", By.WORLD)])
             people = (TrackedPerson(1, Point(x, y)),) if near == "follows" else ()
@@ -329,11 +412,12 @@ class Real:
             ),
             self.clock.now(),
             core.pause_ran_out,
-            (self.robot.where, self.robot.docking, self.robot.homing),
+            (self.robot.where, self.robot.docking, self.robot.homing, self.robot.people),
         )
-        return Saved(tuple(nodes), engine)
+        return Saved(tuple(nodes), engine, self.running())
 
     def restore(self, saved: Saved) -> None:
+        self._running = saved.running
         memo: dict[int, Any] = {}
         for i, node in enumerate(self.nodes):
             target = saved.nodes[i]
@@ -401,24 +485,32 @@ class Real:
             out.append((i, at))
         return tuple(out)
 
-    def running(self) -> Iterator[int]:
-        return (i for i, n in enumerate(self.nodes) if n.status is RUNNING)
+    def running(self) -> list[int]:
+        """The running nodes, pre-order (kept until a tick or a restore changes them)."""
+        found = self._running
+        if found is None:
+            found = self._running = [i for i, n in enumerate(self.nodes) if n.status is RUNNING]
+        return found
 
     def tick(self, oracle: Oracle) -> Step:
         """One tick from the restored state, with ``oracle``'s choices."""
         core, board = self.core, self.core.board
         self.oracle = oracle
+        self.fired: list[int] = []
+        self.timed = False  # a wait's time was running as the tick began
         self.asked = {}
         self.events = []
         self._sent: list[VEvent] = []
         self._drove_to = ""
         step = self.step = Step(started_tour=board.get(keys.TOUR_STATE) is TourState.STARTED)
         help_before = board.get(keys.HELP) is not None
-        running = list(self.running())
+        running = self.running()
         moved = self._before(running)
         self._publish_world(moved)
         faults = core.faults.total
+        self._running = None
         core.tick()
+        self._running = None
         if core.faults.total != faults:
             for seen in core.faults.seen.values():
                 line = f"{seen.where}: {seen.error}"
@@ -426,7 +518,15 @@ class Real:
                     self.found.failed.append(line)
         step.events = self.events
         self._after(step, help_before)
+        self._canonical()
         return step
+
+    def _canonical(self) -> None:
+        """The interval since the last approach, pending whenever no approach runs: all
+        a later approach may see is that it has to wait (until the explorer lets the
+        interval run out) or not, and waiting first covers both."""
+        if not any(self.nodes[i].status is RUNNING for i in self.approaches):
+            self.core.actions.last_approach_at = self.clock.now()
 
     def _before(self, running: list[int]) -> bool:
         """The operator's command, a wait running out, or the world's answers: the
@@ -449,25 +549,14 @@ class Real:
         helping = board.get(keys.HELP)
         if helping is not None and board.get(keys.HELP_ANSWER) is None:
             options += [("retry", By.WORLD), ("done_by_hand", By.WORLD)]
-        deadlines: dict[float, int] = {}
-        now = self.clock.now()
-        for i in running:
-            w = self.worlds[i]
-            if w is not None and w.timer is not None:
-                due = w.timer(self.nodes[i])
-                if due is not None and due > now:
-                    deadlines.setdefault(due, i)
-        since = core.standing.paused_since
-        if paused and since is not None:
-            deadlines.setdefault(since + core.operator.pause_max, -1)
-        timers = sorted(deadlines.items())
-        options += [(_timer_label(self.nodes, i), By.ROBOT) for _, i in timers]
+        timers = self._timers(running, paused)
+        self.timed = bool(timers)
+        options += [(label, By.ROBOT) for label in timers]
         what = self._choose(-1, "operator", options)
         if what == "none":
             return self._answers(running)
-        if what.startswith("time: "):
-            due = next(d for d, i in timers if _timer_label(self.nodes, i) == what)
-            self.clock.set(due)
+        if what in timers:
+            timers[what]()
             return False
         if what == "done_by_hand" and helping is not None:  # a person did the step
             if helping.about is HelpAbout.UNDOCK:
@@ -479,6 +568,47 @@ class Real:
         if not answer.ok:
             raise Pruned(what)
         return False
+
+    def _timers(self, running: list[int], paused: bool) -> dict[str, Callable[[], None]]:
+        """The waits still ahead, each with what makes it run out now. The clock never
+        moves: a wait runs out by its own times moving back (``World.fire``), so that
+        the others stay pending; which runs out first is the explorer's choice."""
+        now = self.clock.now()
+        out: dict[str, Callable[[], None]] = {}
+        for i in running:
+            w = self.worlds[i]
+            if w is None or w.timer is None:
+                continue
+            due = w.timer(self.nodes[i])
+            if due is not None and due > now:
+                label = _timer_label(self.nodes, i)
+                out[label if label not in out else f"{label} ({i})"] = partial(
+                    self._fire, i, w, due - now
+                )
+        standing = self.core.standing
+        since = standing.paused_since
+        if paused and since is not None:
+            left = since + self.core.operator.pause_max - now
+            if left > 0:
+
+                def pause_runs_out() -> None:
+                    assert standing.paused_since is not None
+                    standing.paused_since -= left
+
+                out[_timer_label(self.nodes, -1)] = pause_runs_out
+        return out
+
+    def _fire(self, i: int, world: World, seconds: float) -> None:
+        """Node ``i``'s wait runs out now: its ``fire``, or its ``times`` moved back."""
+        node = self.nodes[i]
+        self.fired.append(i)
+        if world.fire is not None:
+            world.fire(node, seconds)
+            return
+        for name in world.times:
+            value = getattr(node, name, None)
+            if value is not None:
+                setattr(node, name, value - seconds)
 
     def _answers(self, running: list[int]) -> bool:
         """The robot answers its pending goal, the docking the running Docking asked
@@ -537,15 +667,15 @@ class Real:
         step.ticked = []
         for node in self.touched:
             i = self.index[id(node)]
-            before = self.live_status[i]
-            if node.status is not py_trees.common.Status.INVALID or before is not RUNNING:
-                step.ticked.append((i, before is not RUNNING))
+            started = i not in self.was_running
+            if node.status is not py_trees.common.Status.INVALID or started:
+                step.ticked.append((i, started))
         if board.get(keys.HELP) is not None and not help_before:
             asking = next((i for i in self.running() if _role(self.worlds[i]) == "help"), 0)
             step.events.append((VEvent.HELP, asking, self.world_view()))
         for i in self.retries:
             retry: Any = self.nodes[i]
-            was = self.live_failures[i] if self.live_status[i] is RUNNING else 0
+            was = self.was_failures.get(i, 0)
             if retry.status is RUNNING and retry.failures > was:
                 step.events.append((VEvent.RETRY, i, self.world_view()))
         if board.get(keys.HOME) is None:
@@ -568,10 +698,14 @@ class Real:
         declare is reported by class."""
         for node in self.touched:
             i = self.index[id(node)]
-            before = saved.nodes[i]
-            for name, value in node.__dict__.items():
-                if name in self.declared[i]:
-                    continue
+            before, now = saved.nodes[i], node.__dict__
+            watch = self.watch[i]
+            if watch is not None and now.keys() == before.keys() and watch(now) == watch(before):
+                continue  # no field it does not declare changed (compared at C speed)
+            undeclared = [name for name in now if name not in self.declared[i]]
+            self.watch[i] = operator.itemgetter(*undeclared) if undeclared else _nothing
+            for name in undeclared:
+                value = now[name]
                 if name not in before or (before[name] is not value and before[name] != value):
                     self.found.undeclared.setdefault(type(node).__name__, set()).add(name)
 
@@ -615,64 +749,96 @@ class Real:
         followed = {getattr(self.nodes[i], "goal", None) for i in self.running()} | {
             core.actions.pending
         }
-        enc = _Encoder(now, base, poses, {g.id for g in followed if isinstance(g, Goal)})
+        enc = _Encoder(
+            now,
+            base,
+            poses,
+            {g.id for g in followed if isinstance(g, Goal)},
+            self._board_get(keys.VISITOR),
+        )
         nodes: list[object] = []
         oldest = last
+        since: dict[str, int] = {}  # a count's value as a running node that counts it began
         for i in self.running():
             node, w = self.nodes[i], self.worlds[i]
             if w is None:
                 nodes.append(i)
                 continue
+            for name, at in w.counts:
+                since[name] = getattr(node, at, None) or 0
             if w.key is not None:
                 nodes.append((i, w.key(node)))
                 continue
             fields: list[Hashable] = []
             for name in w.state:
+                if name in w.ignores:
+                    continue
                 value = getattr(node, name, None)
                 if name in w.indexes and isinstance(value, int):
                     oldest = min(oldest, value)
                     fields.append(value - last)
+                elif name in w.people:
+                    fields.append(enc.person(value))
+                elif any(name == at for _, at in w.counts):
+                    continue  # with the count on the board: the count since it began
                 else:
                     fields.append(enc(value))
             nodes.append((i, tuple(fields)))
-        cooling = self.site.recruit.retry_after
         live, presence = self.liveness.live(
             self.positions(), self._board_get(keys.RESUME) is not None
         )
         truthy = self.liveness.truthy
-        board = tuple(
-            (k.name, bool(v))
-            if k in truthy
-            else (k.name, enc(v) if k is not keys.APPROACH_FAILED else _cooling(v, now, cooling))
-            if k in live
-            else (k.name, v is not None)
-            for store in (core.board._values, core.standing.values)
-            for k, v in store.items()
-            # a value of None reads as none written; an unset truthy key reads false
-            if v is not None and (k in live or k in presence) and (k not in truthy or v)
-        )
+        board: list[tuple[str, Hashable]] = []
+        for store in (core.board._values, core.standing.values):
+            for k, v in store.items():
+                # a value of None reads as none written; an unset truthy key reads false
+                if v is None or (k not in live and k not in presence) or (k in truthy and not v):
+                    continue
+                if k in truthy:
+                    board.append((k.name, True))
+                elif k not in live:
+                    board.append((k.name, True))  # only whether it is set
+                elif k.name in since:  # unset, or none since it began: left out alike
+                    if v != since[k.name]:
+                        board.append((k.name, v - since[k.name]))
+                elif k.name in self.counted:
+                    continue  # read only as a count since a node starts: none runs
+                elif k.name in self.views:
+                    seen = tuple(view(v) for view in self.views[k.name])
+                    board.append((k.name, enc.person(seen) if k.name in self.people else enc(seen)))
+                elif k.name in self.people:
+                    board.append((k.name, enc.person(v)))
+                else:
+                    board.append((k.name, enc(v)))
+        board.sort(key=lambda e: e[0])
         tail = tuple(e.message for e in log.since(oldest)) if oldest < last else ()
         actions = core.actions
         engine = (
             enc(actions.pending),
             enc(latest),
-            enc(actions.before),
+            # the goal the pending one replaced while open: what a stale answer answers
+            enc(actions.before) if actions.pending is not None else None,
             enc(actions.unconfirmed),
             enc(core.standing.paused_since),
             min(round(now - actions.last_approach_at, 3), self.site.recruit.approach_interval),
         )
-        return (tuple(nodes), board, tail, engine, self.robot.key())
+        return (tuple(nodes), tuple(board), tail, engine, self.robot.key(self._near))
 
     # ------------------------------------------------------------ successors
 
-    def successors(self, saved: Saved) -> Iterator[tuple[Saved, Step]]:
-        """Every next state with the tick that led there (all choices enumerated)."""
+    def successors(self, saved: Saved) -> Iterator[tuple[Callable[[], Saved], Step]]:
+        """Every next state with the tick that led there (all choices enumerated): what
+        saves it (to call before the next one; a state already seen need not be)."""
         pending: list[list[int]] = [[]]
         while pending:
             prefix = pending.pop()
             self.restore(saved)
-            self.live_status = [n.status for n in self.nodes]
-            self.live_failures = [getattr(n, "failures", 0) for n in self.nodes]
+            self.was_running = set(self.running())
+            self.was_failures = {
+                i: getattr(self.nodes[i], "failures", 0)
+                for i in self.retries
+                if i in self.was_running
+            }
             oracle = Oracle(prefix)
             try:
                 step = self.tick(oracle)
@@ -681,8 +847,10 @@ class Real:
                 ok = False
             if ok:
                 self.check_declared(saved)
-                touched = [self.index[id(n)] for n in self.touched]
-                yield self.save(saved, touched), step
+                touched = [*{self.index[id(n)]: None for n in self.touched}, *self.fired]
+                for i in touched:
+                    self.live[i] = None  # changed: restore it next time
+                yield partial(self.save, saved, touched), step
             for k in range(len(prefix), len(oracle.widths)):
                 for alt in range(1, oracle.widths[k]):
                     pending.append([*oracle.taken[:k], alt])
@@ -708,8 +876,26 @@ class _Encoder:
     the newest goal; a goal no running node follows (and not pending) only as whether it
     is done (all that the next goal's belief reads of it)."""
 
-    def __init__(self, now: float, base: int, poses: int, followed: set[int]) -> None:
+    def __init__(
+        self, now: float, base: int, poses: int, followed: set[int], visitor: int | None
+    ) -> None:
         self.now, self.base, self.poses, self.followed = now, base, poses, followed
+        self.visitor = visitor
+
+    def person(self, value: Any) -> Hashable:
+        """A value holding people's ids (``World.people``): each id only as whether it is
+        the current visitor's (``/visitor``): people are alike."""
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value == self.visitor
+        if isinstance(value, frozenset | set):
+            return frozenset(self.person(v) for v in value)
+        if isinstance(value, tuple | list):
+            return tuple(self.person(v) for v in value)
+        if isinstance(value, dict):
+            return frozenset((self.person(k), self(v)) for k, v in value.items())
+        if dataclasses.is_dataclass(value) and not isinstance(value, type):
+            return tuple(self.person(getattr(value, f.name)) for f in dataclasses.fields(value))
+        return self(value)
 
     def __call__(self, value: Any) -> Hashable:
         if value is None or isinstance(value, bool | int | str | enum.Enum):
@@ -719,9 +905,12 @@ class _Encoder:
         if isinstance(value, Goal):
             if value.id not in self.followed:
                 return ("goal", value.done)
+            target: Hashable = value.target
+            if value.kind == "approach":  # a person's id
+                target = value.target.isdigit() and int(value.target) == self.visitor
             return (
                 value.kind,
-                value.target,
+                target,
                 value.code,
                 value.acknowledged,
                 value.id - self.base,
@@ -751,15 +940,15 @@ class _Encoder:
         return value  # type: ignore[no-any-return]
 
 
-def _cooling(failed: dict[int, float], now: float, retry_after: float) -> frozenset[int]:
-    """``/approach_failed`` as the seeker reads it: the visitors still passed over."""
-    return frozenset(pid for pid, at in failed.items() if now - at < retry_after)
+# the types whose values a tick never changes in place (learnt as met)
+_SAME: set[type] = {type(None), bool, int, float, str, tuple, frozenset}
 
 
 def _clone(value: Any, memo: dict[int, Any]) -> Any:
     """A copy of a mutable value a tick may change in place (one copy per object in a
     snapshot: the stream's samples are the board's); an immutable one as it is."""
-    if value is None or isinstance(value, bool | int | float | str | tuple | frozenset):
+    kind = type(value)
+    if kind in _SAME:
         return value
     found = memo.get(id(value))
     if found is not None:
@@ -777,7 +966,11 @@ def _clone(value: Any, memo: dict[int, Any]) -> Any:
     elif isinstance(value, dict | list | set):
         out = copy.copy(value)
     elif dataclasses.is_dataclass(value) and getattr(value, "__hash__", None) is not None:
-        return value  # frozen
+        _SAME.add(kind)  # frozen
+        return value
+    elif isinstance(value, enum.Enum | bool | int | float | str | tuple | frozenset):
+        _SAME.add(kind)
+        return value
     elif hasattr(value, "__dict__"):  # one level deeper: its lists and dicts copied
         out = copy.copy(value)
         out.__dict__.update({k: _clone(v, memo) for k, v in value.__dict__.items()})
@@ -785,6 +978,10 @@ def _clone(value: Any, memo: dict[int, Any]) -> Any:
         return value
     memo[id(value)] = out
     return out
+
+
+def _nothing(_: object) -> None:
+    return None
 
 
 def _timer_label(nodes: list[Behaviour], i: int) -> str:
@@ -830,7 +1027,7 @@ def _explore(
         while head < len(graph.states):
             edges: list[tuple[int, Step]] = []
             graph.edges.append(edges)
-            for nxt, step in real.successors(saved[head]):
+            for save, step in real.successors(saved[head]):
                 key = real.key()
                 dst = index.get(key)
                 if dst is None:
@@ -840,10 +1037,18 @@ def _explore(
                     index[key] = dst
                     graph.states.append(real.view())
                     graph.parent.append((head, len(edges)))
-                    saved.append(nxt)
+                    saved.append(save())
                     progress = real.core.board.get(keys.PROGRESS)
                     if progress is not None and progress.done:
                         progresses[progress] = None
+                if (
+                    dst == head
+                    and real.timed
+                    and not any(c.value.startswith("time:") for c in step.choices)
+                ):
+                    # nothing changed while a wait's time runs: time passes (the explorer
+                    # lets it run out as a choice of its own), no loop of the robot's
+                    step.waits.append((-1, "waits for its time to run out"))
                 edges.append((dst, step))
                 if on_step is not None:
                     on_step(head, step, dst, graph.states[dst])

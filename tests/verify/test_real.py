@@ -12,17 +12,20 @@ from __future__ import annotations
 import textwrap
 from pathlib import Path
 
+import pytest
+
 from frog_bt.behaviours import FACTORY
 from frog_bt.behaviours.operator import WaitInService
 from frog_bt.behaviours.registry import DECORATOR_TYPES, LEAF_TYPES
 from frog_bt.behaviours.visit import PlayContent
 from frog_bt.cli import main
 from frog_bt.config import load_site
+from frog_bt.errors import TreeErrors
 from frog_bt.model import keys
 from frog_bt.model.frontend import StartIntroduction
 from frog_bt.tree.factory import NodeFactory
 from frog_bt.tree.leaf import RUNNING, SUCCESS, Leaf, Status
-from frog_bt.tree.world import Channel, World
+from frog_bt.tree.world import Channel, World, world_of
 from frog_bt.verify.prove import Verdict, prove
 from frog_bt.verify.report import tick_line
 
@@ -125,8 +128,15 @@ class Counting(Leaf):
         return SUCCESS
 
 
+class NoWorld(Leaf):
+    """Declares no world interface: verify cannot say what it may do."""
+
+    def update(self) -> Status:
+        return SUCCESS
+
+
 FACTORY_ = NodeFactory(
-    [*LEAF_TYPES, PlayContentNoPause, WaitInServiceNot, WelcomeBack, Quiet, Counting],
+    [*LEAF_TYPES, PlayContentNoPause, WaitInServiceNot, WelcomeBack, Quiet, Counting, NoWorld],
     DECORATOR_TYPES,
 )
 
@@ -210,3 +220,24 @@ def test_verify_real_on_the_command_line(tmp_path: Path, capsys: object) -> None
         "    - {type: WaitInService}\n    - {type: WaitFrontendIdle}\n"
     )
     assert main(["verify", "--real", str(path)]) == 1  # vacuous: no tour to pause
+
+
+def test_every_registered_node_type_declares_its_world() -> None:
+    """verify --real ticks every node type as it is: each says, on its class, what of the
+    world it listens to and what it keeps (frog_bt.tree.world)."""
+    types = [*LEAF_TYPES, *DECORATOR_TYPES]
+    assert types
+    assert [t.__name__ for t in types if world_of(t) is None] == []
+
+
+def test_a_leaf_without_a_world_or_an_unknown_name_is_an_error(tmp_path: Path) -> None:
+    with pytest.raises(TreeErrors) as found:
+        verdict(tour(tmp_path, welcome="NoWorld"), restarts=False)
+    assert "leaf type NoWorld declares no world interface" in str(found.value.errors[0])
+    path = tmp_path / "idle.yaml"
+    path.write_text(
+        "root:\n  type: Sequence\n  memory: false\n  children:\n"
+        "    - {type: WaitInService}\n"
+        "properties:\n  - {never: [Nope, WaitInService], together: true}\n"
+    )
+    assert main(["verify", "--real", str(path)]) == 2
