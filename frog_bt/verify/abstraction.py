@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
+from typing import Any, Protocol
 
 from frog_bt.verify.world import (
     ABORT,
@@ -37,12 +37,26 @@ from frog_bt.verify.world import (
     Role,
 )
 
-if TYPE_CHECKING:
-    from frog_bt.verify.model import CNode
-
 Option = tuple[str, By]
 R, S, F = "running", "success", "failure"
 STATUS = {R: RUNNING, S: SUCCESS, F: FAILURE}
+
+
+class NodeView(Protocol):
+    """What a rule reads of a compiled node (:class:`frog_bt.verify.model.CNode`; named
+    here as a protocol so that this module does not import the model that imports it)."""
+
+    @property
+    def index(self) -> int: ...
+    @property
+    def abstraction(self) -> Abstraction: ...
+    @property
+    def dock(self) -> str: ...
+    @property
+    def params(self) -> dict[str, Any]: ...
+    @property
+    def reads_paused(self) -> bool: ...
+    def type_name_in(self, *names: str) -> bool: ...
 
 
 class TickLike(Protocol):
@@ -50,7 +64,7 @@ class TickLike(Protocol):
 
     world: list[object]
 
-    def choose(self, node: CNode, what: str, options: Sequence[Option]) -> str:
+    def choose(self, node: NodeView, what: str, options: Sequence[Option]) -> str:
         """One of ``options`` (each is explored); the first is taken when there is one."""
         ...
 
@@ -58,14 +72,14 @@ class TickLike(Protocol):
         """An input of this tick (the same for every leaf that reads it in the tick)."""
         ...
 
-    def event(self, kind: Event, node: CNode) -> None: ...
+    def event(self, kind: Event, node: NodeView) -> None: ...
 
-    def waits(self, node: CNode, by: By, why: str) -> None:
+    def waits(self, node: NodeView, by: By, why: str) -> None:
         """The node holds for ``by`` (a person's resume, service_on) this tick."""
         ...
 
 
-Rule = Callable[[TickLike, "CNode", int, bool], tuple[int, int]]
+Rule = Callable[[TickLike, NodeView, int, bool], tuple[int, int]]
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,7 +111,7 @@ def options(a: Abstraction, count: int, starting: bool = False) -> list[Option]:
     return out or [(S, a.by)]
 
 
-def plain(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def plain(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     """A leaf whose outcome is one of its ``outcomes`` (no effect on the world)."""
     a = n.abstraction
     count = 0 if starting else aux
@@ -112,7 +126,7 @@ def _next(a: Abstraction, count: int, starting: bool) -> int:
     return count if starting or a.bound is None else min(count + 1, a.bound)
 
 
-def _held(t: TickLike, n: CNode) -> bool:
+def _held(t: TickLike, n: NodeView) -> bool:
     """A leaf that reads /paused holds its action while the operator's pause lasts."""
     if n.reads_paused and t.world[PAUSED]:
         t.waits(n, By.WORLD, "paused: waits for resume")
@@ -120,7 +134,7 @@ def _held(t: TickLike, n: CNode) -> bool:
     return False
 
 
-def goal(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def goal(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     """A goal leaf (Navigate, ApproachVisitor): the goal goes out unless paused (aux bit 0:
     out); a pause while it is out stops the robot; then running, success or failure."""
     out, count = (0, 0) if starting else (aux & 1, aux >> 1)
@@ -140,7 +154,7 @@ def goal(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
     return STATUS[chosen], (_next(n.abstraction, count, starting) << 1) | out
 
 
-def speak(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def speak(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     """StartIntroduction, AskTour: said at once, unless paused (then held until resume)."""
     if _held(t, n):
         return RUNNING, 0
@@ -148,7 +162,7 @@ def speak(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
     return SUCCESS, 0
 
 
-def content(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def content(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     """PlayContent: starts unless paused (aux bit 0: playing), then plays or ends."""
     playing, count = (0, 0) if starting else (aux & 1, aux >> 1)
     if not playing:
@@ -161,7 +175,7 @@ def content(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
     return STATUS[chosen], (_next(n.abstraction, count, fresh) << 1) | playing
 
 
-def docking(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def docking(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     """Docking: at once when the robot already is where asked; else running, docked or
     undocked (the world follows), or failed."""
     dock = n.params.get("action") == "dock"
@@ -177,7 +191,7 @@ def docking(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
     return STATUS[chosen], _next(n.abstraction, aux, starting)
 
 
-def must_abort(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def must_abort(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     if t.world[ABORT]:
         return SUCCESS, 0
     if not t.world[STARTED]:
@@ -190,17 +204,17 @@ def must_abort(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, in
     return FAILURE, 0
 
 
-def clear_abort(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def clear_abort(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     t.world[ABORT] = t.world[HOME] = t.world[HOMING] = False
     return SUCCESS, 0
 
 
-def give_up(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def give_up(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     t.world[STARTED] = False
     return FAILURE, 0
 
 
-def tour_status(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def tour_status(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     started = n.params.get("state") == "started"
     if started:
         t.event(Event.TOUR_STARTED, n)
@@ -208,14 +222,14 @@ def tour_status(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, i
     return SUCCESS, 0
 
 
-def wait_in_service(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def wait_in_service(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     if t.world[IN_SERVICE]:
         return SUCCESS, 0
     t.waits(n, By.WORLD, "out of service: waits for service_on")
     return RUNNING, 0
 
 
-def ask_for_help(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def ask_for_help(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     """AskForHelp: asks at once (``fault``: while a fault persists; ``restored``: never, as
     verify starts fresh), holds, and takes a person's ``retry`` (FAILURE) or
     ``done_by_hand`` (SUCCESS: the robot is where the step should have left it)."""
@@ -245,7 +259,7 @@ def ask_for_help(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, 
     return RUNNING, 1
 
 
-def wait_event(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def wait_event(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     """WaitEvent: the event arrives (the world), or, once its bound ran out, the wait ends
     with ``on_timeout``."""
     if starting:
@@ -257,7 +271,7 @@ def wait_event(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, in
     return STATUS[t.choose(n, "outcome", choices)], 0
 
 
-def at_poi(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def at_poi(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     """AtPoi: a robot on its charger is at the dock's waypoint; anywhere else, where it
     is (by /pose) is the robot's: at the POI or not."""
     if t.world[DOCKED] and n.params.get("poi") == n.dock:
@@ -265,12 +279,12 @@ def at_poi(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
     return STATUS[t.choose(n, "outcome", [(S, By.ROBOT), (F, By.ROBOT)])], 0
 
 
-def skip_stop(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def skip_stop(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     t.world[SKIPPED] = n.params.get("poi")
     return SUCCESS, 0
 
 
-def skipped(t: TickLike, n: CNode, aux: int, starting: bool) -> tuple[int, int]:
+def skipped(t: TickLike, n: NodeView, aux: int, starting: bool) -> tuple[int, int]:
     return (SUCCESS if t.world[SKIPPED] == n.params.get("poi") else FAILURE), 0
 
 

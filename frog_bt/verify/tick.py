@@ -18,7 +18,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from frog_bt.verify.abstraction import Option, plain
+from frog_bt.verify.abstraction import NodeView, Option, plain
 from frog_bt.verify.model import CNode, Kind, Model
 from frog_bt.verify.world import (
     ABORT,
@@ -130,7 +130,7 @@ class Tick:
             self.step.choices.append(Choice(node, what, value, by))
         return value
 
-    def choose(self, node: CNode, what: str, options: Sequence[Option]) -> str:
+    def choose(self, node: NodeView, what: str, options: Sequence[Option]) -> str:
         return self._pick(node.index, what, options)
 
     def env(self, what: str, options: Sequence[Option]) -> str:
@@ -138,10 +138,10 @@ class Tick:
             self._env[what] = self._pick(-1, what, options)
         return self._env[what]
 
-    def event(self, kind: Event, node: CNode) -> None:
+    def event(self, kind: Event, node: NodeView) -> None:
         self.step.events.append((kind, node.index, tuple(self.world)))
 
-    def waits(self, node: CNode, by: By, why: str) -> None:
+    def waits(self, node: NodeView, by: By, why: str) -> None:
         self.step.waits.append((node.index, why))
 
     # ------------------------------------------------------------ the tick
