@@ -44,19 +44,26 @@ def difference(a: Rate, b: Rate) -> Difference:
     """``b - a`` with Newcombe's 95 % hybrid score interval (method 10, from Wilson's)."""
     if a["rate"] is None or b["rate"] is None:
         return {"a": a, "b": b, "difference": None, "low": None, "high": None, "significant": False}
-    pa, la, ua = a["rate"], a["low"] or 0.0, a["high"] or 0.0
-    pb, lb, ub = b["rate"], b["low"] or 0.0, b["high"] or 0.0
-    d = pb - pa
-    low = d - math.sqrt((pb - lb) ** 2 + (ua - pa) ** 2)
-    high = d + math.sqrt((ub - pb) ** 2 + (pa - la) ** 2)
+    pa, pb = a["rate"], b["rate"]
+    low, high = _mover(pa, a["low"] or 0.0, a["high"] or 0.0, pb, b["low"] or 0.0, b["high"] or 0.0)
     return {
         "a": a,
         "b": b,
-        "difference": d,
+        "difference": pb - pa,
         "low": low,
         "high": high,
         "significant": low > 0 or high < 0,
     }
+
+
+def _mover(va: float, la: float, ua: float, vb: float, lb: float, ub: float) -> tuple[float, float]:
+    """The 95 % interval of ``vb - va`` from each value's own interval (MOVER; with two
+    Wilson intervals, Newcombe's hybrid score interval)."""
+    d = vb - va
+    return (
+        d - math.sqrt((vb - lb) ** 2 + (ua - va) ** 2),
+        d + math.sqrt((ub - vb) ** 2 + (va - la) ** 2),
+    )
 
 
 # Every other headline figure of the page is an estimate with its 95 % interval in the
@@ -198,8 +205,7 @@ def change(a: Estimate, b: Estimate) -> Change:
     la, ua, lb, ub = a["low"], a["high"], b["low"], b["high"]
     if la is None or ua is None or lb is None or ub is None:
         return {"a": a, "b": b, "difference": d, "low": None, "high": None, "significant": False}
-    low = d - math.sqrt((vb - lb) ** 2 + (ua - va) ** 2)
-    high = d + math.sqrt((ub - vb) ** 2 + (va - la) ** 2)
+    low, high = _mover(va, la, ua, vb, lb, ub)
     return {
         "a": a,
         "b": b,
