@@ -19,7 +19,9 @@ def story(t, poi):
 
 @pytest.fixture(scope="module")
 def morning():
-    return tour({"start_time": "2026-06-01T10:30:00+02:00"})
+    # At the robot's real speed (the site's estimate of the time to arrival, which warms
+    # the projector, assumes it), not the fast tours' 2.4 m/s.
+    return tour({"start_time": "2026-06-01T10:30:00+02:00", "navigation": {"speed": 0.6}})
 
 
 def test_engaged_visitor_gets_both_parts_with_counted_decisions(morning):

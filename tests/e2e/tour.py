@@ -27,7 +27,11 @@ from frog_bt.sim.traffic import Record
 from frog_bt.tree.loader import LoadedTree
 
 # High speed and short content: a whole tour takes a few seconds of wall time.
-FAST: dict[str, Any] = {"speed": 1000.0, "content": {"default": 10, "introduction": 8}}
+FAST: dict[str, Any] = {
+    "speed": 1000.0,
+    "navigation": {"speed": 2.4},
+    "content": {"default": 10, "introduction": 8},
+}
 
 __all__ = ["FAST", "Running", "Tour", "after_ticks", "describe", "fast", "free_udp_port", "tour"]
 

@@ -22,7 +22,11 @@ from frog_bt.sim.traffic import Record
 from frog_bt.tree.loader import LoadedTree
 
 # High speed and short content, as in tests/e2e: a tour takes a few seconds of wall time.
-FAST: dict[str, Any] = {"speed": 1000.0, "content": {"default": 10, "introduction": 8}}
+FAST: dict[str, Any] = {
+    "speed": 1000.0,
+    "navigation": {"speed": 2.4},  # 4x the robot's: fewer ticks, the same logic
+    "content": {"default": 10, "introduction": 8},
+}
 
 
 def scenario(data: dict[str, Any] | None = None) -> Scenario:

@@ -29,7 +29,11 @@ from frog_bt.runtime.observer import attach_all, listen
 from frog_bt.sim import Simulator, scenario_from
 from frog_bt.sim.traffic import Record
 
-FAST = {"speed": 1000.0, "content": {"default": 10, "introduction": 8}}
+FAST = {
+    "speed": 1000.0,
+    "navigation": {"speed": 2.4},  # 4x the robot's: fewer ticks, the same logic
+    "content": {"default": 10, "introduction": 8},
+}
 WAIT = 30.0  # wall seconds: a safety net for every wait, never a pace
 
 

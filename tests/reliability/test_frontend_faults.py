@@ -101,9 +101,11 @@ def test_front_end_that_never_acks_gets_eight_sends_then_a_warning(
 
 def test_front_end_silent_mid_tour_content_ends_by_timeout(tmp_path: Path) -> None:
     site = short_timeouts(tmp_path, content=20, POI2=15)
+    # At the robot's real speed: the drive to POI3 outlasts the front end's 60 s silence.
+    slow = {"navigation": {"speed": 0.6}}
 
     async def main() -> None:
-        async with TourRun(site=site) as run:
+        async with TourRun(site=site, scenario=slow) as run:
             sim = run.sim
             # POI2's content starts playing, then the front end hangs for 60 s.
             r = await sim.wait_for(received("start_poi", where=lambda p: p["poi"] == "POI2"), 30)
