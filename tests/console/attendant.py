@@ -33,6 +33,9 @@ def button(d: webdriver.Chrome, words: str, *, under: str | None = None) -> WebE
         return next((b for b in drv.find_elements(By.XPATH, xpath) if b.is_displayed()), False)
 
     found: WebElement = WebDriverWait(d, WAIT, poll_frequency=0.05).until(shown)
+    # As a finger would: the button brought to the middle of the screen, clear of the
+    # answer's banner fixed at the foot (a click there lands on the banner instead).
+    d.execute_script("arguments[0].scrollIntoView({block: 'center'})", found)
     return found
 
 
