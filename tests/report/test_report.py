@@ -40,7 +40,7 @@ from frog_bt.recordings.reader import Item, Primed
 from frog_bt.runtime.observer import attach_all
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
-from corpus_run import make
+from corpus_run import FAST, make
 from relabel import relabel
 
 SEED = 2  # one day: declines, engaged, declines, fault, wander_off, bored; 3 afternoon
@@ -49,7 +49,10 @@ SEED = 2  # one day: declines, engaged, declines, fault, wander_off, bored; 3 af
 @pytest.fixture(scope="module")
 def corpus(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
     out = tmp_path_factory.mktemp("season")
-    return out, make(out, days=1, per_day=6, seed=SEED, jobs=2)
+    # the robot at twice its speed, not the fast tours': the fault (5 simulated minutes
+    # in) still strikes mid-tour
+    fast = {**FAST, "navigation": {"speed": 1.2}}
+    return out, make(out, days=1, per_day=6, seed=SEED, jobs=2, fast=fast)
 
 
 def report(tmp_path: Path, *args: str) -> dict[str, Any]:
