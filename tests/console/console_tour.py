@@ -26,7 +26,10 @@ async def console_tour(
 ) -> AsyncIterator[tuple[Running, People, str]]:
     """The rehearsal, what was started for the people around it, and the console's URL
     (``token_file``: where the token came from; paired devices are kept beside it)."""
-    async with Running(scenario or {}, once=once, **kwargs) as run:
+    # the robot's own speed (not the fast tours' 2.4 m/s): a page is read at wall pace,
+    # and a stop must stay on screen long enough for a browser to see it
+    scenario = {"navigation": {"speed": 0.6}, **(scenario or {})}
+    async with Running(scenario, once=once, **kwargs) as run:
         settings = ConsoleSettings("127.0.0.1", 0, token, token_file)
         people = await start_people(run.executive, settings, [])
         try:
