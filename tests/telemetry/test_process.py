@@ -90,3 +90,32 @@ def test_a_tour_is_written_by_writers_that_take_turns(tmp_path: Path) -> None:
         assert "links" in temporal and "bt" in temporal, (path.name, temporal)
         ids |= {entry.recording_id for entry in RrdReader(path).recordings()}
     assert len(ids) == 1  # the viewer opens them together as one recording
+
+
+def test_a_fresh_writer_starts_only_when_there_are_ticks_to_write() -> None:
+    """Past its rows, a child is replaced only before the next batch with ticks: the day's
+    last log line (or link change) goes into the file that has the ticks before it, never
+    into a new file of its own (seen: a demo's last file held a log line and no tree)."""
+    telemetry = object.__new__(process.TelemetryProcess)
+    telemetry._closed, telemetry._links, telemetry._host = False, {}, None
+    telemetry.timings, telemetry.recycle_rows, telemetry._written = process.Timings(), 2, 0
+    started: list[int] = []
+    sent: list[str] = []
+
+    def start() -> None:
+        started.append(len(sent))
+        telemetry._written = 0
+
+    telemetry._start_child = start
+    telemetry._stop_child = lambda timeout: None
+    telemetry._send = lambda item: sent.append(str(item[0])) is None
+    ticks = Batch(statuses=[(t, t / 10, ((0, 1),)) for t in (1, 2, 3)])
+    last_line = Batch(notes=[(4, 0.4, "tour over", "info")])
+    queued = [ticks, last_line]
+    telemetry.rows = type("Rows", (), {"drain": lambda self: queued.pop(0)})()
+    telemetry.flush()
+    telemetry.flush()
+    assert sent == ["batch", "batch"] and started == []  # past 2 rows, but no tick since
+    queued.append(Batch(statuses=[(5, 0.5, ((0, 2),))]))
+    telemetry.flush()
+    assert started == [2] and sent == ["batch", "batch", "batch"]  # the new file: ticks

@@ -279,6 +279,10 @@ class TelemetryProcess(TelemetryObserver):
             return
         batch = self.rows.drain()
         if len(batch):
+            if self._written >= self.recycle_rows and batch.statuses:
+                # only now, with ticks to write: a new file never holds just the last
+                # link change or log line of a day that ended at the old one's limit
+                self._recycle()
             t0 = time.thread_time_ns()
             data = serialise(batch)
             t1 = time.thread_time_ns()
@@ -287,14 +291,16 @@ class TelemetryProcess(TelemetryObserver):
             self.timings.hand_over.append(time.thread_time_ns() - t1)
             if sent:
                 self._written += len(batch)
-            if self._written >= self.recycle_rows:
-                self._stop_child(CLOSE_TIMEOUT)
-                self._start_child()
-                links, self._links = self._links, {}  # the new file's lanes start with them
-                core = self._host.core if self._host is not None else None
-                if links and core is not None:
-                    self._send(("links", core.ticks, core.clock.now(), list(links.items())))
-                    self._links = links
+
+    def _recycle(self) -> None:
+        """A fresh child for the next file, its link lanes starting where they are."""
+        self._stop_child(CLOSE_TIMEOUT)
+        self._start_child()
+        links, self._links = self._links, {}  # the new file's lanes start with them
+        core = self._host.core if self._host is not None else None
+        if links and core is not None:
+            self._send(("links", core.ticks, core.clock.now(), list(links.items())))
+            self._links = links
 
     def _send(self, item: Item) -> bool:
         if self._closed:
