@@ -35,7 +35,11 @@ def test_three_demos_in_one_folder_are_three_tours_with_the_faults_alert(
     folder = tmp_path / "a"
     folder.mkdir()
     for scenario, code in (("default", 0), ("fault", 1), ("declines", 0)):
-        args = ["--scenario", scenario, "--record", str(folder / f"{scenario}.mcap")]
+        # each shipped scenario, the robot at twice its speed (the fault, 5 simulated
+        # minutes in, still strikes mid-tour)
+        faster = tmp_path / f"{scenario}.yaml"
+        faster.write_text(f"extends: {scenario}\nnavigation:\n  speed: 1.2\n")
+        args = ["--scenario", str(faster), "--record", str(folder / f"{scenario}.mcap")]
         assert main(["demo", *args, "--speed", "400", "--rerun", "off", "--quiet"]) == code
     capsys.readouterr()
     got = report(tmp_path, str(folder))
