@@ -340,6 +340,10 @@ def report(results: dict[str, Any], rows: list[dict[str, Any]]) -> str:
                 f"{k.split('-')[0]} stops",
                 f"{ticks[k]['all']['p50_us'] - off[k]:+.1f}" if off[k] else "n/a",
                 f"{p['serialise'].get('p50_us', 0):.0f} / {p['serialise'].get('max_us', 0):.0f}",
+                "{:.0f} / {:.0f}".format(
+                    p.get("serialise_step", {}).get("p50_us", 0),
+                    p.get("serialise_step", {}).get("max_us", 0),
+                ),
                 f"{p['hand_over'].get('p50_us', 0):.0f} / {p['hand_over'].get('max_us', 0):.0f}",
                 f"{p['write_us_per_batch']:.0f}",
                 f"{p['batches']}",
@@ -353,7 +357,8 @@ def report(results: dict[str, Any], rows: list[dict[str, Any]]) -> str:
                 [
                     "tour",
                     "on the tick: p50 µs",
-                    "serialise µs p50 / max",
+                    "serialise µs/batch p50 / max",
+                    "of it in one step µs p50 / max",
                     "hand over µs p50 / max",
                     "write µs/batch (child CPU)",
                     "batches",

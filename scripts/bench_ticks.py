@@ -271,7 +271,9 @@ async def one_tour(
         )
         handover = {
             "batches": batches,
-            "serialise": summary_us(timings.serialise),
+            "serialise": summary_us(timings.serialise),  # a batch's pieces, summed
+            # one step of it (STEP_ROWS rows): the longest an input waits for it
+            "serialise_step": summary_us(getattr(timings, "serialise_step", ())),
             "hand_over": summary_us(timings.hand_over),
             "write_child_cpu_s": child_s,
             "write_us_per_batch": child_s * 1e6 / max(1, batches),
