@@ -179,13 +179,13 @@ class Director:
             await asyncio.sleep(0.001)
 
 
-async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]:
+async def measure(trials: int, telemetry: bool, workdir: Path, stops: int = 7) -> dict[str, Any]:
     from frog_bt.config import load_site
     from frog_bt.model.wire import INPUTS
 
     plain = {"content": True, "face_stream": False, "projector": False, "check_follower": True}
     site_path = synthetic_site(
-        7,
+        stops,
         workdir,
         flags=plain,
         over={"follow": {"grace": 0.0}, "recruit": {"approach_interval": 0.0}},
@@ -240,6 +240,7 @@ async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]
         await director.server.stop()
     return {
         "trials": trials,
+        "stops": stops,
         "telemetry": telemetry,
         "wall_s": time.monotonic() - wall0,
         "errors": director.errors[:5],
@@ -251,10 +252,15 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--trials", type=int, default=1000)
     p.add_argument("--telemetry", choices=("on", "off"), default="off")
+    p.add_argument(
+        "--stops", type=int, default=7, help="stops of the synthetic tour (the tree's size)"
+    )
     p.add_argument("--out")
     args = p.parse_args()
     with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
-        result = asyncio.run(measure(args.trials, args.telemetry == "on", Path(tmp)))
+        result = asyncio.run(
+            measure(args.trials, args.telemetry == "on", Path(tmp), stops=args.stops)
+        )
     emit(result, args.out)
 
 
