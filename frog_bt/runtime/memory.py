@@ -14,8 +14,6 @@ unmapped, the heap's free top is given back, RSS stays flat.
 from __future__ import annotations
 
 import asyncio
-import ctypes
-import ctypes.util
 import gc
 import os
 from typing import TYPE_CHECKING
@@ -35,6 +33,9 @@ def pin_malloc_thresholds() -> bool:
     """Pin the mmap threshold where glibc is the allocator; True when it was set."""
     if "MALLOC_MMAP_THRESHOLD_" in os.environ:
         return False
+    import ctypes  # here: the collector's functions below are needed before the first tick
+    import ctypes.util
+
     name = ctypes.util.find_library("c")
     if not name:
         return False
@@ -70,12 +71,11 @@ def hold_collector() -> None:
     gc.disable()
 
 
-def freeze_heap() -> int:
+def freeze_heap() -> None:
     """What is alive now is kept for good (the collector no longer walks it), and the
-    collector is on again; the number of objects frozen so far."""
+    collector is on again. (Not ``gc.get_freeze_count()``: it walks what is frozen.)"""
     gc.freeze()
     gc.enable()
-    return gc.get_freeze_count()
 
 
 def refreeze_heap() -> int:
