@@ -23,7 +23,9 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import json
 import math
+import os
 import sys
 import tempfile
 import time
@@ -179,7 +181,9 @@ class Director:
             await asyncio.sleep(0.001)
 
 
-async def measure(trials: int, telemetry: bool, workdir: Path, stops: int = 7) -> dict[str, Any]:
+async def measure(
+    trials: int, telemetry: bool, workdir: Path, stops: int = 7, probe: bool = False
+) -> dict[str, Any]:
     from frog_bt.config import load_site
     from frog_bt.model.wire import INPUTS
 
@@ -220,7 +224,13 @@ async def measure(trials: int, telemetry: bool, workdir: Path, stops: int = 7) -
             "--rerun",
             f"save:{workdir / 'reaction.rrd'}",
         ]
-    proc = await asyncio.create_subprocess_exec(*argv)
+    env = None
+    if probe:  # what held the executive's loop, in its CPU time (scripts/loop_probe)
+        env = dict(os.environ, LOOP_PROBE_OUT=str(workdir / "loop"))
+        env["PYTHONPATH"] = os.pathsep.join(
+            p for p in (env.get("PYTHONPATH"), str(Path(__file__).parent / "loop_probe")) if p
+        )
+    proc = await asyncio.create_subprocess_exec(*argv, env=env)
     sensors = None
     wall0 = time.monotonic()
     try:
@@ -238,7 +248,9 @@ async def measure(trials: int, telemetry: bool, workdir: Path, stops: int = 7) -
         await asyncio.wait_for(proc.wait(), 30)
         director.frontend.close()
         await director.server.stop()
+    probed = [json.loads(f.read_text()) for f in workdir.glob("loop.*")]
     return {
+        **({"loop": probed[0]} if probed else {}),
         "trials": trials,
         "stops": stops,
         "telemetry": telemetry,
@@ -253,13 +265,21 @@ def main() -> None:
     p.add_argument("--trials", type=int, default=1000)
     p.add_argument("--telemetry", choices=("on", "off"), default="off")
     p.add_argument(
+        "--probe",
+        action="store_true",
+        help="also report what held the executive's event loop (its CPU time) and the "
+        "collector's pauses (scripts/loop_probe)",
+    )
+    p.add_argument(
         "--stops", type=int, default=7, help="stops of the synthetic tour (the tree's size)"
     )
     p.add_argument("--out")
     args = p.parse_args()
     with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
         result = asyncio.run(
-            measure(args.trials, args.telemetry == "on", Path(tmp), stops=args.stops)
+            measure(
+                args.trials, args.telemetry == "on", Path(tmp), stops=args.stops, probe=args.probe
+            )
         )
     emit(result, args.out)
 
