@@ -8,6 +8,7 @@ or rerun.
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import sys
 
@@ -52,14 +53,22 @@ def main(argv: list[str] | None = None) -> int:
     # Import only the chosen command: build a parser with just that one when we can.
     name = next((a for a in argv if not a.startswith("-")), None)
     if name in COMMANDS:
-        parser = argparse.ArgumentParser(prog="frog-bt")
-        sub = parser.add_subparsers(dest="command", required=True)
-        mod = importlib.import_module(COMMANDS[name][0])
-        p = sub.add_parser(
-            name, description=mod.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-        )
-        mod.add_arguments(p)
-        args = parser.parse_args(argv)
+        # Importing a command allocates much and frees little: no cyclic collections
+        # meanwhile (they would only cost time; frog_bt.runtime.memory).
+        collecting = gc.isenabled()
+        gc.disable()
+        try:
+            parser = argparse.ArgumentParser(prog="frog-bt")
+            sub = parser.add_subparsers(dest="command", required=True)
+            mod = importlib.import_module(COMMANDS[name][0])
+            p = sub.add_parser(
+                name, description=mod.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+            )
+            mod.add_arguments(p)
+            args = parser.parse_args(argv)
+        finally:
+            if collecting:
+                gc.enable()
         if name != "init":
             from frog_bt.commands import site_folder
 

@@ -55,7 +55,7 @@ def figure(section: str, result: dict[str, Any]) -> dict[str, float]:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--section", choices=("ticks", "reaction"), default="ticks")
-    p.add_argument("--stops", default="6,30,100", help="tour sizes (ticks)")
+    p.add_argument("--stops", default="6,30,100", help="tour sizes")
     p.add_argument("--trials", type=int, default=300, help="trials per run (reaction)")
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--configs", default="off,on", help="telemetry settings, first = base")
@@ -71,19 +71,17 @@ def main() -> None:
         env = dict(os.environ)
         env["PYTHONPATH"] = str(args.before.resolve())
         codes = {"before": env, **codes}
-    sizes = [int(s) for s in args.stops.split(",")] if args.section == "ticks" else [0]
+    sizes = [int(s) for s in args.stops.split(",")]
     runs: dict[str, list[dict[str, Any]]] = {}
     with tempfile.TemporaryDirectory(prefix="frog-ab-") as tmp:
         for r in range(args.rounds):
             for size in sizes:
                 for code, env in codes.items():
                     for config in configs:
-                        extra = (
-                            ["--stops", str(size)]
-                            if args.section == "ticks"
-                            else ["--trials", str(args.trials)]
-                        )
-                        key = f"{code} {size} {config}" if size else f"{code} {config}"
+                        extra = ["--stops", str(size)]
+                        if args.section == "reaction":
+                            extra += ["--trials", str(args.trials)]
+                        key = f"{code} {size} {config}"
                         print(f"round {r + 1}: {key} ...", file=sys.stderr, flush=True)
                         result = one(
                             args.section,

@@ -27,9 +27,9 @@ SECTIONS = ("startup", "ticks", "reaction", "ingest", "replay", "memory", "conso
 PHASES = ("waiting", "undocking", "recruiting", "driving", "content", "returning", "other")
 
 
-def plan(quick: bool) -> dict[str, list[tuple[str, list[str]]]]:
-    """Section -> runs: (name, arguments of its script)."""
-    sizes = (6, 30) if quick else (6, 30, 100)
+def plan(quick: bool, sizes: tuple[int, ...] = ()) -> dict[str, list[tuple[str, list[str]]]]:
+    """Section -> runs: (name, arguments of its script); ``sizes``: the tours' stops."""
+    sizes = sizes or ((6, 30) if quick else (6, 30, 100))
     return {
         "startup": [("startup", ["--runs", "3" if quick else "7", "--telemetry"])],
         "ticks": [
@@ -38,7 +38,12 @@ def plan(quick: bool) -> dict[str, list[tuple[str, list[str]]]]:
             for t in ("off", "on")
         ],
         "reaction": [
-            (t, ["--trials", "200" if quick else "1000", "--telemetry", t]) for t in ("off", "on")
+            (
+                f"{n}-{t}",
+                ["--stops", str(n), "--trials", "200" if quick else "1000", "--telemetry", t],
+            )
+            for n in sizes
+            for t in ("off", "on")
         ],
         "ingest": [("ingest", ["--seconds", "1" if quick else "5"])],
         "replay": [("replay", ["--minutes", "10" if quick else "60"])],
@@ -169,11 +174,12 @@ def budgets(results: dict[str, Any]) -> list[dict[str, Any]]:
                     lambda v: v <= 1.25,
                     "{:.2f}",
                 )
-    for t in ("off", "on") if "reaction" in results else ():
+    for run in results.get("reaction", {}):
+        n, t = run.split("-")
         for kind in ("response 2 -> start_poi", "user_positive -> /GotoWayPoint"):
-            value = get(results, "reaction", t, kind, "p99_us")
+            value = get(results, "reaction", run, kind, "p99_us")
             rows.add(
-                f"reaction p99 {kind}, telemetry {t}",
+                f"reaction p99 {kind}, telemetry {t} ({n} stops)",
                 None if value is None else value / 1000,
                 " ms",
                 "≤ 2 ms",
@@ -340,6 +346,10 @@ def report(results: dict[str, Any], rows: list[dict[str, Any]]) -> str:
                 f"{k.split('-')[0]} stops",
                 f"{ticks[k]['all']['p50_us'] - off[k]:+.1f}" if off[k] else "n/a",
                 f"{p['serialise'].get('p50_us', 0):.0f} / {p['serialise'].get('max_us', 0):.0f}",
+                "{:.0f} / {:.0f}".format(
+                    p.get("serialise_step", {}).get("p50_us", 0),
+                    p.get("serialise_step", {}).get("max_us", 0),
+                ),
                 f"{p['hand_over'].get('p50_us', 0):.0f} / {p['hand_over'].get('max_us', 0):.0f}",
                 f"{p['write_us_per_batch']:.0f}",
                 f"{p['batches']}",
@@ -353,7 +363,8 @@ def report(results: dict[str, Any], rows: list[dict[str, Any]]) -> str:
                 [
                     "tour",
                     "on the tick: p50 µs",
-                    "serialise µs p50 / max",
+                    "serialise µs/batch p50 / max",
+                    "of it in one step µs p50 / max",
                     "hand over µs p50 / max",
                     "write µs/batch (child CPU)",
                     "batches",
@@ -401,7 +412,13 @@ def main(argv: list[str] | None = None) -> int:
         metavar="SECTION[,SECTION]",
         help=f"run only these sections ({', '.join(SECTIONS)})",
     )
+    p.add_argument(
+        "--stops",
+        metavar="N[,N]",
+        help="tour sizes for ticks and reaction (default: 6,30 with --quick, else 6,30,100)",
+    )
     args = p.parse_args(argv)
+    sizes = tuple(int(n) for n in args.stops.split(",")) if args.stops else ()
     chosen = SECTIONS if not args.only else tuple(s for s in args.only.split(",") if s)
     unknown = [s for s in chosen if s not in SECTIONS]
     if unknown:
@@ -419,7 +436,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     failed = False
     with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
-        for name, runs in plan(args.quick).items():
+        for name, runs in plan(args.quick, sizes).items():
             if name in chosen:
                 results[name] = run_section(name, runs, Path(tmp))
                 failed |= any("error" in r for r in results[name].values())

@@ -23,7 +23,9 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import json
 import math
+import os
 import sys
 import tempfile
 import time
@@ -179,13 +181,15 @@ class Director:
             await asyncio.sleep(0.001)
 
 
-async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]:
+async def measure(
+    trials: int, telemetry: bool, workdir: Path, stops: int = 7, probe: bool = False
+) -> dict[str, Any]:
     from frog_bt.config import load_site
     from frog_bt.model.wire import INPUTS
 
     plain = {"content": True, "face_stream": False, "projector": False, "check_follower": True}
     site_path = synthetic_site(
-        7,
+        stops,
         workdir,
         flags=plain,
         over={"follow": {"grace": 0.0}, "recruit": {"approach_interval": 0.0}},
@@ -220,7 +224,13 @@ async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]
             "--rerun",
             f"save:{workdir / 'reaction.rrd'}",
         ]
-    proc = await asyncio.create_subprocess_exec(*argv)
+    env = None
+    if probe:  # what held the executive's loop, in its CPU time (scripts/loop_probe)
+        env = dict(os.environ, LOOP_PROBE_OUT=str(workdir / "loop"))
+        env["PYTHONPATH"] = os.pathsep.join(
+            p for p in (env.get("PYTHONPATH"), str(Path(__file__).parent / "loop_probe")) if p
+        )
+    proc = await asyncio.create_subprocess_exec(*argv, env=env)
     sensors = None
     wall0 = time.monotonic()
     try:
@@ -238,8 +248,11 @@ async def measure(trials: int, telemetry: bool, workdir: Path) -> dict[str, Any]
         await asyncio.wait_for(proc.wait(), 30)
         director.frontend.close()
         await director.server.stop()
+    probed = [json.loads(f.read_text()) for f in workdir.glob("loop.*")]
     return {
+        **({"loop": probed[0]} if probed else {}),
         "trials": trials,
+        "stops": stops,
         "telemetry": telemetry,
         "wall_s": time.monotonic() - wall0,
         "errors": director.errors[:5],
@@ -251,10 +264,23 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--trials", type=int, default=1000)
     p.add_argument("--telemetry", choices=("on", "off"), default="off")
+    p.add_argument(
+        "--probe",
+        action="store_true",
+        help="also report what held the executive's event loop (its CPU time) and the "
+        "collector's pauses (scripts/loop_probe)",
+    )
+    p.add_argument(
+        "--stops", type=int, default=7, help="stops of the synthetic tour (the tree's size)"
+    )
     p.add_argument("--out")
     args = p.parse_args()
     with tempfile.TemporaryDirectory(prefix="frog-bench-") as tmp:
-        result = asyncio.run(measure(args.trials, args.telemetry == "on", Path(tmp)))
+        result = asyncio.run(
+            measure(
+                args.trials, args.telemetry == "on", Path(tmp), stops=args.stops, probe=args.probe
+            )
+        )
     emit(result, args.out)
 
 

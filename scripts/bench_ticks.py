@@ -128,6 +128,28 @@ class _Probe:
         self.gc_ns.append(self._gc)
 
 
+class _Pauses:
+    """The collector's pauses over the tour (wall time), by generation."""
+
+    def __init__(self) -> None:
+        self.ns: dict[int, list[int]] = defaultdict(list)
+        self._t0 = 0
+        gc.callbacks.append(self._collecting)
+
+    def _collecting(self, phase: str, info: dict[str, Any]) -> None:
+        if phase == "start":
+            self._t0 = time.perf_counter_ns()
+        else:
+            self.ns[info["generation"]].append(time.perf_counter_ns() - self._t0)
+
+    def summary(self) -> dict[str, Any]:
+        gc.callbacks.remove(self._collecting)
+        return {
+            str(g): {"n": len(v), "max_ms": max(v) / 1e6, "total_ms": sum(v) / 1e6}
+            for g, v in sorted(self.ns.items())
+        }
+
+
 class _Null:
     """An observer that hears every event and does nothing with it."""
 
@@ -190,6 +212,12 @@ async def one_tour(
     executive = Executive(site, tree, clock, *links_to(sim, listen, clock), sim_time=True)
     rules = ExitRules(once=True)
     executive.observers.attach(executive, [rules])
+    from frog_bt.runtime import memory as heap
+
+    freeze = getattr(heap, "freeze_heap", None)
+    if freeze is not None:  # as `frog-bt run` does once loaded (the code before: nothing)
+        freeze()
+    pauses = _Pauses()
     observers: list[Any] = []
     writes: list[int] = []
     if telemetry == "null":  # an observer that does nothing: what listening alone costs
@@ -259,6 +287,9 @@ async def one_tour(
             f.name: f.stat().st_size for f in workdir.iterdir() if f.suffix in (".rrd", ".mcap")
         }
     wall = time.monotonic() - wall0
+    t0 = time.thread_time_ns()
+    gc.collect()
+    full_ms = (time.thread_time_ns() - t0) / 1e6
     every = [dt for values in samples.values() for dt in values]
     # Telemetry's phases: on the tick (its taps: the overhead above), then after the tick
     # serialise and hand over (this process), then write (the writer child, its CPU time).
@@ -271,7 +302,9 @@ async def one_tour(
         )
         handover = {
             "batches": batches,
-            "serialise": summary_us(timings.serialise),
+            "serialise": summary_us(timings.serialise),  # a batch's pieces, summed
+            # one step of it (STEP_ROWS rows): the longest an input waits for it
+            "serialise_step": summary_us(getattr(timings, "serialise_step", ())),
             "hand_over": summary_us(timings.hand_over),
             "write_child_cpu_s": child_s,
             "write_us_per_batch": child_s * 1e6 / max(1, batches),
@@ -296,6 +329,8 @@ async def one_tour(
         "telemetry_dropped_batches": getattr(observers[-1], "dropped", 0) if observers else 0,
         "file_bytes": sizes,  # the recording and the .rrd of the tour
         "gc_collections": [s["collections"] for s in gc.get_stats()],
+        "gc_pauses": pauses.summary(),  # the whole tour, in ticks or between them
+        "full_collection_ms": full_ms,  # what one would cost the loop at the tour's end
         **(
             {
                 "probe": {

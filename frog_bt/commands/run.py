@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import gc
 import logging
 import os
 import signal
@@ -225,6 +226,10 @@ def attach_observers(
 
 
 def run(args: argparse.Namespace) -> int:
+    from frog_bt.runtime import memory
+
+    collecting = gc.isenabled()
+    memory.hold_collector()  # loading the site and the tree: nothing to free (memory.py)
     tree_and_config(args)
     logs.setup(args.verbose, os.environ.get("FROG_BT_LOG_FORMAT") or args.log_format or "text")
     try:
@@ -236,6 +241,8 @@ def run(args: argparse.Namespace) -> int:
         console = console_settings(args)
         lock = claim_checkpoint(settings.checkpoint) if settings.checkpoint else None
     except FrogError as exc:
+        if collecting:
+            gc.enable()
         for line in error_lines(exc):
             print(f"frog-bt: {line}", file=sys.stderr)
         return 2
@@ -243,6 +250,9 @@ def run(args: argparse.Namespace) -> int:
     config = Path(args.config) if args.config else resources.site_dir() / resources.SITE_FILE
     for line in exposed(config, site):
         logging.getLogger("frog_bt").warning("%s", line)
+    # What start-up built lives all day: frozen, later full collections skip it; the
+    # collector is on again from here.
+    memory.freeze_heap()
     try:
         return asyncio.run(_main(args, site, tree, settings, console))
     except AddressError as exc:  # the listen port is taken, the front end's host unknown
@@ -264,10 +274,9 @@ async def _main(
     settings: Settings,
     console: ConsoleSettings | None = None,
 ) -> int:
-    from frog_bt.runtime.memory import pin_malloc_thresholds
+    from frog_bt.runtime.memory import HeapKeeper, pin_malloc_thresholds
 
     pin_malloc_thresholds()  # all day without creeping up
-    from frog_bt.live.summary import TourSummary
     from frog_bt.runtime.exits import ExitRules
     from frog_bt.runtime.keeper import Keeper
     from frog_bt.runtime.status import StatusLine
@@ -279,6 +288,8 @@ async def _main(
     if keeper is not None:
         attach_all(executive, [keeper])
     attach_all(executive, [ExitRules(once=args.once)])  # --once, and the tree giving up
+    if args.watch:  # a reloaded tree: the old one collected, the new one frozen
+        attach_all(executive, [HeapKeeper()])
     loop = asyncio.get_running_loop()
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, executive.stop, f"stopped by {sig.name}", 0)

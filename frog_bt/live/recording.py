@@ -41,7 +41,8 @@ Each channel carries a JSON Schema (encoding ``jsonschema``), so Foxglove
 can browse and plot the fields. Writing costs one encoding and one
 ``add_message`` per message, both once the event loop's current callback
 (a tick, an input) is over, in order (an event is kept as it is until then);
-chunks are bounded (:data:`CHUNK_SIZE`) and flushed at least every
+chunks are bounded (:data:`CHUNK_SIZE`, ended by the recorder just after the tick under
+way: :data:`CHUNK_PAUSE`) and flushed at least every
 :data:`FLUSH_EVERY` wall seconds, so memory stays small and a crash loses little.
 :meth:`Recorder.close` (idempotent, also run at interpreter exit) writes the summary
 and footer: a recording stays valid MCAP when the run command stops on SIGTERM, or on
@@ -110,6 +111,14 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 CHUNK_SIZE = 256 * 1024  # bytes of uncompressed messages per chunk
+# Closing a chunk costs the event loop ~0.2 ms plus ~0.6 µs a message (mcap compresses it
+# and writes each message's index entry in Python): 1-2 ms at the bench's rates. mcap
+# would close it inside whichever add_message crossed the size, i.e. in the drain right
+# after an input, before the tick that input calls for; the recorder ends chunks itself,
+# this long after the drain that found one full, so that the tick goes first.
+CHUNK_PAUSE = 0.0005  # seconds
+_UNBOUNDED = 1 << 62  # mcap's own chunk size: never reached (the recorder ends chunks)
+_RECORD = 31  # bytes of an MCAP message record besides its data (opcode, length, header)
 FLUSH_EVERY = 1.0  # wall seconds between chunk flushes: a kill loses at most this much
 PRIMER_DATAGRAMS = 16  # recent datagrams in, so that their resends stay duplicates
 PRIMER_SEQS = 64  # recent seqs out, so that resends of earlier commands are not new ones
@@ -163,10 +172,13 @@ class Recorder:
         path: Path,
         *,
         chunk_size: int = CHUNK_SIZE,
+        chunk_pause: float = CHUNK_PAUSE,
         flush_every: float = FLUSH_EVERY,
         metadata: dict[str, str] | None = None,
     ) -> None:
         self._chunk_size = chunk_size
+        self._chunk_pause = chunk_pause
+        self._ending: asyncio.TimerHandle | None = None  # the chunk's end, when scheduled
         self._flush_every = flush_every
         # Messages wait in _incoming until the event loop's current callback (a tick, an
         # input) is over, so that a tick pays a list append per message, not an MCAP
@@ -210,7 +222,8 @@ class Recorder:
             compression = CompressionType.LZ4
         except ImportError:
             pass
-        self._writer = Writer(stream, chunk_size=self._chunk_size, compression=compression)
+        self._writer = Writer(stream, chunk_size=_UNBOUNDED, compression=compression)
+        self._chunk_bytes = 0  # in the chunk being written (its uncompressed size)
         self._writer.start(profile="", library=f"frog-bt {__version__}")
         if metadata:
             self._writer.add_metadata("frog_bt", metadata)
@@ -396,9 +409,14 @@ class Recorder:
             return  # close() wrote them
         try:
             self._stamp()
-            _write_queued(self._writer, self._queue)
-            if time.monotonic() - self._flushed_at >= self._flush_every:
-                self._flush()
+            queue = self._queue
+            self._chunk_bytes += sum(len(q[2]) for q in queue) + _RECORD * len(queue)
+            _write_queued(self._writer, queue)
+            if (
+                self._chunk_bytes >= self._chunk_size
+                or time.monotonic() - self._flushed_at >= self._flush_every
+            ):
+                self._end_chunk_soon()
             elif self._flush_timer is None:  # a quiet spell must not keep the tail back
                 try:
                     loop = asyncio.get_running_loop()
@@ -407,6 +425,25 @@ class Recorder:
                 self._flush_timer = loop.call_later(self._flush_every, self._timed_flush)
         except Exception as exc:  # disk full, ...: stop recording, never stop the robot
             self._failed(exc)
+
+    def _end_chunk_soon(self) -> None:
+        """End the chunk :data:`CHUNK_PAUSE` from now: what is ready meanwhile (the tick an
+        input calls for) goes first. At once without an event loop."""
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:
+            self._flush()
+            return
+        if self._ending is None:
+            self._ending = loop.call_later(self._chunk_pause, self._end_chunk)
+
+    def _end_chunk(self) -> None:
+        self._ending = None
+        if not self.closed:
+            try:
+                self._flush()
+            except Exception as exc:
+                self._failed(exc)
 
     def _timed_flush(self) -> None:
         self._flush_timer = None
@@ -420,6 +457,7 @@ class Recorder:
         """End the chunk and hand it to the OS (a kill -9 then loses nothing of it), and
         ask for it on the disk (power loss) in a worker thread, off the event loop."""
         self._flushed_at = time.monotonic()
+        self._chunk_bytes = 0
         self._writer.flush()
         self._stream.flush()
         if self._syncing:
@@ -483,6 +521,9 @@ class Recorder:
         if self._flush_timer is not None:
             self._flush_timer.cancel()
             self._flush_timer = None
+        if self._ending is not None:
+            self._ending.cancel()
+            self._ending = None
         self._finalizer()
 
     def close(self) -> None:

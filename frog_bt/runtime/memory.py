@@ -1,4 +1,5 @@
-"""Flat memory for a process that runs all day: glibc's malloc thresholds pinned.
+"""Memory for a process that runs all day: glibc's malloc thresholds pinned, the
+start-up's objects frozen out of the cyclic collector's way (below).
 
 glibc raises its mmap threshold each time a large block (the recorder's 256 KiB
 chunks, rerun's and numpy's buffers) is freed, so later blocks of that size come
@@ -12,9 +13,16 @@ unmapped, the heap's free top is given back, RSS stays flat.
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
+import asyncio
+import gc
 import os
+from typing import TYPE_CHECKING
+
+from frog_bt.model.events import Event, Ticked
+
+if TYPE_CHECKING:
+    from frog_bt.engine.core import Core
+    from frog_bt.runtime.observer import Host
 
 M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3  # glibc's mallopt parameters
 MMAP_THRESHOLD = 128 * 1024  # bytes: glibc's default starting values
@@ -25,6 +33,9 @@ def pin_malloc_thresholds() -> bool:
     """Pin the mmap threshold where glibc is the allocator; True when it was set."""
     if "MALLOC_MMAP_THRESHOLD_" in os.environ:
         return False
+    import ctypes  # here, not with the module: `run` imports it before loading (below)
+    import ctypes.util
+
     name = ctypes.util.find_library("c")
     if not name:
         return False
@@ -38,3 +49,72 @@ def pin_malloc_thresholds() -> bool:
     return bool(
         mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD) and mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD)
     )
+
+
+# ---------------------------------------------------------------- the cyclic collector
+#
+# Start-up allocates tens of thousands of objects (modules, classes, the site, the tree:
+# about 46,000 alive once loaded) and frees almost none: the collector's runs then only
+# cost time (a full one 20-60 ms). And they stay in the oldest generation for the whole
+# day, so that every later full collection walks all of them again, from inside
+# whichever callback it falls in (one of 64 ms seen with telemetry on; 26-28 ms at the
+# end of a 30-stop tour, 7.5 ms frozen: docs/PERFORMANCE.md). So the ``run`` command
+# starts with the collector off, and once the site and the tree are loaded moves
+# everything alive into the permanent generation (gc.freeze): full collections then
+# walk only what the day allocated. Frozen objects are never collected as cycles
+# (reference counting still frees the others): what is garbage in cycles at that moment
+# stays (about 1,300 objects at a start, some 100 KB, once), which is why a reload
+# thaws, collects and freezes again (:class:`HeapKeeper`): the old tree must go.
+
+
+def hold_collector() -> None:
+    """No cyclic collections until :func:`freeze_heap` (start-up: nothing to free)."""
+    gc.disable()
+
+
+def freeze_heap() -> None:
+    """What is alive now is kept for good (the collector no longer walks it), and the
+    collector is on again. (Not ``gc.get_freeze_count()``: it walks what is frozen.)"""
+    gc.freeze()
+    gc.enable()
+
+
+def refreeze_heap() -> int:
+    """After a reload: thaw, collect what the old tree left (a full collection, at an
+    idle point), freeze what is alive; the number of objects collected."""
+    gc.unfreeze()
+    found = gc.collect()
+    gc.freeze()
+    return found
+
+
+class HeapKeeper:
+    """An observer of the ``run`` command: when the host runs another tree (``run
+    --watch`` swapped it in at an idle point, docked), :func:`refreeze_heap` once that
+    tick is over, so that the old tree is collected and the new one frozen."""
+
+    def __init__(self) -> None:
+        self._host: Host | None = None
+        self._core: Core | None = None
+        self.refrozen = 0  # reloads followed
+
+    def attach(self, host: Host) -> None:
+        self._host = host
+        self._core = host.core
+
+    def on_event(self, event: Event) -> None:
+        host = self._host
+        if host is None or type(event) is not Ticked or host.core is self._core:
+            return
+        self._core = host.core
+        try:
+            asyncio.get_running_loop().call_soon(self._refreeze)
+        except RuntimeError:
+            self._refreeze()
+
+    def _refreeze(self) -> None:
+        refreeze_heap()
+        self.refrozen += 1
+
+    def close(self) -> None:
+        self._host = self._core = None

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import asyncio
+import gc
 import shutil
 from pathlib import Path
 
@@ -15,6 +16,7 @@ from frog_bt.config import load_site
 from frog_bt.engine.operator import Command
 from frog_bt.model import keys
 from frog_bt.model.outcomes import TourState
+from frog_bt.runtime.memory import HeapKeeper
 from frog_bt.runtime.watch import Watch
 
 WAIT = "Wait for the front end"
@@ -38,6 +40,8 @@ def test_a_valid_change_takes_over_when_idle_and_a_bad_one_is_refused(tmp_path: 
         # The front end never says it is idle: the robot stays docked, no tour starts.
         async with Running({"frontend": {"idle_at": 10_000}}, site=site, tree=tree) as run:
             exe = run.executive
+            keeper = HeapKeeper()  # as `run --watch` attaches it (frog_bt.runtime.memory)
+            exe.observers.attach(exe, [keeper])
             refused: list[list[str]] = []
             watch = Watch(tour_file, None, tree, exe.offer, refuse=refused.append)
             assert await watch.check() is None  # nothing changed
@@ -69,8 +73,13 @@ def test_a_valid_change_takes_over_when_idle_and_a_bad_one_is_refused(tmp_path: 
             await after_ticks(exe, lambda: exe.core.ticks > 0)
             tip = exe.core.root.tip()
             assert tip is not None and tip.name == f"{WAIT} again"
+            # the heap was frozen again once, after the tick that swapped the tree in
+            assert keeper.refrozen == 1
 
-    asyncio.run(main())
+    try:
+        asyncio.run(main())
+    finally:
+        gc.unfreeze()  # what the keeper froze in this test's process
 
 
 def test_no_swap_while_a_tour_runs(tmp_path: Path) -> None:

@@ -282,12 +282,15 @@ def test_what_was_flushed_survives_a_kill(tmp_path: Path) -> None:
     async def run() -> None:
         executive = fake_executive()
         executive.clock.set(1_780_000_000.0)
-        recorder = Recorder(path, flush_every=0.0)
+        # chunks end CHUNK_PAUSE after the drain that finds them due: here at once after it
+        recorder = Recorder(path, flush_every=0.0, chunk_pause=0.0)
         attach_all(executive, [recorder])
         datagram, _ = wire_of(executive)
         for i in range(1, 31):
             datagram("in", b'{"type":"frontend_idle","seq":%d}' % i, 1_780_000_000.0 + i)
             await asyncio.sleep(0)  # the drain runs once this callback is over
+        for _ in range(2):  # the drain, then the chunk's end it scheduled (a timer due now)
+            await asyncio.sleep(0)
         copy.write_bytes(path.read_bytes())  # what a kill -9 now would leave
         recorder.close()
 
@@ -297,3 +300,40 @@ def test_what_was_flushed_survives_a_kill(tmp_path: Path) -> None:
     got = [data for topic, _, data in recording.messages() if topic == FRONTEND_IN]
     assert len(got) == 30 and got[-1] == b'{"type":"frontend_idle","seq":30}'
     assert not open_recording(path).recovered  # the closed file is whole
+
+
+def test_a_full_chunk_ends_after_the_tick_its_input_calls_for(tmp_path: Path) -> None:
+    """Closing a chunk (compressing it, writing each message's index entry) costs the loop
+    1-2 ms at high rates: a chunk found full in the drain after an input ends a moment
+    later, so that the tick the input called for (ready meanwhile) runs first."""
+    path = tmp_path / "chunks.mcap"
+    seen: list[tuple[str, int]] = []
+
+    async def run() -> None:
+        executive = fake_executive()
+        executive.clock.set(1_780_000_000.0)
+        recorder = Recorder(path, chunk_size=2000, chunk_pause=0.0)
+        attach_all(executive, [recorder])
+        datagram, _ = wire_of(executive)
+        loop = asyncio.get_running_loop()
+        for _ in range(3):  # the drain, the first chunk's end (primer, tree), settled
+            await asyncio.sleep(0)
+        stream = recorder._stream  # its position: what mcap wrote, buffered or not
+        written = stream.tell()
+
+        def an_input() -> None:  # more than a chunk's worth, then the tick it calls for
+            for i in range(40):
+                datagram("in", b'{"type":"frontend_idle","seq":%d}' % i, 1_780_000_001.0)
+            loop.call_soon(lambda: seen.append(("tick", stream.tell() - written)))
+
+        loop.call_soon(an_input)
+        for _ in range(4):
+            await asyncio.sleep(0)
+        seen.append(("after", stream.tell() - written))
+        recorder.close()
+
+    asyncio.run(run())
+    assert seen[0] == ("tick", 0)  # the tick ran with the chunk still open
+    assert seen[1][0] == "after" and seen[1][1] > 2000  # then the chunk was written
+    _, messages = read_all(path)
+    assert sum(1 for _, c, _ in messages if c.topic == FRONTEND_IN) == 40

@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import asyncio
 import subprocess
 import sys
+from collections import deque
 from pathlib import Path
+
+import pytest
 
 from frog_bt.live.telemetry import process
 from frog_bt.live.telemetry.process import _numbered, _Pending, serialise
@@ -92,6 +96,56 @@ def test_a_tour_is_written_by_writers_that_take_turns(tmp_path: Path) -> None:
     assert len(ids) == 1  # the viewer opens them together as one recording
 
 
+def test_a_batch_pickled_in_steps_reads_back_whole() -> None:
+    rows = 5 * process.STEP_ROWS + 3
+    batch = Batch(
+        poses=[(n, 100.0 + n, 1.0, 2.0, 0.0) for n in range(rows)],
+        statuses=[(n, 100.0 + n, ((1, 0), (n % 7, 2))) for n in range(rows)],
+        marks=[(3, 103.0, "staff", "INFO", "pause (web): done")],
+    )
+    work = process.Serialising(batch)
+    steps = 0
+    while work.step():
+        steps += 1
+    assert steps == 2 * 6 + 1  # no step pickles more than STEP_ROWS rows
+    back = process.deserialise(work.bytes())
+    assert back.columns() == batch.columns()
+
+
+def test_inputs_go_before_a_batch_being_pickled(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A full batch is pickled in steps after the tick: a callback that is ready meanwhile
+    (an input, the tick it calls for) runs before the batch is done and handed over."""
+    from frog_bt.behaviours import load_tree
+    from frog_bt.config import load_site
+
+    sent: list[process.Item] = []
+    monkeypatch.setattr(process.TelemetryProcess, "_start_child", lambda self: None)
+    site = load_site()
+    telemetry = process.TelemetryProcess("save:unused.rrd", site, load_tree(site=site))
+    poses = [(n, 100.0 + n, 1.0, 2.0, 0.0) for n in range(10 * process.STEP_ROWS)]
+
+    async def scenario() -> list[tuple[str, int]]:
+        order: list[tuple[str, int]] = []
+        handed = asyncio.Event()
+        monkeypatch.setattr(
+            process.TelemetryProcess,
+            "_send",
+            lambda self, item: (sent.append(item), handed.set(), True)[-1],
+        )
+        telemetry.rows.batch.poses.extend(poses)
+        telemetry._flush_soon()  # as after the tick that filled the rows
+        asyncio.get_running_loop().call_soon(lambda: order.append(("input", len(sent))))
+        await handed.wait()
+        order.append(("handed over", len(sent)))
+        return order
+
+    assert asyncio.run(scenario()) == [("input", 0), ("handed over", 1)]
+    [(kind, data)] = sent
+    assert kind == "batch" and isinstance(data, bytes)
+    assert process.deserialise(data).poses == poses
+    telemetry._closed = True  # no child to stop
+
+
 def test_a_fresh_writer_starts_only_when_there_are_ticks_to_write() -> None:
     """Past its rows, a child is replaced only before the next batch with ticks: the day's
     last log line (or link change) goes into the file that has the ticks before it, never
@@ -99,6 +153,7 @@ def test_a_fresh_writer_starts_only_when_there_are_ticks_to_write() -> None:
     telemetry = object.__new__(process.TelemetryProcess)
     telemetry._closed, telemetry._links, telemetry._host = False, {}, None
     telemetry.timings, telemetry.recycle_rows, telemetry._written = process.Timings(), 2, 0
+    telemetry._stepping, telemetry._serialising = None, deque()
     started: list[int] = []
     sent: list[str] = []
 

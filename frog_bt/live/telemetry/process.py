@@ -7,8 +7,11 @@ queue to a child process that owns the rerun recording stream
 (:class:`~frog_bt.live.telemetry.Telemetry` there) and does all the formatting and
 logging. So:
 
-* the tick never waits for rerun (the batch is pickled once the tick is over, the
-  queue's feeder thread only copies bytes); the child merges batches for a file
+* the tick never waits for rerun: the batch is pickled once the tick is over, in
+  steps of :data:`STEP_ROWS` rows with a pause between them, so that an input
+  arriving meanwhile (and the tick it calls for) goes first: it waits for one step
+  (~0.1 ms), never for a whole batch (1-3 ms with many inputs); the queue's feeder
+  thread only copies bytes; the child merges batches for a file
   (:class:`_Pending`: fewer, larger rerun chunks, a smaller file);
 * the rerun SDK's own memory, which grows with every row it has logged (see
   docs/PERFORMANCE.md), is the child's, not the executive's; and the child is
@@ -25,7 +28,9 @@ event loop); on platforms without ``fork`` the live executive writes in-process.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
+import io
 import logging
 import multiprocessing
 import multiprocessing.queues
@@ -35,8 +40,9 @@ import queue
 import time
 import uuid
 from collections import deque
+from collections.abc import Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import msgspec
 
@@ -62,6 +68,8 @@ NICE = 5  # the child's niceness: when both are ready, the executive's inputs go
 TIMINGS = 1000  # hand-overs whose cost is kept (Timings), for scripts/bench
 MERGE_BATCHES = 10  # batches a save: file is written in at once (500 ticks, 50 s at 10 Hz)
 HOLD = 60.0  # seconds the child holds a batch for a save: file at most
+STEP_ROWS = 64  # rows pickled per step of a batch (~0.1 ms; an input waits for one step)
+STEP_PAUSE = 0.0005  # seconds between two steps: what is ready (an input, its tick) goes first
 
 
 def available() -> bool:
@@ -73,23 +81,66 @@ Item = tuple[object, ...]  # ("batch", bytes) | ("links", tick, t, changes) | ("
 
 class Timings:
     """What the last :data:`TIMINGS` hand-overs cost the executive, in ns of its thread's
-    CPU time: ``serialise`` (the batch to bytes) and ``hand_over`` (into the queue)."""
+    CPU time: ``serialise`` (a batch to bytes, its steps summed), ``serialise_step`` (one
+    step: the longest an input may wait for it) and ``hand_over`` (into the queue)."""
 
     def __init__(self) -> None:
         self.serialise: deque[int] = deque(maxlen=TIMINGS)
+        self.serialise_step: deque[int] = deque(maxlen=TIMINGS * 8)
         self.hand_over: deque[int] = deque(maxlen=TIMINGS)
 
 
+def _pieces(batch: Batch, rows: int) -> Iterator[tuple[int, list[Any]]]:
+    """The batch as (column, up to ``rows`` rows) pieces, in column order."""
+    for column, values in enumerate(batch.columns()):
+        for start in range(0, len(values), rows):
+            yield column, values[start : start + rows]
+
+
+class Serialising:
+    """One batch being pickled, :data:`STEP_ROWS` rows per :meth:`step`, with one pickler
+    (a class is named once per batch, not per step; its memo holds the rows until the
+    bytes are taken, as the batch itself would). The inputs are pickled as received
+    (``Rows.raw_inputs``: the rosbridge bytes), ten times faster than their Structs."""
+
+    def __init__(self, batch: Batch, rows: int = STEP_ROWS) -> None:
+        self.rows = len(batch)
+        self.ticks = bool(batch.statuses)  # the tree's rows among them
+        self._stream = io.BytesIO()
+        self._pickler = pickle.Pickler(self._stream, protocol=pickle.HIGHEST_PROTOCOL)
+        self._pieces = _pieces(batch, rows)
+        self.ns = 0  # thread CPU time spent so far
+
+    def step(self) -> bool:
+        """Pickle the next piece; False once the batch is done."""
+        t0 = time.thread_time_ns()
+        piece = next(self._pieces, None)
+        if piece is not None:
+            self._pickler.dump(piece)
+        self.ns += time.thread_time_ns() - t0
+        return piece is not None
+
+    def bytes(self) -> bytes:
+        while self.step():
+            pass
+        return self._stream.getvalue()
+
+
 def serialise(batch: Batch) -> bytes:
-    """A batch as bytes for the child: pickled, with the inputs as received (``Rows.raw_inputs``:
-    the rosbridge bytes), which pickle ten times faster than their decoded Structs."""
-    return pickle.dumps(batch, protocol=pickle.HIGHEST_PROTOCOL)
+    """A batch as bytes for the child, at once (see :class:`Serialising`)."""
+    return Serialising(batch).bytes()
 
 
 def deserialise(data: bytes) -> Batch:
-    """The child's side of :func:`serialise`: inputs decoded again by their topic's codec."""
-    batch = pickle.loads(data)
-    assert isinstance(batch, Batch)
+    """The child's side of :class:`Serialising`: the pieces, in order, as one batch;
+    inputs decoded again by their topic's codec."""
+    stream = io.BytesIO(data)
+    unpickler = pickle.Unpickler(stream)  # one, as one pickler wrote them (its memo)
+    batch = Batch()
+    columns = batch.columns()
+    while stream.tell() < len(data):
+        column, rows = unpickler.load()
+        columns[column].extend(rows)
     inputs = batch.inputs
     for n, (tick, t, role, value) in enumerate(inputs):
         if isinstance(value, msgspec.Raw):
@@ -228,6 +279,8 @@ class TelemetryProcess(TelemetryObserver):
         self.children = 0
         self.dropped = 0  # batches not written (the queue was full)
         self._written = 0  # rows sent to the current child
+        self._serialising: deque[Serialising] = deque()  # batches being pickled, oldest first
+        self._stepping: asyncio.TimerHandle | None = None  # the next step, when one is due
         self._warnings = WarningLimiter(60.0, logger=log)
         self._start_child()
 
@@ -270,27 +323,61 @@ class TelemetryProcess(TelemetryObserver):
         self._send(("tree", tick, t, index, generation))
 
     def _flush_soon(self) -> None:
-        self.flush()
-
-    def flush(self) -> None:
-        """Send the buffered rows to the child (never waits: a full queue drops them)."""
+        """After the tick that filled the rows: pickle them in steps (:meth:`_step`)."""
         self._flush_pending = False
         if self._closed:
             return
         batch = self.rows.drain()
         if len(batch):
-            if self._written >= self.recycle_rows and batch.statuses:
-                # only now, with ticks to write: a new file never holds just the last
-                # link change or log line of a day that ended at the old one's limit
-                self._recycle()
-            t0 = time.thread_time_ns()
-            data = serialise(batch)
-            t1 = time.thread_time_ns()
-            sent = self._send(("batch", data))
-            self.timings.serialise.append(t1 - t0)
-            self.timings.hand_over.append(time.thread_time_ns() - t1)
-            if sent:
-                self._written += len(batch)
+            self._serialising.append(Serialising(batch))
+            if self._stepping is None:
+                self._step()
+
+    def _step(self) -> None:
+        """One step of the oldest batch being pickled (handed over when done); then a
+        short pause, in which an input that is ready, and the tick it calls for, go
+        first (no pause while batches queue up behind it)."""
+        self._stepping = None
+        if not self._serialising or self._closed:
+            return
+        work = self._serialising[0]
+        t0 = time.thread_time_ns()
+        more = work.step()
+        self.timings.serialise_step.append(time.thread_time_ns() - t0)
+        if not more:
+            self._serialising.popleft()
+            self._hand_over(work)
+        if self._serialising:
+            pause = STEP_PAUSE if len(self._serialising) == 1 else 0.0
+            self._stepping = asyncio.get_running_loop().call_later(pause, self._step)
+
+    def flush(self) -> None:
+        """Send the buffered rows to the child now, after any batch still being pickled
+        (never waits: a full queue drops them)."""
+        self._flush_pending = False
+        if self._closed:
+            return
+        if self._stepping is not None:
+            self._stepping.cancel()
+            self._stepping = None
+        while self._serialising:
+            self._hand_over(self._serialising.popleft())
+        batch = self.rows.drain()
+        if len(batch):
+            self._hand_over(Serialising(batch))
+
+    def _hand_over(self, work: Serialising) -> None:
+        if self._written >= self.recycle_rows and work.ticks:
+            # only now, with ticks to write: a new file never holds just the last link
+            # change or log line of a day that ended at the old one's limit
+            self._recycle()
+        data = work.bytes()  # what is left of it, at once
+        t1 = time.thread_time_ns()
+        sent = self._send(("batch", data))
+        self.timings.serialise.append(work.ns)
+        self.timings.hand_over.append(time.thread_time_ns() - t1)
+        if sent:
+            self._written += work.rows
 
     def _recycle(self) -> None:
         """A fresh child for the next file, its link lanes starting where they are."""

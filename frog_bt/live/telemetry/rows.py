@@ -83,6 +83,20 @@ class Batch:
     marks: list[tuple[int, float, str, str, str]] = field(default_factory=list)
     # ^ bookmarks: kind ("staff" | "doubted" | "fault"), level, text
 
+    def columns(self) -> tuple[list[Any], ...]:
+        """The lists of rows, in field order (pickled as such for another process: no
+        dataclass state to build per batch)."""
+        return (
+            self.poses,
+            self.inputs,
+            self.outputs,
+            self.events,
+            self.statuses,
+            self.notes,
+            self.blackboard,
+            self.marks,
+        )
+
     def extend(self, later: Batch) -> None:
         """Append the rows of a later batch (a writer merging batches, see
         :mod:`frog_bt.live.telemetry.process`)."""

@@ -1,0 +1,68 @@
+"""The cyclic collector around start-up and reloads (frog_bt.runtime.memory)."""
+
+from __future__ import annotations
+
+import gc
+import weakref
+from collections.abc import Iterator
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+
+from frog_bt.cli import main
+from frog_bt.model.events import Ticked
+from frog_bt.runtime import memory
+
+
+class _Node:
+    """An object in a cycle with itself: only the cyclic collector frees it."""
+
+    def __init__(self) -> None:
+        self.me = self
+
+
+@pytest.fixture
+def thawed() -> Iterator[None]:
+    """Whatever a test freezes is thawed again, and the collector left on."""
+    yield
+    gc.unfreeze()
+    gc.enable()
+
+
+def test_start_up_objects_are_frozen_and_a_reload_frees_the_old_ones(thawed: None) -> None:
+    """What is alive at the freeze is out of the collector's way (a full collection does
+    not walk or free it, even once it is garbage); refreezing, as after a reload, frees
+    it."""
+    old = _Node()
+    gone = weakref.ref(old)
+    memory.hold_collector()
+    assert not gc.isenabled()
+    memory.freeze_heap()
+    assert gc.isenabled() and gc.get_freeze_count() > 0
+    del old
+    gc.collect()
+    assert gone() is not None  # frozen: kept, though garbage
+    assert memory.refreeze_heap() >= 1
+    assert gone() is None and gc.get_freeze_count() > 0
+
+
+def test_the_heap_keeper_refreezes_when_the_host_runs_another_tree(thawed: None) -> None:
+    core = _Node()
+    gone = weakref.ref(core)
+    host = SimpleNamespace(core=core)
+    keeper = memory.HeapKeeper()
+    keeper.attach(host)  # type: ignore[arg-type]
+    memory.freeze_heap()
+    ticked = Ticked(1.0, 1, "RUNNING")
+    keeper.on_event(ticked)
+    assert keeper.refrozen == 0  # the same tree: nothing to do
+    host.core = _Node()  # a reload swapped the tree in
+    del core
+    keeper.on_event(ticked)  # no event loop here: at once
+    assert keeper.refrozen == 1 and gone() is None
+
+
+def test_a_run_that_cannot_start_leaves_the_collector_on(tmp_path: Path) -> None:
+    assert main(["run", "--config", str(tmp_path / "missing.yaml")]) == 2
+    assert gc.isenabled()
