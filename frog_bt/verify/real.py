@@ -1,5 +1,5 @@
-"""Explore the real tree: the loader's nodes in a real :class:`~frog_bt.engine.core.Core`,
-ticked, with only the world abstracted.
+"""The explorer: the real tree (the loader's nodes in a real
+:class:`~frog_bt.engine.core.Core`) ticked, with only the world abstracted.
 
 A :class:`Real` holds one core (a :class:`~frog_bt.clock.ManualClock`, the outputs
 captured: the seam the tests use). From a state it restores every node and the engine,
@@ -14,7 +14,7 @@ wait running out, the robot's answer to the pending goal (a pose at the goal wit
 arrival; the camera seeing the visitor with an approach's success), the docking state,
 the front end's events; and, as a node reads them, the diagnostics, nobody or someone
 new facing the robot, someone following, a face. Every combination is explored (an
-:class:`~frog_bt.verify.tick.Oracle` replays a prefix of choices; each choice beyond it
+:class:`~frog_bt.verify.explore.Oracle` replays a prefix of choices; each choice beyond it
 branches).
 
 The project clock never moves: a wait runs out by its own times moving back
@@ -75,10 +75,9 @@ from frog_bt.model.ros import (
 )
 from frog_bt.model.wire import FAILED, SUCCEEDED
 from frog_bt.tree.world import Channel, World, world_of
-from frog_bt.verify.explore import MAX_STATES, Graph, TooBig
+from frog_bt.verify.explore import MAX_STATES, Choice, Graph, Oracle, Step, TooBig
 from frog_bt.verify.liveness import Liveness
 from frog_bt.verify.model import Model, preorder
-from frog_bt.verify.tick import Choice, Oracle, Step
 from frog_bt.verify.world import By
 from frog_bt.verify.world import Event as VEvent
 
@@ -646,6 +645,10 @@ class Real:
                 messages += [m for m in w.frontend(node) if m not in messages]
             if w.docking is not None:
                 self._docking(i, w.docking(node))
+        if not running:  # the first tick: the front end may have spoken before it
+            for node, w in zip(self.nodes, self.worlds, strict=True):
+                if w is not None and w.frontend is not None:
+                    messages += [m for m in w.frontend(node) if m not in messages]
         if messages:
             options = [("none", By.QUIET), *((m.type, By.WORLD) for m in messages)]
             sent = self._choose(-1, "front end", options)
@@ -992,7 +995,7 @@ def _role(world: World | None) -> str:
     return world.role.value if world is not None else ""
 
 
-def explore_real(
+def explore(
     model: Model,
     site: Site,
     on_step: Callable[[int, Step, int, Any], None] | None = None,
