@@ -3,8 +3,9 @@
 The shipped tour is explored once per run (tests/verify/conftest.py): every run of it is
 the most expensive thing verify does. A mutation is shown on :data:`SMALL`, a tour of
 the shipped parts (the abort guard, the start, the way home and docking, the drive with
-its retries, ``recruit.yaml`` where a test wants it) with one stop, written beside a
-copy of the shipped trees: every real node, only fewer of them.
+its retries, ``recruit.yaml`` where a test wants it) with one stop and no checkpoint
+(nothing to restart from: the resumed runs are tests/verify/test_real.py's), written
+beside a copy of the shipped trees: every real node, only fewer of them.
 """
 
 from __future__ import annotations
@@ -42,42 +43,34 @@ root:
       memory: true
       children:
         - {type: ConfirmResume}
-        - type: Checkpointed
-          name: Start
-          checkpoint: start
-          child:
-            type: Sequence
-            name: Start a tour
-            memory: true
-            scope: tour
-            children:
-              - type: Sequence
-                name: Ready to start
-                memory: false
-                children:
-                  - {type: WaitInService, name: Wait while out of service}
-                  - {type: WaitFrontendIdle, name: Wait for the front end}
-              - {type: TourStatus, state: started}
-              - {type: Docking, action: undock}
-        - type: Checkpointed
-          name: Stop
-          checkpoint: stop 0
-          child:
-            type: Sequence
-            name: Visit POI1
-            memory: true
-            children:
-              - {include: goto.yaml, with: {poi: POI1}}
-              - {type: PlayContent, poi: POI1, part: a}
+        - type: Sequence
+          name: Start a tour
+          memory: true
+          scope: tour
+          children:
+            - type: Sequence
+              name: Ready to start
+              memory: false
+              children:
+                - {type: WaitInService, name: Wait while out of service}
+                - {type: WaitFrontendIdle, name: Wait for the front end}
+            - {type: TourStatus, state: started}
+            - {type: Docking, action: undock}
+        - type: Sequence
+          name: Visit POI1
+          memory: true
+          children:
+            - {include: goto.yaml, with: {poi: POI1}}
+            - {type: PlayContent, poi: POI1, part: a}
         - {include: home.yaml}
         - {type: TourStatus, state: ended}
 """
-RECRUIT = """        - type: Checkpointed
-          name: Stop
+RECRUIT = """        - type: Sequence
+          name: Visit POI1
 """
 WITH_RECRUIT = """        - {include: recruit.yaml}
-        - type: Checkpointed
-          name: Stop
+        - type: Sequence
+          name: Visit POI1
 """
 
 

@@ -81,7 +81,8 @@ def test_the_suite_s_recordings_and_a_seeded_season_conform(shipped: Shipped) ->
     files = 1 + len(list(shipped.helped.glob("*.mcap"))) + len(list(DATA.glob("*.mcap")))
     assert any(p.name.endswith("-resumed.mcap") for p in shipped.helped.glob("*.mcap"))
     out = shipped.out.splitlines()
-    assert f"conformance: {files} of {files} recordings took only steps the explorer allows" in out
+    told = f"conformance: {files} of {files} recordings took only steps the explorer allows"
+    assert told in out, shipped.out
     assert next(t for t in out if t.startswith("conformance: ")) == out[0]  # none named
 
 

@@ -14,6 +14,7 @@ from frog_bt.behaviours.navigation import Navigate
 from frog_bt.behaviours.recruit import ApproachVisitor, AskTour
 from frog_bt.behaviours.registry import DECORATOR_TYPES, LEAF_TYPES
 from frog_bt.cli import main
+from frog_bt.commands import verify as verify_command
 from frog_bt.commands.check import VERIFY_STATES
 from frog_bt.engine.loaded import LoadedTree
 from frog_bt.errors import TreeErrors
@@ -36,7 +37,7 @@ def test_the_shipped_tree_holds_every_property(shipped: Shipped) -> None:
     assert v.ok, [(b.name, b.run.note) for b in v.broken]
     assert set(BUILT_IN) <= set(v.checked)
     assert len(v.graph.starts) > 1  # the restarts from every checkpoint, explored too
-    assert shipped.code == 0, shipped.err
+    assert shipped.code == 0, shipped.out + shipped.err
     out = shipped.out
     assert "verified: " in out and "7 properties hold" in out
     # each property's trigger was reached, and how often is said
@@ -63,15 +64,15 @@ def test_check_proves_as_verify_does(
     assert asked == [(shipped.verdict.model.tree.file, {"limit": VERIFY_STATES})]
 
 
-OLD_READY = """              - type: Sequence
-                name: Ready to start
-                memory: false
-                children:
-                  - {type: WaitInService, name: Wait while out of service}
-                  - {type: WaitFrontendIdle, name: Wait for the front end}
+OLD_READY = """            - type: Sequence
+              name: Ready to start
+              memory: false
+              children:
+                - {type: WaitInService, name: Wait while out of service}
+                - {type: WaitFrontendIdle, name: Wait for the front end}
 """
-OLD_SHAPE = """              - {type: WaitInService, name: Wait while out of service}
-              - {type: WaitFrontendIdle, name: Wait for the front end}
+OLD_SHAPE = """            - {type: WaitInService, name: Wait while out of service}
+            - {type: WaitFrontendIdle, name: Wait for the front end}
 """
 
 
@@ -225,14 +226,14 @@ def test_the_dock_failure_branch_made_to_loop_breaks_ends_well(tmp_path: Path) -
 def test_content_in_parallel_with_a_drive_breaks_no_content_while_driving(
     tmp_path: Path,
 ) -> None:
-    drive = """              - {include: goto.yaml, with: {poi: POI1}}
-              - {type: PlayContent, poi: POI1, part: a}
+    drive = """            - {include: goto.yaml, with: {poi: POI1}}
+            - {type: PlayContent, poi: POI1, part: a}
 """
-    parallel = """              - type: Parallel
-                name: Drive and talk to POI1
-                children:
-                  - {include: goto.yaml, with: {poi: POI1}}
-                  - {type: PlayContent, poi: POI1, part: a}
+    parallel = """            - type: Parallel
+              name: Drive and talk to POI1
+              children:
+                - {include: goto.yaml, with: {poi: POI1}}
+                - {type: PlayContent, poi: POI1, part: a}
 """
     v = verdict(copy(tmp_path, {"tour.yaml": [(drive, parallel)]}))
     run = run_of(v, "no-content-while-driving")
@@ -250,10 +251,11 @@ def test_a_deleted_engagement_decision_is_a_dead_read(tmp_path: Path) -> None:
 
 
 def test_a_broken_property_is_reported_at_its_node_in_the_included_file(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """``check`` and ``verify`` alike: one ``file:line:column: path: property: what`` line
-    at the node (in recruit.yaml, which tour.yaml includes), its shortest run after it."""
+    at the node (in recruit.yaml, which tour.yaml includes), its shortest run after it
+    (verify prints the verdict check explored: one exploration)."""
     decide = "            - {type: DecideEngagement, about: introduction}\n"
     tour = copy(tmp_path, {"recruit.yaml": [(decide, "")]}, recruit=True)
     recruit = tour.with_name("recruit.yaml")
@@ -263,20 +265,23 @@ def test_a_broken_property_is_reported_at_its_node_in_the_included_file(
         f"{recruit}:{line}:{column}: root.child.children[2].child.children[2]: "
         "no-dead-reads: AskTour reads /engaged, which no run writes before it"
     )
-    assert main(["check", str(tour)]) == 2
+    code, v = cli(monkeypatch, "check", str(tour))
+    assert code == 2 and v is not None
     err = capsys.readouterr().err.splitlines()
     assert err[0] == located
     assert [e for e in err if not e.startswith("  ")] == [located]  # the run: indented
-    assert (  # from the start checkpoint: a restarted executive's tour
-        "    4. front end: finish_introduction; [visitor addressed: AskTour]; "
+    assert err[7] == (
+        "    5. front end: finish_introduction; [visitor addressed: AskTour]; "
         "WaitAnswer waits for a person or the front end"
-    ) in err
+    )
+    monkeypatch.setattr(verify_command, "prove", lambda tree, site: v)
     assert main(["verify", str(tour)]) == 1
     out = capsys.readouterr().out.splitlines()
     assert out[0] == located
     assert out[2:4] == [
-        "  the shortest run (4 ticks):",
-        "    1. SeekVisitor camera someone new faces it",
+        "  the shortest run (5 ticks):",
+        "    1. front end: frontend_idle; [tour started: TourStatus 'TourStatus started']; "
+        "[undock sent: Docking 'Docking undock']",
     ]
 
 
