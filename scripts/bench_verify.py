@@ -1,87 +1,127 @@
-"""How verify's cost grows with the tour, both explorers side by side: states, transitions,
-seconds and states per second for the shipped tree over 6, 30 and 100 stops (the site's
-stops repeated), and the model's per-property times.
+"""How verify's cost grows with the tour: states, transitions, seconds and states per
+second for the shipped tree over 6, 30 and 100 stops (the site's stops repeated), from a
+fresh start and with the restarts from every checkpoint (what ``frog-bt verify`` does);
+with ``--before REV``, side by side with the explorer of an earlier commit, run on the
+same machine from an exported copy of it.
 
-    .venv/bin/python scripts/bench_verify.py [--stops 6 30 100] [--real-limit 20000]
+    .venv/bin/python scripts/bench_verify.py [--stops 6 30 100] [--limit 200000]
+    .venv/bin/python scripts/bench_verify.py --before 78c26e7   # the model explorer
 
-The model explorer (:mod:`frog_bt.verify.tick`) ticks a copy of the tree over tuples of
-ints; the real one (``verify --real``, :mod:`frog_bt.verify.real`) ticks the loader's
-nodes in a core with only the world abstracted, from a fresh start (``--restarts``: and
-from every checkpoint the tree writes, as ``verify --real`` does), and stops at
-``--real-limit`` states.
+The explorer ticks the loader's nodes in a core with only the world abstracted
+(:mod:`frog_bt.verify.real`). Up to 78c26e7 verify explored a model of the tree by
+default (``verify/tick.py``: a copy of how the composites tick, over tuples of ints, each
+leaf by a table of abstractions); ``--before`` exports that commit (``git archive``)
+to a temporary folder and runs its model explorer there (``PYTHONPATH``), one process
+per figure, so that both rows come from the same machine in the same minutes. Figures
+vary with the load of the machine: run it on a quiet one, or say it was not.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import subprocess
+import sys
+import tarfile
+import tempfile
 import time
+from pathlib import Path
 
 from frog_bt.behaviours import load_tree
 from frog_bt.config import Site, load_site
-from frog_bt.verify import designer
-from frog_bt.verify.explore import TooBig, explore
+from frog_bt.verify.explore import TooBig
 from frog_bt.verify.model import compile_tree
-from frog_bt.verify.properties import Safety, bounded_retries, ends_well, home_obeyed, no_dead_reads
-from frog_bt.verify.real import explore_real
+from frog_bt.verify.real import explore
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# Run in the exported copy of an earlier commit: its model explorer (verify/tick.py).
+BEFORE = """
+import sys
+from frog_bt.behaviours import load_tree
+from frog_bt.config import load_site
+from frog_bt.verify.explore import explore
+from frog_bt.verify.model import compile_tree
+from frog_bt.verify.properties import Safety
+
+base = load_site(None)
+n = int(sys.argv[1])
+stops = [base.tour.stops[i % len(base.tour.stops)] for i in range(n)]
+site = base.model_copy(update={"tour": base.tour.model_copy(update={"stops": stops})})
+model = compile_tree(load_tree(None, site), site)
+graph = explore(model, Safety(model))
+print(len(graph.states), graph.transitions, graph.seconds)
+"""
 
 
-def model_row(site: Site) -> str:
-    tree = load_tree(None, site)
-    model = compile_tree(tree, site)
-    safety = Safety(model)
-    graph = explore(model, safety)
-    times = {}
-    for name, check in (
-        ("ends-well", ends_well),
-        ("bounded-retries", bounded_retries),
-        ("home-obeyed", home_obeyed),
-        ("no-dead-reads", no_dead_reads),
-    ):
-        t0 = time.perf_counter()
-        check(graph, model)  # type: ignore[operator]
-        times[name] = time.perf_counter() - t0
-    designer.read_properties(tree.file)
-    per = ", ".join(f"{k} {v:.2f}" for k, v in times.items())
-    rate = len(graph.states) / graph.seconds
-    return (
-        f"model {len(graph.states):>8} {graph.transitions:>10} {graph.seconds:>8.2f} "
-        f"{rate:>8.0f}  ({per})"
-    )
+def sized(base: Site, n: int) -> Site:
+    stops = [base.tour.stops[i % len(base.tour.stops)] for i in range(n)]
+    return base.model_copy(update={"tour": base.tour.model_copy(update={"stops": stops})})
+
+
+def row(name: str, states: int, transitions: int, seconds: float) -> str:
+    return f"{name:<16} {states:>8} {transitions:>11} {seconds:>8.2f} {states / seconds:>9.0f}"
 
 
 def real_row(site: Site, limit: int, restarts: bool) -> str:
-    tree = load_tree(None, site)
-    model = compile_tree(tree, site, real=True)
+    name = "real+restarts" if restarts else "real (fresh)"
+    model = compile_tree(load_tree(None, site))
     t0 = time.perf_counter()
     try:
-        graph, _ = explore_real(model, site, limit=limit, restarts=restarts)
+        graph, _ = explore(model, site, limit=limit, restarts=restarts)
     except TooBig:
         seconds = time.perf_counter() - t0
-        return (
-            f"real  {'>' + str(limit):>8} {'':>10} {seconds:>8.2f} {limit / seconds:>8.0f}  "
-            "(stopped at the limit)"
-        )
-    rate = len(graph.states) / graph.seconds
-    return (
-        f"real  {len(graph.states):>8} {graph.transitions:>10} {graph.seconds:>8.2f} {rate:>8.0f}"
+        return f"{name:<16} {'>' + str(limit):>8} {'':>11} {seconds:>8.2f}  (stopped at the limit)"
+    return row(name, len(graph.states), graph.transitions, graph.seconds)
+
+
+def export(rev: str, into: Path) -> Path:
+    """The tree of commit ``rev`` in ``into`` (``git archive``)."""
+    archive = into / "before.tar"
+    with archive.open("wb") as out:
+        subprocess.run(["git", "-C", str(ROOT), "archive", rev], stdout=out, check=True)
+    with tarfile.open(archive) as tar:
+        tar.extractall(into / "src", filter="data")
+    return into / "src"
+
+
+def before_row(src: Path, rev: str, n: int) -> str:
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    done = subprocess.run(
+        [sys.executable, "-c", BEFORE, str(n)],
+        cwd=src,
+        env=env,
+        capture_output=True,
+        text=True,
+        check=False,
     )
+    if done.returncode != 0:
+        return f"{'model ' + rev:<16} failed: {done.stderr.strip().splitlines()[-1:]}"
+    states, transitions, seconds = done.stdout.split()
+    return row(f"model {rev}", int(states), int(transitions), float(seconds))
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stops", type=int, nargs="+", default=[6, 30, 100])
-    parser.add_argument("--real-limit", type=int, default=100000)
-    parser.add_argument(
-        "--restarts", action="store_true", help="the real explorer from every checkpoint too"
-    )
+    parser.add_argument("--limit", type=int, default=200_000, help="states, per exploration")
+    parser.add_argument("--before", metavar="REV", help="and the explorer of commit REV")
+    parser.add_argument("--no-restarts", action="store_true", help="from a fresh start only")
     args = parser.parse_args()
     base = load_site(None)
-    print(f"{'stops':>5} {'':5} {'states':>8} {'transitions':>10} {'seconds':>8} {'states/s':>8}")
-    for n in args.stops:
-        stops = [base.tour.stops[i % len(base.tour.stops)] for i in range(n)]
-        site = base.model_copy(update={"tour": base.tour.model_copy(update={"stops": stops})})
-        print(f"{n:>5} {model_row(site)}")
-        print(f"{n:>5} {real_row(site, args.real_limit, args.restarts)}")
+    print(
+        f"{'stops':>5} {'explorer':<16} {'states':>8} {'transitions':>11} {'seconds':>8} "
+        f"{'states/s':>9}"
+    )
+    with tempfile.TemporaryDirectory() as tmp:
+        src = export(args.before, Path(tmp)) if args.before else None
+        for n in args.stops:
+            site = sized(base, n)
+            print(f"{n:>5} {real_row(site, args.limit, restarts=False)}", flush=True)
+            if not args.no_restarts:
+                print(f"{n:>5} {real_row(site, args.limit, restarts=True)}", flush=True)
+            if src is not None:
+                print(f"{n:>5} {before_row(src, args.before, n)}", flush=True)
 
 
 if __name__ == "__main__":

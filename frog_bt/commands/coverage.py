@@ -61,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
     except (UsageError, DefinitionError) as exc:
         print(f"frog-bt: {exc}", file=sys.stderr)
         return 2
-    model = compile_tree(tree, site)
+    model = compile_tree(tree)
     counts = [NodeCount() for _ in model.nodes]
     tours: Counter[str] = Counter()
     read = 0

@@ -1,19 +1,24 @@
-"""Prove a tour tree: explore every run of it under every outcome of its leaves.
+"""Prove a tour tree: explore every run of the code that runs, under every answer of the world.
 
-Each leaf is replaced by its abstraction (the outcomes it may have per tick; a wait runs
-for a bounded number of ticks), the guards' inputs (battery, faults, operator commands,
-the front end's and visitors' answers) are chosen anew at every tick, and every state the
-tree can reach is visited, breadth first. The built-in properties (ends-well,
-home-obeyed, service-off-obeyed, pause-obeyed, no-content-while-driving,
-bounded-retries, no-dead-reads) and the tree file's own `properties:` are checked, and
-for each, how often its trigger was reached (states paused, out of service, ...).
-Exit 0 when all hold; 1 with the shortest run that breaks each one that does not, or
-when one holds vacuously (no run reaches its trigger); 2 when the tree or the
-configuration is invalid, a leaf type declares no world interface, or a property of
-the tree file names a node the tree does not have. `--conformance` replays recordings
-on the tree and checks that every step they took (which nodes run, tick by tick) is one
-the exploration has; the first step outside, per recording, is named with its tick and
-node, and the exit is 1.
+The tree is built by the loader, as `frog-bt run` builds it, and its own nodes are
+ticked in a core: the composites, the decorators, the operator's commands, the guards
+and each leaf's own `update()` run as in production. Only the world is abstracted:
+what no leaf can know in advance (the robot's answer to a goal, the docking state, the
+front end's events, a visitor, battery and faults, the operator's commands, a wait
+running out) is chosen at every tick from the finite set each node type declares on its
+class, and every state the tree can reach is visited, breadth first, from a fresh start
+and from every checkpoint the tree writes (a restarted executive resumes from it). The
+built-in properties (ends-well, home-obeyed, service-off-obeyed, pause-obeyed,
+no-content-while-driving, bounded-retries, no-dead-reads) and the tree file's own
+`properties:` are checked, and for each, how often its trigger was reached (states
+paused, out of service, ...). Exit 0 when all hold; 1 with the shortest run that breaks
+each one that does not, when one holds vacuously (no run reaches its trigger), or when
+a node keeps state its class does not declare or its code raised; 2 when the tree or
+the configuration is invalid, a leaf type declares no world interface, or a property
+of the tree file names a node the tree does not have. `--conformance` replays
+recordings on the same tree and checks that every step they took (which nodes run,
+tick by tick) is one the exploration has; the first step outside, per recording, is
+named with its tick and node, and the exit is 1.
 
 Examples:
 
@@ -48,8 +53,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--real",
         action="store_true",
-        help="explore the real tree (its nodes ticked in a core, only the world abstracted; "
-        "restarts from each checkpoint too) instead of the model",
+        help="accepted and ignored: the real tree is what verify always explores",
     )
     p.add_argument(
         "--conformance",
@@ -69,7 +73,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     try:
         _, site, tree = load_tree_argument(args)
-        verdict = prove(tree, site, real=args.real)
+        verdict = prove(tree, site)
     except UsageError as exc:
         print(f"frog-bt: {exc}", file=sys.stderr)
         return 2
@@ -121,7 +125,11 @@ def conformance_lines(verdict: Verdict, paths: list[Path], site: Site, tree: Loa
     print(
         f"conformance: {files - len(outside)} of {files} recordings took only steps the "
         "explorer allows"
-        + (f"; {len(outside)} left the model (the world model missed them)" if outside else "")
+        + (
+            f"; {len(outside)} left the exploration (the world's abstraction missed them)"
+            if outside
+            else ""
+        )
     )
     return not outside and files > 0
 
@@ -155,5 +163,5 @@ def season_share(graph: Graph, directory: Path, site: Site, tree: LoadedTree) ->
         f"coverage: {files} recordings reached {got} of {len(configs)} explored states "
         f"({100 * got / max(1, len(configs)):.0f} %) and {moved} of {len(moves)} transitions "
         f"({100 * moved / max(1, len(moves)):.0f} %), states seen as which nodes run"
-        + (f"; {outside} states outside the model" if outside else "")
+        + (f"; {outside} states outside the exploration" if outside else "")
     )

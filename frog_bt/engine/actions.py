@@ -81,7 +81,7 @@ class Actions:
 
     def snapshot(self) -> Held:
         """Everything it holds, as values: :meth:`restore` gives it back (an explorer of
-        every run, ``verify --real``, steps back to a state this way). Goals are frozen."""
+        every run, ``frog-bt verify``, steps back to a state this way). Goals are frozen."""
         return Held(
             copy.copy(self._ids),
             self.pending,

@@ -53,7 +53,9 @@ class Role(enum.Enum):
 
 
 class Observed:
-    """Mixin (before the py_trees base): ``stop`` appends the node to ``stop_log``; a node
+    """Mixin (before the py_trees base): ``stop`` appends the node to ``stop_log`` (and
+    runs py_trees' stop without formatting its debug message unless py_trees' debug
+    logging is on: :data:`_PY_TREES_STOPS`); a node
     with a ``scope`` clears it when it starts (:meth:`start_scope`); ``role`` says what the
     executive may ask of it (:class:`Role`)."""
 
@@ -86,7 +88,13 @@ class Observed:
         if trace is not None:
             trace.acting.append(self)  # type: ignore[arg-type]
         try:
-            super().stop(new_status)  # type: ignore[misc]
+            quiet = _QUIET.get(type(self))
+            if quiet is None:
+                quiet = _QUIET[type(self)] = _quiet_stop(type(self))
+            if quiet is _loud or py_trees.logging.level < py_trees.logging.Level.INFO:
+                super().stop(new_status)  # type: ignore[misc]
+            else:
+                quiet(self, new_status)
         except Exception as exc:
             faults = self._faults
             if faults is None:
@@ -100,6 +108,76 @@ class Observed:
         log = self.stop_log
         if log is not None:
             log.append(self)  # type: ignore[arg-type]
+
+
+INVALID = py_trees.common.Status.INVALID
+RUNNING = py_trees.common.Status.RUNNING
+
+
+def _behaviour_stop(node: Any, new_status: py_trees.common.Status) -> None:
+    """py_trees' ``Behaviour.stop``, but for its debug message."""
+    node.terminate(new_status)
+    node.status = new_status
+    node.iterator = node.tick()
+
+
+def _composite_stop(node: Any, new_status: py_trees.common.Status) -> None:
+    """py_trees' ``Composite.stop`` (and ``Sequence``'s and ``Selector``'s, which log and
+    call it), but for its debug message."""
+    if new_status == INVALID:
+        node.current_child = None
+        for child in node.children:
+            if child.status != INVALID:
+                child.stop(new_status)
+    node.terminate(new_status)
+    node.status = new_status
+    node.iterator = node.tick()
+
+
+def _parallel_stop(node: Any, new_status: py_trees.common.Status) -> None:
+    """py_trees' ``Parallel.stop``, but for its debug message."""
+    for child in node.children:
+        if child.status == RUNNING:
+            child.stop(INVALID)
+    _composite_stop(node, new_status)
+
+
+def _decorator_stop(node: Any, new_status: py_trees.common.Status) -> None:
+    """py_trees' ``Decorator.stop``, but for its debug message."""
+    node.terminate(new_status)
+    if new_status == INVALID:
+        node.decorated.stop(new_status)
+    if node.decorated.status == RUNNING:
+        node.decorated.stop(INVALID)
+    node.status = new_status
+
+
+def _loud(node: Any, new_status: py_trees.common.Status) -> None:
+    raise AssertionError("a marker: py_trees' own stop runs")
+
+
+# py_trees' stops, each with the same calls in the same order but for the debug message
+# it formats whether debug logging is on or not (half the time verify spends stopping)
+_PY_TREES_STOPS: dict[Any, Any] = {
+    py_trees.behaviour.Behaviour.stop: _behaviour_stop,
+    py_trees.composites.Composite.stop: _composite_stop,
+    py_trees.composites.Sequence.stop: _composite_stop,
+    py_trees.composites.Selector.stop: _composite_stop,
+    py_trees.composites.Parallel.stop: _parallel_stop,
+    py_trees.decorators.Decorator.stop: _decorator_stop,
+}
+_QUIET: dict[type, Any] = {}
+
+
+def _quiet_stop(cls: type) -> Any:
+    """The quiet equal of the py_trees ``stop`` that ``super().stop`` reaches from
+    :meth:`Observed.stop` in ``cls``, or :func:`_loud` when that is no stop of py_trees'
+    own known here (then py_trees' runs)."""
+    mro = cls.__mro__
+    for base in mro[mro.index(Observed) + 1 :]:
+        if "stop" in base.__dict__:
+            return _PY_TREES_STOPS.get(base.__dict__["stop"], _loud)
+    return _loud
 
 
 def attach(root: Behaviour, log: list[Behaviour]) -> None:

@@ -1,15 +1,16 @@
 """Conformance with the field: is every step a recording took one the explorer allows?
 
-Each recording is replayed on the tree verify explored (:class:`~frog_bt.offline.replay.Replay`
-ticks exactly where the live executive did) with a :class:`Steps` observer: after each
-tick it reads which nodes run. A state is seen as which nodes run (what a recording can
-show: it keeps no memory positions, counters or abstract keys), so a step is allowed
-when the explored graph has a transition between the two configurations (or the
-configuration holds: a tick that changed nothing the recording shows, a wait, which on
-the robot takes as many ticks as its seconds and in the model as few as it can; verify
-leaves durations out). The first step
-outside names the recording, the tick and the node: the world model missed something the
-robot did. Only the first per recording is told; what follows it is its consequence.
+Each recording is replayed on the tree verify explored, built afresh by the same loader
+(:class:`~frog_bt.offline.replay.Replay` ticks exactly where the live executive did),
+with a :class:`Steps` observer: after each tick it reads which nodes run. A state is
+seen as which nodes run (what a recording can show: it keeps no memory positions,
+counters or abstract keys), so a step is allowed when the explored graph has a
+transition between the two configurations (or the configuration holds: a tick that
+changed nothing the recording shows, a wait, which on the robot takes as many ticks as
+its seconds and in the exploration as few as it can; verify leaves durations out). The
+first step outside names the recording, the tick and the node: the world's abstraction
+missed something the robot did. Only the first per recording is told; what follows it
+is its consequence.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from frog_bt.verify.explore import Graph
 from frog_bt.verify.model import Model, preorder
 
 RUNNING = "RUNNING"
+START: Config = frozenset({-1})  # before a recording's first tick (any start of the graph)
 
 
 @dataclass(frozen=True, slots=True)
@@ -41,7 +43,7 @@ class Outside:
     def line(self) -> str:
         return (
             f"{self.recording}: tick {self.tick}: {self.node} {self.what}: "
-            "a step the explored model does not allow"
+            "a step the exploration does not allow"
         )
 
 
@@ -72,15 +74,19 @@ class Allowed:
     def __init__(self, graph: Graph, model: Model) -> None:
         self.model = model
         configs, moves = explored_configurations(graph)
-        self.start = frozenset(i for i, v in enumerate(graph.states[0][0]) if v > 0)
         self.configs = configs
         self.after: dict[Config, set[Config]] = {}
         for a, b in moves:
             self.after.setdefault(a, set()).add(b)
+        # a recording starts fresh or, after a restart, from a checkpoint: from any start
+        starts = {
+            frozenset(i for i, v in enumerate(graph.states[s][0]) if v > 0) for s in graph.starts
+        }
+        self.after[START] = set().union(*(self.after.get(s, set()) for s in starts))
         self.ever = frozenset().union(*configs)  # the nodes some explored state runs
 
     def first_outside(self, path: Path, seen: list[tuple[int, Config]]) -> Outside | None:
-        before = self.start
+        before = START
         for tick, now in seen:
             if now == before and now in self.configs:
                 continue  # a wait: the ticks a wait takes are seconds, which verify leaves out
@@ -118,7 +124,7 @@ def conformance(
 ) -> tuple[int, list[Outside]]:
     """Replay every recording (each on a ``fresh()`` tree) and check each of its steps
     against ``graph``: how many were replayed, and the first step outside of each that
-    left the model. A recording that cannot be replayed goes to ``on_error``."""
+    left the exploration. A recording that cannot be replayed goes to ``on_error``."""
     from frog_bt.offline.replay import Replay
     from frog_bt.recordings.commands import ReplayError
 

@@ -1,6 +1,6 @@
 """What a node type tells ``frog-bt verify`` about itself: its world interface and its state.
 
-``verify --real`` ticks the real tree (:mod:`frog_bt.verify.real`); only the world is
+``frog-bt verify`` ticks the real tree (:mod:`frog_bt.verify.real`); only the world is
 abstracted. Each node type says, on its class, as ``world = World(...)``:
 
 * ``inputs``: the parts of the world it listens to (:class:`Channel`): what the explorer

@@ -1,10 +1,11 @@
-"""Trees you can prove: every run of a tour tree under every outcome of its leaves.
+"""Trees you can prove: every run of the code that runs, under every answer of the world.
 
-:mod:`.model` compiles a tree built by the loader into numbered nodes, each leaf with
-its abstraction (:mod:`.abstraction`); :mod:`.tick` ticks that model as py_trees ticks
-the real one, asking an oracle for every leaf outcome and environment input;
-:mod:`.explore` enumerates those choices breadth-first over hashed states; the
-properties (:mod:`.properties`, the designer's in :mod:`.designer`) are checked on the
-transitions and the graph, and :mod:`.report` prints what holds or the shortest run that
-breaks it. :mod:`.coverage` counts what recorded tours ran.
+:mod:`.real` builds nothing of its own: it ticks the tree the loader built, in a real
+core, with only the world abstracted (what each node type declares on its class,
+:mod:`frog_bt.tree.world`), enumerating every choice of the world at every tick and
+hashing each state it reaches, breadth first (:mod:`.explore`: the graph, the steps);
+:mod:`.model` numbers the tree's nodes for the properties (:mod:`.properties`, the
+designer's in :mod:`.designer`), checked on the transitions and the graph, and
+:mod:`.report` prints what holds or the shortest run that breaks it. :mod:`.coverage`
+counts what recorded tours ran.
 """

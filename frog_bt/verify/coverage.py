@@ -17,9 +17,8 @@ from typing import Any
 
 from frog_bt.engine.loaded import LoadedTree
 from frog_bt.model.events import Event, Ticked
-from frog_bt.verify.explore import Graph
+from frog_bt.verify.explore import Graph, State
 from frog_bt.verify.model import Model, preorder
-from frog_bt.verify.tick import State
 
 RUNNING = "RUNNING"
 

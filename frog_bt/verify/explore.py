@@ -1,28 +1,73 @@
-"""Breadth-first over every state a compiled tree can reach.
+"""What an exploration finds: the graph of every state reached, each transition with the
+tick that made it (:class:`Step`), and the choices that tick took of the world.
 
-From each state every combination of choices of one tick is enumerated (an
-:class:`~frog_bt.verify.tick.Oracle` replays a prefix of option indexes, and each choice
-point beyond it branches); states are hashed into one table, so each is expanded once
-and the first path found to any state is a shortest one. Every transition is kept
-(its target and its :class:`~frog_bt.verify.tick.Step`) for the properties that look at
-the graph: loops, what can still be reached, what was written before a read.
+The explorer (:mod:`.real`) enumerates every combination of choices of one tick with an
+:class:`Oracle` (it replays a prefix of option indexes; each choice point beyond it
+branches); states are hashed into one table, so each is expanded once and the first
+path found to any state is a shortest one. Every transition is kept (its target and its
+:class:`Step`) for the properties that look at the graph: loops, what can still be
+reached, what was written before a read.
 """
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 
 from frog_bt.verify.model import Model
-from frog_bt.verify.tick import Oracle, State, Step, Tick
-from frog_bt.verify.world import INITIAL
+from frog_bt.verify.world import By, Event
 
 MAX_STATES = 2_000_000
+
+# A state as the properties see it: per node (pre-order) 0 not running, 1 running, 2
+# running with its action out (a goal, content playing); the world (:mod:`.world`).
+State = tuple[tuple[int, ...], tuple[object, ...]]
 
 
 class TooBig(Exception):
     """More states than the limit: the tree is too big to verify whole."""
+
+
+@dataclass(frozen=True, slots=True)
+class Choice:
+    node: int  # -1: an input of the tick, not a node's
+    what: str
+    value: str
+    by: By
+
+
+@dataclass(slots=True)
+class Step:
+    """What one tick did: the choices taken, the events, the nodes ticked (in order, with
+    whether each started), the world when each event happened."""
+
+    choices: list[Choice] = field(default_factory=list)
+    events: list[tuple[Event, int, tuple[object, ...]]] = field(default_factory=list)
+    ticked: list[tuple[int, bool]] = field(default_factory=list)
+    waits: list[tuple[int, str]] = field(default_factory=list)
+    started_tour: bool = False  # the tour was under way as the tick began
+
+    @property
+    def quiet(self) -> bool:
+        """No person, front end or operator did anything, and nothing waited for one."""
+        return not self.waits and all(c.by is not By.WORLD for c in self.choices)
+
+
+class Oracle:
+    """Replays ``prefix`` (option indexes), then takes the first option, noting how many
+    each choice point had (the explorer branches on the rest)."""
+
+    def __init__(self, prefix: Sequence[int]) -> None:
+        self.prefix = prefix
+        self.taken: list[int] = []
+        self.widths: list[int] = []
+
+    def pick(self, width: int) -> int:
+        k = len(self.taken)
+        index = self.prefix[k] if k < len(self.prefix) else 0
+        self.taken.append(index)
+        self.widths.append(width)
+        return index
 
 
 @dataclass(slots=True)
@@ -51,50 +96,3 @@ class Graph:
         for src, edges in enumerate(self.edges):
             for dst, step in edges:
                 yield src, dst, step
-
-
-def successors(model: Model, state: State) -> Iterator[tuple[State, Step]]:
-    """Every next state with the tick that led there (all choices enumerated)."""
-    pending: list[list[int]] = [[]]
-    while pending:
-        prefix = pending.pop()
-        oracle = Oracle(prefix)
-        nxt, step = Tick(model, state, oracle).run()
-        yield nxt, step
-        for k in range(len(prefix), len(oracle.widths)):
-            for alt in range(1, oracle.widths[k]):
-                pending.append([*oracle.taken[:k], alt])
-
-
-def explore(
-    model: Model,
-    on_step: Callable[[int, Step, int, State], None] | None = None,
-    limit: int = MAX_STATES,
-) -> Graph:
-    """Every reachable state, breadth-first; ``on_step(src, step, dst, state)`` sees each
-    transition as it is found (in breadth-first order: the first one to break a safety
-    property ends the shortest run that does)."""
-    started = time.perf_counter()
-    initial: State = (tuple(0 for _ in model.nodes), INITIAL)
-    graph = Graph(model, [initial], [(-1, -1)], [])
-    index = {initial: 0}
-    head = 0
-    while head < len(graph.states):
-        state = graph.states[head]
-        edges: list[tuple[int, Step]] = []
-        graph.edges.append(edges)
-        for nxt, step in successors(model, state):
-            dst = index.get(nxt)
-            if dst is None:
-                dst = len(graph.states)
-                if dst >= limit:
-                    raise TooBig(f"more than {limit} states")
-                index[nxt] = dst
-                graph.states.append(nxt)
-                graph.parent.append((head, len(edges)))
-            edges.append((dst, step))
-            if on_step is not None:
-                on_step(head, step, dst, nxt)
-        head += 1
-    graph.seconds = time.perf_counter() - started
-    return graph

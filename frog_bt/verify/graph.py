@@ -11,8 +11,7 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from frog_bt.verify.explore import Graph
-from frog_bt.verify.tick import Step
+from frog_bt.verify.explore import Graph, Step
 
 Tick_ = tuple[int, Step, int]  # (from state, step, to state)
 

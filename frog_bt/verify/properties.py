@@ -13,10 +13,9 @@ from typing import Any
 
 from frog_bt.model.key import Key, Source
 from frog_bt.model.keys import by_name
-from frog_bt.verify.explore import Graph
+from frog_bt.verify.explore import Graph, State, Step
 from frog_bt.verify.graph import Run, can_reach, find_loop, monitor
 from frog_bt.verify.model import Model
-from frog_bt.verify.tick import State, Step
 from frog_bt.verify.world import (
     DOCKED,
     HOME,
@@ -57,13 +56,10 @@ class Broken:
 
 
 def _running(state: State, model: Model, role: Role) -> list[int]:
-    """Leaves of ``role`` running with their action out (aux bit 0)."""
+    """Leaves of ``role`` running with their action out (2 in the state's view of the
+    nodes, :meth:`~frog_bt.verify.real.Real.view`)."""
     nodes = state[0]
-    return [
-        n.index
-        for n in model.nodes
-        if n.role is role and nodes[n.index] > 0 and (nodes[n.index] - 1) & 1
-    ]
+    return [n.index for n in model.nodes if n.role is role and nodes[n.index] == 2]
 
 
 class Safety:

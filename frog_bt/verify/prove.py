@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from frog_bt.config import Site
+from frog_bt.config import Site, load_site
 from frog_bt.engine.loaded import LoadedTree
 from frog_bt.errors import TreeErrors
 from frog_bt.verify import designer
-from frog_bt.verify.explore import MAX_STATES, Graph, explore
+from frog_bt.verify.explore import MAX_STATES, Graph
 from frog_bt.verify.model import Model, compile_tree
 from frog_bt.verify.properties import (
     BUILT_IN,
@@ -19,6 +19,7 @@ from frog_bt.verify.properties import (
     builtin_triggers,
     check_builtin,
 )
+from frog_bt.verify.real import explore
 
 
 @dataclass(slots=True)
@@ -29,8 +30,8 @@ class Verdict:
     broken: list[Broken] = field(default_factory=list)
     triggers: dict[str, Trigger] = field(default_factory=dict)  # by name or title
     nodes: dict[str, int] = field(default_factory=dict)  # a designer property: its node
-    undeclared: dict[str, set[str]] = field(default_factory=dict)  # class -> fields (real)
-    failed: list[str] = field(default_factory=list)  # a node's code raised (real)
+    undeclared: dict[str, set[str]] = field(default_factory=dict)  # class -> fields
+    failed: list[str] = field(default_factory=list)  # a node's code raised
 
     @property
     def vacuous(self) -> list[str]:
@@ -53,35 +54,26 @@ def prove(
     properties: list[designer.Property] | None = None,
     only: tuple[str, ...] = (),
     limit: int = MAX_STATES,
-    real: bool = False,
     restarts: bool = True,
 ) -> Verdict:
-    """Explore ``tree`` and check the built-in properties (``only`` those, if given) and
-    ``properties`` (default: the tree file's own). Raises TreeErrors, before exploring,
-    for a leaf type with no declared world interface and a property naming a node the
-    tree does not have; TooBig past ``limit`` states. ``real``: explore the real tree
-    (:mod:`.real`: its nodes ticked, only the world abstracted), from a fresh start and,
-    with ``restarts``, from every checkpoint it writes; else the model (:mod:`.tick`)."""
-    model = compile_tree(tree, site, real)
+    """Explore ``tree`` (:mod:`.real`: its own nodes ticked, only the world abstracted)
+    from a fresh start and, with ``restarts``, from every checkpoint it writes; check the
+    built-in properties (``only`` those, if given) and ``properties`` (default: the tree
+    file's own). Raises TreeErrors, before exploring, for a leaf type with no declared
+    world interface and a property naming a node the tree does not have; TooBig past
+    ``limit`` states."""
+    model = compile_tree(tree)
     if properties is None:
         properties = designer.read_properties(tree.file) if tree.file.endswith("yaml") else []
     errors = [*model.undeclared_errors(), *designer.check_names(tree.file, properties, model)]
     if errors:
         raise TreeErrors(errors)
     safety = Safety(model)
-    found = None
-    if real:
-        from frog_bt.config import load_site
-        from frog_bt.verify.real import explore_real
-
-        graph, found = explore_real(model, site or load_site(None), safety, limit, restarts)
-    else:
-        graph = explore(model, safety, limit)
+    graph, found = explore(model, site or load_site(None), safety, limit, restarts)
     broken_builtin = check_builtin(graph, model, safety)
     names = [n for n in BUILT_IN if not only or n in only]
     verdict = Verdict(model, graph, [*names, *(p.title() for p in properties)])
-    if found is not None:
-        verdict.undeclared, verdict.failed = found.undeclared, found.failed
+    verdict.undeclared, verdict.failed = found.undeclared, found.failed
     triggers = builtin_triggers(graph, model)
     for name in names:
         verdict.broken += broken_builtin[name]

@@ -1,5 +1,5 @@
-"""Explore the real tree: the loader's nodes in a real :class:`~frog_bt.engine.core.Core`,
-ticked, with only the world abstracted.
+"""The explorer: the real tree (the loader's nodes in a real
+:class:`~frog_bt.engine.core.Core`) ticked, with only the world abstracted.
 
 A :class:`Real` holds one core (a :class:`~frog_bt.clock.ManualClock`, the outputs
 captured: the seam the tests use). From a state it restores every node and the engine,
@@ -14,7 +14,7 @@ wait running out, the robot's answer to the pending goal (a pose at the goal wit
 arrival; the camera seeing the visitor with an approach's success), the docking state,
 the front end's events; and, as a node reads them, the diagnostics, nobody or someone
 new facing the robot, someone following, a face. Every combination is explored (an
-:class:`~frog_bt.verify.tick.Oracle` replays a prefix of choices; each choice beyond it
+:class:`~frog_bt.verify.explore.Oracle` replays a prefix of choices; each choice beyond it
 branches).
 
 The project clock never moves: a wait runs out by its own times moving back
@@ -75,10 +75,9 @@ from frog_bt.model.ros import (
 )
 from frog_bt.model.wire import FAILED, SUCCEEDED
 from frog_bt.tree.world import Channel, World, world_of
-from frog_bt.verify.explore import MAX_STATES, Graph, TooBig
+from frog_bt.verify.explore import MAX_STATES, Choice, Graph, Oracle, Step, TooBig
 from frog_bt.verify.liveness import Liveness
 from frog_bt.verify.model import Model, preorder
-from frog_bt.verify.tick import Choice, Oracle, Step
 from frog_bt.verify.world import By
 from frog_bt.verify.world import Event as VEvent
 
@@ -108,10 +107,11 @@ class Robot:
     homing: bool = False
     people: int = 0  # the persons the camera has shown so far (the next one is new)
     seen: int | None = None  # the visitor the camera sees as an approach succeeds
+    reported: bool = True  # its docking state heard since the executive started
 
     def key(self, near: Callable[[str | None], Hashable]) -> tuple[object, ...]:
         """Its encoding; ``near``: where it is, as the nodes tell places apart."""
-        return (near(self.where), self.docking, self.homing)
+        return (near(self.where), self.docking, self.homing, self.reported)
 
 
 @dataclass(slots=True)
@@ -339,7 +339,10 @@ class Real:
             self.core.on_ros(self.site.topic("pose"), pose)
         else:  # the same pose, repeated
             inputs.latest[keys.POSE] = Reading(pose, now)
-        inputs.latest[keys.DOCKING] = Reading(self.robot.docking, now)
+        if self.robot.reported:
+            inputs.latest[keys.DOCKING] = Reading(self.robot.docking, now)
+        else:  # a restarted executive has not heard it yet
+            inputs.latest.pop(keys.DOCKING, None)
 
     # ------------------------------------------------------------ what the tree did
 
@@ -412,7 +415,14 @@ class Real:
             ),
             self.clock.now(),
             core.pause_ran_out,
-            (self.robot.where, self.robot.docking, self.robot.homing, self.robot.people),
+            (
+                self.robot.where,
+                self.robot.docking,
+                self.robot.homing,
+                self.robot.people,
+                None,
+                self.robot.reported,
+            ),
         )
         return Saved(tuple(nodes), engine, self.running())
 
@@ -502,6 +512,7 @@ class Real:
         self.events = []
         self._sent: list[VEvent] = []
         self._drove_to = ""
+        self._heard_late = False
         step = self.step = Step(started_tour=board.get(keys.TOUR_STATE) is TourState.STARTED)
         help_before = board.get(keys.HELP) is not None
         running = self.running()
@@ -511,6 +522,8 @@ class Real:
         self._running = None
         core.tick()
         self._running = None
+        if self._heard_late:
+            self.robot.reported = True  # heard before the next tick
         if core.faults.total != faults:
             for seen in core.faults.seen.values():
                 line = f"{seen.where}: {seen.error}"
@@ -532,6 +545,13 @@ class Real:
         """The operator's command, a wait running out, or the world's answers: the
         inputs of this tick. Whether the robot moved (a new pose)."""
         core, board, robot = self.core, self.core.board, self.robot
+        if not robot.reported:
+            # a restart: the robot's docking state comes in the first tick or the next,
+            # whatever else happens (well within ``checkpoint.confirm``: what
+            # ConfirmResume waits for is there before it gives up)
+            how = self._choose(-1, "robot", [("reports", By.ROBOT), ("not heard yet", By.ROBOT)])
+            robot.reported = how == "reports"  # published before the tree ticks
+            self._heard_late = not robot.reported
         options: list[tuple[str, By]] = [("none", By.QUIET)]
         touring = board.get(keys.TOUR_STATE) is TourState.STARTED
         ending = board.get(keys.HOME) is not None or board.get(keys.ABORT_REASON) is not None
@@ -563,7 +583,12 @@ class Real:
                 robot.docking = DockingState.UNDOCKED
             elif helping.about is not HelpAbout.FAULT:
                 robot.docking, robot.where = DockingState.DOCKED, self.dock
-                self._publish_world(moved=True)
+            self._publish_world(moved=True)
+            # and the robot said so before the operator answered: the board has it (the
+            # operator checks done_by_hand against the robot's docking state there)
+            reported = core.inputs.latest.get(keys.DOCKING)
+            if reported is not None:
+                board.set(keys.DOCKING, reported)
         answer = core.command(Command(what))
         if not answer.ok:
             raise Pruned(what)
@@ -646,6 +671,10 @@ class Real:
                 messages += [m for m in w.frontend(node) if m not in messages]
             if w.docking is not None:
                 self._docking(i, w.docking(node))
+        if not running:  # the first tick: the front end may have spoken before it
+            for node, w in zip(self.nodes, self.worlds, strict=True):
+                if w is not None and w.frontend is not None:
+                    messages += [m for m in w.frontend(node) if m not in messages]
         if messages:
             options = [("none", By.QUIET), *((m.type, By.WORLD) for m in messages)]
             sent = self._choose(-1, "front end", options)
@@ -858,15 +887,16 @@ class Real:
     def resumed(self, progress: Progress, docked: bool) -> Saved:
         """A start state of a restarted executive: the fresh start with ``progress`` as
         the checkpoint to resume (``/resume``, as the executive sets it), the robot away
-        from the dock (``docked``: on its charger)."""
+        from the dock (``docked``: on its charger), its docking state not heard yet (it
+        comes in the first tick or the second: ``ConfirmResume`` may wait for it)."""
         self.restore(self.initial)
         self.core.board.set(
             keys.RESUME, Resume(frozenset(progress.done), progress.visitor, progress.done)
         )
         if docked:
-            self.robot = Robot(self.dock)
+            self.robot = Robot(self.dock, reported=False)
         else:
-            self.robot = Robot(None, DockingState.UNDOCKED)
+            self.robot = Robot(None, DockingState.UNDOCKED, reported=False)
         self._publish_world(moved=True)
         return self.save()
 
@@ -992,7 +1022,7 @@ def _role(world: World | None) -> str:
     return world.role.value if world is not None else ""
 
 
-def explore_real(
+def explore(
     model: Model,
     site: Site,
     on_step: Callable[[int, Step, int, Any], None] | None = None,

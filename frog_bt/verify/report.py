@@ -9,11 +9,11 @@ from collections.abc import Iterable
 
 from frog_bt.engine.loaded import Where
 from frog_bt.errors import format_path
+from frog_bt.verify.explore import Step
 from frog_bt.verify.graph import Run
 from frog_bt.verify.model import Model
 from frog_bt.verify.properties import Broken
 from frog_bt.verify.prove import Verdict
-from frog_bt.verify.tick import Step
 from frog_bt.verify.world import By, Event
 
 

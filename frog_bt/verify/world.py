@@ -1,9 +1,9 @@
-"""The abstract world a verified tree runs in: the values of the keys guards read, the
-labels of choices and the events properties watch.
+"""The world as the properties read it, the labels of choices and the events properties
+watch.
 
-A state is the tree's (each node running or not, with its small counters) and the
-world's: the tuple :data:`INITIAL` indexed by the constants below. The robot starts
-docked, in service, with no tour.
+A state, as the properties see it, is the tree's (each node running or not, with its
+action out or not) and the world's: a tuple indexed by the constants below, read from
+the real tree's board and the explorer's robot (:meth:`.real.Real.world_view`).
 """
 
 from __future__ import annotations
@@ -21,12 +21,6 @@ IN_SERVICE = 4  # /in_service
 DOCKED = 5  # the robot is on its charger
 SKIPPED = 6  # /skipped: the POI being skipped, or None
 HOMING = 7  # since home was asked: the dock sequence (or a person's help) was reached
-WORLD_NAMES = ("started", "abort", "home", "paused", "in_service", "docked", "skipped", "homing")
-INITIAL: tuple[object, ...] = (False, False, False, False, True, True, None, False)
-
-# Statuses in the compiled model (py_trees': INVALID is "not running", 0).
-RUNNING, SUCCESS, FAILURE = 1, 2, 3
-STATUS_NAMES = {RUNNING: "running", SUCCESS: "success", FAILURE: "failure"}
 
 
 class By(enum.Enum):

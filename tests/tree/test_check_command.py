@@ -14,7 +14,9 @@ from frog_bt.cli import main
 
 
 def test_the_shipped_tour_and_site_pass(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["check"]) == 0
+    """Without the proof (tests/verify/test_verify.py: check with it, on the verdict the
+    run explored once)."""
+    assert main(["check", "--no-verify"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("ok: ") and "tour.yaml (" in out and "site.yaml" in out
 

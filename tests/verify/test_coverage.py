@@ -1,36 +1,22 @@
 """``frog-bt coverage``: a seeded recording replayed, its nodes counted, the never-run
-ones marked."""
+ones marked; ``verify --coverage`` and ``--conformance``: recordings against the real
+tree's exploration."""
 
 from __future__ import annotations
 
-import sys
+import dataclasses
 from pathlib import Path
 
 import pytest
 
-from frog_bt.behaviours import visit
+from frog_bt.behaviours import tour
 from frog_bt.behaviours.registry import DECORATOR_TYPES, LEAF_TYPES
 from frog_bt.cli import main
 from frog_bt.config import load_site
 from frog_bt.offline.conformance import conformance
 from frog_bt.tree.factory import NodeFactory
-from frog_bt.verify.abstraction import Abstraction, S, content
 from frog_bt.verify.prove import prove
-from frog_bt.verify.world import Role
-
-sys.path.insert(0, str(Path(__file__).parents[1] / "recording"))
-
-from recorded_tour import record_tour
-
-
-@pytest.fixture(scope="module")
-def one_tour(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The seeding, made once for this file: one whole tour of the default scenario,
-    nothing going wrong."""
-    path = tmp_path_factory.mktemp("one-tour") / "tour.mcap"
-    recorded = record_tour(path)
-    assert recorded.outcome.code == 0, recorded.outcome.reason
-    return path
+from tests.verify.conftest import DATA, Shipped
 
 
 def test_coverage_of_a_recorded_tour(
@@ -80,32 +66,43 @@ def test_coverage_of_a_recorded_tour(
 
 
 def test_verify_says_which_share_of_the_explored_states_a_season_reached(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], one_tour: Path
+    shipped: Shipped,
 ) -> None:
-    (tmp_path / "season").mkdir()
-    (tmp_path / "season" / "tour.mcap").write_bytes(one_tour.read_bytes())
-    assert main(["verify", "--coverage", str(tmp_path / "season")]) == 0
-    out = capsys.readouterr().out
-    line = next(text for text in out.splitlines() if text.startswith("coverage: "))
+    line = next(text for text in shipped.out.splitlines() if text.startswith("coverage: "))
     got, explored = (int(n) for n in line.split("reached ")[1].split(" explored")[0].split(" of "))
     assert 10 < got < explored  # one happy tour: many states, far from all
-    assert "transitions" in line and "states outside the model" not in line
+    assert "transitions" in line and "states outside the exploration" not in line
 
-    # conformance: every step the recorded tour took is one the explorer allows...
-    assert main(["verify", "--conformance", str(tmp_path / "season")]) == 0
-    out = capsys.readouterr().out.splitlines()
-    assert out[0] == "conformance: 1 of 1 recordings took only steps the explorer allows"
-    assert out[1].startswith("verified: ")
 
-    # ...and a recording the world model does not allow is named, with its tick and node:
-    # here the model says a stop's content ends in the tick it starts (it plays for
-    # seconds, over many ticks, on the robot)
+def test_the_suite_s_recordings_and_a_seeded_season_conform(shipped: Shipped) -> None:
+    """Every step the recorded tours took (one happy tour, the seeded season with a help
+    of each kind and a restart resumed from its checkpoint, the suite's own recording of
+    a failed undock) is one the explorer allows, on the same real tree."""
+    files = 1 + len(list(shipped.helped.glob("*.mcap"))) + len(list(DATA.glob("*.mcap")))
+    assert any(p.name.endswith("-resumed.mcap") for p in shipped.helped.glob("*.mcap"))
+    out = shipped.out.splitlines()
+    told = f"conformance: {files} of {files} recordings took only steps the explorer allows"
+    assert told in out, shipped.out
+    assert not [t for t in out if t.endswith("a step the exploration does not allow")]
+
+
+class WaitFrontendIdle(tour.WaitFrontendIdle):
+    """WaitFrontendIdle as a wrong world model has it: the front end never says it is
+    idle (its code is the real one; only what the explorer may send it is wrong)."""
+
+    world = dataclasses.replace(tour.WaitFrontendIdle.world, frontend=lambda n: ())
+
+
+def test_a_recording_the_world_model_does_not_allow_is_named(one_tour: Path) -> None:
+    """The happy tour, checked against the exploration of a world whose front end never
+    says it is ready: the first step the robot took outside it is named, with its tick
+    and node (the explorer never let the tour start)."""
     factory = NodeFactory(
-        [*(c for c in LEAF_TYPES if c.__name__ != "PlayContent"), PlayContent], DECORATOR_TYPES
+        [*(c for c in LEAF_TYPES if c.__name__ != "WaitFrontendIdle"), WaitFrontendIdle],
+        DECORATOR_TYPES,
     )
     site = load_site(None)
-    tree = factory.load(None, site)
-    v = prove(tree, site)
+    v = prove(factory.load(None, site), site, restarts=False)
     files, outside = conformance(
         v.graph,
         v.model,
@@ -116,18 +113,12 @@ def test_verify_says_which_share_of_the_explored_states_a_season_reached(
     )
     assert files == 1
     (step,) = outside
-    assert step.recording == one_tour and step.tick > 1
-    assert step.node == "PlayContent 'PlayContent POI1 a'" and step.what == "running"
+    assert step.recording == one_tour and step.tick >= 1
+    # the first node running that the exploration never ran: the tour's undock
+    assert (step.node, step.what) == ("Retry 'Undock, or ask for help'", "running")
     assert step.line() == (
-        f"{one_tour}: tick {step.tick}: PlayContent 'PlayContent POI1 a' running: "
-        "a step the explored model does not allow"
+        f"{one_tour}: tick {step.tick}: {step.node} running: a step the exploration does not allow"
     )
-
-
-class PlayContent(visit.PlayContent):
-    """PlayContent as a wrong world model sees it: over in the tick it starts."""
-
-    verify = Abstraction((S,), role=Role.CONTENT, rule=content)
 
 
 def test_every_outcome_coverage_shows_is_in_its_key() -> None:

@@ -1,10 +1,10 @@
-"""``verify --real``: the real tree's nodes ticked in a core, only the world abstracted.
+"""``verify``: the real tree's nodes ticked in a core, only the world abstracted.
 
 A guard deleted from a leaf's own Python code (not from the tree) breaks the property it
 served; a leaf that breaks a property only when a tour is resumed is found from the
 checkpoints the tree writes; a leaf that keeps state it does not declare is named.
-A small tour keeps these fast: the shipped tree's real exploration is the bench's
-(scripts/bench_verify.py).
+A small tour keeps these fast: the shipped tree is explored once per run
+(tests/verify/conftest.py), and its cost is the bench's (scripts/bench_verify.py).
 """
 
 from __future__ import annotations
@@ -155,9 +155,7 @@ def tour(
 
 def verdict(path: Path, restarts: bool = True) -> Verdict:
     site = load_site(None)
-    return prove(
-        FACTORY_.load(path, site), site, properties=[], only=GUARDS, real=True, restarts=restarts
-    )
+    return prove(FACTORY_.load(path, site), site, properties=[], only=GUARDS, restarts=restarts)
 
 
 def broken(v: Verdict) -> dict[str, list[str]]:
@@ -213,17 +211,18 @@ def test_state_a_leaf_does_not_declare_is_named_by_class(tmp_path: Path) -> None
     assert not v.ok
 
 
-def test_verify_real_on_the_command_line(tmp_path: Path, capsys: object) -> None:
+def test_verify_on_the_command_line(tmp_path: Path) -> None:
     path = tmp_path / "idle.yaml"
     path.write_text(
         "root:\n  type: Sequence\n  memory: false\n  children:\n"
         "    - {type: WaitInService}\n    - {type: WaitFrontendIdle}\n"
     )
-    assert main(["verify", "--real", str(path)]) == 1  # vacuous: no tour to pause
+    assert main(["verify", str(path)]) == 1  # vacuous: no tour to pause
+    assert main(["verify", "--real", str(path)]) == 1  # --real: accepted, the same
 
 
 def test_every_registered_node_type_declares_its_world() -> None:
-    """verify --real ticks every node type as it is: each says, on its class, what of the
+    """verify ticks every node type as it is: each says, on its class, what of the
     world it listens to and what it keeps (frog_bt.tree.world)."""
     types = [*LEAF_TYPES, *DECORATOR_TYPES]
     assert types
@@ -240,4 +239,4 @@ def test_a_leaf_without_a_world_or_an_unknown_name_is_an_error(tmp_path: Path) -
         "    - {type: WaitInService}\n"
         "properties:\n  - {never: [Nope, WaitInService], together: true}\n"
     )
-    assert main(["verify", "--real", str(path)]) == 2
+    assert main(["verify", str(path)]) == 2

@@ -1,5 +1,6 @@
-"""``frog-bt verify``: the shipped tree proves; the old service_off shape and five
-mutations of the shipped tree each break their property, with the shortest run."""
+"""``frog-bt verify``: the shipped tree proves (explored once, tests/verify/conftest.py);
+the old service_off shape and mutations of the shipped parts (tests/verify/mutate.py)
+each break their property, with the shortest run."""
 
 from __future__ import annotations
 
@@ -13,27 +14,32 @@ from frog_bt.behaviours.navigation import Navigate
 from frog_bt.behaviours.recruit import ApproachVisitor, AskTour
 from frog_bt.behaviours.registry import DECORATOR_TYPES, LEAF_TYPES
 from frog_bt.cli import main
+from frog_bt.commands import verify as verify_command
+from frog_bt.commands.check import VERIFY_STATES
+from frog_bt.engine.loaded import LoadedTree
 from frog_bt.errors import TreeErrors
 from frog_bt.model import keys
 from frog_bt.model.frontend import AskTour as AskTourCommand
 from frog_bt.tree.factory import NodeFactory
 from frog_bt.tree.leaf import RUNNING, SUCCESS, Leaf, Status
-from frog_bt.verify.abstraction import Abstraction
+from frog_bt.tree.world import Channel, World
+from frog_bt.verify import prove as proving
 from frog_bt.verify.graph import Run
 from frog_bt.verify.properties import BUILT_IN, Broken
+from frog_bt.verify.prove import Verdict
 from frog_bt.verify.report import finding
-from frog_bt.verify.world import By, Role
-from tests.verify.mutate import copy, lines, run_of, verdict
+from tests.verify.conftest import Shipped
+from tests.verify.mutate import cli, copy, lines, run_of, verdict
 
 
-def test_the_shipped_tree_holds_every_property(capsys: pytest.CaptureFixture[str]) -> None:
-    v = verdict(None)
+def test_the_shipped_tree_holds_every_property(shipped: Shipped) -> None:
+    v = shipped.verdict
     assert v.ok, [(b.name, b.run.note) for b in v.broken]
     assert set(BUILT_IN) <= set(v.checked)
-    assert v.graph.seconds < 30
-    assert main(["verify"]) == 0
-    out = capsys.readouterr().out
-    assert out.startswith("verified: ") and "7 properties hold" in out
+    assert len(v.graph.starts) > 1  # the restarts from every checkpoint, explored too
+    assert shipped.code == 0, shipped.out + shipped.err
+    out = shipped.out
+    assert "verified: " in out and "7 properties hold" in out
     # each property's trigger was reached, and how often is said
     counts = dict(re.findall(r"^  ([a-z-]+): triggered by (\d+) ", out, re.MULTILINE))
     assert set(counts) == set(BUILT_IN) and all(int(n) > 0 for n in counts.values())
@@ -41,35 +47,50 @@ def test_the_shipped_tree_holds_every_property(capsys: pytest.CaptureFixture[str
     assert "states out of service (service_off)" in out
 
 
-OLD_READY = """                    - type: Sequence
-                      name: Ready to start
-                      memory: false        # checked again on every tick: service_off
-                      children:            # holds even while the front end is awaited
-                        - {type: AskForHelp, about: restored, name: Still waiting for a person}
-                        - {type: WaitInService, name: Wait while out of service}
-                        - {type: AskForHelp, about: fault, name: Hold while a fault persists}
-                        - {type: WaitFrontendIdle, name: Wait for the front end}
+def test_check_proves_as_verify_does(
+    shipped: Shipped, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check`` runs verify's proof on the shipped tour (here the verdict this run
+    explored once: check asks for the same tree, with its state limit)."""
+    asked: list[tuple[str, dict[str, object]]] = []
+
+    def explored(tree: LoadedTree, site: object, **kwargs: object) -> Verdict:
+        asked.append((tree.file, kwargs))
+        return shipped.verdict
+
+    monkeypatch.setattr(proving, "prove", explored)
+    assert main(["check"]) == 0
+    assert capsys.readouterr().out.endswith("; 7 properties hold\n")
+    assert asked == [(shipped.verdict.model.tree.file, {"limit": VERIFY_STATES})]
+
+
+OLD_READY = """            - type: Sequence
+              name: Ready to start
+              memory: false
+              children:
+                - {type: WaitInService, name: Wait while out of service}
+                - {type: WaitFrontendIdle, name: Wait for the front end}
 """
-OLD_SHAPE = """                    - {type: WaitInService, name: Wait while out of service}
-                    - {type: WaitFrontendIdle, name: Wait for the front end}
+OLD_SHAPE = """            - {type: WaitInService, name: Wait while out of service}
+            - {type: WaitFrontendIdle, name: Wait for the front end}
 """
 
 
 def test_the_old_service_off_bug_is_found(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # WaitInService checked once, then WaitFrontendIdle, in "Start a tour" (memory: true)
     tour = copy(tmp_path, {"tour.yaml": [(OLD_READY, OLD_SHAPE)]})
-    v = verdict(tour)
+    code, v = cli(monkeypatch, "verify", str(tour), "--format", "mermaid")
+    assert code == 1 and v is not None
     assert [b.name for b in v.broken] == ["service-off-obeyed"]
     run = run_of(v, "service-off-obeyed")
-    assert lines(v, run) == [
-        "WaitFrontendIdle 'Wait for the front end' running",
-        "operator: service_off; WaitFrontendIdle 'Wait for the front end' success; "
-        "[tour started: TourStatus 'TourStatus started']; "
+    assert lines(v, run) == [  # the front end was idle before the first tick; a fault held
+        "front end: frontend_idle; diagnostics: fault; "
+        "WaitFrontendIdle 'Wait for the front end' waits for a person or the front end",
+        "operator: service_off; [tour started: TourStatus 'TourStatus started']; "
         "[undock sent: Docking 'Docking undock']",
     ]
-    assert main(["verify", str(tour), "--format", "mermaid"]) == 1
     out = capsys.readouterr().out
     assert f"{tour}:" in out and ": service-off-obeyed: " in out
     assert "  2. operator: service_off" in out
@@ -77,14 +98,14 @@ def test_the_old_service_off_bug_is_found(
 
 
 def test_abort_guard_removed_breaks_home_obeyed(tmp_path: Path) -> None:
-    abort = """      - type: Sequence
-        name: Abort politely
-        memory: true
-        children:
-          - {type: MustAbort}
-          - {type: TourStatus, state: aborted}
-          - {include: home.yaml}
-          - {type: ClearAbort}
+    abort = """    - type: Sequence
+      name: Abort politely
+      memory: true
+      children:
+        - {type: MustAbort}
+        - {type: TourStatus, state: aborted}
+        - {include: home.yaml}
+        - {type: ClearAbort}
 """
     v = verdict(copy(tmp_path, {"tour.yaml": [(abort, "")]}))
     run = run_of(v, "home-obeyed")
@@ -100,11 +121,11 @@ def test_a_retry_bound_removed_breaks_bounded_retries(tmp_path: Path) -> None:
     run = run_of(v, "bounded-retries")
     assert run.loop_from is not None
     loop = lines(v, run)[run.loop_from :]
-    assert all("Guide a visitor" not in t for t in loop)
-    assert any(
-        "Navigate 'Navigate POI0' failure; [Retry 'Go to POI0' tries again]" in t for t in loop
-    )
-    assert run.note == "Retry 'Go to POI0' retries for ever on the robot's own failures"
+    assert loop == [  # on the way home (a low battery aborted the tour), for ever
+        "robot: fails; [Retry 'Go to SHOP' tries again]",
+        "[drive goal sent: Navigate 'Navigate SHOP']",
+    ]
+    assert run.note == "Retry 'Go to SHOP' retries for ever on the robot's own failures"
 
 
 class NavigateNoPause(Navigate):
@@ -118,21 +139,10 @@ class WaitWhilePaused(Leaf):
     """A pause guard as a leaf: RUNNING while ``/paused``, else SUCCESS."""
 
     optional_reads = (keys.PAUSED,)
-    verify = Abstraction(role=Role.NONE, rule=lambda t, n, aux, starting: _paused(t, n))
+    world = World(inputs=(Channel.OPERATOR,))
 
     def update(self) -> Status:
         return RUNNING if self.get(keys.PAUSED) else SUCCESS
-
-
-def _paused(t: object, n: object) -> tuple[int, int]:
-    from frog_bt.verify.world import PAUSED
-    from frog_bt.verify.world import RUNNING as R
-    from frog_bt.verify.world import SUCCESS as S
-
-    if t.world[PAUSED]:  # type: ignore[attr-defined]
-        t.waits(n, By.WORLD, "paused")  # type: ignore[attr-defined]
-        return R, 0
-    return S, 0
 
 
 def test_the_pause_guard_after_the_drive_breaks_pause_obeyed(tmp_path: Path) -> None:
@@ -142,7 +152,7 @@ def test_the_pause_guard_after_the_drive_breaks_pause_obeyed(tmp_path: Path) -> 
         [*(c for c in LEAF_TYPES if c is not Navigate), NavigateNoPause, WaitWhilePaused],
         DECORATOR_TYPES,
     )
-    goto = """  child: {type: Navigate, poi: "{poi}"}"""
+    goto = """  child: {type: Navigate, poi: "{poi}"}"""  # in goto.yaml
     moved = """  child:
     type: Sequence
     name: "Drive to {poi}, then mind the pause"
@@ -194,7 +204,7 @@ def test_a_recruiting_leaf_that_ignores_the_pause_breaks_pause_obeyed(
     """CONTRACT §7: no new goal and no new content until resume, the approach and the
     question to the visitor too."""
     factory = NodeFactory([*LEAF_TYPES, AskTourNoPause, ApproachNoPause], DECORATOR_TYPES)
-    v = verdict(copy(tmp_path, {"recruit.yaml": [(old, new)]}), factory)
+    v = verdict(copy(tmp_path, {"recruit.yaml": [(old, new)]}, recruit=True), factory)
     run = run_of(v, "pause-obeyed")
     assert any("operator: pause" in t for t in lines(v, run))
     assert run.note == note
@@ -207,22 +217,25 @@ def test_the_dock_failure_branch_made_to_loop_breaks_ends_well(tmp_path: Path) -
     run = run_of(v, "ends-well")
     assert run.loop_from is not None
     loop = lines(v, run)[run.loop_from :]
-    assert any("Navigate 'Navigate SHOP' failure" in t for t in loop)  # the way home fails,
+    assert "operator: time: Docking dock runs out; [Retry 'Dock' tries again]" in loop  # fails,
     assert any("[Retry 'Home, or ask for help' tries again]" in t for t in loop)  # again
+    assert "[drive goal sent: Navigate 'Navigate SHOP']" in loop  # and again
     assert all("AskForHelp" not in t for t in loop)
 
 
 def test_content_in_parallel_with_a_drive_breaks_no_content_while_driving(
     tmp_path: Path,
 ) -> None:
-    drive = """                child: {include: goto.yaml}"""
-    parallel = """                child:
-                  type: Parallel
-                  name: "Drive and talk to {poi}"
-                  children:
-                    - {include: goto.yaml}
-                    - {type: PlayContent, poi: "{poi}", part: a}"""
-    v = verdict(copy(tmp_path, {"visit_poi.yaml": [(drive, parallel)]}))
+    drive = """            - {include: goto.yaml, with: {poi: POI1}}
+            - {type: PlayContent, poi: POI1, part: a}
+"""
+    parallel = """            - type: Parallel
+              name: Drive and talk to POI1
+              children:
+                - {include: goto.yaml, with: {poi: POI1}}
+                - {type: PlayContent, poi: POI1, part: a}
+"""
+    v = verdict(copy(tmp_path, {"tour.yaml": [(drive, parallel)]}))
     run = run_of(v, "no-content-while-driving")
     text = lines(v, run)
     assert "[drive goal sent: Navigate 'Navigate POI1']" in text[-1]
@@ -232,18 +245,19 @@ def test_content_in_parallel_with_a_drive_breaks_no_content_while_driving(
 
 def test_a_deleted_engagement_decision_is_a_dead_read(tmp_path: Path) -> None:
     decide = "            - {type: DecideEngagement, about: introduction}\n"
-    v = verdict(copy(tmp_path, {"recruit.yaml": [(decide, "")]}))
+    v = verdict(copy(tmp_path, {"recruit.yaml": [(decide, "")]}, recruit=True))
     runs = [b.run for b in v.broken if b.name == "no-dead-reads"]
     assert any(r.note == "AskTour reads /engaged, which no run writes before it" for r in runs)
 
 
 def test_a_broken_property_is_reported_at_its_node_in_the_included_file(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """``check`` and ``verify`` alike: one ``file:line:column: path: property: what`` line
-    at the node (in recruit.yaml, which tour.yaml includes), its shortest run after it."""
+    at the node (in recruit.yaml, which tour.yaml includes), its shortest run after it
+    (verify prints the verdict check explored: one exploration)."""
     decide = "            - {type: DecideEngagement, about: introduction}\n"
-    tour = copy(tmp_path, {"recruit.yaml": [(decide, "")]})
+    tour = copy(tmp_path, {"recruit.yaml": [(decide, "")]}, recruit=True)
     recruit = tour.with_name("recruit.yaml")
     (line,) = [n for n, text in enumerate(recruit.read_text().splitlines(), 1) if "AskTour" in text]
     column = recruit.read_text().splitlines()[line - 1].index("{type: AskTour}") + 1
@@ -251,18 +265,22 @@ def test_a_broken_property_is_reported_at_its_node_in_the_included_file(
         f"{recruit}:{line}:{column}: root.child.children[2].child.children[2]: "
         "no-dead-reads: AskTour reads /engaged, which no run writes before it"
     )
-    assert main(["check", str(tour)]) == 2
+    code, v = cli(monkeypatch, "check", str(tour))
+    assert code == 2 and v is not None
     err = capsys.readouterr().err.splitlines()
     assert err[0] == located
     assert [e for e in err if not e.startswith("  ")] == [located]  # the run: indented
-    assert "    5. [visitor addressed: AskTour]" in err
+    assert err[7] == (
+        "    5. front end: finish_introduction; [visitor addressed: AskTour]; "
+        "WaitAnswer waits for a person or the front end"
+    )
+    monkeypatch.setattr(verify_command, "prove", lambda tree, site: v)
     assert main(["verify", str(tour)]) == 1
     out = capsys.readouterr().out.splitlines()
     assert out[0] == located
     assert out[2:4] == [
         "  the shortest run (5 ticks):",
-        "    1. WaitFrontendIdle 'Wait for the front end' success; "
-        "[tour started: TourStatus 'TourStatus started']; "
+        "    1. front end: frontend_idle; [tour started: TourStatus 'TourStatus started']; "
         "[undock sent: Docking 'Docking undock']",
     ]
 
@@ -270,16 +288,20 @@ def test_a_broken_property_is_reported_at_its_node_in_the_included_file(
 def test_designer_properties(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     props = """
 properties:
-  - {never: [Guide to POI1, Present POI1], together: true}
+  - {never: [Go to POI1, PlayContent POI1 a], together: true}
   - {between: [TourStatus aborted, TourStatus started], never: Docking undock}
-  - {after: Docking undock, within: 1, reaches: Go to POI0}
+  - {after: Docking undock, within: 1, reaches: PlayContent POI1 a}
 """
     tour = copy(tmp_path, {})
     tour.write_text(tour.read_text() + props)
     v = verdict(tour)
-    assert [b.name for b in v.broken] == ["after 'Docking undock', within 1 ticks, 'Go to POI0'"]
-    assert v.broken[0].run.note == "'Go to POI0' not started within 1 ticks"
-    tour.write_text(tour.read_text() + "  - {never: [No such node, Undock], together: true}\n")
+    assert [b.name for b in v.broken] == [
+        "after 'Docking undock', within 1 ticks, 'PlayContent POI1 a'"
+    ]
+    assert v.broken[0].run.note == "'PlayContent POI1 a' not started within 1 ticks"
+    tour.write_text(
+        tour.read_text() + "  - {never: [No such node, Docking undock], together: true}\n"
+    )
     assert main(["check", str(tour)]) == 2
     assert "no node named 'No such node' in the tree" in capsys.readouterr().err
     # verify as check: exit 2, one line per unknown name, at the property
@@ -294,7 +316,7 @@ properties:
 
 
 def test_a_property_whose_trigger_no_run_reaches_is_vacuous(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A designer's property about a node that never starts, and the built-ins of a tree
     with no tour: each is named vacuous, and verify exits 1."""
@@ -304,10 +326,10 @@ def test_a_property_whose_trigger_no_run_reaches_is_vacuous(
         tour.read_text()
         + "properties:\n  - {never: [ClearAbort, Docking undock], together: true}\n"
     )
-    v = verdict(tour)
+    code, v = cli(monkeypatch, "verify", str(tour))
     title = "never 'ClearAbort' and 'Docking undock' together"
-    assert v.vacuous == [title] and not v.broken and not v.ok
-    assert main(["verify", str(tour)]) == 1
+    assert v is not None and v.vacuous == [title] and not v.broken and not v.ok
+    assert code == 1
     out = capsys.readouterr().out.splitlines()
     assert re.fullmatch(
         rf".*/tour\.yaml:\d+:\d+: root\..*: {re.escape(title)}: vacuous: no run reaches its "
@@ -324,7 +346,9 @@ def test_a_property_whose_trigger_no_run_reaches_is_vacuous(
     assert main(["verify", str(idle)]) == 1
     out = capsys.readouterr().out
     assert f"{idle}:2:3: root: pause-obeyed: vacuous: no run reaches its trigger (0 states " in out
-    assert "  service-off-obeyed: triggered by 1 states out of service" in out
+    assert re.search(
+        r"^  service-off-obeyed: triggered by [1-9]\d* states out of service", out, re.M
+    )
     assert main(["check", str(idle)]) == 2
     assert ": root: bounded-retries: vacuous: " in capsys.readouterr().err
 
@@ -352,21 +376,22 @@ def test_a_leaf_type_without_a_world_interface_is_an_error(tmp_path: Path) -> No
                 )
             ]
         },
+        small=False,
     )
     with pytest.raises(TreeErrors) as raised:
-        verdict(tour, factory)
+        verdict(tour, factory)  # raised before it explores: the shipped tour is cheap here
     (error,) = raised.value.errors  # one line for the type, though every stop has one
     assert re.fullmatch(
         r".*/visit_poi\.yaml:\d+:\d+: root\..*: leaf type Chime declares no world interface "
-        r"for verify \(a `verify` Abstraction on its class\)",
+        r"for verify \(a `world` World on its class\)",
         str(error),
     ), str(error)
 
 
-def test_a_finding_about_no_node_is_at_the_root_of_the_tree_file() -> None:
+def test_a_finding_about_no_node_is_at_the_root_of_the_tree_file(shipped: Shipped) -> None:
     """A property broken by the tree as a whole (a loop with no node to blame) points at
     the root of the tour file."""
-    v = verdict(None)
+    v = shipped.verdict
     broken = Broken("ends-well", "every tour ends well", Run([], note="loops"))
     first, meaning, *_ = finding(v.model, broken)
     assert re.fullmatch(r".*/tour\.yaml:\d+:\d+: root: ends-well: loops", first), first
