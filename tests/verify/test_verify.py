@@ -28,7 +28,7 @@ from frog_bt.verify.graph import Run
 from frog_bt.verify.properties import BUILT_IN, Broken
 from frog_bt.verify.prove import Verdict
 from frog_bt.verify.report import finding
-from tests.verify.conftest import Shipped
+from tests.verify.conftest import DATA, Shipped
 from tests.verify.mutate import cli, copy, lines, run_of, verdict
 
 
@@ -396,3 +396,28 @@ def test_a_finding_about_no_node_is_at_the_root_of_the_tree_file(shipped: Shippe
     first, meaning, *_ = finding(v.model, broken)
     assert re.fullmatch(r".*/tour\.yaml:\d+:\d+: root: ends-well: loops", first), first
     assert meaning == "  ends-well: every tour ends well"
+
+
+# Here, not in test_coverage.py: the tests that read the shipped tree's exploration are
+# in one file, so that -n 2 (whole files per worker) explores it once, not once per worker.
+
+
+def test_verify_says_which_share_of_the_explored_states_a_season_reached(
+    shipped: Shipped,
+) -> None:
+    line = next(text for text in shipped.out.splitlines() if text.startswith("coverage: "))
+    got, explored = (int(n) for n in line.split("reached ")[1].split(" explored")[0].split(" of "))
+    assert 10 < got < explored  # one happy tour: many states, far from all
+    assert "transitions" in line and "states outside the exploration" not in line
+
+
+def test_the_suite_s_recordings_and_a_seeded_season_conform(shipped: Shipped) -> None:
+    """Every step the recorded tours took (one happy tour, the seeded season with a help
+    of each kind and a restart resumed from its checkpoint, the suite's own recording of
+    a failed undock) is one the explorer allows, on the same real tree."""
+    files = 1 + len(list(shipped.helped.glob("*.mcap"))) + len(list(DATA.glob("*.mcap")))
+    assert any(p.name.endswith("-resumed.mcap") for p in shipped.helped.glob("*.mcap"))
+    out = shipped.out.splitlines()
+    told = f"conformance: {files} of {files} recordings took only steps the explorer allows"
+    assert told in out, shipped.out
+    assert not [t for t in out if t.endswith("a step the exploration does not allow")]
