@@ -24,10 +24,14 @@ def test_ctl_exit_codes_and_answers(tmp_path: Path, capsys: pytest.CaptureFixtur
         out = []
         async with console_tour() as (tour, _people, url):
             await tour.sim.wait_for(is_("tour", state="started"), 60)
+            # the robot undocking for simulated seconds that last as long in wall time:
+            # no stop is under way yet while ctl asks (at 1000x the first could be)
+            tour.sim.speed = 1.0
             for argv in (["skip", "--console", url], ["home", "--console", url]):
                 code = await asyncio.to_thread(ctl, *argv)
                 printed = capsys.readouterr()
                 out.append((code, printed.out.strip(), printed.err.strip()))
+            tour.sim.speed = 1000.0
             await tour.sim.wait_for(is_("tour", state="aborted"), 60)
             await tour.finish()
         return out
