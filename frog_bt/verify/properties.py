@@ -9,9 +9,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
-from frog_bt.model.key import Key, Source
+from frog_bt.model.key import Source
 from frog_bt.model.keys import by_name
 from frog_bt.verify.explore import Graph, State, Step
 from frog_bt.verify.graph import Run, can_reach, find_loop, monitor
@@ -196,22 +195,30 @@ def no_dead_reads(graph: Graph, model: Model) -> list[Run]:
     for name, nodes in sorted(readers.items()):
         key = declared[name]
         live: set[int] = set()
+        # per node, once: does its start clear the key (a scope it is within), does it
+        # read it, write it (the monitor below asks for every transition of the graph)
+        clears = frozenset(
+            n.index
+            for n in model.nodes
+            if n.scope is not None and not key.lasting and key.scope.within(n.scope)
+        )
+        reads = frozenset(n.index for n in model.nodes if name in n.reads)
+        writes = frozenset(n.index for n in model.nodes if name in n.writes)
 
         def bit(
-            step: Step, on: bool, name: str = name, live: set[int] = live, key: Key[Any] = key
+            step: Step,
+            on: bool,
+            live: set[int] = live,
+            clears: frozenset[int] = clears,
+            reads: frozenset[int] = reads,
+            writes: frozenset[int] = writes,
         ) -> tuple[bool, int | None]:
             for i, started in step.ticked:
-                n = model.nodes[i]
-                if (
-                    started
-                    and n.scope is not None
-                    and not key.lasting
-                    and key.scope.within(n.scope)
-                ):
+                if started and i in clears:
                     on = False
-                if on and name in n.reads:
+                if on and i in reads:
                     live.add(i)
-                if name in n.writes:
+                if i in writes:
                     on = True
             return on, None
 
