@@ -130,7 +130,7 @@ def test_service_off_before_frontend_idle_keeps_the_robot_docked() -> None:
 
 def test_a_pause_while_driving_stops_the_robot_within_one_tick() -> None:
     async def main() -> None:
-        async with Running({}) as run:
+        async with Running({"dt": 0.1}) as run:  # the robot's pose every tick
             exe, world = run.executive, run.sim.world
             await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 60)
             await run.sim.wait_for(lambda r: r.channel == "/GotoWayPoint", 60)  # off to POI0

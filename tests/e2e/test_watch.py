@@ -38,7 +38,9 @@ def test_a_valid_change_takes_over_when_idle_and_a_bad_one_is_refused(tmp_path: 
 
     async def main() -> None:
         # The front end never says it is idle: the robot stays docked, no tour starts.
-        async with Running({"frontend": {"idle_at": 10_000}}, site=site, tree=tree) as run:
+        async with Running(
+            {"dt": 0.1, "frontend": {"idle_at": 10_000}}, site=site, tree=tree
+        ) as run:
             exe = run.executive
             keeper = HeapKeeper()  # as `run --watch` attaches it (frog_bt.runtime.memory)
             exe.observers.attach(exe, [keeper])
@@ -108,7 +110,9 @@ def test_a_change_of_links_or_topics_is_refused_it_takes_a_restart(tmp_path: Pat
     renamed = site.model_copy(update={"topics": {"pose": "/robot/pose"}})
 
     async def main() -> None:
-        async with Running({"frontend": {"idle_at": 10_000}}, site=site, tree=tree) as run:
+        async with Running(
+            {"dt": 0.1, "frontend": {"idle_at": 10_000}}, site=site, tree=tree
+        ) as run:
             exe = run.executive
             # docked and idle: a valid offer would be swapped now
             await after_ticks(exe, lambda: bool(exe.core.ticks and exe.idle()))
@@ -132,7 +136,9 @@ def test_a_reload_keeps_what_people_decided(tmp_path: Path) -> None:
     tree = load_tree(tour_file, site)
 
     async def main() -> None:
-        async with Running({"frontend": {"idle_at": 10_000}}, site=site, tree=tree) as run:
+        async with Running(
+            {"dt": 0.1, "frontend": {"idle_at": 10_000}}, site=site, tree=tree
+        ) as run:
             exe = run.executive
             await after_ticks(exe, lambda: bool(exe.core.ticks and exe.idle()))
             assert (await exe.staff.submit(Command.SERVICE_OFF)).ok
@@ -199,7 +205,9 @@ def test_run_watch_rerun_the_viewer_follows_a_reloaded_tree(tmp_path: Path) -> N
     rrd = tmp_path / "watch.rrd"
 
     async def main() -> None:
-        async with Running({"frontend": {"idle_at": 10_000}}, site=site, tree=tree) as run:
+        async with Running(
+            {"dt": 0.1, "frontend": {"idle_at": 10_000}}, site=site, tree=tree
+        ) as run:
             exe = run.executive
             observers = attach_observers(exe, record=None, rerun=f"save:{rrd}")
             try:

@@ -29,6 +29,7 @@ from frog_bt.tree.loader import LoadedTree
 # High speed and short content: a whole tour takes a few seconds of wall time.
 FAST: dict[str, Any] = {
     "speed": 1000.0,
+    "dt": 0.2,  # the world simulated in steps of 0.2 s: half the inputs, the same logic
     "navigation": {"speed": 2.4},
     "content": {"default": 10, "introduction": 8},
 }

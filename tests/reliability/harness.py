@@ -31,6 +31,7 @@ from frog_bt.sim.traffic import Record
 
 FAST = {
     "speed": 1000.0,
+    "dt": 0.2,  # the world simulated in steps of 0.2 s: half the inputs, the same logic
     "navigation": {"speed": 2.4},  # 4x the robot's: fewer ticks, the same logic
     "content": {"default": 10, "introduction": 8},
 }
