@@ -93,6 +93,7 @@ def record_tour(
 # Tours back to back: a fast robot, short content, a visitor who comes back.
 FAST_TOURS: dict[str, Any] = {
     "speed": 1000.0,
+    "dt": 0.2,
     "navigation": {"speed": 3.0, "approach_time": 1.0},
     "docking": {"undock_time": 2.0, "dock_time": 3.0},
     "content": {"default": 4, "introduction": 3},
