@@ -439,14 +439,14 @@ class Recorder:
 
     def _end_chunk(self) -> None:
         self._ending = None
-        if not self.closed:
-            try:
-                self._flush()
-            except Exception as exc:
-                self._failed(exc)
+        self._flush_safely()
 
     def _timed_flush(self) -> None:
         self._flush_timer = None
+        self._flush_safely()
+
+    def _flush_safely(self) -> None:
+        """:meth:`_flush` from a timer: an error stops the recording, never the robot."""
         if not self.closed:
             try:
                 self._flush()

@@ -100,14 +100,8 @@ class Batch:
     def extend(self, later: Batch) -> None:
         """Append the rows of a later batch (a writer merging batches, see
         :mod:`frog_bt.live.telemetry.process`)."""
-        self.poses.extend(later.poses)
-        self.inputs.extend(later.inputs)
-        self.outputs.extend(later.outputs)
-        self.events.extend(later.events)
-        self.statuses.extend(later.statuses)
-        self.notes.extend(later.notes)
-        self.blackboard.extend(later.blackboard)
-        self.marks.extend(later.marks)
+        for rows, more in zip(self.columns(), later.columns(), strict=True):
+            rows.extend(more)
 
     def restamp(self, t: float) -> None:
         """Give rows that arrived before the clock had a time (NaN) the time ``t``."""
@@ -124,16 +118,7 @@ class Batch:
         return (self.poses, self.inputs, self.outputs, self.events, self.marks)
 
     def __len__(self) -> int:
-        return (
-            len(self.poses)
-            + len(self.inputs)
-            + len(self.outputs)
-            + len(self.events)
-            + len(self.statuses)
-            + len(self.notes)
-            + len(self.blackboard)
-            + len(self.marks)
-        )
+        return sum(map(len, self.columns()))
 
 
 class Rows:
