@@ -161,14 +161,43 @@ def free_port(kind: int = socket.SOCK_DGRAM) -> int:
 # ------------------------------------------------------------------ the fake robot
 
 
+def stamped_connection() -> Any:
+    """A websockets server connection that stamps each data message (``stamps``, in
+    order) with ``perf_counter_ns()`` taken as the bytes that complete it arrive (in
+    ``data_received``, before they are parsed)."""
+    from collections import deque
+
+    from websockets.asyncio.server import ServerConnection
+    from websockets.frames import DATA_OPCODES, Frame
+
+    class Stamped(ServerConnection):
+        def __init__(self, *args: Any, **kwargs: Any) -> None:
+            super().__init__(*args, **kwargs)
+            self.stamps: deque[int] = deque()
+            self._received = 0
+
+        def data_received(self, data: bytes) -> None:
+            self._received = time.perf_counter_ns()
+            super().data_received(data)
+
+        def process_event(self, event: Any) -> None:
+            if isinstance(event, Frame) and event.opcode in DATA_OPCODES and event.fin:
+                self.stamps.append(self._received)
+            super().process_event(event)
+
+    return Stamped
+
+
 class FakeRosbridge:
     """A minimal rosbridge v2 server for one client at a time, with socket timestamps.
 
     Like rosbridge_server (tornado) it offers no permessage-deflate. It records what
     the client advertises and subscribes to, hands every ``publish`` from the client to
     ``on_publish(topic, msg, t_ns)`` with ``t_ns = perf_counter_ns()`` taken as the
-    frame comes off the socket, and :meth:`publish` returns the same clock's time
-    taken just before the frame is written.
+    bytes that complete the frame come off the socket (:func:`stamped_connection`:
+    before this process parses them, so its own work and scheduling do not count),
+    and :meth:`publish` returns the same clock's time taken just before the frame is
+    written.
     """
 
     def __init__(
@@ -189,7 +218,14 @@ class FakeRosbridge:
     async def start(self) -> None:
         from websockets.asyncio.server import serve
 
-        self._server = await serve(self._handle, LOOPBACK, 0, compression=None, max_size=1 << 22)
+        self._server = await serve(
+            self._handle,
+            LOOPBACK,
+            0,
+            compression=None,
+            max_size=1 << 22,
+            create_connection=stamped_connection(),
+        )
         self.port = next(iter(self._server.sockets)).getsockname()[1]
 
     @property
@@ -209,7 +245,7 @@ class FakeRosbridge:
         self.connections += 1
         try:
             async for frame in ws:
-                t = time.perf_counter_ns()
+                t = ws.stamps.popleft() if ws.stamps else time.perf_counter_ns()
                 obj = json.loads(frame)
                 op = obj.get("op")
                 if op == "publish":

@@ -39,11 +39,13 @@ is held and stamped with that first time, so a recording has no zero stamps.
 
 Each channel carries a JSON Schema (encoding ``jsonschema``), so Foxglove
 can browse and plot the fields. Writing costs one encoding and one
-``add_message`` per message, both once the event loop's current callback
-(a tick, an input) is over, in order (an event is kept as it is until then);
-chunks are bounded (:data:`CHUNK_SIZE`, ended by the recorder just after the tick under
-way: :data:`CHUNK_PAUSE`) and flushed at least every
+``add_message`` per message, both in a background job (:mod:`frog_bt.runtime.background`:
+at a quiet turn of the event loop, after any input, tick or command that is due), in
+order (an event is kept as it is until then); chunks are bounded (:data:`CHUNK_SIZE`,
+ended by the recorder in a background job of its own) and flushed at least every
 :data:`FLUSH_EVERY` wall seconds, so memory stays small and a crash loses little.
+Each chunk's message index is written by :func:`frog_bt.live.mcap_index.install`'s
+packing, byte for byte as mcap's own and several times faster.
 :meth:`Recorder.close` (idempotent, also run at interpreter exit) writes the summary
 and footer: a recording stays valid MCAP when the run command stops on SIGTERM, or on
 an exception.
@@ -70,6 +72,7 @@ from frog_bt import __version__
 from frog_bt.config import fingerprint
 from frog_bt.errors import DecodeError
 from frog_bt.frontend.protocol import decode_datagram
+from frog_bt.live import mcap_index
 from frog_bt.model import channels
 from frog_bt.model.channels import (
     DATAGRAM_TYPE,
@@ -102,6 +105,7 @@ from frog_bt.model.events import (
 )
 from frog_bt.model.run import RUN_METADATA
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS, Keep
+from frog_bt.runtime import background
 from frog_bt.tree.btcpp import tree_xml
 from frog_bt.tree.registry import NodeRegistry
 
@@ -109,14 +113,13 @@ if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host
 
 log = logging.getLogger(__name__)
+mcap_index.install()
 
 CHUNK_SIZE = 256 * 1024  # bytes of uncompressed messages per chunk
-# Closing a chunk costs the event loop ~0.2 ms plus ~0.6 µs a message (mcap compresses it
-# and writes each message's index entry in Python): 1-2 ms at the bench's rates. mcap
-# would close it inside whichever add_message crossed the size, i.e. in the drain right
-# after an input, before the tick that input calls for; the recorder ends chunks itself,
-# this long after the drain that found one full, so that the tick goes first.
-CHUNK_PAUSE = 0.0005  # seconds
+# Closing a chunk costs the event loop ~0.2 ms plus ~0.2 µs a message (compressing it,
+# writing its message index). mcap would close it inside whichever add_message crossed
+# the size, i.e. in the drain right after an input, before the tick that input calls
+# for; the recorder ends chunks itself, in a background job, so that the tick goes first.
 _UNBOUNDED = 1 << 62  # mcap's own chunk size: never reached (the recorder ends chunks)
 _RECORD = 31  # bytes of an MCAP message record besides its data (opcode, length, header)
 FLUSH_EVERY = 1.0  # wall seconds between chunk flushes: a kill loses at most this much
@@ -172,17 +175,16 @@ class Recorder:
         path: Path,
         *,
         chunk_size: int = CHUNK_SIZE,
-        chunk_pause: float = CHUNK_PAUSE,
         flush_every: float = FLUSH_EVERY,
         metadata: dict[str, str] | None = None,
     ) -> None:
         self._chunk_size = chunk_size
-        self._chunk_pause = chunk_pause
-        self._ending: asyncio.TimerHandle | None = None  # the chunk's end, when scheduled
+        self._ending: object | None = None  # the token of the chunk's end, when one is due
         self._flush_every = flush_every
-        # Messages wait in _incoming until the event loop's current callback (a tick, an
-        # input) is over, so that a tick pays a list append per message, not an MCAP
-        # record each; _queue holds them stamped, for the writer (and the finalizer).
+        # Messages wait in _incoming until a quiet turn of the event loop (after the tick,
+        # the input, the command under way), so that a tick pays a list append per
+        # message, not an MCAP record each; _queue holds them stamped, for the writer (and
+        # the finalizer).
         self._incoming: list[Incoming] = []
         self._queue: list[Queued] = []
         self._drain_scheduled = False
@@ -365,13 +367,8 @@ class Recorder:
             return
         self._incoming.append((topic, t, data))
         if not self._drain_scheduled:
-            try:
-                loop = asyncio.get_running_loop()
-            except RuntimeError:  # no event loop: write now
-                self._drain()
-                return
             self._drain_scheduled = True
-            loop.call_soon(self._drain)
+            background.soon(self._drain)  # at once without an event loop
 
     def _stamp(self) -> None:
         """Give the incoming messages their log times and sequence numbers, in order."""
@@ -427,23 +424,20 @@ class Recorder:
             self._failed(exc)
 
     def _end_chunk_soon(self) -> None:
-        """End the chunk :data:`CHUNK_PAUSE` from now: what is ready meanwhile (the tick an
-        input calls for) goes first. At once without an event loop."""
-        try:
-            loop = asyncio.get_running_loop()
-        except RuntimeError:
-            self._flush()
-            return
+        """End the chunk in a background job: what is due meanwhile (the tick an input
+        calls for, its command) goes first. At once without an event loop."""
         if self._ending is None:
-            self._ending = loop.call_later(self._chunk_pause, self._end_chunk)
+            token = self._ending = object()
+            background.soon(lambda: self._end_chunk(token))
 
-    def _end_chunk(self) -> None:
-        self._ending = None
-        self._flush_safely()
+    def _end_chunk(self, token: object) -> None:
+        if self._ending is token:  # not for a file closed meanwhile
+            self._ending = None
+            self._flush_safely()
 
     def _timed_flush(self) -> None:
         self._flush_timer = None
-        self._flush_safely()
+        self._end_chunk_soon()
 
     def _flush_safely(self) -> None:
         """:meth:`_flush` from a timer: an error stops the recording, never the robot."""
@@ -521,9 +515,7 @@ class Recorder:
         if self._flush_timer is not None:
             self._flush_timer.cancel()
             self._flush_timer = None
-        if self._ending is not None:
-            self._ending.cancel()
-            self._ending = None
+        self._ending = None
         self._finalizer()
 
     def close(self) -> None:

@@ -7,7 +7,10 @@ into typed values with :data:`frog_bt.model.ros.ROS_TYPES`.
 
 * ``advertise``/``subscribe``/``publish``/... are plain synchronous calls, O(1)
   and never blocking, so behaviour-tree leaves may call them inside a tick.
-  Frames go onto an outbox drained, in order, by one writer task per
+  A frame is written to the socket at once when nothing is waiting before it and
+  the connection can take it without waiting (:func:`_write_now`: the command a
+  tick sends leaves while the tick goes on, not after it and what follows it);
+  otherwise it goes onto an outbox drained, in order, by one writer task per
   connection. While the link is down publishes wait in the Session's bounded
   queue (oldest dropped and counted).
 * The connect loop reconnects for ever with capped exponential backoff and,
@@ -35,6 +38,7 @@ from typing import Any
 
 from websockets.asyncio.client import ClientConnection, connect
 from websockets.exceptions import ConnectionClosed, InvalidURI, WebSocketException
+from websockets.protocol import State
 from websockets.uri import parse_uri
 
 from frog_bt.errors import DecodeError
@@ -53,6 +57,7 @@ from frog_bt.warning_limit import WarningLimiter
 __all__ = ["FRAME_TOPIC", "ClientStats", "LinkState", "RosbridgeClient", "backoff_delays"]
 
 log = logging.getLogger(__name__)
+_OPEN = State.OPEN
 
 FRAME_TOPIC = "<frame>"  # stats/warning key for frames too broken to name a topic
 # A frame above decode_frame's guard is counted as malformed; only far larger
@@ -342,9 +347,20 @@ class RosbridgeClient:
             self.stats.sent += 1
 
     def _enqueue(self, frames: list[str]) -> None:
-        if frames:
-            self._outbox.extend(frames)
-            self._wake.set()
+        if not frames:
+            return
+        out = self._outbox
+        if not out and self._ws is not None and self._link.connected:
+            # nothing before them, the writer idle: write now while the link takes them
+            i = 0
+            while i < len(frames) and _write_now(self._ws, frames[i]):
+                self.stats.sent += 1
+                i += 1
+            frames = frames[i:]
+            if not frames:
+                return
+        out.extend(frames)
+        self._wake.set()
 
     def _on_up(self, ws: Any) -> None:
         with contextlib.suppress(Exception):  # addresses only feed the auth MAC
@@ -478,6 +494,36 @@ class RosbridgeClient:
         held = self._throttle.allow(key)
         if held is not None:
             log.warning(fmt + "%s", *args, _held(held))
+
+
+def _write_now(ws: Any, text: str) -> bool:
+    """Write one text frame to ``ws`` now, when it can take it without waiting; False
+    (nothing written) otherwise: the writer task sends it, in order.
+
+    What websockets' ``send`` does for one text frame, minus its waits: the frame goes to
+    the sans-I/O protocol (``ws.protocol``) and its bytes to the transport, only while
+    the connection is open, no fragmented message is being sent and the transport's
+    buffer is empty (so no backpressure is skipped). A connection of another kind (a
+    test's in-memory wire, a websockets without these) always says False."""
+    if not isinstance(ws, ClientConnection):
+        return False
+    try:
+        if (
+            ws.protocol.state is not _OPEN
+            or ws.send_in_progress is not None
+            or ws.transport.get_write_buffer_size()
+            or ws.protocol.close_expected()
+        ):
+            return False
+        ws.protocol.send_text(text.encode())
+    except Exception:  # not as this websockets has it: leave the frame to the writer
+        return False
+    try:
+        ws.send_data()
+    except Exception as exc:  # written to the protocol: the link is broken, as send says
+        ws.set_connection_exc(exc)
+        ws.transport.abort()
+    return True
 
 
 def backoff_delays(initial: float, maximum: float) -> Iterator[float]:

@@ -14,6 +14,7 @@ from typing import Any, ClassVar, Literal
 import py_trees
 from pydantic import Field
 
+from frog_bt.engine.lean import LeanSelector, LeanSequence
 from frog_bt.engine.observed import Observed
 from frog_bt.model.key import Scope
 from frog_bt.tree.node import Params
@@ -50,7 +51,7 @@ class _Composite(Observed, py_trees.composites.Composite):
         return cls(name, memory=params.memory, children=children)  # type: ignore[call-arg]
 
 
-class Sequence(_Composite, py_trees.composites.Sequence):
+class Sequence(_Composite, LeanSequence):
     """Runs its children in order; SUCCESS when all succeed, FAILURE at the first that
     fails."""
 
@@ -61,7 +62,7 @@ class Sequence(_Composite, py_trees.composites.Sequence):
         scope: ScopeName | None = Field(None, description=SCOPE_DOC)
 
 
-class Selector(_Composite, py_trees.composites.Selector):
+class Selector(_Composite, LeanSelector):
     """Tries its children in order; SUCCESS at the first that succeeds, FAILURE when all
     fail."""
 

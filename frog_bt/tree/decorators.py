@@ -24,12 +24,13 @@ from typing import Any, TypeVar
 import py_trees
 from pydantic import BaseModel, Field
 
+from frog_bt.engine.lean import LeanDecorator
 from frog_bt.engine.observed import Observed
 from frog_bt.tree.node import FAILURE, RUNNING, Declared, Params, Status
 from frog_bt.tree.world import Channel, World
 
 
-class FrogDecorator(Observed, Declared, py_trees.decorators.Decorator):
+class FrogDecorator(Observed, Declared, LeanDecorator):
     """A decorator a tree file can name. One that is a py_trees decorator with our
     parameters lists that class among its bases and maps the parameters to its
     constructor's in :meth:`base_kwargs`."""

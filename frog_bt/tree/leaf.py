@@ -14,9 +14,9 @@ called twice.
 
 from __future__ import annotations
 
-import py_trees
 from pydantic import BaseModel
 
+from frog_bt.engine.lean import LeanBehaviour
 from frog_bt.engine.observed import Observed
 from frog_bt.tree.node import (
     FAILURE,
@@ -31,7 +31,7 @@ from frog_bt.tree.node import (
 __all__ = ["FAILURE", "INVALID", "RUNNING", "SUCCESS", "Leaf", "Params", "Status"]
 
 
-class Leaf(Observed, Declared, py_trees.behaviour.Behaviour):
+class Leaf(Observed, Declared, LeanBehaviour):
     def __init__(self, name: str, params: BaseModel | None = None) -> None:
         super().__init__(name)
         self._declare(params)

@@ -35,6 +35,7 @@ from frog_bt.model.links import Links, LinkStatus
 from frog_bt.model.run import RunId
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rehearsal import free_udp_port
+from frog_bt.runtime import background
 from frog_bt.runtime.observer import Observers, attach_all
 from frog_bt.sim import Simulator
 
@@ -282,15 +283,12 @@ def test_what_was_flushed_survives_a_kill(tmp_path: Path) -> None:
     async def run() -> None:
         executive = fake_executive()
         executive.clock.set(1_780_000_000.0)
-        # chunks end CHUNK_PAUSE after the drain that finds them due: here at once after it
-        recorder = Recorder(path, flush_every=0.0, chunk_pause=0.0)
+        recorder = Recorder(path, flush_every=0.0)
         attach_all(executive, [recorder])
         datagram, _ = wire_of(executive)
         for i in range(1, 31):
             datagram("in", b'{"type":"frontend_idle","seq":%d}' % i, 1_780_000_000.0 + i)
-            await asyncio.sleep(0)  # the drain runs once this callback is over
-        for _ in range(2):  # the drain, then the chunk's end it scheduled (a timer due now)
-            await asyncio.sleep(0)
+            await background.settled()  # the drain, then the chunk's end it asked for
         copy.write_bytes(path.read_bytes())  # what a kill -9 now would leave
         recorder.close()
 
@@ -303,21 +301,20 @@ def test_what_was_flushed_survives_a_kill(tmp_path: Path) -> None:
 
 
 def test_a_full_chunk_ends_after_the_tick_its_input_calls_for(tmp_path: Path) -> None:
-    """Closing a chunk (compressing it, writing each message's index entry) costs the loop
-    1-2 ms at high rates: a chunk found full in the drain after an input ends a moment
-    later, so that the tick the input called for (ready meanwhile) runs first."""
+    """Closing a chunk (compressing it, writing its message index) costs the loop up to a
+    millisecond at high rates: the drain after an input, and the chunk's end it finds due,
+    are background jobs, so the tick the input called for (ready meanwhile) runs first."""
     path = tmp_path / "chunks.mcap"
     seen: list[tuple[str, int]] = []
 
     async def run() -> None:
         executive = fake_executive()
         executive.clock.set(1_780_000_000.0)
-        recorder = Recorder(path, chunk_size=2000, chunk_pause=0.0)
+        recorder = Recorder(path, chunk_size=2000)
         attach_all(executive, [recorder])
         datagram, _ = wire_of(executive)
         loop = asyncio.get_running_loop()
-        for _ in range(3):  # the drain, the first chunk's end (primer, tree), settled
-            await asyncio.sleep(0)
+        await background.settled()  # the drain, the first chunk's end (primer, tree)
         stream = recorder._stream  # its position: what mcap wrote, buffered or not
         written = stream.tell()
 
@@ -327,8 +324,8 @@ def test_a_full_chunk_ends_after_the_tick_its_input_calls_for(tmp_path: Path) ->
             loop.call_soon(lambda: seen.append(("tick", stream.tell() - written)))
 
         loop.call_soon(an_input)
-        for _ in range(4):
-            await asyncio.sleep(0)
+        await asyncio.sleep(0)  # the input runs, then the tick it calls for
+        await background.settled()
         seen.append(("after", stream.tell() - written))
         recorder.close()
 

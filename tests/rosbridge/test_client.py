@@ -149,6 +149,36 @@ def test_publish_reaches_server_with_ids_in_order() -> None:
     run(main())
 
 
+def test_a_publish_on_an_idle_link_is_written_before_the_tick_goes_on() -> None:
+    """A command sent inside a tick leaves at once (the transport has it before the call
+    returns), not once the tick and what follows it are over; with a frame already
+    waiting (the transport's buffer not empty), it goes behind it, in order."""
+
+    async def main() -> None:
+        rec = Recorder()
+        async with FakeRosbridge() as server, client_for(server.url, rec) as client:
+            client.advertise("/docking/dock", "std_msgs/String")
+            client.start()
+            assert await client.wait_connected(5)
+            await server.take(1)
+            await client.flush(5)
+            sent = client.stats.sent
+            client.publish("/docking/dock", encode_string("undock"))  # no await since
+            assert client.stats.sent == sent + 1 and not client._outbox
+            ws = client._ws
+            assert ws is not None
+            real = ws.transport.get_write_buffer_size  # a busy buffer, as on a slow link
+            ws.transport.get_write_buffer_size = lambda: 1  # type: ignore[method-assign]
+            client.publish("/docking/dock", encode_string("dock"))
+            client.publish("/docking/dock", encode_string("undock"))
+            assert len(client._outbox) == 2  # behind what the transport holds, in order
+            ws.transport.get_write_buffer_size = real  # type: ignore[method-assign]
+            frames = await server.take(3)
+            assert [f["msg"]["data"] for f in frames] == ["undock", "dock", "undock"]
+
+    run(main())
+
+
 def test_subscribe_to_a_type_without_decoder_is_refused() -> None:
     client = RosbridgeClient("ws://127.0.0.1:9")
     with pytest.raises(ValueError, match="no decoder"):

@@ -17,7 +17,6 @@ logged where: ``docs/TELEMETRY.md``.
 
 from __future__ import annotations
 
-import asyncio
 import logging
 from collections import deque
 from collections.abc import Iterator
@@ -26,6 +25,7 @@ from typing import TYPE_CHECKING
 from frog_bt.live.telemetry.layout import TreeIndex, tidy_layout
 from frog_bt.live.telemetry.observer import TelemetryObserver
 from frog_bt.live.telemetry.spec import Sink, parse_spec
+from frog_bt.runtime import background
 
 if TYPE_CHECKING:
     from rerun import RecordingStream
@@ -38,7 +38,6 @@ __all__ = ["Sink", "Telemetry", "TreeIndex", "parse_spec", "tidy_layout"]
 log = logging.getLogger(__name__)
 BATCH_TICKS = 50  # rows are written every this many ticks (5 s at 10 Hz), and on flush()
 CLOSE_TIMEOUT = 5.0  # seconds close() waits for the sink
-STEP_PAUSE = 0.0005  # seconds between two steps of writing a batch (see Telemetry._step)
 
 
 class Telemetry(TelemetryObserver):
@@ -104,9 +103,9 @@ class Telemetry(TelemetryObserver):
             log.exception("rerun telemetry: could not write the links")
 
     def _flush_soon(self) -> None:
-        """Write the rows in steps (:meth:`Writer.steps`) with short pauses between them,
-        so that an input arriving meanwhile waits for one step (a fraction of a
-        millisecond), not for the whole batch."""
+        """Write the rows in steps (:meth:`Writer.steps`), each a background job
+        (:mod:`frog_bt.runtime.background`), so that an input arriving meanwhile waits for
+        one step at most (a fraction of a millisecond), not for the whole batch."""
         self._flush_pending = False
         if self._closed:
             return
@@ -120,10 +119,9 @@ class Telemetry(TelemetryObserver):
         while self._writing and not self._next_step():
             pass
         if self._writing:
-            # A short pause between steps lets what is ready (an input, the tick it calls
-            # for, the frames that tick sends) go first; with batches queued, no pause.
-            pause = STEP_PAUSE if len(self._writing) == 1 else 0.0
-            asyncio.get_running_loop().call_later(pause, self._step)
+            # the next step at a quiet turn: what is due (an input, the tick it calls
+            # for, the frames that tick sends) goes first
+            background.soon(self._step)
 
     def _next_step(self) -> bool:
         """One step of the oldest batch being written; False when that batch is done."""

@@ -8,9 +8,11 @@ queue to a child process that owns the rerun recording stream
 logging. So:
 
 * the tick never waits for rerun: the batch is pickled once the tick is over, in
-  steps of :data:`STEP_ROWS` rows with a pause between them, so that an input
-  arriving meanwhile (and the tick it calls for) goes first: it waits for one step
-  (~0.1 ms), never for a whole batch (1-3 ms with many inputs); the queue's feeder
+  steps of :data:`STEP_ROWS` rows, each a background job
+  (:mod:`frog_bt.runtime.background`: at a quiet turn of the event loop), so that an
+  input arriving meanwhile (and the tick it calls for, and its command) goes first: it
+  waits for one step at most (~0.1 ms), never for a whole batch (1-3 ms with many
+  inputs); the queue's feeder
   thread only copies bytes; the child merges batches for a file
   (:class:`_Pending`: fewer, larger rerun chunks, a smaller file);
 * the rerun SDK's own memory, which grows with every row it has logged (see
@@ -28,7 +30,6 @@ event loop); on platforms without ``fork`` the live executive writes in-process.
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import io
 import logging
@@ -53,6 +54,7 @@ from frog_bt.live.telemetry.rows import Batch
 from frog_bt.live.telemetry.spec import parse_spec
 from frog_bt.model.links import LinkStatus
 from frog_bt.model.wire import INPUTS
+from frog_bt.runtime import background
 from frog_bt.warning_limit import WarningLimiter
 
 if TYPE_CHECKING:
@@ -64,12 +66,11 @@ log = logging.getLogger(__name__)
 QUEUE_BATCHES = 64  # batches waiting for the child (50 ticks each: 5 minutes at 10 Hz)
 RECYCLE_ROWS = 250_000  # rows a child writes before a fresh one takes over (~20 min)
 CLOSE_TIMEOUT = 6.0  # seconds close() waits for the child to finish its file
-NICE = 5  # the child's niceness: when both are ready, the executive's inputs go first
+NICE = 19  # the child's niceness where SCHED_IDLE is missing (it runs only when idle)
 TIMINGS = 1000  # hand-overs whose cost is kept (Timings), for scripts/bench
 MERGE_BATCHES = 10  # batches a save: file is written in at once (500 ticks, 50 s at 10 Hz)
 HOLD = 60.0  # seconds the child holds a batch for a save: file at most
 STEP_ROWS = 64  # rows pickled per step of a batch (~0.1 ms; an input waits for one step)
-STEP_PAUSE = 0.0005  # seconds between two steps: what is ready (an input, its tick) goes first
 
 
 def available() -> bool:
@@ -201,6 +202,19 @@ class _Pending:
             log.exception("rerun telemetry: could not write a batch")
 
 
+def _yield_to_the_robot() -> str:
+    """Run this process (and the threads it starts: rerun's) only when a CPU would
+    otherwise be idle (``SCHED_IDLE``), or at the lowest niceness where that class is
+    missing; the policy it got."""
+    with contextlib.suppress(AttributeError, OSError):
+        os.sched_setscheduler(0, os.SCHED_IDLE, os.sched_param(0))
+        return "idle"
+    with contextlib.suppress(OSError):
+        os.nice(NICE)
+        return f"nice {NICE}"
+    return "normal"
+
+
 def _serve(
     spec: str,
     site: Site,
@@ -211,8 +225,7 @@ def _serve(
     """The child: write what comes until ``close`` (or the parent is gone)."""
     from frog_bt.live.telemetry import Telemetry
 
-    with contextlib.suppress(OSError):
-        os.nice(NICE)
+    _yield_to_the_robot()
     telemetry = Telemetry.open(spec, site, tree, recording_id=recording_id)
     pending = _Pending(telemetry, live=parse_spec(spec).kind != "save")
     try:
@@ -280,7 +293,7 @@ class TelemetryProcess(TelemetryObserver):
         self.dropped = 0  # batches not written (the queue was full)
         self._written = 0  # rows sent to the current child
         self._serialising: deque[Serialising] = deque()  # batches being pickled, oldest first
-        self._stepping: asyncio.TimerHandle | None = None  # the next step, when one is due
+        self._stepping = False  # a step is due (a background job)
         self._warnings = WarningLimiter(60.0, logger=log)
         self._start_child()
 
@@ -330,14 +343,15 @@ class TelemetryProcess(TelemetryObserver):
         batch = self.rows.drain()
         if len(batch):
             self._serialising.append(Serialising(batch))
-            if self._stepping is None:
-                self._step()
+            if not self._stepping:
+                self._stepping = True
+                background.soon(self._step)
 
     def _step(self) -> None:
-        """One step of the oldest batch being pickled (handed over when done); then a
-        short pause, in which an input that is ready, and the tick it calls for, go
-        first (no pause while batches queue up behind it)."""
-        self._stepping = None
+        """One step of the oldest batch being pickled (handed over when done); the next
+        is another background job: an input that is ready, the tick it calls for and its
+        command go first."""
+        self._stepping = False
         if not self._serialising or self._closed:
             return
         work = self._serialising[0]
@@ -348,8 +362,8 @@ class TelemetryProcess(TelemetryObserver):
             self._serialising.popleft()
             self._hand_over(work)
         if self._serialising:
-            pause = STEP_PAUSE if len(self._serialising) == 1 else 0.0
-            self._stepping = asyncio.get_running_loop().call_later(pause, self._step)
+            self._stepping = True
+            background.soon(self._step)
 
     def flush(self) -> None:
         """Send the buffered rows to the child now, after any batch still being pickled
@@ -357,10 +371,7 @@ class TelemetryProcess(TelemetryObserver):
         self._flush_pending = False
         if self._closed:
             return
-        if self._stepping is not None:
-            self._stepping.cancel()
-            self._stepping = None
-        while self._serialising:
+        while self._serialising:  # a step still due finds none left
             self._hand_over(self._serialising.popleft())
         batch = self.rows.drain()
         if len(batch):

@@ -1,0 +1,125 @@
+"""Work that yields to the robot: telemetry's writing runs when the event loop is quiet.
+
+The recorder's writing (encoding, ``add_message``, ending a chunk) and telemetry's
+pickling are not on the tick, but they share the executive's one thread with it. A
+datagram that arrives while a chunk is being compressed waits for it (0.5-2 ms), and so
+does the tick it calls for and the command that tick sends. :func:`soon` runs such work
+as a *background job* instead: one job per turn of the event loop, and only when nothing
+else is due — no callback ready (an input's, a tick's, a command being written) and no
+socket with something to read. A job that finds the loop busy waits for the next turn,
+at most :data:`MAX_WAIT`; then it runs all the same, so telemetry is never starved.
+
+The test of "busy" reads two attributes of CPython's selector event loop (``_ready``,
+the callbacks due now, and ``_selector``, polled without waiting); on a loop without
+them every job runs at its turn, in order, as ``call_soon`` would. Without a running
+loop (a replay, a test) :func:`soon` runs the job at once.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import time
+import weakref
+from collections import deque
+from collections.abc import Callable
+
+log = logging.getLogger(__name__)
+
+MAX_WAIT = 0.005  # seconds a job waits for a quiet turn at most; then it runs anyway
+
+Job = Callable[[], None]
+
+
+class Background:
+    """The background jobs of one event loop, run in the order they came (see the module
+    docstring). Each job guards its own errors; one that raises is logged and the next
+    runs."""
+
+    def __init__(self, loop: asyncio.AbstractEventLoop, max_wait: float = MAX_WAIT) -> None:
+        self.loop = loop
+        self.max_wait = max_wait
+        self._jobs: deque[tuple[float, Job]] = deque()
+        self._turn: asyncio.Handle | None = None
+        self.waited = 0  # turns a job let go by because the loop was busy
+        self.forced = 0  # jobs run busy or not, after MAX_WAIT
+        self._settled: list[asyncio.Future[None]] = []  # settled()'s waiters
+
+    def __len__(self) -> int:
+        return len(self._jobs)
+
+    def call(self, job: Job) -> None:
+        """Run ``job`` at a quiet turn of the loop, after the jobs before it."""
+        self._jobs.append((time.monotonic(), job))
+        if self._turn is None:
+            self._turn = self.loop.call_soon(self._run)
+
+    def busy(self) -> bool:
+        """Is something more urgent due: a callback ready, or a socket with input?"""
+        if getattr(self.loop, "_ready", None):
+            return True
+        selector = getattr(self.loop, "_selector", None)
+        return selector is not None and bool(selector.select(0))
+
+    def _run(self) -> None:
+        self._turn = None
+        if not self._jobs:
+            return
+        since, job = self._jobs[0]
+        if self.busy():
+            if time.monotonic() - since < self.max_wait:
+                self.waited += 1
+                self._turn = self.loop.call_soon(self._run)
+                return
+            self.forced += 1
+        self._jobs.popleft()
+        try:
+            job()
+        except Exception:
+            log.exception("background job %r failed", job)
+        if self._jobs:
+            if self._turn is None:
+                self._turn = self.loop.call_soon(self._run)
+        else:
+            self._wake_settled()
+
+    async def settled(self) -> None:
+        """Return once no job is waiting (a test's, a writer's closing wait)."""
+        while self._jobs:
+            waiter = self.loop.create_future()
+            self._settled.append(waiter)
+            await waiter
+
+    def _wake_settled(self) -> None:
+        waiters, self._settled = self._settled, []
+        for waiter in waiters:
+            if not waiter.done():
+                waiter.set_result(None)
+
+
+_LOOPS: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, Background] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def of(loop: asyncio.AbstractEventLoop) -> Background:
+    """The background jobs of ``loop`` (made on first use; they go with the loop)."""
+    jobs = _LOOPS.get(loop)
+    if jobs is None:
+        jobs = _LOOPS[loop] = Background(loop)
+    return jobs
+
+
+async def settled() -> None:
+    """Return once the running loop's background jobs are all done."""
+    await of(asyncio.get_running_loop()).settled()
+
+
+def soon(job: Job) -> None:
+    """Run ``job`` at a quiet turn of the running loop; at once without one."""
+    try:
+        loop = asyncio.get_running_loop()
+    except RuntimeError:
+        job()
+        return
+    of(loop).call(job)

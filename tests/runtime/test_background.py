@@ -1,0 +1,95 @@
+"""Background jobs (telemetry's writing) run at a quiet turn of the loop, in order, and
+are never starved."""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+
+from frog_bt.runtime import background
+
+
+def test_a_job_runs_after_the_callbacks_that_are_due() -> None:
+    async def scenario() -> list[str]:
+        order: list[str] = []
+        loop = asyncio.get_running_loop()
+        background.soon(lambda: order.append("job"))
+        loop.call_soon(lambda: order.append("input"))
+        loop.call_soon(lambda: loop.call_soon(lambda: order.append("its tick")))
+        await background.settled()
+        return order
+
+    assert asyncio.run(scenario()) == ["input", "its tick", "job"]
+
+
+def test_a_job_waits_for_a_datagram_that_has_arrived() -> None:
+    """Input waiting on a socket goes first, though its callback is not due yet."""
+
+    async def scenario() -> list[str]:
+        order: list[str] = []
+        loop = asyncio.get_running_loop()
+
+        class Receiver(asyncio.DatagramProtocol):
+            def datagram_received(self, data: bytes, addr: object) -> None:
+                order.append(data.decode())
+
+        transport, _ = await loop.create_datagram_endpoint(
+            Receiver, local_addr=("127.0.0.1", 0)
+        )
+        try:
+            with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as peer:
+
+                def arrives_during_a_callback() -> None:
+                    peer.sendto(b"user_positive", transport.get_extra_info("sockname"))
+                    background.soon(lambda: order.append("job"))
+
+                loop.call_soon(arrives_during_a_callback)
+                await asyncio.sleep(0)
+                await background.settled()
+        finally:
+            transport.close()
+        return order
+
+    assert asyncio.run(scenario()) == ["user_positive", "job"]
+
+
+def test_jobs_run_in_order_and_a_failing_one_is_logged(caplog) -> None:  # type: ignore[no-untyped-def]
+    async def scenario() -> list[int]:
+        done: list[int] = []
+        background.soon(lambda: done.append(1))
+        background.soon(lambda: 1 / 0)  # type: ignore[func-returns-value]
+        background.soon(lambda: done.append(3))
+        await background.settled()
+        return done
+
+    assert asyncio.run(scenario()) == [1, 3]
+    assert "background job" in caplog.text and "ZeroDivisionError" in caplog.text
+
+
+def test_a_job_is_not_starved_by_a_loop_that_never_rests() -> None:
+    """A loop with a callback always due still runs the job, after ``max_wait``."""
+
+    async def scenario() -> tuple[bool, int, int]:
+        loop = asyncio.get_running_loop()
+        jobs = background.Background(loop, max_wait=0.002)
+        ran: list[bool] = []
+        spinning = [True]
+
+        def spin() -> None:
+            if spinning[0]:
+                loop.call_soon(spin)
+
+        spin()
+        jobs.call(lambda: ran.append(True))
+        await jobs.settled()
+        spinning[0] = False
+        return bool(ran), jobs.forced, jobs.waited
+
+    ran, forced, waited = asyncio.run(scenario())
+    assert ran and forced == 1 and waited > 0
+
+
+def test_without_an_event_loop_a_job_runs_at_once() -> None:
+    done: list[str] = []
+    background.soon(lambda: done.append("now"))
+    assert done == ["now"]
