@@ -44,8 +44,9 @@ at a quiet turn of the event loop, after any input, tick or command that is due)
 order (an event is kept as it is until then); chunks are bounded (:data:`CHUNK_SIZE`,
 ended by the recorder in a background job of its own) and flushed at least every
 :data:`FLUSH_EVERY` wall seconds, so memory stays small and a crash loses little.
-Each chunk's message index is written by :func:`frog_bt.live.mcap_index.install`'s
-packing, byte for byte as mcap's own and several times faster.
+Chunks are zstd-compressed; :func:`frog_bt.live.mcap_speed.install` makes ending one
+several times cheaper (its message index packed at once, one compressor reused), byte
+for byte as mcap's own.
 :meth:`Recorder.close` (idempotent, also run at interpreter exit) writes the summary
 and footer: a recording stays valid MCAP when the run command stops on SIGTERM, or on
 an exception.
@@ -72,7 +73,7 @@ from frog_bt import __version__
 from frog_bt.config import fingerprint
 from frog_bt.errors import DecodeError
 from frog_bt.frontend.protocol import decode_datagram
-from frog_bt.live import mcap_index
+from frog_bt.live import mcap_speed
 from frog_bt.model import channels
 from frog_bt.model.channels import (
     DATAGRAM_TYPE,
@@ -113,13 +114,16 @@ if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host
 
 log = logging.getLogger(__name__)
-mcap_index.install()
+mcap_speed.install()
 
-CHUNK_SIZE = 256 * 1024  # bytes of uncompressed messages per chunk
-# Closing a chunk costs the event loop ~0.2 ms plus ~0.2 µs a message (compressing it,
-# writing its message index). mcap would close it inside whichever add_message crossed
-# the size, i.e. in the drain right after an input, before the tick that input calls
-# for; the recorder ends chunks itself, in a background job, so that the tick goes first.
+# Chunks of 64 KiB compressed with zstd: closing one (compressing it, writing its message
+# index) holds the event loop ~0.2 ms (at most ~0.45), where 256 KiB with LZ4 held it
+# 0.6-1 ms, and the file is about a quarter smaller (docs/PERFORMANCE.md). mcap would
+# close a chunk inside whichever add_message crossed the size, i.e. in the drain right
+# after an input, before the tick that input calls for; the recorder ends chunks itself,
+# in a background job, so that the tick goes first.
+CHUNK_SIZE = 64 * 1024  # bytes of uncompressed messages per chunk
+DRAIN_STEP = 100  # messages written in one background job (~0.1 ms)
 _UNBOUNDED = 1 << 62  # mcap's own chunk size: never reached (the recorder ends chunks)
 _RECORD = 31  # bytes of an MCAP message record besides its data (opcode, length, header)
 FLUSH_EVERY = 1.0  # wall seconds between chunk flushes: a kill loses at most this much
@@ -190,6 +194,9 @@ class Recorder:
         self._drain_scheduled = False
         self._flush_timer: asyncio.TimerHandle | None = None
         self._syncing = False
+        self._unsynced = False  # handed to the OS since the last fsync began
+        self._synced_at = 0.0  # when the last fsync began (monotonic)
+        self._sync_timer: asyncio.TimerHandle | None = None
         self._registered: dict[str, str] = {}  # topic -> type, for the next file too
         self._last_ns = 0
         self._held: list[tuple[str, bytes | Recorded]] = []
@@ -217,14 +224,7 @@ class Recorder:
         stream: IO[bytes] = os.fdopen(fd, "wb")  # closed by _finish
         os.fchmod(fd, RECORDING_MODE)  # also when the file was there before
         self._stream = stream
-        compression = CompressionType.NONE
-        try:
-            import lz4.frame  # noqa: F401 - optional, chosen only when installed
-
-            compression = CompressionType.LZ4
-        except ImportError:
-            pass
-        self._writer = Writer(stream, chunk_size=_UNBOUNDED, compression=compression)
+        self._writer = Writer(stream, chunk_size=_UNBOUNDED, compression=CompressionType.ZSTD)
         self._chunk_bytes = 0  # in the chunk being written (its uncompressed size)
         self._writer.start(profile="", library=f"frog-bt {__version__}")
         if metadata:
@@ -366,9 +366,7 @@ class Recorder:
         if self.closed:
             return
         self._incoming.append((topic, t, data))
-        if not self._drain_scheduled:
-            self._drain_scheduled = True
-            background.soon(self._drain)  # at once without an event loop
+        self._drain_soon()
 
     def _stamp(self) -> None:
         """Give the incoming messages their log times and sequence numbers, in order."""
@@ -400,20 +398,30 @@ class Recorder:
         self.messages += 1
 
     def _drain(self) -> None:
-        """Write the queued messages, in order; flush a chunk every ``flush_every`` s."""
+        """Write the queued messages, in order, at most :data:`DRAIN_STEP` in a job (the
+        rest in the next) and never past a full chunk: a chunk that is full or
+        ``flush_every`` s old is ended first (:meth:`_end_chunk`, which drains on)."""
         self._drain_scheduled = False
         if self.closed:
             return  # close() wrote them
         try:
             self._stamp()
-            queue = self._queue
-            self._chunk_bytes += sum(len(q[2]) for q in queue) + _RECORD * len(queue)
-            _write_queued(self._writer, queue)
-            if (
-                self._chunk_bytes >= self._chunk_size
-                or time.monotonic() - self._flushed_at >= self._flush_every
-            ):
+            if self._ending is not None:
+                return  # the chunk is due to end: its end drains on after it
+            queue, writer, size = self._queue, self._writer, self._chunk_size
+            n = 0
+            for cid, ns, data, seq in queue:
+                if n == DRAIN_STEP or self._chunk_bytes >= size:
+                    break
+                writer.add_message(cid, log_time=ns, data=data, publish_time=ns, sequence=seq)
+                self._chunk_bytes += len(data) + _RECORD
+                n += 1
+            del queue[:n]  # in place: the finalizer holds this list
+            due = time.monotonic() - self._flushed_at >= self._flush_every
+            if self._chunk_bytes >= size or due:
                 self._end_chunk_soon()
+            elif queue:
+                self._drain_soon()
             elif self._flush_timer is None:  # a quiet spell must not keep the tail back
                 try:
                     loop = asyncio.get_running_loop()
@@ -422,6 +430,11 @@ class Recorder:
                 self._flush_timer = loop.call_later(self._flush_every, self._timed_flush)
         except Exception as exc:  # disk full, ...: stop recording, never stop the robot
             self._failed(exc)
+
+    def _drain_soon(self) -> None:
+        if not self._drain_scheduled:
+            self._drain_scheduled = True
+            background.soon(self._drain)  # at once without an event loop
 
     def _end_chunk_soon(self) -> None:
         """End the chunk in a background job: what is due meanwhile (the tick an input
@@ -434,6 +447,8 @@ class Recorder:
         if self._ending is token:  # not for a file closed meanwhile
             self._ending = None
             self._flush_safely()
+            if self._queue or self._incoming:
+                self._drain_soon()
 
     def _timed_flush(self) -> None:
         self._flush_timer = None
@@ -449,20 +464,43 @@ class Recorder:
 
     def _flush(self) -> None:
         """End the chunk and hand it to the OS (a kill -9 then loses nothing of it), and
-        ask for it on the disk (power loss) in a worker thread, off the event loop."""
+        ask for it on the disk (power loss): :meth:`_sync_soon`."""
         self._flushed_at = time.monotonic()
         self._chunk_bytes = 0
         self._writer.flush()
         self._stream.flush()
-        if self._syncing:
-            return
+        self._unsynced = True
+        self._sync_soon()
+
+    def _sync_soon(self) -> None:
+        """``fsync`` what was handed to the OS, in a worker thread, off the event loop, at
+        most once every ``flush_every`` seconds (chunks end more often at high rates;
+        each sync wakes a thread): a power loss loses at most that long."""
+        if self._syncing or self._sync_timer is not None:
+            return  # the sync under way, or the one due, covers it (_synced)
         try:
             loop = asyncio.get_running_loop()
         except RuntimeError:
             return
-        self._syncing = True
-        future = loop.run_in_executor(None, _fsync, self._stream)
-        future.add_done_callback(lambda _f: setattr(self, "_syncing", False))
+        wait = self._synced_at + self._flush_every - time.monotonic()
+        if wait > 0:
+            self._sync_timer = loop.call_later(wait, self._sync_now)
+        else:
+            self._sync_now()
+
+    def _sync_now(self) -> None:
+        self._sync_timer = None
+        if self.closed or not self._unsynced:
+            return
+        self._unsynced, self._syncing = False, True
+        self._synced_at = time.monotonic()
+        future = asyncio.get_running_loop().run_in_executor(None, _fsync, self._stream)
+        future.add_done_callback(self._synced)
+
+    def _synced(self, _future: object) -> None:
+        self._syncing = False
+        if self._unsynced:  # handed to the OS while that sync ran
+            self._sync_soon()
 
     def _failed(self, exc: Exception) -> None:
         log.error("recording to %s stopped: %s", self.path, exc)
@@ -515,6 +553,10 @@ class Recorder:
         if self._flush_timer is not None:
             self._flush_timer.cancel()
             self._flush_timer = None
+        if self._sync_timer is not None:
+            self._sync_timer.cancel()
+            self._sync_timer = None
+        self._unsynced = False
         self._ending = None
         self._finalizer()
 

@@ -7,10 +7,11 @@ into typed values with :data:`frog_bt.model.ros.ROS_TYPES`.
 
 * ``advertise``/``subscribe``/``publish``/... are plain synchronous calls, O(1)
   and never blocking, so behaviour-tree leaves may call them inside a tick.
-  A frame is written to the socket at once when nothing is waiting before it and
-  the connection can take it without waiting (:func:`_write_now`: the command a
-  tick sends leaves while the tick goes on, not after it and what follows it);
-  otherwise it goes onto an outbox drained, in order, by one writer task per
+  A frame is written to the socket at once, while the connection takes it
+  without waiting (:meth:`RosbridgeClient._write_waiting`): the command a tick
+  sends leaves while the tick goes on, not after the tick and whatever the event
+  loop has queued behind it (the observers, telemetry). What the connection does
+  not take at once waits in an outbox drained, in order, by one writer task per
   connection. While the link is down publishes wait in the Session's bounded
   queue (oldest dropped and counted).
 * The connect loop reconnects for ever with capped exponential backoff and,
@@ -134,6 +135,7 @@ class RosbridgeClient:
         self._link = LinkState(connected=False, since=time.monotonic())
         self._throttle = WarningLimiter(logger=log)
         self._outbox: deque[str] = deque()  # frames for the current connection, in order
+        self._writing = False  # the writer task is sending the outbox's first frame
         self._wake = asyncio.Event()  # outbox became non-empty
         self._drained = asyncio.Event()  # the writer found the outbox empty
         self._up = asyncio.Event()  # set while connected
@@ -342,25 +344,31 @@ class RosbridgeClient:
                 continue
             # Peek, send, then pop: a frame whose send failed is still in the
             # outbox when the link goes down, and publishes there are re-queued.
-            await ws.send(out[0])
+            # (_writing: write_now leaves the outbox alone until it is popped.)
+            self._writing = True
+            try:
+                await ws.send(out[0])
+            finally:
+                self._writing = False
             out.popleft()
             self.stats.sent += 1
 
     def _enqueue(self, frames: list[str]) -> None:
-        if not frames:
-            return
-        out = self._outbox
-        if not out and self._ws is not None and self._link.connected:
-            # nothing before them, the writer idle: write now while the link takes them
-            i = 0
-            while i < len(frames) and _write_now(self._ws, frames[i]):
+        if frames:
+            self._outbox.extend(frames)
+            if self._write_waiting():
+                self._wake.set()  # the writer task sends the rest
+
+    def _write_waiting(self) -> bool:
+        """Write the frames waiting in the outbox, in order, now, as far as the
+        connection takes them without waiting (:func:`_write_now`); none while the
+        writer task is sending one (it pops it when done). True when some are left."""
+        ws, out = self._ws, self._outbox
+        if ws is not None and not self._writing and self._link.connected:
+            while out and _write_now(ws, out[0]):
+                out.popleft()
                 self.stats.sent += 1
-                i += 1
-            frames = frames[i:]
-            if not frames:
-                return
-        out.extend(frames)
-        self._wake.set()
+        return bool(out)
 
     def _on_up(self, ws: Any) -> None:
         with contextlib.suppress(Exception):  # addresses only feed the auth MAC

@@ -149,10 +149,11 @@ def test_publish_reaches_server_with_ids_in_order() -> None:
     run(main())
 
 
-def test_a_publish_on_an_idle_link_is_written_before_the_tick_goes_on() -> None:
-    """A command sent inside a tick leaves at once (the transport has it before the call
-    returns), not once the tick and what follows it are over; with a frame already
-    waiting (the transport's buffer not empty), it goes behind it, in order."""
+def test_a_command_leaves_when_it_is_sent() -> None:
+    """A publish is written to the transport before the call returns (a command a tick
+    sends leaves while the tick goes on, not after it and what the loop has queued);
+    with the transport's buffer busy (a slow link) it waits for the writer task, and
+    what comes after it waits behind it, in order."""
 
     async def main() -> None:
         rec = Recorder()
@@ -171,10 +172,11 @@ def test_a_publish_on_an_idle_link_is_written_before_the_tick_goes_on() -> None:
             ws.transport.get_write_buffer_size = lambda: 1  # type: ignore[method-assign]
             client.publish("/docking/dock", encode_string("dock"))
             client.publish("/docking/dock", encode_string("undock"))
-            assert len(client._outbox) == 2  # behind what the transport holds, in order
+            assert len(client._outbox) == 2
             ws.transport.get_write_buffer_size = real  # type: ignore[method-assign]
             frames = await server.take(3)
             assert [f["msg"]["data"] for f in frames] == ["undock", "dock", "undock"]
+            assert client.stats.sent == sent + 3
 
     run(main())
 

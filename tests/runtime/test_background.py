@@ -33,9 +33,7 @@ def test_a_job_waits_for_a_datagram_that_has_arrived() -> None:
             def datagram_received(self, data: bytes, addr: object) -> None:
                 order.append(data.decode())
 
-        transport, _ = await loop.create_datagram_endpoint(
-            Receiver, local_addr=("127.0.0.1", 0)
-        )
+        transport, _ = await loop.create_datagram_endpoint(Receiver, local_addr=("127.0.0.1", 0))
         try:
             with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as peer:
 
