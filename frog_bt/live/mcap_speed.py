@@ -57,9 +57,9 @@ def _write(self: records.MessageIndex, stream: Any) -> None:
 def install() -> None:
     """Make mcap's writer use :func:`_write` and one reused compressor (idempotent)."""
     records.MessageIndex.write = _write  # type: ignore[method-assign]
-    if not isinstance(mcap.writer.zstandard, SimpleNamespace):
+    if not isinstance(getattr(mcap.writer, "zstandard", None), SimpleNamespace):
         compressor = zstandard.ZstdCompressor(level=ZSTD_LEVEL)
-        mcap.writer.zstandard = SimpleNamespace(compress=compressor.compress)  # type: ignore[attr-defined]
+        setattr(mcap.writer, "zstandard", SimpleNamespace(compress=compressor.compress))  # noqa: B010
 
 
 def original() -> Any:

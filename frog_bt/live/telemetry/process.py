@@ -66,7 +66,7 @@ log = logging.getLogger(__name__)
 QUEUE_BATCHES = 64  # batches waiting for the child (50 ticks each: 5 minutes at 10 Hz)
 RECYCLE_ROWS = 250_000  # rows a child writes before a fresh one takes over (~20 min)
 CLOSE_TIMEOUT = 6.0  # seconds close() waits for the child to finish its file
-NICE = 19  # the child's niceness where SCHED_IDLE is missing (it runs only when idle)
+NICE = 5  # the child's niceness: when both are ready, the executive's inputs go first
 TIMINGS = 1000  # hand-overs whose cost is kept (Timings), for scripts/bench
 MERGE_BATCHES = 10  # batches a save: file is written in at once (500 ticks, 50 s at 10 Hz)
 HOLD = 60.0  # seconds the child holds a batch for a save: file at most
@@ -202,19 +202,6 @@ class _Pending:
             log.exception("rerun telemetry: could not write a batch")
 
 
-def _yield_to_the_robot() -> str:
-    """Run this process (and the threads it starts: rerun's) only when a CPU would
-    otherwise be idle (``SCHED_IDLE``), or at the lowest niceness where that class is
-    missing; the policy it got."""
-    with contextlib.suppress(AttributeError, OSError):
-        os.sched_setscheduler(0, os.SCHED_IDLE, os.sched_param(0))
-        return "idle"
-    with contextlib.suppress(OSError):
-        os.nice(NICE)
-        return f"nice {NICE}"
-    return "normal"
-
-
 def _serve(
     spec: str,
     site: Site,
@@ -225,7 +212,8 @@ def _serve(
     """The child: write what comes until ``close`` (or the parent is gone)."""
     from frog_bt.live.telemetry import Telemetry
 
-    _yield_to_the_robot()
+    with contextlib.suppress(OSError):
+        os.nice(NICE)
     telemetry = Telemetry.open(spec, site, tree, recording_id=recording_id)
     pending = _Pending(telemetry, live=parse_spec(spec).kind != "save")
     try:
