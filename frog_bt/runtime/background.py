@@ -8,6 +8,10 @@ as a *background job* instead: one job per turn of the event loop, and only when
 else is due — no callback ready (an input's, a tick's, a command being written) and no
 socket with something to read. A job that finds the loop busy waits for the next turn,
 at most :data:`MAX_WAIT`; then it runs all the same, so telemetry is never starved.
+For :data:`HOLD` after each tick (:func:`hold`, called by the executive) no job starts
+either: the answers to the commands a tick sent (a front end's ack, a robot's reply)
+often come within a millisecond, and go first; the job waits on a timer meanwhile, not
+in a spin.
 
 The test of "busy" reads two attributes of CPython's selector event loop (``_ready``,
 the callbacks due now, and ``_selector``, polled without waiting); on a loop without
@@ -27,6 +31,7 @@ from collections.abc import Callable
 log = logging.getLogger(__name__)
 
 MAX_WAIT = 0.005  # seconds a job waits for a quiet turn at most; then it runs anyway
+HOLD = 0.001  # seconds after a tick in which no job starts: the answers to its commands
 
 Job = Callable[[], None]
 
@@ -40,10 +45,11 @@ class Background:
         self.loop = loop
         self.max_wait = max_wait
         self._jobs: deque[tuple[float, Job]] = deque()
-        self._turn: asyncio.Handle | None = None
+        self._turn: asyncio.Handle | asyncio.TimerHandle | None = None
         self.waited = 0  # turns a job let go by because the loop was busy
         self.forced = 0  # jobs run busy or not, after MAX_WAIT
         self._settled: list[asyncio.Future[None]] = []  # settled()'s waiters
+        self._held_until = 0.0  # no job starts before this (monotonic), MAX_WAIT permitting
 
     def __len__(self) -> int:
         return len(self._jobs)
@@ -53,6 +59,11 @@ class Background:
         self._jobs.append((time.monotonic(), job))
         if self._turn is None:
             self._turn = self.loop.call_soon(self._run)
+
+    def hold(self, seconds: float = HOLD) -> None:
+        """Start no job for ``seconds`` (the executive, after a tick: what it sent is
+        often answered within a millisecond, and the answer goes first)."""
+        self._held_until = max(self._held_until, time.monotonic() + seconds)
 
     def busy(self) -> bool:
         """Is something more urgent due: a callback ready, or a socket with input?"""
@@ -66,8 +77,15 @@ class Background:
         if not self._jobs:
             return
         since, job = self._jobs[0]
+        now = time.monotonic()
+        late = now - since >= self.max_wait
+        if not late and now < self._held_until:  # a timer, not a spin: the loop may sleep
+            self.waited += 1
+            wait = min(self._held_until, since + self.max_wait) - now
+            self._turn = self.loop.call_later(wait, self._run)
+            return
         if self.busy():
-            if time.monotonic() - since < self.max_wait:
+            if not late:
                 self.waited += 1
                 self._turn = self.loop.call_soon(self._run)
                 return
@@ -113,6 +131,16 @@ def of(loop: asyncio.AbstractEventLoop) -> Background:
 async def settled() -> None:
     """Return once the running loop's background jobs are all done."""
     await of(asyncio.get_running_loop()).settled()
+
+
+def hold(seconds: float = HOLD) -> None:
+    """Start no job of the running loop for ``seconds`` (:meth:`Background.hold`);
+    nothing without a running loop."""
+    try:
+        loop = asyncio.get_running_loop()
+    except RuntimeError:
+        return
+    of(loop).hold(seconds)
 
 
 def soon(job: Job) -> None:

@@ -43,7 +43,7 @@ from frog_bt.model.links import Links, states
 from frog_bt.model.outcomes import DockingState, IncidentKind, TourState
 from frog_bt.model.wire import CLOCK, INPUTS, OUTPUTS
 from frog_bt.rosbridge.link import LinkState, RobotLink
-from frog_bt.runtime import logctx
+from frog_bt.runtime import background, logctx
 from frog_bt.runtime.notify import Notifier
 from frog_bt.runtime.observer import Observers
 from frog_bt.runtime.resuming import ResumingLedger
@@ -345,7 +345,10 @@ class Executive:
         (Observers hear it as :class:`~frog_bt.model.events.Ticked`: the exit rules, the
         keeper of the checkpoint, the recorder.)"""
         self._between_ticks()
-        return self.core.tick()  # the staff check the alerts at its end (_after_tick)
+        try:
+            return self.core.tick()  # the staff check the alerts at its end (_after_tick)
+        finally:
+            background.hold()  # the answers to its commands go before telemetry's work
 
     def _between_ticks(self) -> None:
         """The links' states, a checked tree swapped in at an idle point, a restart of the

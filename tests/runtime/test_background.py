@@ -91,3 +91,23 @@ def test_without_an_event_loop_a_job_runs_at_once() -> None:
     done: list[str] = []
     background.soon(lambda: done.append("now"))
     assert done == ["now"]
+
+
+def test_after_a_tick_jobs_hold_so_that_the_answer_goes_first() -> None:
+    """In the hold after a tick, a job waits (on a timer, the loop free to sleep) and an
+    answer that comes meanwhile is served first; the job runs once the hold is over."""
+
+    async def scenario() -> tuple[list[str], float]:
+        order: list[str] = []
+        loop = asyncio.get_running_loop()
+        jobs = background.of(loop)
+        jobs.hold(0.003)
+        started = loop.time()
+        background.soon(lambda: order.append("job"))
+        loop.call_later(0.001, lambda: order.append("answer"))  # after the loop slept
+        await jobs.settled()
+        return order, loop.time() - started
+
+    order, took = asyncio.run(scenario())
+    assert order == ["answer", "job"]
+    assert took >= 0.002  # it waited for the hold (bounded by MAX_WAIT)
