@@ -45,6 +45,15 @@ def _checked(node: Behaviour, new_status: Status) -> Status:
     return new_status
 
 
+def _update(node: Behaviour) -> None:
+    """The end of a behaviour's or a decorator's tick: ``update``, checked; stopped when
+    it is not RUNNING; the status set."""
+    new_status = _checked(node, node.update())
+    if new_status != RUNNING:
+        node.stop(new_status)
+    node.status = new_status
+
+
 class LeanBehaviour(Behaviour):
     """py_trees' ``Behaviour.tick``, lean."""
 
@@ -54,10 +63,7 @@ class LeanBehaviour(Behaviour):
             return
         if self.status != RUNNING:
             self.initialise()
-        new_status = _checked(self, self.update())
-        if new_status != RUNNING:
-            self.stop(new_status)
-        self.status = new_status
+        _update(self)
         yield self
 
 
@@ -71,10 +77,7 @@ class LeanDecorator(py_trees.decorators.Decorator):
         if self.status != RUNNING:
             self.initialise()
         yield from self.decorated.tick()
-        new_status = _checked(self, self.update())
-        if new_status != RUNNING:
-            self.stop(new_status)
-        self.status = new_status
+        _update(self)
         yield self
 
 

@@ -117,11 +117,11 @@ log = logging.getLogger(__name__)
 mcap_speed.install()
 
 # Chunks of 64 KiB compressed with zstd: closing one (compressing it, writing its message
-# index) holds the event loop ~0.2 ms (at most ~0.45), where 256 KiB with LZ4 held it
-# 0.6-1 ms, and the file is about a quarter smaller (docs/PERFORMANCE.md). mcap would
-# close a chunk inside whichever add_message crossed the size, i.e. in the drain right
-# after an input, before the tick that input calls for; the recorder ends chunks itself,
-# in a background job, so that the tick goes first.
+# index) takes ~0.2 ms offline and ~0.6 ms in the running executive (cold caches), where
+# 256 KiB with LZ4 took 0.7 and ~1.2 ms, and the file is about a quarter smaller
+# (docs/PERFORMANCE.md). mcap would close a chunk inside whichever add_message crossed
+# the size, i.e. in the drain right after an input, before the tick that input calls
+# for; the recorder ends chunks itself, in a background job, so that the tick goes first.
 CHUNK_SIZE = 64 * 1024  # bytes of uncompressed messages per chunk
 DRAIN_STEP = 100  # messages written in one background job (~0.1 ms)
 _UNBOUNDED = 1 << 62  # mcap's own chunk size: never reached (the recorder ends chunks)

@@ -51,9 +51,6 @@ class Background:
         self._settled: list[asyncio.Future[None]] = []  # settled()'s waiters
         self._held_until = 0.0  # no job starts before this (monotonic), MAX_WAIT permitting
 
-    def __len__(self) -> int:
-        return len(self._jobs)
-
     def call(self, job: Job) -> None:
         """Run ``job`` at a quiet turn of the loop, after the jobs before it."""
         self._jobs.append((time.monotonic(), job))
