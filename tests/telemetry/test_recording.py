@@ -125,6 +125,17 @@ def test_the_running_path_is_a_small_graph_from_the_root(recorded: Recorded):
     assert len({tuple(ids) for ids in rows}) > 3  # it follows the tour
 
 
+def test_the_running_paths_edges_join_each_shown_node_to_its_parent(recorded: Recorded):
+    tree = recorded.values("/bt/graph", "GraphEdges:edges", static=True)[0]
+    parent = {pair["second"]: pair["first"] for pair in tree}
+    ids = recorded.values("/bt/path", "GraphNodes:node_ids")
+    edges = recorded.values("/bt/path", "GraphEdges:edges")
+    assert len(edges) == len(ids) > 10  # logged together, whenever the path changes
+    for shown, pairs in zip(ids, edges, strict=True):
+        assert len(pairs) == len(shown) - 1
+        assert {(p["first"], p["second"]) for p in pairs} == {(parent[n], n) for n in shown[1:]}
+
+
 def test_each_stop_has_a_lane_reached_then_played(recorded: Recorded):
     lane = [s[0] for s in recorded.values("/stops/POI1", "StateChange:state")]
     assert lane[:2] == ["reached", "played"]
