@@ -35,7 +35,6 @@ import io
 import logging
 import multiprocessing
 import multiprocessing.queues
-import os
 import pickle
 import queue
 import time
@@ -50,6 +49,7 @@ import msgspec
 from frog_bt.errors import DecodeError
 from frog_bt.live.telemetry.layout import TreeIndex
 from frog_bt.live.telemetry.observer import TelemetryObserver
+from frog_bt.live.telemetry.priority import ChildPriority, can_raise, enter, leave
 from frog_bt.live.telemetry.rows import Batch
 from frog_bt.live.telemetry.spec import parse_spec
 from frog_bt.model.links import LinkStatus
@@ -66,7 +66,6 @@ log = logging.getLogger(__name__)
 QUEUE_BATCHES = 64  # batches waiting for the child (50 ticks each: 5 minutes at 10 Hz)
 RECYCLE_ROWS = 250_000  # rows a child writes before a fresh one takes over (~20 min)
 CLOSE_TIMEOUT = 6.0  # seconds close() waits for the child to finish its file
-NICE = 5  # the child's niceness: when both are ready, the executive's inputs go first
 TIMINGS = 1000  # hand-overs whose cost is kept (Timings), for scripts/bench
 MERGE_BATCHES = 10  # batches a save: file is written in at once (500 ticks, 50 s at 10 Hz)
 HOLD = 60.0  # seconds the child holds a batch for a save: file at most
@@ -208,12 +207,13 @@ def _serve(
     tree: LoadedTree,
     recording_id: str,
     inbox: multiprocessing.queues.Queue[Item],
+    idle: bool = False,
 ) -> None:
-    """The child: write what comes until ``close`` (or the parent is gone)."""
+    """The child: write what comes until ``close`` (or the parent is gone); in the idle
+    scheduling class when ``idle`` (:mod:`~frog_bt.live.telemetry.priority`)."""
     from frog_bt.live.telemetry import Telemetry
 
-    with contextlib.suppress(OSError):
-        os.nice(NICE)
+    enter(idle)
     telemetry = Telemetry.open(spec, site, tree, recording_id=recording_id)
     pending = _Pending(telemetry, live=parse_spec(spec).kind != "save")
     try:
@@ -241,6 +241,8 @@ def _serve(
             elif kind == "links":
                 telemetry.writer.write_links(*item[1:])  # type: ignore[arg-type]
             elif kind == "close":
+                if idle:
+                    leave()
                 return
     finally:
         pending.write()
@@ -283,6 +285,7 @@ class TelemetryProcess(TelemetryObserver):
         self._serialising: deque[Serialising] = deque()  # batches being pickled, oldest first
         self._stepping = False  # a step is due (a background job)
         self._warnings = WarningLimiter(60.0, logger=log)
+        self._idle = can_raise()  # the child in the idle class, raised when behind
         self._start_child()
 
     def _start_child(self) -> None:
@@ -298,13 +301,17 @@ class TelemetryProcess(TelemetryObserver):
                 self.tree,
                 self.recording_id,
                 self._inbox,
+                self._idle,
             ),
         )
         self._child.start()
+        assert self._child.pid is not None
+        self.priority = ChildPriority(self._child.pid, idle=self._idle)
         self._written = 0
 
     def _stop_child(self, timeout: float) -> None:
         inbox, child = self._inbox, self._child
+        self.priority.finish()
         with contextlib.suppress(queue.Full):
             inbox.put(("close",), timeout=timeout)
         inbox.close()
@@ -393,8 +400,10 @@ class TelemetryProcess(TelemetryObserver):
             return False
         try:
             self._inbox.put_nowait(item)
+            self.priority.follow(self._inbox.qsize())
             return True
         except queue.Full:
+            self.priority.follow(QUEUE_BATCHES)
             self.dropped += 1
             self._warnings.warn(
                 "full",
