@@ -51,6 +51,39 @@ def test_a_job_waits_for_a_datagram_that_has_arrived() -> None:
     assert asyncio.run(scenario()) == ["user_positive", "job"]
 
 
+def test_a_job_past_the_hold_still_lets_an_input_and_its_tick_go_first() -> None:
+    """Ticks at 1 kHz keep a job waiting past ``max_wait`` (the hold gives way), yet an
+    input that has arrived, and the tick it calls for, still go before it."""
+
+    async def scenario() -> list[str]:
+        order: list[str] = []
+        loop = asyncio.get_running_loop()
+        jobs = background.Background(loop, max_wait=0.0, max_late=10.0)
+
+        class Receiver(asyncio.DatagramProtocol):
+            def datagram_received(self, data: bytes, addr: object) -> None:
+                order.append(data.decode())
+                loop.call_soon(lambda: order.append("its tick"))
+
+        transport, _ = await loop.create_datagram_endpoint(Receiver, local_addr=("127.0.0.1", 0))
+        try:
+            with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as peer:
+
+                def arrives_during_a_tick() -> None:
+                    jobs.hold(10.0)  # a tick just ended: its hold, ignored (max_wait 0)
+                    peer.sendto(b"user_positive", transport.get_extra_info("sockname"))
+                    jobs.call(lambda: order.append("job"))
+
+                loop.call_soon(arrives_during_a_tick)
+                await asyncio.sleep(0)
+                await jobs.settled()
+        finally:
+            transport.close()
+        return order
+
+    assert asyncio.run(scenario()) == ["user_positive", "its tick", "job"]
+
+
 def test_jobs_run_in_order_and_a_failing_one_is_logged(caplog) -> None:  # type: ignore[no-untyped-def]
     async def scenario() -> list[int]:
         done: list[int] = []
@@ -65,11 +98,11 @@ def test_jobs_run_in_order_and_a_failing_one_is_logged(caplog) -> None:  # type:
 
 
 def test_a_job_is_not_starved_by_a_loop_that_never_rests() -> None:
-    """A loop with a callback always due still runs the job, after ``max_wait``."""
+    """A loop with a callback always due still runs the job, after ``max_late``."""
 
     async def scenario() -> tuple[bool, int, int]:
         loop = asyncio.get_running_loop()
-        jobs = background.Background(loop, max_wait=0.002)
+        jobs = background.Background(loop, max_wait=0.001, max_late=0.002)
         ran: list[bool] = []
         spinning = [True]
 
