@@ -12,8 +12,12 @@ yields two trials per turn:
 
 Then the content is done, the robot drives to the second stop and arrives alone
 (``follow.grace: 0``): the visitor is lost, the tree goes back to POI0 and
-recruits again, and the loop turns. Both ends take ``perf_counter_ns`` right at
-the socket. Pose and person detections flow at 10 Hz throughout.
+recruits again, and the loop turns. A trial starts just before the fake robot or front
+end writes the input and ends when the kernel received the command on the other socket
+(its receive timestamp, ``bench_support.StampingSocket``): the executive's reaction,
+not the fake robot's own wake-up to read it. That longer figure, to the robot's read, is
+kept beside it (``read by the robot``). Pose and person detections flow at 10 Hz
+throughout.
 
     .venv/bin/python scripts/bench_reaction.py --trials 1000
 """
@@ -63,6 +67,7 @@ class Director:
         self.pois = {name: (p.x, p.y) for name, p in site.pois.items()}
         self.robot = self.pois[site.tour.dock]
         self.samples: dict[str, list[int]] = {ARRIVAL: [], ANSWER: []}
+        self.read: dict[str, list[int]] = {ARRIVAL: [], ANSWER: []}  # to the robot's read
         self.pending: tuple[str, int] | None = None
         self.lost = False  # arrived at a stop without the visitor
         self.done = asyncio.Event()
@@ -76,9 +81,10 @@ class Director:
         self._tasks.add(task)
         task.add_done_callback(self._tasks.discard)
 
-    def finish_trial(self, kind: str, t: int) -> None:
+    def finish_trial(self, kind: str, t: int, read: int) -> None:
         if self.pending is not None and self.pending[0] == kind:
             self.samples[kind].append(t - self.pending[1])
+            self.read[kind].append(read - self.pending[1])
             self.pending = None
             if all(len(v) >= self.trials + WARMUP for v in self.samples.values()):
                 self.done.set()
@@ -93,7 +99,7 @@ class Director:
             target = min(self.pois, key=lambda n: math.dist(self.pois[n], (p["x"], p["y"])))
             self.lost = False
             if target == self.stops[0]:
-                self.finish_trial(ANSWER, t)
+                self.finish_trial(ANSWER, t, self.server.read_ns)
             self.spawn(self.arrive(target))
         elif topic == "/ApproachPeopleFar":
             self.spawn(self.server.publish("/FROG_response", {"data": 2}))
@@ -158,7 +164,7 @@ class Director:
         fm, front = self.fm, self.frontend
         assert front is not None
         if isinstance(message, fm.StartPoi):
-            self.finish_trial(ARRIVAL, t)
+            self.finish_trial(ARRIVAL, t, front.read_ns)
             front.send(fm.ContentDone(message.poi, message.part))
         elif isinstance(message, fm.StartIntroduction):
             front.send(fm.FinishIntroduction())
@@ -257,6 +263,9 @@ async def measure(
         "wall_s": time.monotonic() - wall0,
         "errors": director.errors[:5],
         **{kind: summary_us(values[WARMUP:]) for kind, values in director.samples.items()},
+        "read by the robot": {
+            kind: summary_us(values[WARMUP:]) for kind, values in director.read.items()
+        },
     }
 
 

@@ -13,6 +13,7 @@ import json
 import math
 import os
 import socket
+import struct
 import sys
 import time
 from collections.abc import Callable, Iterable
@@ -161,10 +162,66 @@ def free_port(kind: int = socket.SOCK_DGRAM) -> int:
 # ------------------------------------------------------------------ the fake robot
 
 
+# The kernel's receive time of what a socket reads (Linux, socket(7)): a datagram's with
+# SO_TIMESTAMPNS, a TCP stream's (its last segment read) with SO_TIMESTAMPING.
+SO_TIMESTAMPNS = 35
+SO_TIMESTAMPING = 37
+RX_SOFTWARE = 0x8 | 0x10  # SOF_TIMESTAMPING_RX_SOFTWARE | SOF_TIMESTAMPING_SOFTWARE
+
+
+class StampingSocket:
+    """A transport's socket that reads with ``recvmsg`` and keeps, in ``stamp``, when the
+    kernel received what it read (``perf_counter_ns`` clock), and in ``read`` when this
+    process read it. With these the ruler stops where the bytes reach this process's
+    socket, before this process is even scheduled to read them: the fake robot's own
+    wake-up and work are not the executive's reaction."""
+
+    def __init__(self, sock: socket.socket, option: int, value: int) -> None:
+        sock.setsockopt(socket.SOL_SOCKET, option, value)
+        self._sock = sock
+        self.stamp = 0
+        self.read = 0
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._sock, name)
+
+    def _recv(self, size: int) -> tuple[bytes, Any]:
+        data, ancillary, _, addr = self._sock.recvmsg(size, socket.CMSG_SPACE(48))
+        real, self.read = time.time_ns(), time.perf_counter_ns()
+        self.stamp = self.read
+        for level, kind, raw in ancillary:
+            if level == socket.SOL_SOCKET and kind in (SO_TIMESTAMPNS, SO_TIMESTAMPING):
+                sec, nsec = struct.unpack_from("qq", raw)
+                if sec or nsec:
+                    self.stamp = min(self.read, sec * 1_000_000_000 + nsec - (real - self.read))
+        return data, addr
+
+    def recv(self, size: int) -> bytes:
+        return self._recv(size)[0]
+
+    def recvfrom(self, size: int) -> tuple[bytes, Any]:
+        return self._recv(size)
+
+
+def stamp_transport(transport: Any, option: int, value: int) -> StampingSocket | None:
+    """Make an asyncio selector transport read through a :class:`StampingSocket`; None
+    where it cannot (not Linux, another kind of transport): read times then."""
+    sock = getattr(transport, "_sock", None)
+    if not sys.platform.startswith("linux") or not isinstance(sock, socket.socket):
+        return None
+    try:
+        stamping = StampingSocket(sock, option, value)
+    except OSError:
+        return None
+    transport._sock = stamping
+    return stamping
+
+
 def stamped_connection() -> Any:
     """A websockets server connection that stamps each data message (``stamps``, in
-    order) with ``perf_counter_ns()`` taken as the bytes that complete it arrive (in
-    ``data_received``, before they are parsed)."""
+    order) with the kernel's receive time of the bytes that complete it
+    (:class:`StampingSocket`; the time they were read where that is not available), and
+    keeps the read time too (``reads``)."""
     from collections import deque
 
     from websockets.asyncio.server import ServerConnection
@@ -174,15 +231,26 @@ def stamped_connection() -> Any:
         def __init__(self, *args: Any, **kwargs: Any) -> None:
             super().__init__(*args, **kwargs)
             self.stamps: deque[int] = deque()
-            self._received = 0
+            self.reads: deque[int] = deque()
+            self._received = self._read = 0
+            self._stamping: StampingSocket | None = None
+
+        def connection_made(self, transport: Any) -> None:
+            self._stamping = stamp_transport(transport, SO_TIMESTAMPING, RX_SOFTWARE)
+            super().connection_made(transport)
 
         def data_received(self, data: bytes) -> None:
-            self._received = time.perf_counter_ns()
+            stamping = self._stamping
+            if stamping is not None:
+                self._received, self._read = stamping.stamp, stamping.read
+            else:
+                self._received = self._read = time.perf_counter_ns()
             super().data_received(data)
 
         def process_event(self, event: Any) -> None:
             if isinstance(event, Frame) and event.opcode in DATA_OPCODES and event.fin:
                 self.stamps.append(self._received)
+                self.reads.append(self._read)
             super().process_event(event)
 
     return Stamped
@@ -210,6 +278,7 @@ class FakeRosbridge:
         self.subscribed: dict[str, str] = {}
         self.ready = asyncio.Event()  # the current client subscribed to `expect` topics
         self.ready_ns = 0
+        self.read_ns = 0  # when this process read the frame last handed to on_publish
         self.connections = 0
         self.ws: Any = None
         self.port = 0
@@ -246,6 +315,7 @@ class FakeRosbridge:
         try:
             async for frame in ws:
                 t = ws.stamps.popleft() if ws.stamps else time.perf_counter_ns()
+                self.read_ns = ws.reads.popleft() if ws.reads else t
                 obj = json.loads(frame)
                 op = obj.get("op")
                 if op == "publish":
@@ -289,8 +359,9 @@ class FakeRosbridge:
 class FakeFrontend(asyncio.DatagramProtocol):
     """The content front end over UDP: acks commands, sends events, socket timestamps.
 
-    ``on_command(message, t_ns)`` gets every new command, ``t_ns`` taken as the
-    datagram is read; :meth:`send` returns the time just before an event is written.
+    ``on_command(message, t_ns)`` gets every new command, ``t_ns`` the kernel's
+    receive time of its datagram (:class:`StampingSocket`; ``read_ns`` when this
+    process read it); :meth:`send` returns the time just before an event is written.
     """
 
     def __init__(
@@ -303,16 +374,23 @@ class FakeFrontend(asyncio.DatagramProtocol):
         self.on_command = on_command
         self.endpoint = Endpoint(executive[0], COMMANDS)
         self.transport: Any = None
+        self.read_ns = 0
+        self._stamping: StampingSocket | None = None
 
     async def open(self, port: int = 0) -> int:
         loop = asyncio.get_running_loop()
         self.transport, _ = await loop.create_datagram_endpoint(
             lambda: self, local_addr=(LOOPBACK, port)
         )
+        self._stamping = stamp_transport(self.transport, SO_TIMESTAMPNS, 1)
         return int(self.transport.get_extra_info("sockname")[1])
 
     def datagram_received(self, data: bytes, addr: tuple[str, int]) -> None:  # type: ignore[override]
-        t = time.perf_counter_ns()
+        stamping = self._stamping
+        if stamping is not None:
+            t, self.read_ns = stamping.stamp, stamping.read
+        else:
+            t = self.read_ns = time.perf_counter_ns()
         received = self.endpoint.receive(data, addr[0], time.monotonic())
         if received.reply is not None:
             self.transport.sendto(received.reply, addr)
