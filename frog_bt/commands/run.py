@@ -274,7 +274,7 @@ async def _main(
     settings: Settings,
     console: ConsoleSettings | None = None,
 ) -> int:
-    from frog_bt.runtime.memory import HeapKeeper, pin_malloc_thresholds
+    from frog_bt.runtime.memory import HeapKeeper, QuietCollector, pin_malloc_thresholds
 
     pin_malloc_thresholds()  # all day without creeping up
     from frog_bt.runtime.exits import ExitRules
@@ -288,6 +288,7 @@ async def _main(
     if keeper is not None:
         attach_all(executive, [keeper])
     attach_all(executive, [ExitRules(once=args.once)])  # --once, and the tree giving up
+    attach_all(executive, [QuietCollector()])  # the collector at quiet turns, not in a tick
     if args.watch:  # a reloaded tree: the old one collected, the new one frozen
         attach_all(executive, [HeapKeeper()])
     loop = asyncio.get_running_loop()

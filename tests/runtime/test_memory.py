@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import gc
 import weakref
 from collections.abc import Iterator
@@ -12,7 +13,7 @@ import pytest
 
 from frog_bt.cli import main
 from frog_bt.model.events import Ticked
-from frog_bt.runtime import memory
+from frog_bt.runtime import background, memory
 
 
 class _Node:
@@ -66,3 +67,44 @@ def test_the_heap_keeper_refreezes_when_the_host_runs_another_tree(thawed: None)
 def test_a_run_that_cannot_start_leaves_the_collector_on(tmp_path: Path) -> None:
     assert main(["run", "--config", str(tmp_path / "missing.yaml")]) == 2
     assert gc.isenabled()
+
+
+def test_the_collector_runs_at_a_quiet_turn_after_the_tick_that_made_it_due() -> None:
+    """Left to itself the collector would run inside the 700th allocation's callback;
+    here a tick that ends with a collection due queues it as a background job (after
+    what is waiting), the backstop threshold keeps it from running by itself meanwhile,
+    and every tenth collection takes the next generation too."""
+    before = gc.get_threshold()
+    collector = memory.QuietCollector()
+    collector.attach(SimpleNamespace())  # type: ignore[arg-type]
+    ticked = Ticked(1.0, 1, "RUNNING")
+
+    async def scenario() -> tuple[list[str], bool]:
+        order: list[str] = []
+        gc.collect()
+        garbage = [_Node() for _ in range(memory.QUIET_AFTER // 4)]
+        gone = weakref.ref(garbage[0])  # each in a cycle: only the collector frees it
+        del garbage
+        collector.on_event(Ticked(1.0, 1, "RUNNING"))  # not due: fewer allocations
+        assert collector.collected == [0, 0, 0]
+        more = [_Node() for _ in range(memory.QUIET_AFTER)]
+        del more
+        asyncio.get_running_loop().call_soon(lambda: order.append("input"))
+        collector.on_event(ticked)  # due now: queued, not run
+        assert gone() is not None and collector.collected == [0, 0, 0]
+        await background.settled()
+        order.append(f"collected {collector.collected}")
+        return order, gone() is None
+
+    try:
+        assert gc.get_threshold()[0] == memory.BACKSTOP
+        order, freed = asyncio.run(scenario())
+        assert order == ["input", "collected [1, 0, 0]"] and freed
+        for _ in range(memory.OLDER_EVERY):
+            gc.collect(0)  # as ten collections of the youngest would
+        collector._due = True
+        collector._collect()
+        assert collector.collected == [1, 1, 0]
+    finally:
+        collector.close()
+    assert gc.get_threshold() == before
