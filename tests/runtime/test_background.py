@@ -53,12 +53,13 @@ def test_a_job_waits_for_a_datagram_that_has_arrived() -> None:
 
 def test_a_job_past_the_hold_still_lets_an_input_and_its_tick_go_first() -> None:
     """Ticks at 1 kHz keep a job waiting past ``max_wait`` (the hold gives way), yet an
-    input that has arrived, and the tick it calls for, still go before it."""
+    input that has arrived, and the tick it calls for, still go before it (its late
+    turns)."""
 
     async def scenario() -> list[str]:
         order: list[str] = []
         loop = asyncio.get_running_loop()
-        jobs = background.Background(loop, max_wait=0.0, max_late=10.0)
+        jobs = background.Background(loop, max_wait=0.0)
 
         class Receiver(asyncio.DatagramProtocol):
             def datagram_received(self, data: bytes, addr: object) -> None:
@@ -98,11 +99,12 @@ def test_jobs_run_in_order_and_a_failing_one_is_logged(caplog) -> None:  # type:
 
 
 def test_a_job_is_not_starved_by_a_loop_that_never_rests() -> None:
-    """A loop with a callback always due still runs the job, after ``max_late``."""
+    """A loop with a callback always due still runs the job, after ``max_wait`` and
+    ``late_turns`` more turns."""
 
     async def scenario() -> tuple[bool, int, int]:
         loop = asyncio.get_running_loop()
-        jobs = background.Background(loop, max_wait=0.001, max_late=0.002)
+        jobs = background.Background(loop, max_wait=0.002)
         ran: list[bool] = []
         spinning = [True]
 
