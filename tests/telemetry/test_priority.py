@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from frog_bt.live.telemetry import priority
-from frog_bt.live.telemetry.priority import BEHIND, CAUGHT_UP, NICE, ChildPriority
+from frog_bt.live.telemetry.priority import BEHIND, CALM, CAUGHT_UP, NICE, ChildPriority
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "SCHED_IDLE"), reason="Linux scheduling")
 
@@ -79,16 +79,25 @@ def test_the_child_and_its_threads_start_idle_and_niced(child: int) -> None:
 
 
 @needs_raise
-def test_a_child_behind_is_raised_and_lowered_once_it_caught_up(child: int) -> None:
-    prio = ChildPriority(child, idle=True)
+def test_a_child_behind_is_raised_and_lowered_after_a_calm_minute(child: int) -> None:
+    now = [0.0]
+    prio = ChildPriority(child, idle=True, clock=lambda: now[0])
     prio.follow(BEHIND - 1)
     assert set(_threads(child)) == {IDLE}  # a few batches waiting: left as it is
     prio.follow(BEHIND)
     assert set(_threads(child)) == {NICED} and prio.raised == 1
-    prio.follow(CAUGHT_UP + 1)
-    assert set(_threads(child)) == {NICED}  # still catching up
+    now[0] = CALM / 2
     prio.follow(CAUGHT_UP)
-    assert set(_threads(child)) == {IDLE}
+    assert set(_threads(child)) == {NICED}  # caught up, not for long: still writing
+    now[0] = CALM
+    prio.follow(CAUGHT_UP + 1)
+    assert set(_threads(child)) == {NICED}  # behind again: the calm starts over
+    now[0] = 2 * CALM - 1
+    prio.follow(CAUGHT_UP)
+    assert set(_threads(child)) == {NICED}
+    now[0] = 2 * CALM
+    prio.follow(CAUGHT_UP)
+    assert set(_threads(child)) == {IDLE}  # a calm minute: back in the idle class
     prio.finish()  # closing: finishes its file at niceness 5
     assert set(_threads(child)) == {NICED}
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import queue
 import subprocess
 import sys
 from collections import deque
@@ -130,7 +131,7 @@ def test_inputs_go_before_a_batch_being_pickled(monkeypatch: pytest.MonkeyPatch)
         monkeypatch.setattr(
             process.TelemetryProcess,
             "_send",
-            lambda self, item: (sent.append(item), handed.set(), True)[-1],
+            lambda self, item, until=None: (sent.append(item), handed.set(), True)[-1],
         )
         telemetry.rows.batch.poses.extend(poses)
         telemetry._flush_soon()  # as after the tick that filled the rows
@@ -163,7 +164,7 @@ def test_a_fresh_writer_starts_only_when_there_are_ticks_to_write() -> None:
 
     telemetry._start_child = start
     telemetry._stop_child = lambda timeout: None
-    telemetry._send = lambda item: sent.append(str(item[0])) is None
+    telemetry._send = lambda item, until=None: sent.append(str(item[0])) is None
     ticks = Batch(statuses=[(t, t / 10, ((0, 1),)) for t in (1, 2, 3)])
     last_line = Batch(notes=[(4, 0.4, "tour over", "info")])
     queued = [ticks, last_line]
@@ -174,3 +175,46 @@ def test_a_fresh_writer_starts_only_when_there_are_ticks_to_write() -> None:
     queued.append(Batch(statuses=[(5, 0.5, ((0, 2),))]))
     telemetry.flush()
     assert started == [2] and sent == ["batch", "batch", "batch"]  # the new file: ticks
+
+
+def test_closing_waits_for_room_in_the_queue_rather_than_dropping(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """At close the rest goes to the child even when its queue is full for now (it is
+    taking them): waited for, bounded by CLOSE_TIMEOUT, not dropped."""
+    from frog_bt.behaviours import load_tree
+    from frog_bt.config import load_site
+    from frog_bt.live.telemetry.priority import ChildPriority
+
+    class Inbox:  # full to put_nowait; room after a wait
+        def __init__(self) -> None:
+            self.items: list[process.Item] = []
+
+        def put_nowait(self, item: process.Item) -> None:
+            raise queue.Full
+
+        def put(self, item: process.Item, timeout: float) -> None:
+            assert 0 < timeout <= process.CLOSE_TIMEOUT
+            self.items.append(item)
+
+        def qsize(self) -> int:
+            return len(self.items)
+
+    monkeypatch.setattr(process.TelemetryProcess, "_start_child", lambda self: None)
+    monkeypatch.setattr(process.TelemetryProcess, "_stop_child", lambda self, timeout: None)
+    site = load_site()
+    telemetry = process.TelemetryProcess("save:unused.rrd", site, load_tree(site=site))
+    telemetry.priority = ChildPriority(0, idle=False)
+    inbox = Inbox()
+    telemetry._inbox = inbox  # type: ignore[assignment]
+    for n in range(3):  # batches still being pickled, and rows not yet drained
+        telemetry._serialising.append(
+            process.Serialising(Batch(poses=[(n, 100.0 + n, 1.0, 2.0, 0.0)], notes=[]))
+        )
+    telemetry.rows.batch.poses.append((3, 103.0, 1.0, 2.0, 0.0))
+    telemetry._send(("links", 1, 100.0, []))  # while running: dropped, counted
+    assert telemetry.dropped == 1
+    telemetry.close()
+    assert telemetry.dropped == 1 and [kind for kind, *_ in inbox.items] == ["batch"] * 4
+    poses = [process.deserialise(data).poses[0][0] for _, data in inbox.items]  # type: ignore[arg-type]
+    assert poses == [0, 1, 2, 3]

@@ -9,7 +9,9 @@ idle-class tasks as free when it places a waking one.
 An idle-class task may get almost nothing on a machine busy all the time, so the
 executive (at normal priority) watches the child's backlog: from :data:`BEHIND`
 batches waiting it puts the child back at niceness 5 (:meth:`ChildPriority.follow`),
-and when the child has caught up, back in the idle class. Closing raises it too (both
+and back in the idle class only once none has waited for :data:`CALM` seconds. (Lowered
+as soon as the queue was short, the child was starved again in the middle of writing
+what it had just read: the tick bench at 400x dropped half its batches.) Closing raises it too (both
 sides: the child itself when it reads ``close``), so that it finishes its file within
 its time.
 
@@ -24,13 +26,16 @@ import contextlib
 import logging
 import os
 import threading
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 log = logging.getLogger(__name__)
 
 NICE = 5  # the child's niceness when it is not in the idle class
 BEHIND = 8  # batches waiting for the child (of QUEUE_BATCHES) that raise it
-CAUGHT_UP = 1  # at most this many waiting: back in the idle class
+CAUGHT_UP = 1  # at most this many waiting: caught up
+CALM = 60.0  # seconds caught up before a raised child goes back to the idle class
 
 _IDLE = getattr(os, "SCHED_IDLE", None)
 _OTHER = getattr(os, "SCHED_OTHER", None)
@@ -81,22 +86,29 @@ class ChildPriority:
     """The executive's side: moves every thread of the child ``pid`` between the idle
     class and niceness :data:`NICE`, by how many batches wait for it."""
 
-    def __init__(self, pid: int, *, idle: bool) -> None:
+    def __init__(
+        self, pid: int, *, idle: bool, clock: Callable[[], float] = time.monotonic
+    ) -> None:
         self.pid = pid
         self.enabled = idle  # the child started idle, and can be raised
         self.idle = idle
         self.raised = 0  # times it was raised (it fell behind), for the log and tests
+        self._clock = clock
+        self._busy_at = 0.0  # when more than CAUGHT_UP last waited (clock's time)
 
     def follow(self, waiting: int) -> None:
-        """After a hand-over: raise the child from :data:`BEHIND` batches waiting, lower
-        it again at :data:`CAUGHT_UP`."""
+        """After a hand-over: raise the child from :data:`BEHIND` batches waiting; lower
+        it again once no more than :data:`CAUGHT_UP` have waited for :data:`CALM`."""
         if not self.enabled:
             return
+        now = self._clock()
+        if waiting > CAUGHT_UP:
+            self._busy_at = now
         if self.idle and waiting >= BEHIND:
             self.raised += 1
             log.info("rerun telemetry: the writer is %d batches behind; raised", waiting)
             self._set(idle=False)
-        elif not self.idle and waiting <= CAUGHT_UP:
+        elif not self.idle and now - self._busy_at >= CALM:
             self._set(idle=True)
 
     def finish(self) -> None:

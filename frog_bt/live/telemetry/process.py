@@ -360,26 +360,26 @@ class TelemetryProcess(TelemetryObserver):
             self._stepping = True
             background.soon(self._step)
 
-    def flush(self) -> None:
-        """Send the buffered rows to the child now, after any batch still being pickled
-        (never waits: a full queue drops them)."""
+    def flush(self, until: float | None = None) -> None:
+        """Send the buffered rows to the child now, after any batch still being pickled;
+        a full queue drops them, or (closing) is waited for until ``until`` (monotonic)."""
         self._flush_pending = False
         if self._closed:
             return
         while self._serialising:  # a step still due finds none left
-            self._hand_over(self._serialising.popleft())
+            self._hand_over(self._serialising.popleft(), until)
         batch = self.rows.drain()
         if len(batch):
-            self._hand_over(Serialising(batch))
+            self._hand_over(Serialising(batch), until)
 
-    def _hand_over(self, work: Serialising) -> None:
+    def _hand_over(self, work: Serialising, until: float | None = None) -> None:
         if self._written >= self.recycle_rows and work.ticks:
             # only now, with ticks to write: a new file never holds just the last link
             # change or log line of a day that ended at the old one's limit
             self._recycle()
         data = work.bytes()  # what is left of it, at once
         t1 = time.thread_time_ns()
-        sent = self._send(("batch", data))
+        sent = self._send(("batch", data), until)
         self.timings.serialise.append(work.ns)
         self.timings.hand_over.append(time.thread_time_ns() - t1)
         if sent:
@@ -395,11 +395,14 @@ class TelemetryProcess(TelemetryObserver):
             self._send(("links", core.ticks, core.clock.now(), list(links.items())))
             self._links = links
 
-    def _send(self, item: Item) -> bool:
+    def _send(self, item: Item, until: float | None = None) -> bool:
         if self._closed:
             return False
         try:
-            self._inbox.put_nowait(item)
+            if until is None:
+                self._inbox.put_nowait(item)
+            else:  # closing: the child is taking the rest
+                self._inbox.put(item, timeout=max(0.0, until - time.monotonic()))
             self.priority.follow(self._inbox.qsize())
             return True
         except queue.Full:
@@ -415,7 +418,8 @@ class TelemetryProcess(TelemetryObserver):
         """Send what is left, let the child finish its file (bounded). Idempotent."""
         if self._closed:
             return
-        self.flush()
+        self.priority.finish()  # at niceness 5: it takes the rest and finishes its file
+        self.flush(until=time.monotonic() + CLOSE_TIMEOUT)  # what is left is not dropped
         self._closed = True
         self.rows.detach()
         self._stop_child(CLOSE_TIMEOUT)
