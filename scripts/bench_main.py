@@ -160,6 +160,14 @@ def budgets(results: dict[str, Any]) -> list[dict[str, Any]]:
             "(off the tick)",
             None,
         )
+        rows.add(  # a figure bought by dropping telemetry is no figure
+            f"telemetry batches dropped ({n} stops)",
+            get(ticks, f"{n}-on", "telemetry_dropped_batches"),
+            "",
+            "= 0",
+            lambda v: v == 0,
+            "{:.0f}",
+        )
     if len(sizes) > 1:
         small, large = sizes[0], sizes[-1]
         for t in ("off", "on"):
@@ -184,6 +192,15 @@ def budgets(results: dict[str, Any]) -> list[dict[str, Any]]:
                 " ms",
                 "≤ 2 ms",
                 lambda v: v <= 2,
+                "{:.2f}",
+            )
+            read = get(results, "reaction", run, "read by the robot", kind, "p99_us")
+            rows.add(  # the same, to when the fake robot read it: its own wake-up too
+                f"  the same, read by the robot ({t}, {n} stops)",
+                None if read is None else read / 1000,
+                " ms",
+                "",
+                None,
                 "{:.2f}",
             )
     ingest = get(results, "ingest", "ingest") or {}
