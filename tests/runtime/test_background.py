@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import socket
+from collections.abc import Awaitable, Callable
 
 from frog_bt.runtime import background
 
@@ -22,31 +23,47 @@ def test_a_job_runs_after_the_callbacks_that_are_due() -> None:
     assert asyncio.run(scenario()) == ["input", "its tick", "job"]
 
 
+async def _an_input_arrives(
+    submit: Callable[[list[str]], None],
+    settled: Callable[[], Awaitable[None]],
+    with_tick: bool,
+) -> list[str]:
+    """A datagram arrives during a callback that also submits a job (``submit``); the
+    order in which the datagram, the tick it calls for (``with_tick``) and the job ran."""
+    order: list[str] = []
+    loop = asyncio.get_running_loop()
+
+    class Receiver(asyncio.DatagramProtocol):
+        def datagram_received(self, data: bytes, addr: object) -> None:
+            order.append(data.decode())
+            if with_tick:
+                loop.call_soon(lambda: order.append("its tick"))
+
+    transport, _ = await loop.create_datagram_endpoint(Receiver, local_addr=("127.0.0.1", 0))
+    try:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as peer:
+
+            def arrives_during_a_callback() -> None:
+                peer.sendto(b"user_positive", transport.get_extra_info("sockname"))
+                submit(order)
+
+            loop.call_soon(arrives_during_a_callback)
+            await asyncio.sleep(0)
+            await settled()
+    finally:
+        transport.close()
+    return order
+
+
 def test_a_job_waits_for_a_datagram_that_has_arrived() -> None:
     """Input waiting on a socket goes first, though its callback is not due yet."""
 
     async def scenario() -> list[str]:
-        order: list[str] = []
-        loop = asyncio.get_running_loop()
-
-        class Receiver(asyncio.DatagramProtocol):
-            def datagram_received(self, data: bytes, addr: object) -> None:
-                order.append(data.decode())
-
-        transport, _ = await loop.create_datagram_endpoint(Receiver, local_addr=("127.0.0.1", 0))
-        try:
-            with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as peer:
-
-                def arrives_during_a_callback() -> None:
-                    peer.sendto(b"user_positive", transport.get_extra_info("sockname"))
-                    background.soon(lambda: order.append("job"))
-
-                loop.call_soon(arrives_during_a_callback)
-                await asyncio.sleep(0)
-                await background.settled()
-        finally:
-            transport.close()
-        return order
+        return await _an_input_arrives(
+            lambda order: background.soon(lambda: order.append("job")),
+            background.settled,
+            with_tick=False,
+        )
 
     assert asyncio.run(scenario()) == ["user_positive", "job"]
 
@@ -57,30 +74,13 @@ def test_a_job_past_the_hold_still_lets_an_input_and_its_tick_go_first() -> None
     turns)."""
 
     async def scenario() -> list[str]:
-        order: list[str] = []
-        loop = asyncio.get_running_loop()
-        jobs = background.Background(loop, max_wait=0.0)
+        jobs = background.Background(asyncio.get_running_loop(), max_wait=0.0)
 
-        class Receiver(asyncio.DatagramProtocol):
-            def datagram_received(self, data: bytes, addr: object) -> None:
-                order.append(data.decode())
-                loop.call_soon(lambda: order.append("its tick"))
+        def submit(order: list[str]) -> None:
+            jobs.hold(10.0)  # a tick just ended: its hold, ignored (max_wait 0)
+            jobs.call(lambda: order.append("job"))
 
-        transport, _ = await loop.create_datagram_endpoint(Receiver, local_addr=("127.0.0.1", 0))
-        try:
-            with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as peer:
-
-                def arrives_during_a_tick() -> None:
-                    jobs.hold(10.0)  # a tick just ended: its hold, ignored (max_wait 0)
-                    peer.sendto(b"user_positive", transport.get_extra_info("sockname"))
-                    jobs.call(lambda: order.append("job"))
-
-                loop.call_soon(arrives_during_a_tick)
-                await asyncio.sleep(0)
-                await jobs.settled()
-        finally:
-            transport.close()
-        return order
+        return await _an_input_arrives(submit, jobs.settled, with_tick=True)
 
     assert asyncio.run(scenario()) == ["user_positive", "its tick", "job"]
 
