@@ -100,6 +100,9 @@ def test_a_child_behind_is_raised_and_lowered_after_a_calm_minute(child: int) ->
     assert set(_threads(child)) == {IDLE}  # a calm minute: back in the idle class
     prio.finish()  # closing: finishes its file at niceness 5
     assert set(_threads(child)) == {NICED}
+    now[0] = 10 * CALM
+    prio.follow(0)  # what is left, handed over while closing: stays raised
+    assert set(_threads(child)) == {NICED}
 
 
 def test_where_it_could_not_be_raised_the_child_is_only_niced(child: int) -> None:

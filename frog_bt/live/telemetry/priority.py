@@ -95,11 +95,12 @@ class ChildPriority:
         self.raised = 0  # times it was raised (it fell behind), for the log and tests
         self._clock = clock
         self._busy_at = 0.0  # when more than CAUGHT_UP last waited (clock's time)
+        self._finishing = False  # finish() was called: raised for good
 
     def follow(self, waiting: int) -> None:
         """After a hand-over: raise the child from :data:`BEHIND` batches waiting; lower
         it again once no more than :data:`CAUGHT_UP` have waited for :data:`CALM`."""
-        if not self.enabled:
+        if not self.enabled or self._finishing:
             return
         now = self._clock()
         if waiting > CAUGHT_UP:
@@ -112,7 +113,9 @@ class ChildPriority:
             self._set(idle=True)
 
     def finish(self) -> None:
-        """Before closing: at niceness :data:`NICE`, so that it finishes within its time."""
+        """Before closing: at niceness :data:`NICE` for good (the hand-overs of what is
+        left no longer lower it), so that it finishes within its time."""
+        self._finishing = True
         if self.enabled and self.idle:
             self._set(idle=False)
 
