@@ -97,11 +97,14 @@ class ChildPriority:
         self._busy_at = 0.0  # when more than CAUGHT_UP last waited (clock's time)
         self._finishing = False  # finish() was called: raised for good
 
-    def follow(self, waiting: int) -> None:
-        """After a hand-over: raise the child from :data:`BEHIND` batches waiting; lower
-        it again once no more than :data:`CAUGHT_UP` have waited for :data:`CALM`."""
+    def follow(self, backlog: Callable[[], int]) -> None:
+        """After a hand-over: raise the child from :data:`BEHIND` batches waiting
+        (``backlog()``: asked only when enabled, as a queue's ``qsize`` is not
+        everywhere); lower it again once no more than :data:`CAUGHT_UP` have waited for
+        :data:`CALM`."""
         if not self.enabled or self._finishing:
             return
+        waiting = backlog()
         now = self._clock()
         if waiting > CAUGHT_UP:
             self._busy_at = now

@@ -403,10 +403,10 @@ class TelemetryProcess(TelemetryObserver):
                 self._inbox.put_nowait(item)
             else:  # closing: the child is taking the rest
                 self._inbox.put(item, timeout=max(0.0, until - time.monotonic()))
-            self.priority.follow(self._inbox.qsize())
+            self.priority.follow(self._inbox.qsize)
             return True
         except queue.Full:
-            self.priority.follow(QUEUE_BATCHES)
+            self.priority.follow(lambda: QUEUE_BATCHES)
             self.dropped += 1
             self._warnings.warn(
                 "full",
