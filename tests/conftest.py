@@ -15,11 +15,6 @@ sys.path.insert(0, str(Path(__file__).parent))
 if sys.dont_write_bytecode and "PYTEST_XDIST_WORKER" not in os.environ:
     compileall.compile_dir(Path(__file__).parents[1] / "frog_bt", quiet=1)
 
-# An executive that connects imports numpy in a thread (frog_bt/runtime/warm.py); a test
-# that runs after it in the same process could see numpy half imported (pytest.approx
-# looks it up in sys.modules). Imported here first, warm() finds it done.
-import numpy  # noqa: F401
-
 # The files that take longest (CPU seconds on this machine, measured per file), first:
 # with -n 2 a worker takes whole files in collection order (pyproject.toml's
 # --no-loadscope-reorder), and a long file taken last would leave the other worker idle

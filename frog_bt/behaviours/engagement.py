@@ -46,7 +46,7 @@ class FaceStream(FrogDecorator):
         times=("last_face_data", "next_meter"),
         copy=("samples",),
         passes=True,
-        key=lambda n: tuple(float(v) for v in n.samples.levels()),
+        key=lambda n: n.samples.levels(),
         why="engagement: one face sample per stream, engaged or not, or none; the vote "
         "over many samples is the maths' own (tests/maths). When the meter is sent "
         "changes what it says, not what the tree decides",

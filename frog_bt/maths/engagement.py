@@ -16,19 +16,15 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import Protocol
 
-if TYPE_CHECKING:
-    import numpy as np
-
-
-def _np() -> Any:
-    """numpy, imported on first use: ``frog-bt run`` starts without it (0.1 s) and
-    warms it in a thread once connected (:func:`frog_bt.runtime.warm.warm`)."""
-    import numpy
-
-    return numpy
+# Plain Python on purpose: the series are short (a 2 s window, a stop's samples), and
+# the executive's process never imports numpy. A C extension imported mid-tour can be
+# left half-initialised for good when the process runs out of descriptors at that
+# moment ("cannot load module more than once per process"); the face stream then
+# failed every tick and the tour stood still.
 
 
 class FaceLike(Protocol):
@@ -67,44 +63,43 @@ class Decision:
         )
 
 
-def vote(levels: np.ndarray) -> tuple[int, int]:
+def vote(levels: Sequence[float]) -> tuple[int, int]:
     """(engaged votes, not-engaged votes) of ``levels``."""
-    engaged = int(_np().count_nonzero(levels >= 0.0))
-    return engaged, int(levels.size) - engaged
+    engaged = sum(1 for level in levels if level >= 0.0)
+    return engaged, len(levels) - engaged
 
 
-def meter(levels: np.ndarray) -> float | None:
+def meter(levels: Sequence[float]) -> float | None:
     """The meter level for one window's samples (see the module docstring)."""
-    if levels.size == 0:
+    if not levels:
         return None
     engaged, not_engaged = vote(levels)
     if engaged > not_engaged:
-        side = levels[levels >= 0.0]
+        side = [level for level in levels if level >= 0.0]
     elif not_engaged > engaged:
-        side = levels[levels < 0.0]
+        side = [level for level in levels if level < 0.0]
     else:
-        side = levels
-    return float(_np().clip(side.mean(), -1.0, 1.0))
+        side = list(levels)
+    return min(1.0, max(-1.0, math.fsum(side) / len(side)))
 
 
-def edge_indices(n: int, edge: float) -> np.ndarray:
+def edge_indices(n: int, edge: float) -> list[int]:
     """Indices of the first and last ``ceil(edge·n)`` of ``n`` samples, each once."""
-    np_ = _np()
     if n == 0:
-        return np_.empty(0, dtype=np_.intp)  # type: ignore[no-any-return]
+        return []
     k = min(n, math.ceil(edge * n - 1e-9))
-    return np_.union1d(np_.arange(k), np_.arange(n - k, n))  # type: ignore[no-any-return]
+    return sorted({*range(k), *range(n - k, n)})
 
 
-def decide(levels: np.ndarray, edge: float = 0.15, on_tie: bool = False) -> Decision:
-    n = int(levels.size)
+def decide(levels: Sequence[float], edge: float = 0.15, on_tie: bool = False) -> Decision:
+    n = len(levels)
     if n == 0:
         return Decision(None, 0, 0, 0)
-    chosen = levels[edge_indices(n, edge)]
+    chosen = [levels[i] for i in edge_indices(n, edge)]
     engaged, not_engaged = vote(chosen)
     if engaged == not_engaged:
-        return Decision(on_tie, engaged, int(chosen.size), n, tie=True)
-    return Decision(engaged > not_engaged, engaged, int(chosen.size), n)
+        return Decision(on_tie, engaged, len(chosen), n, tie=True)
+    return Decision(engaged > not_engaged, engaged, len(chosen), n)
 
 
 class Samples:
@@ -126,10 +121,9 @@ class Samples:
         more = " ..." if len(self._level) > 8 else ""
         return f"{len(self)} samples: {levels}{more}"
 
-    def levels(self) -> np.ndarray:
-        return _np().asarray(self._level, dtype=float)  # type: ignore[no-any-return]
+    def levels(self) -> tuple[float, ...]:
+        return tuple(self._level)
 
-    def window(self, start: float, end: float) -> np.ndarray:
+    def window(self, start: float, end: float) -> tuple[float, ...]:
         """Levels of the samples with ``start < t <= end``."""
-        t = _np().asarray(self._t, dtype=float)
-        return self.levels()[(t > start) & (t <= end)]  # type: ignore[no-any-return]
+        return tuple(v for t, v in zip(self._t, self._level, strict=True) if start < t <= end)

@@ -320,9 +320,7 @@ class TourLedger:
         levels = [level for ts, level in self._samples if ts <= end]
         visit.samples = len(levels)
         if levels:
-            import numpy  # on first use, as maths.engagement does: `run` starts without it
-
-            d = decide(numpy.asarray(levels), self.plan.edge)
+            d = decide(levels, self.plan.edge)
             visit.edge_engaged, visit.edge_total = d.engaged_votes, d.votes
 
     def _frontend_in(self, t: float, message: object) -> None:

@@ -49,7 +49,6 @@ from frog_bt.runtime.observer import Observers
 from frog_bt.runtime.resuming import ResumingLedger
 from frog_bt.runtime.staff import Staff
 from frog_bt.runtime.status import link_line, status_line
-from frog_bt.runtime.warm import warm
 from frog_bt.tree.loader import LoadedTree
 
 log = logging.getLogger(__name__)
@@ -155,8 +154,6 @@ class Executive:
         self.emit(AlertChanged(t, alert))
 
     def _on_link(self, state: LinkState) -> None:
-        if state.connected and not self.was_connected:
-            warm()  # numpy and the like, for later, now that the wire is up
         self.was_connected = self.was_connected or state.connected
         actions = self.core.actions
         if not state.connected:

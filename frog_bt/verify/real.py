@@ -952,7 +952,7 @@ class _Encoder:
         if isinstance(value, Pose):
             return (round(value.x, 2), round(value.y, 2))
         if isinstance(value, Samples):
-            return tuple(float(v) for v in value.levels())
+            return value.levels()
         if isinstance(value, tuple | list | deque):
             return tuple(self(v) for v in value)
         if isinstance(value, frozenset | set):

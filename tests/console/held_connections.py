@@ -28,10 +28,12 @@ class Count(logging.Handler):
         super().__init__()
         self.lines = 0
         self.tracebacks = 0
+        self.out_of_files = 0
 
     def emit(self, record: logging.LogRecord) -> None:
         self.lines += 1
         self.tracebacks += record.exc_info is not None
+        self.out_of_files += "out of file descriptors" in record.getMessage()
 
 
 async def main(limit: int) -> dict[str, object]:
@@ -69,6 +71,7 @@ async def main(limit: int) -> dict[str, object]:
             "state": status,
             "lines": count.lines,
             "tracebacks": count.tracebacks,
+            "out_of_files": count.out_of_files,
         }
 
 

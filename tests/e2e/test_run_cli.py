@@ -27,7 +27,7 @@ def checkpoint_claim(path):
         handle.close()
 
 
-async def _run_once() -> tuple[int, bytes, list[str], str]:
+async def _run_once(*python: str) -> tuple[int, bytes, list[str], str]:
     scenario = fast({"speed": 400.0})  # not paced by the executive (another process)
     listen = free_udp_port()
     sim = Simulator(scenario, rosbridge_port=0, frontend_port=0, executive=("127.0.0.1", listen))
@@ -35,6 +35,7 @@ async def _run_once() -> tuple[int, bytes, list[str], str]:
     try:
         proc = await asyncio.create_subprocess_exec(
             sys.executable,
+            *python,
             "-m",
             "frog_bt",
             "run",
@@ -68,6 +69,19 @@ def test_run_once_exits_0_after_one_tour_ends_docked():
     assert banner[1].startswith("  clock sim time (/clock); rosbridge ws://127.0.0.1:")
     assert banner[2] == "  checkpoint off; recording off; telemetry off"
     assert "  outcome:   tour ended docked, every stop visited" in stdout.splitlines()
+
+
+def test_a_tour_with_face_data_never_imports_numpy_in_the_executive():
+    # numpy imported mid-tour, at a moment the process is out of descriptors, is left
+    # half-initialised for good ("cannot load module more than once per process"): the
+    # face stream then failed every tick and the tour stood still. The executive's
+    # process does without it; -X importtime lists every import the process made.
+    code, stderr, tours, stdout = asyncio.run(_run_once("-X", "importtime"))
+    assert code == 0 and tours == ["started", "ended"], stderr.decode()[-2000:]
+    assert "engaged?   introduction: engaged: " in stdout  # the face stream was used
+    imported = [line.rsplit("|", 1)[-1].strip() for line in stderr.decode().splitlines()]
+    assert "frog_bt.maths.engagement" in imported
+    assert not [name for name in imported if name.split(".")[0] == "numpy"]
 
 
 def test_bad_config_is_one_line_and_exit_2(tmp_path):

@@ -61,6 +61,18 @@ def connection_cap(limit: int = MAX_CONNECTIONS) -> int:
     return limit if soft == resource.RLIM_INFINITY else max(8, min(limit, soft // 2))
 
 
+def accept_burst(cap: int, most: int = 128) -> int:
+    """The listen backlog for a door of ``cap``: asyncio accepts up to the backlog's count
+    of connections in one turn before any reaches its :class:`Gate`, so that many
+    descriptors are held on top of the cap for a moment. A quarter of what the cap leaves
+    to the tour keeps a flood from taking the rest (a module imported at that moment
+    failed for want of descriptors)."""
+    soft, _hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    if soft == resource.RLIM_INFINITY:
+        return most
+    return max(1, min(most, (soft - cap) // 4))
+
+
 @dataclass
 class Door:
     """How many connections are open, how many may be, how many were turned away, and how
@@ -163,7 +175,7 @@ class GatedSite(web.BaseSite):
     """``host:port`` (0: any free port, then :attr:`port`), through a :class:`Door`."""
 
     def __init__(self, runner: web.BaseRunner, host: str, port: int, door: Door) -> None:
-        super().__init__(runner, backlog=128)
+        super().__init__(runner, backlog=accept_burst(door.cap))
         self._host, self._port, self.door = host, port, door
 
     @property
