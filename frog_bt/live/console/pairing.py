@@ -58,7 +58,7 @@ class PairDesk:
 
 
 PAIR_DESK = web.AppKey("pair_desk", PairDesk)
-DEVICE = "frog_bt.device"  # request key: the paired device that sent it
+DEVICE = web.RequestKey("frog_bt.device", Device)  # the paired device that sent it
 
 
 def device_of(request: web.Request) -> Device | None:
