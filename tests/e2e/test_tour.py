@@ -159,6 +159,16 @@ def test_visitor_wandering_off_before_poi2_sends_the_robot_back_to_recruit():
     assert t.summary.recruited == [7, 9]
 
 
+def test_four_visitors_lost_in_a_row_give_the_tour_up_with_its_reason_and_dock():
+    # One visitor who says yes and never follows: lost on arrival at POI1 each time.
+    t = tour({"visitors": [{"id": 7, "position": [103.0, 36.0], "facing": True, "follow": False}]})
+    assert (t.outcome.code, t.outcome.reason) == (1, "tour aborted: no visitor could be guided")
+    assert t.frontend_commands("tour")[-1] == "tour aborted no visitor could be guided"
+    commands = t.ros_commands()
+    assert commands.count("/ApproachPeopleFar 7") == 4  # the Retry's four tries
+    assert commands[-2:] == ["/GotoWayPoint SHOP", "/docking/dock dock"]
+
+
 def test_navigation_failure_is_retried_then_the_stop_is_skipped():
     t = tour(
         {
