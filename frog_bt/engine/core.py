@@ -29,6 +29,7 @@ from frog_bt.engine.loaded import LoadedTree
 from frog_bt.engine.observed import Observed, Role, Trace
 from frog_bt.engine.operator import Answer, Command, Operator
 from frog_bt.engine.standing import Standing
+from frog_bt.engine.walk import children
 from frog_bt.model import keys
 from frog_bt.model.events import (
     Blamed,
@@ -42,11 +43,12 @@ from frog_bt.model.events import (
     RobotInput,
     Ticked,
 )
-from frog_bt.model.frontend import FrontendMessage, Tour
+from frog_bt.model.frontend import FrontendMessage, Tour, UserNegative, UserPositive
 from frog_bt.model.goals import Goal
 from frog_bt.model.key import Reading
 from frog_bt.model.outcomes import AbortReason, TourState
 from frog_bt.model.wire import INPUTS, OUTPUTS
+from frog_bt.warning_limit import WarningLimiter
 
 log = logging.getLogger(__name__)
 Status = py_trees.common.Status
@@ -98,6 +100,8 @@ class Core:
         self.faults = standing.faults
         self.faults.emit = self._faulted
         self.ctx = Context(clock, site, self.actions, self._send_message, self.journal, self.faults)
+        self.stray_answers = 0  # a visitor's answers that came with no question open
+        self._warnings = WarningLimiter(logger=log)
         self.snapshot = Snapshot(
             self.board,
             self.inputs,
@@ -222,6 +226,28 @@ class Core:
         if self.emit:
             self.emit(FrontendIn(now, message))
         self.inputs.events.append((message, now))
+        if isinstance(message, UserPositive | UserNegative) and not self._awaited(message):
+            self._stray_answer(message)
+
+    def _awaited(self, message: FrontendMessage) -> bool:
+        """Does a running node wait for ``message``'s kind now (its ``world.frontend``)?"""
+        stack = [self.root]
+        while stack:
+            node = stack.pop()
+            world = getattr(node, "world", None)
+            waits = getattr(world, "frontend", None)
+            if waits is not None and any(type(m) is type(message) for m in waits(node)):
+                return True
+            stack.extend(c for c in children(node) if c.status is Status.RUNNING)
+        return False
+
+    def _stray_answer(self, message: FrontendMessage) -> None:
+        """A visitor's answer nobody asked for now (after the answer timeout, or twice):
+        the tree ignores it; counted, noted, and logged (at most once per interval)."""
+        self.stray_answers += 1
+        what = f"the visitor's {message.type} came with no question open: ignored"
+        self.ctx.note(what)
+        self._warnings.warn("stray answer", f"{what} ({self.stray_answers} so far)")
 
     # ------------------------------------------------------------ operator commands
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import itertools
 import json
+import logging
 from collections import Counter
 
 from tour import Running, tour
@@ -93,3 +94,30 @@ def test_twenty_percent_loss_each_way_every_part_once_and_tour_ended_acked():
     ended = [seq for seq, m in out.items() if m["type"] == "tour" and m["state"] == "ended"]
     assert len(ended) == 1 and ended[0] in acked  # acked before the executive exited
     assert run.executive.link.pending == 0
+
+
+def test_a_yes_after_the_answer_timeout_is_ignored_counted_and_logged(caplog):
+    # The front end answers 10 s after the site's answer timeout: the visitor has been
+    # declined and the robot seeks again. The late "yes" must not start the tour, and it
+    # must not vanish either.
+    caplog.set_level(logging.WARNING, logger="frog_bt.engine.core")
+    visitors = [
+        {"id": 7, "position": [103.0, 36.0], "facing": True},
+        {"id": 8, "position": [106.0, 37.5], "facing": True, "appear_at": 400},
+    ]
+
+    async def main() -> tuple[int, list[str], list[str]]:
+        async with Running({"visitors": visitors, "frontend": {"answer_delay": 130}}) as run:
+            core = run.executive.core
+            await run.executive_ticks_until(lambda: core.stray_answers > 0, 30)
+            notes = [n.text for n in core.journal.notes]
+            return core.stray_answers, notes, run.tour().ros_commands()
+
+    stray, notes, commands = asyncio.run(main())
+    assert stray == 1
+    assert "visitor 7 gave no answer within 120 s: seek again" in notes
+    assert notes[-1] == "the visitor's user_positive came with no question open: ignored"
+    assert "/GotoWayPoint POI1a" not in commands  # the tour did not start on it
+    assert [r.getMessage() for r in caplog.records] == [
+        "the visitor's user_positive came with no question open: ignored (1 so far)"
+    ]
