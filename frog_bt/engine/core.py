@@ -29,7 +29,6 @@ from frog_bt.engine.loaded import LoadedTree
 from frog_bt.engine.observed import Observed, Role, Trace
 from frog_bt.engine.operator import Answer, Command, Operator
 from frog_bt.engine.standing import Standing
-from frog_bt.engine.walk import children
 from frog_bt.model import keys
 from frog_bt.model.events import (
     Blamed,
@@ -102,6 +101,7 @@ class Core:
         self.ctx = Context(clock, site, self.actions, self._send_message, self.journal, self.faults)
         self.stray_answers = 0  # a visitor's answers that came with no question open
         self._warnings = WarningLimiter(logger=log)
+        self._waiters: dict[type, list[py_trees.behaviour.Behaviour]] | None = None  # _awaited
         self.snapshot = Snapshot(
             self.board,
             self.inputs,
@@ -230,16 +230,15 @@ class Core:
             self._stray_answer(message)
 
     def _awaited(self, message: FrontendMessage) -> bool:
-        """Does a running node wait for ``message``'s kind now (its ``world.frontend``)?"""
-        stack = [self.root]
-        while stack:
-            node = stack.pop()
-            world = getattr(node, "world", None)
-            waits = getattr(world, "frontend", None)
-            if waits is not None and any(type(m) is type(message) for m in waits(node)):
-                return True
-            stack.extend(c for c in children(node) if c.status is Status.RUNNING)
-        return False
+        """Does a node wait for ``message``'s kind now? (It runs, and its ``world.frontend``
+        names the kind: found once per tree, so an answer costs a few status reads.)"""
+        if self._waiters is None:
+            self._waiters = {}
+            for node in self.root.iterate():
+                waits = getattr(getattr(node, "world", None), "frontend", None)
+                for kind in {type(m) for m in waits(node)} if waits is not None else ():
+                    self._waiters.setdefault(kind, []).append(node)
+        return any(n.status is Status.RUNNING for n in self._waiters.get(type(message), ()))
 
     def _stray_answer(self, message: FrontendMessage) -> None:
         """A visitor's answer nobody asked for now (after the answer timeout, or twice):

@@ -29,6 +29,7 @@ def content(poi: str, waypoint: str | None = None, parts: str = "a") -> list[str
 def test_morning_tour_takes_the_a_variants_and_ends_docked():
     t = tour({"start_time": "2026-06-01T10:30:00+02:00"})
     assert t.outcome.code == 0, t.outcome.reason
+    assert t.executive.core.stray_answers == 0  # the "yes" came while it was asked for
     assert t.ros_commands() == [
         "/docking/dock undock",
         "/GotoWayPoint POI0",
