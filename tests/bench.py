@@ -54,7 +54,7 @@ class Bench:
             self.site,
             tree,
             self.clock,
-            lambda topic, msg: self.published.append((topic, msg)),
+            lambda topic, msg, urgent: self.published.append((topic, msg)),
             lambda message: self.sent.append(message),
             emit=self.observers,
         )

@@ -75,8 +75,14 @@ class FakeRobot:
     ) -> None:
         self.subscribed[topic] = type
 
-    def publish(self, topic: str, msg: Any) -> None:
+    def publish(self, topic: str, msg: Any, urgent: bool = False) -> None:
         self.published.append((topic, msg))
+
+    def hold(self) -> None:
+        """Nothing is held here: published is what the executive asked for."""
+
+    def release(self) -> None:
+        """Nothing was held."""
 
     def leave(self) -> None:
         self.left = True

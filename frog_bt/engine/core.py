@@ -63,11 +63,12 @@ class Core:
         site: Site,
         tree: LoadedTree,
         clock: Clock,
-        publish: Callable[[str, dict[str, Any]], None],
+        publish: Callable[[str, dict[str, Any], bool], None],
         send: Callable[[FrontendMessage], None],
         emit: Emit | None = None,
         standing: Standing | None = None,
         after_tick: Callable[[], None] | None = None,
+        blame_first: bool = True,
     ) -> None:
         self.site = site
         self.tree = tree
@@ -82,6 +83,10 @@ class Core:
         self.after_tick = after_tick
         # The executive's state, kept across trees (a reload hands the next core the same)
         standing = self.standing = standing if standing is not None else Standing(clock)
+        # Blame is worked out as a command goes out: before it where the host reads it in
+        # its publish (a replay compares it), after it where the command must not wait
+        # (the executive: ~20 µs per command off the way to the robot)
+        self.blame_first = blame_first
         self.blamed = "-"  # the node that sent the latest command (see who())
         self.blamed_reads: dict[str, str] = {}  # what that node read, as short text
         self._labels: dict[int, str] = {}
@@ -167,9 +172,12 @@ class Core:
 
     def _publish(self, role: str, value: object, goal: Goal | None) -> None:
         topic = self.site.topic(role)
-        self._note_sender()
         msg = OUTPUTS[role].codec.encode(value)
-        self._publish_topic(topic, msg)
+        if self.blame_first:
+            self._note_sender()
+        self._publish_topic(topic, msg, goal is not None)  # a goal goes out at once
+        if not self.blame_first:
+            self._note_sender()
         emit = self.emit
         if emit:
             now = self.clock.now()
@@ -190,10 +198,13 @@ class Core:
             self.emit(event)
 
     def _send_message(self, message: FrontendMessage) -> None:
-        self._note_sender()
+        if self.blame_first:
+            self._note_sender()
+        self._send(message)
+        if not self.blame_first:
+            self._note_sender()
         if isinstance(message, Tour) and message.state == TourState.STARTED:
             self.journal.tally.tour_started()
-        self._send(message)
         emit = self.emit
         if emit:
             now = self.clock.now()

@@ -219,7 +219,7 @@ class Replay:
 
     # ------------------------------------------------------------ outputs of the replayed tree
 
-    def _publish(self, topic: str, msg: dict[str, Any]) -> None:
+    def _publish(self, topic: str, msg: dict[str, Any], urgent: bool = False) -> None:
         self._got.append(
             Command(
                 self.clock.now(),

@@ -32,7 +32,7 @@ import json
 import logging
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import AbstractAsyncContextManager
 from dataclasses import replace
 from typing import Any
@@ -136,6 +136,7 @@ class RosbridgeClient:
         self._throttle = WarningLimiter(logger=log)
         self._outbox: deque[str] = deque()  # frames for the current connection, in order
         self._writing = False  # the writer task is sending the outbox's first frame
+        self._held = False  # publishes wait for release() (hold: the executive's tick)
         self._wake = asyncio.Event()  # outbox became non-empty
         self._drained = asyncio.Event()  # the writer found the outbox empty
         self._up = asyncio.Event()  # set while connected
@@ -177,15 +178,30 @@ class RosbridgeClient:
     def unsubscribe(self, topic: str) -> None:
         self._enqueue(self.session.unsubscribe(topic))
 
-    def publish(self, topic: str, msg: Any) -> None:
-        """Send now, or queue while the link is down. Never blocks.
+    def publish(self, topic: str, msg: Any, urgent: bool = False) -> None:
+        """Send now, or queue while the link is down. Never blocks. While held
+        (:meth:`hold`), the frame waits for :meth:`release`, unless ``urgent`` (a goal):
+        then it goes at once, with those waiting before it, in one write.
 
         Raises ValueError for a topic never advertised or a message that is not
         finite JSON (NaN, Infinity): programming errors, caught at the call.
         """
         dropped = self.session.dropped
-        self._enqueue(self.session.publish(topic, msg))
+        self._enqueue(self.session.publish(topic, msg), urgent)
         self._note_dropped(dropped)
+
+    def hold(self) -> None:
+        """Keep what is published from now in the outbox, until :meth:`release` or an
+        urgent publish: the executive holds during a tick, so that its commands reach the
+        robot in one write (one wake-up of the robot's server, not one per command)."""
+        self._held = True
+
+    def release(self) -> None:
+        """Write what :meth:`hold` kept, in order, in one write where the connection
+        takes it now (the writer task sends the rest)."""
+        self._held = False
+        if self._outbox and self._write_waiting():
+            self._wake.set()
 
     def leave(self) -> None:
         """Unsubscribe from every topic and unadvertise every one, so that the server is
@@ -353,21 +369,22 @@ class RosbridgeClient:
             out.popleft()
             self.stats.sent += 1
 
-    def _enqueue(self, frames: list[str]) -> None:
+    def _enqueue(self, frames: list[str], urgent: bool = True) -> None:
         if frames:
             self._outbox.extend(frames)
-            if self._write_waiting():
+            if (urgent or not self._held) and self._write_waiting():
                 self._wake.set()  # the writer task sends the rest
 
     def _write_waiting(self) -> bool:
-        """Write the frames waiting in the outbox, in order, now, as far as the
-        connection takes them without waiting (:func:`_write_now`); none while the
+        """Write the frames waiting in the outbox, in order, now, in one write, as far as
+        the connection takes them without waiting (:func:`_write_now`); none while the
         writer task is sending one (it pops it when done). True when some are left."""
         ws, out = self._ws, self._outbox
-        if ws is not None and not self._writing and self._link.connected:
-            while out and _write_now(ws, out[0]):
+        if ws is not None and not self._writing and self._link.connected and out:
+            written = _write_now(ws, out)
+            for _ in range(written):
                 out.popleft()
-                self.stats.sent += 1
+            self.stats.sent += written
         return bool(out)
 
     def _on_up(self, ws: Any) -> None:
@@ -504,17 +521,19 @@ class RosbridgeClient:
             log.warning(fmt + "%s", *args, _held(held))
 
 
-def _write_now(ws: Any, text: str) -> bool:
-    """Write one text frame to ``ws`` now, when it can take it without waiting; False
-    (nothing written) otherwise: the writer task sends it, in order.
+def _write_now(ws: Any, texts: Iterable[str]) -> int:
+    """Write text frames to ``ws`` now, in order, in one write, when it can take them
+    without waiting; how many were written (0: the writer task sends them, in order).
 
-    What websockets' ``send`` does for one text frame, minus its waits: the frame goes to
-    the sans-I/O protocol (``ws.protocol``) and its bytes to the transport, only while
-    the connection is open, no fragmented message is being sent and the transport's
-    buffer is empty (so no backpressure is skipped). A connection of another kind (a
-    test's in-memory wire, a websockets without these) always says False."""
+    What websockets' ``send`` does for each text frame, minus its waits: the frames go to
+    the sans-I/O protocol (``ws.protocol``) and their bytes to the transport together
+    (one ``writelines``: one system call, one segment where they fit), only while the
+    connection is open, no fragmented message is being sent and the transport's buffer
+    is empty (so no backpressure is skipped). A connection of another kind (a test's
+    in-memory wire, a websockets without these) always says 0."""
     if not isinstance(ws, ClientConnection):
-        return False
+        return 0
+    written = 0
     try:
         if (
             ws.protocol.state is not _OPEN
@@ -522,16 +541,32 @@ def _write_now(ws: Any, text: str) -> bool:
             or ws.transport.get_write_buffer_size()
             or ws.protocol.close_expected()
         ):
-            return False
-        ws.protocol.send_text(text.encode())
-    except Exception:  # not as this websockets has it: leave the frame to the writer
-        return False
+            return 0
+        for text in texts:
+            ws.protocol.send_text(text.encode())
+            written += 1
+    except Exception:  # not as this websockets has it: leave the frames to the writer
+        if not written:
+            return 0
     try:
-        ws.send_data()
+        data = ws.protocol.data_to_send()
+        if all(data):
+            ws.transport.writelines(data)
+        else:  # an end of stream among them (b""): as websockets' own send_data
+            _send_each(ws, data)
     except Exception as exc:  # written to the protocol: the link is broken, as send says
         ws.set_connection_exc(exc)
         ws.transport.abort()
-    return True
+    return written
+
+
+def _send_each(ws: Any, data: list[bytes]) -> None:
+    """websockets' ``send_data`` over chunks already taken from the protocol."""
+    for chunk in data:
+        if chunk:
+            ws.transport.write(chunk)
+        elif ws.transport.can_write_eof():
+            ws.transport.write_eof()
 
 
 def backoff_delays(initial: float, maximum: float) -> Iterator[float]:

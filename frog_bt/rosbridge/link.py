@@ -98,7 +98,13 @@ class RobotLink(Protocol):
     def subscribe(
         self, topic: str, type: str, throttle_rate: int = 0, queue_length: int = 0
     ) -> None: ...
-    def publish(self, topic: str, msg: Any) -> None: ...
+    def publish(self, topic: str, msg: Any, urgent: bool = False) -> None: ...
+    def hold(self) -> None:
+        """Keep what is published until :meth:`release` (or an ``urgent`` publish)."""
+
+    def release(self) -> None:
+        """Send what :meth:`hold` kept, in order."""
+
     def leave(self) -> None:
         """Unsubscribe and unadvertise everything (while connected)."""
 

@@ -123,6 +123,7 @@ class Executive:
             emit=self.observers,
             standing=self.standing,
             after_tick=self._after_tick,
+            blame_first=False,  # the Blamed event reads it after the send
         )
 
     def _after_tick(self) -> None:
@@ -342,9 +343,11 @@ class Executive:
         (Observers hear it as :class:`~frog_bt.model.events.Ticked`: the exit rules, the
         keeper of the checkpoint, the recorder.)"""
         self._between_ticks()
+        self.client.hold()  # the tick's commands to the robot in one write (a goal: at once)
         try:
             return self.core.tick()  # the staff check the alerts at its end (_after_tick)
         finally:
+            self.client.release()
             background.hold()  # the answers to its commands go before telemetry's work
 
     def _between_ticks(self) -> None:

@@ -149,7 +149,7 @@ class Real:
             site,
             tree,
             self.clock,
-            lambda topic, msg: None,
+            lambda topic, msg, urgent: None,
             lambda message: None,
             emit=self._heard,
             after_tick=self._after_tick,

@@ -181,6 +181,75 @@ def test_a_command_leaves_when_it_is_sent() -> None:
     run(main())
 
 
+def test_held_publishes_leave_together_with_a_goal_or_at_release() -> None:
+    """While held (the executive's tick), a publish waits; an urgent one (a goal) goes at
+    once and takes those waiting before it in the same write; release writes the rest in
+    one write. The order on the wire is the order of the calls."""
+
+    async def main() -> None:
+        rec = Recorder()
+        async with FakeRosbridge() as server, client_for(server.url, rec) as client:
+            client.advertise("/ICL_command", "std_msgs/String")
+            client.advertise("/GotoWayPoint", "geometry_msgs/PoseStamped")
+            client.start()
+            assert await client.wait_connected(5)
+            await server.take(2)
+            await client.flush(5)
+            ws = client._ws
+            assert ws is not None
+            writes: list[int] = []  # the transport writes asked for (the frames are masked)
+            transport = ws.transport
+            real_write, real_writelines = transport.write, transport.writelines
+            inside = [False]  # writelines may write through write (Python 3.11)
+
+            def write(data: bytes) -> None:
+                if not inside[0]:
+                    writes.append(len(data))
+                real_write(data)
+
+            def writelines(chunks: list[bytes]) -> None:
+                writes.append(sum(len(c) for c in chunks))
+                inside[0] = True
+                try:
+                    real_writelines(chunks)
+                finally:
+                    inside[0] = False
+
+            transport.write, transport.writelines = write, writelines  # type: ignore[method-assign]
+            sent = client.stats.sent
+            client.hold()
+            client.publish("/ICL_command", encode_string("stop"))
+            assert writes == [] and len(client._outbox) == 1  # held
+            client.publish("/GotoWayPoint", encode_pose(1.0, 2.0, 0.0, 1.0, stamp=1.0), True)
+            assert len(writes) == 1 and not client._outbox  # the goal took the stop along
+            assert client.stats.sent == sent + 2
+            client.publish("/ICL_command", encode_string("start"))
+            client.publish("/ICL_command", encode_string("stop"))
+            assert len(writes) == 1
+            client.release()
+            assert len(writes) == 2 and client.stats.sent == sent + 4  # both, in one write
+            client.publish("/ICL_command", encode_string("start"))  # not held: at once
+            assert len(writes) == 3
+            frames = await server.take(5)
+            assert [f["topic"] for f in frames] == [
+                "/ICL_command",
+                "/GotoWayPoint",
+                "/ICL_command",
+                "/ICL_command",
+                "/ICL_command",
+            ]
+            assert [f["msg"].get("data") for f in frames] == [
+                "stop",
+                None,
+                "start",
+                "stop",
+                "start",
+            ]
+            assert client.stats.sent == sent + 5
+
+    run(main())
+
+
 def test_subscribe_to_a_type_without_decoder_is_refused() -> None:
     client = RosbridgeClient("ws://127.0.0.1:9")
     with pytest.raises(ValueError, match="no decoder"):
