@@ -266,6 +266,11 @@ async def measure(
         "read by the robot": {
             kind: summary_us(values[WARMUP:]) for kind, values in director.read.items()
         },
+        # every trial (ns), for scripts/bench to pool rounds: {"measured"|"read": {kind: [...]}}
+        "samples_ns": {
+            "measured": {kind: values[WARMUP:] for kind, values in director.samples.items()},
+            "read": {kind: values[WARMUP:] for kind, values in director.read.items()},
+        },
     }
 
 

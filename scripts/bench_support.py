@@ -16,7 +16,7 @@ import socket
 import struct
 import sys
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -31,7 +31,7 @@ FROG_BT = Path(sys.executable).parent / "frog-bt"  # the console script of this 
 # ------------------------------------------------------------------ statistics
 
 
-def percentile(sorted_values: list[float], q: float) -> float:
+def percentile(sorted_values: Sequence[float], q: float) -> float:
     """Nearest-rank percentile (``q`` in 0..1) of an already sorted list."""
     if not sorted_values:
         return math.nan
@@ -385,7 +385,7 @@ class FakeFrontend(asyncio.DatagramProtocol):
         self._stamping = stamp_transport(self.transport, SO_TIMESTAMPNS, 1)
         return int(self.transport.get_extra_info("sockname")[1])
 
-    def datagram_received(self, data: bytes, addr: tuple[str, int]) -> None:  # type: ignore[override]
+    def datagram_received(self, data: bytes, addr: tuple[str, int]) -> None:
         stamping = self._stamping
         if stamping is not None:
             t, self.read_ns = stamping.stamp, stamping.read
