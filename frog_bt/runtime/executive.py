@@ -89,6 +89,7 @@ class Executive:
         self.sim_time = sim_time
         self.outcome = Outcome()
         self.observers = Observers()  # every observer, told each event (on_event)
+        self.observers.host_settles = True  # tick() tells them the tick's end itself
         self.ledger = ResumingLedger(site.tour_plan())  # the one count of tours, told first
         self.observers.attach(self, [self.ledger])
         self.client = client
@@ -292,8 +293,8 @@ class Executive:
                         self.tick()
                     except Exception as exc:
                         self.core.faults.failed("the executive", exc, "a tick")
-                    # the observers hear the tick's end (Observers.later) before the loop
-                    # goes on: an exit rule that stops the run stops it before another tick
+                    # the observers heard the tick's end in tick(); an exit rule that stops
+                    # the run stops it before another tick. Let the loop's callbacks run.
                     await asyncio.sleep(0)
         finally:
             periodic.cancel()
@@ -348,6 +349,7 @@ class Executive:
             return self.core.tick()  # the staff check the alerts at its end (_after_tick)
         finally:
             self.client.release()
+            self.observers.settle()  # they hear the tick's end now its commands are out
             background.hold()  # the answers to its commands go before telemetry's work
 
     def _between_ticks(self) -> None:

@@ -69,6 +69,10 @@ class Observers:
         self._calls: list[Callable[[Event], None]] = []  # their on_event, bound once
         self._later: list[Event] = []  # told once the current callback is over (later())
         self._scheduled = False
+        # The host settles itself once its callback (the tick) is over: later() then only
+        # holds the event (no loop handle per tick). The executive does, after the tick's
+        # commands have gone out.
+        self.host_settles = False
         self.failures: dict[tuple[str, str], int] = {}  # (observer, error) -> how many
 
     def __bool__(self) -> bool:
@@ -120,7 +124,7 @@ class Observers:
         work on a tick's end (telemetry's statuses, the recorder's tick record, the status
         line) is off the tick's path. At once without an event loop (replay)."""
         self._later.append(event)
-        if self._scheduled:
+        if self._scheduled or self.host_settles:
             return
         try:
             loop = asyncio.get_running_loop()

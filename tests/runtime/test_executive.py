@@ -58,6 +58,23 @@ def test_tick_ticks_and_decides_nothing_about_the_run() -> None:
     assert exe.outcome.reason == "" and not exe._stopping.is_set()
 
 
+def test_in_the_loop_the_observers_hear_the_ticks_end_before_tick_returns() -> None:
+    """The executive settles its observers itself once the tick's commands are out: no
+    loop handle per tick, and nothing heard late."""
+
+    async def main() -> None:
+        exe, _, _ = executive()
+        heard: list[Ticked] = []
+        listen(exe, heard.append, Ticked)
+        loop = asyncio.get_running_loop()
+        ready = len(loop._ready)  # type: ignore[attr-defined]
+        exe.tick()
+        assert [e.tick for e in heard] == [1]
+        assert len(loop._ready) == ready  # type: ignore[attr-defined]
+
+    asyncio.run(main())
+
+
 @pytest.mark.parametrize(
     ("once", "board", "status", "stopped", "tours"),
     [
