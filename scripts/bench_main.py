@@ -27,7 +27,7 @@ SECTIONS = ("startup", "ticks", "reaction", "ingest", "replay", "memory", "conso
 PHASES = ("waiting", "undocking", "recruiting", "driving", "content", "returning", "other")
 
 
-TICK_ROUNDS = 3  # tours of each size, off and on in turns: the overhead is paired
+TICK_ROUNDS = 5  # tours of each size, off and on in turns: the overhead is paired
 REACTION_ROUNDS = 2  # reaction runs of each size and setting, off and on in turns
 ROUND = "#"  # a run's label: "{stops}-{telemetry}#{round}"
 
