@@ -217,6 +217,16 @@ async def one_tour(
     freeze = getattr(heap, "freeze_heap", None)
     if freeze is not None:  # as `frog-bt run` does once loaded (the code before: nothing)
         freeze()
+    # What `frog-bt run` does with telemetry or without (off is the executive as it runs,
+    # not a bare one): malloc's thresholds pinned, the collector at quiet turns.
+    pin = getattr(heap, "pin_malloc_thresholds", None)
+    if pin is not None:
+        pin()
+    quiet = getattr(heap, "QuietCollector", None)
+    if quiet is not None:
+        from frog_bt.runtime.observer import attach_all as attach_quiet
+
+        attach_quiet(executive, [quiet()])
     pauses = _Pauses()
     observers: list[Any] = []
     writes: list[int] = []
@@ -226,9 +236,7 @@ async def one_tour(
         observers = attach_all(executive, [_Null()])
     elif telemetry != "off":  # as frog-bt run --record FILE --rerun save:FILE attaches them
         from frog_bt.commands.run import attach_observers
-        from frog_bt.runtime.memory import pin_malloc_thresholds
 
-        pin_malloc_thresholds()
         observers = attach_observers(
             executive,
             record=workdir / "ticks.mcap" if telemetry != "rerun" else None,

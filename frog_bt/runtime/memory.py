@@ -5,10 +5,13 @@ glibc raises its mmap threshold each time a large block (the recorder's 256 KiB
 chunks, rerun's and numpy's buffers) is freed, so later blocks of that size come
 from the heap instead, where the small objects allocated around them keep the
 heap from shrinking: RSS crept up by 30 to 70 KB per tour (docs/PERFORMANCE.md).
-Setting ``M_MMAP_THRESHOLD`` and ``M_TRIM_THRESHOLD`` explicitly (to glibc's own
-starting values) turns that adjustment off: large blocks are mapped and
-unmapped, the heap's free top is given back, RSS stays flat.
-``MALLOC_MMAP_THRESHOLD_`` in the environment does the same, and wins.
+Setting ``M_MMAP_THRESHOLD`` and ``M_TRIM_THRESHOLD`` explicitly turns that
+adjustment off: blocks from 1 MiB are mapped and unmapped, the heap's free top beyond
+2 MiB is given back, RSS stays flat. Not glibc's starting values (128 KiB each): asyncio
+reads each socket into a 256 KiB buffer, which at 128 KiB was mapped, faulted in and
+unmapped on every read, and the heap's top trimmed and grown again all the time (the
+tick 4-5 % slower, telemetry or not: docs/PERFORMANCE.md, "sixth pass").
+``MALLOC_MMAP_THRESHOLD_`` in the environment wins over both.
 """
 
 from __future__ import annotations
@@ -26,8 +29,8 @@ if TYPE_CHECKING:
     from frog_bt.runtime.observer import Host
 
 M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3  # glibc's mallopt parameters
-MMAP_THRESHOLD = 128 * 1024  # bytes: glibc's default starting values
-TRIM_THRESHOLD = 128 * 1024
+MMAP_THRESHOLD = 1024 * 1024  # bytes: above asyncio's 256 KiB read buffer, with room
+TRIM_THRESHOLD = 2 * 1024 * 1024  # the heap's free top kept before it is given back
 
 
 def pin_malloc_thresholds() -> bool:

@@ -108,3 +108,12 @@ def test_the_collector_runs_at_a_quiet_turn_after_the_tick_that_made_it_due() ->
     finally:
         collector.close()
     assert gc.get_threshold() == before
+
+
+def test_malloc_thresholds_leave_asyncios_read_buffer_on_the_heap() -> None:
+    # asyncio reads every socket into a buffer of max_size bytes: at or above the pinned
+    # mmap threshold, each read was mapped, faulted in and unmapped (the tick 4-5 % slower)
+    from asyncio.selector_events import _SelectorSocketTransport
+
+    assert 2 * _SelectorSocketTransport.max_size < memory.MMAP_THRESHOLD
+    assert memory.TRIM_THRESHOLD >= memory.MMAP_THRESHOLD
