@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from frog_bt.maths.engagement import Samples, decide, edge_indices, meter, qualifies
+from frog_bt.maths.engagement import Samples, decide, edge_indices, mean, meter, qualifies
 from frog_bt.model.ros import Face
 
 
@@ -83,3 +83,23 @@ def test_decision_votes_are_consistent(levels, edge):
         assert 1 <= d.votes <= len(levels)
         assert 0 <= d.engaged_votes <= d.votes
         assert d.engaged is (d.engaged_votes * 2 > d.votes) or d.tie
+
+
+@given(st.lists(st.floats(-1, 1), min_size=1, max_size=700))
+def test_the_mean_is_numpys_to_the_last_bit(levels):
+    # the meter goes to the front end and into recordings: replays of tours recorded
+    # when this maths used numpy must find the same doubles
+    import numpy as np
+
+    assert mean(levels) == float(np.mean(np.array(levels, dtype=float)))
+    assert meter(levels) == float(np.clip(np.array(levels)[_side(levels)].mean(), -1, 1))
+
+
+def _side(levels):
+    engaged = sum(1 for v in levels if v >= 0.0)
+    rest = len(levels) - engaged
+    if engaged > rest:
+        return [v >= 0.0 for v in levels]
+    if rest > engaged:
+        return [v < 0.0 for v in levels]
+    return [True] * len(levels)

@@ -63,6 +63,40 @@ class Decision:
         )
 
 
+PAIRWISE_BLOCK = 128  # numpy's PW_BLOCKSIZE
+
+
+def _pairwise(values: Sequence[float], lo: int, n: int) -> float:
+    """numpy's pairwise summation of ``values[lo:lo + n]`` (``pairwise_sum_DOUBLE``):
+    the same additions in the same order, so the same double."""
+    if n < 8:
+        total = 0.0
+        for i in range(lo, lo + n):
+            total += values[i]
+        return total
+    if n <= PAIRWISE_BLOCK:
+        r = list(values[lo : lo + 8])
+        i, end = 8, n - n % 8
+        while i < end:
+            for j in range(8):
+                r[j] += values[lo + i + j]
+            i += 8
+        total = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+        for k in range(lo + i, lo + n):
+            total += values[k]
+        return total
+    half = n // 2
+    half -= half % 8
+    return _pairwise(values, lo, half) + _pairwise(values, lo + half, n - half)
+
+
+def mean(values: Sequence[float]) -> float:
+    """The mean of ``values`` (not empty) to the last bit as ``numpy.mean`` has it: the
+    meter the front end gets, and the recordings replayed against it, stay identical to
+    those made when this maths used numpy."""
+    return _pairwise(values, 0, len(values)) / len(values)
+
+
 def vote(levels: Sequence[float]) -> tuple[int, int]:
     """(engaged votes, not-engaged votes) of ``levels``."""
     engaged = sum(1 for level in levels if level >= 0.0)
@@ -80,7 +114,7 @@ def meter(levels: Sequence[float]) -> float | None:
         side = [level for level in levels if level < 0.0]
     else:
         side = list(levels)
-    return min(1.0, max(-1.0, math.fsum(side) / len(side)))
+    return min(1.0, max(-1.0, mean(side)))
 
 
 def edge_indices(n: int, edge: float) -> list[int]:
