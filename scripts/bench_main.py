@@ -32,57 +32,50 @@ REACTION_ROUNDS = 2  # reaction runs of each size and setting, off and on in tur
 ROUND = "#"  # a run's label: "{stops}-{telemetry}#{round}"
 
 
-def merge_rounds(runs: dict[str, Any]) -> dict[str, Any]:
-    """The tick runs of one size and setting, merged: the round with the median tick p50
-    stands for them (its phases, files, telemetry), with every round's p50 beside it
-    (``rounds_p50_us``, in order) and the batches dropped summed over the rounds."""
+def combine_rounds(
+    runs: dict[str, Any], combine: Callable[[list[dict[str, Any]]], dict[str, Any]]
+) -> dict[str, Any]:
+    """The runs of each size and setting (labels ``{stops}-{telemetry}#{round}``) made
+    one by ``combine`` (their rounds, in order); a failed round stands for all of them."""
     groups: dict[str, list[dict[str, Any]]] = {}
     for label, run in runs.items():
         groups.setdefault(label.split(ROUND)[0], []).append(run)
-    merged: dict[str, Any] = {}
+    combined: dict[str, Any] = {}
     for label, rounds in groups.items():
         failed = [r for r in rounds if "error" in r]
-        if failed:
-            merged[label] = failed[0]
-            continue
-        p50s = [get(r, "all", "p50_us") for r in rounds]
-        order = sorted(range(len(rounds)), key=lambda i: p50s[i] or 0.0)
-        run = dict(rounds[order[len(order) // 2]])
-        run["rounds_p50_us"] = p50s
-        drops = [r.get("telemetry_dropped_batches") for r in rounds]
-        if any(d is not None for d in drops):
-            run["telemetry_dropped_batches"] = sum(d or 0 for d in drops)
-        merged[label] = run
-    return merged
+        combined[label] = failed[0] if failed else combine(rounds)
+    return combined
 
 
-def pool_rounds(runs: dict[str, Any]) -> dict[str, Any]:
-    """The reaction runs of one size and setting, pooled: each kind's figures over the
-    trials of every round (``rounds``: how many), the raw trials left out of the JSON."""
-    groups: dict[str, list[dict[str, Any]]] = {}
-    for label, run in runs.items():
-        groups.setdefault(label.split(ROUND)[0], []).append(run)
-    pooled: dict[str, Any] = {}
-    for label, rounds in groups.items():
-        failed = [r for r in rounds if "error" in r]
-        if failed:
-            pooled[label] = failed[0]
-            continue
-        run = {k: v for k, v in rounds[0].items() if k != "samples_ns"}
-        run["rounds"] = len(rounds)
-        run["trials"] = sum(r.get("trials", 0) for r in rounds)
-        run["errors"] = [e for r in rounds for e in r.get("errors", [])][:5]
-        measured: dict[str, list[int]] = {}
-        read: dict[str, list[int]] = {}
-        for r in rounds:
-            for kind, values in get(r, "samples_ns", "measured").items():
-                measured.setdefault(kind, []).extend(values)
-            for kind, values in get(r, "samples_ns", "read").items():
-                read.setdefault(kind, []).extend(values)
-        run.update({kind: summary_us(values) for kind, values in measured.items()})
-        run["read by the robot"] = {kind: summary_us(v) for kind, v in read.items()}
-        pooled[label] = run
-    return pooled
+def median_round(rounds: list[dict[str, Any]]) -> dict[str, Any]:
+    """Tick runs: the round with the median tick p50 stands for them (its phases, files,
+    telemetry), with every round's p50 beside it (``rounds_p50_us``, in order) and the
+    batches dropped summed over the rounds."""
+    p50s = [get(r, "all", "p50_us") for r in rounds]
+    order = sorted(range(len(rounds)), key=lambda i: p50s[i] or 0.0)
+    run = dict(rounds[order[len(order) // 2]])
+    run["rounds_p50_us"] = p50s
+    drops = [r.get("telemetry_dropped_batches") for r in rounds]
+    if any(d is not None for d in drops):
+        run["telemetry_dropped_batches"] = sum(d or 0 for d in drops)
+    return run
+
+
+def pooled_trials(rounds: list[dict[str, Any]]) -> dict[str, Any]:
+    """Reaction runs: each kind's figures over the trials of every round (``rounds``: how
+    many), the raw trials left out of the JSON."""
+    run = {k: v for k, v in rounds[0].items() if k != "samples_ns"}
+    run["rounds"] = len(rounds)
+    run["trials"] = sum(r.get("trials", 0) for r in rounds)
+    run["errors"] = [e for r in rounds for e in r.get("errors", [])][:5]
+    pooled: dict[str, dict[str, list[int]]] = {"measured": {}, "read": {}}
+    for r in rounds:
+        for which, kinds in pooled.items():
+            for kind, values in (get(r, "samples_ns", which) or {}).items():
+                kinds.setdefault(kind, []).extend(values)
+    run.update({kind: summary_us(v) for kind, v in pooled["measured"].items()})
+    run["read by the robot"] = {kind: summary_us(v) for kind, v in pooled["read"].items()}
+    return run
 
 
 def overhead_pct(ticks: dict[str, Any], n: int) -> float | None:
@@ -543,9 +536,9 @@ def main(argv: list[str] | None = None) -> int:
             if name in chosen:
                 results[name] = run_section(name, runs, Path(tmp))
                 if name == "ticks":
-                    results[name] = merge_rounds(results[name])
+                    results[name] = combine_rounds(results[name], median_round)
                 elif name == "reaction":
-                    results[name] = pool_rounds(results[name])
+                    results[name] = combine_rounds(results[name], pooled_trials)
                 failed |= any("error" in r for r in results[name].values())
     results["machine"]["load_after"] = os.getloadavg() if hasattr(os, "getloadavg") else None
     results["wall_s"] = time.monotonic() - started
