@@ -234,11 +234,14 @@ class Core:
     def on_event(self, message: FrontendMessage) -> None:
         """Queue a new front-end event for the next tick's snapshot."""
         now = self.clock.now()
+        if isinstance(message, UserPositive | UserNegative) and not self._awaited(message):
+            # Nobody asked: the tree would not read it, so no observer counts it either (a
+            # late "yes" is no recruit); counted, noted and logged here instead.
+            self._stray_answer(message)
+            return
         if self.emit:
             self.emit(FrontendIn(now, message))
         self.inputs.events.append((message, now))
-        if isinstance(message, UserPositive | UserNegative) and not self._awaited(message):
-            self._stray_answer(message)
 
     def _awaited(self, message: FrontendMessage) -> bool:
         """Does a node wait for ``message``'s kind now? (It runs, and its ``world.frontend``
@@ -253,7 +256,8 @@ class Core:
 
     def _stray_answer(self, message: FrontendMessage) -> None:
         """A visitor's answer nobody asked for now (after the answer timeout, or twice):
-        the tree ignores it; counted, noted, and logged (at most once per interval)."""
+        neither the tree nor the observers get it; counted, noted, and logged (at most
+        once per interval). The datagram itself is recorded as it came."""
         self.stray_answers += 1
         what = f"the visitor's {message.type} came with no question open: ignored"
         self.ctx.note(what)

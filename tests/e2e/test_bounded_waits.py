@@ -111,7 +111,10 @@ def test_a_yes_after_the_answer_timeout_is_ignored_counted_and_logged(caplog):
             core = run.executive.core
             await run.executive_ticks_until(lambda: core.stray_answers > 0, 30)
             notes = [n.text for n in core.journal.notes]
-            return core.stray_answers, notes, run.tour().ros_commands()
+            tour = run.tour()
+            assert tour.summary.recruited == []  # a "yes" nobody asked for recruits nobody
+            assert run.executive.ledger.said_yes == 0
+            return core.stray_answers, notes, tour.ros_commands()
 
     stray, notes, commands = asyncio.run(main())
     assert stray == 1
