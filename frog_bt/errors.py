@@ -41,14 +41,22 @@ def format_path(path: Sequence[str | int]) -> str:
 class DefinitionError(FrogError):
     """A definition file is invalid: ``file: path: what was expected``."""
 
-    def __init__(self, file: str, path: Sequence[str | int], message: str) -> None:
+    def __init__(
+        self,
+        file: str,
+        path: Sequence[str | int],
+        message: str,
+        at: tuple[int, int] | None = None,
+    ) -> None:
         self.file = str(file)
         self.path = tuple(path)
         self.detail = message
-        self.line = line_of(self.file, self.path) if self.path else None
-        at = f"{self.file}:{self.line[0]}:{self.line[1]}" if self.line else self.file
+        # (line, column) from 1: ``at`` where the caller knows it (a YAML syntax error),
+        # else where ``path`` is written
+        self.line = at or (line_of(self.file, self.path) if self.path else None)
+        place = f"{self.file}:{self.line[0]}:{self.line[1]}" if self.line else self.file
         where = f"{format_path(self.path)}: " if self.path else ""
-        super().__init__(f"{at}: {where}{message}")
+        super().__init__(f"{place}: {where}{message}")
 
 
 class ConfigError(DefinitionError):
@@ -65,7 +73,7 @@ class TreeErrors(TreeError):
     def __init__(self, errors: Sequence[TreeError]) -> None:
         self.errors = list(errors)
         first = self.errors[0]
-        DefinitionError.__init__(self, first.file, first.path, first.detail)
+        DefinitionError.__init__(self, first.file, first.path, first.detail, first.line)
         self.args = ("\n".join(str(e) for e in self.errors),)
 
     def __str__(self) -> str:

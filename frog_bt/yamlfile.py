@@ -36,9 +36,9 @@ def load_yaml_marked(path: str | Path, error: type[DefinitionError]) -> tuple[An
         node, data = _parse(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
+        at = (mark.line + 1, mark.column + 1) if mark else None  # file:line:col: as check's
         problem = getattr(exc, "problem", None) or str(exc)
-        raise error(str(path), (), f"not valid YAML: {where}{problem}") from exc
+        raise error(str(path), (), f"not valid YAML: {problem}", at) from exc
     marks: Marks = {}
     if node is not None:
         mark_paths(node, (), marks)

@@ -96,11 +96,21 @@ def test_the_shipped_tour_loads_and_has_every_stop(site):
         ("root: {type: FinishPoi, poi: POI1, when: sunny}", "t.yaml: root.when: unknown variable"),
         ("rot: {type: FinishPoi, poi: POI1}", "t.yaml: rot: unknown key"),
         ("root: [1, 2]", "t.yaml: root: expected a node (a mapping), got [1, 2]"),
-        ("root: {type: Sequence, memory: true\n", "t.yaml: not valid YAML: line"),
+        (
+            "root: {type: Sequence, memory: true\n",
+            "t.yaml: not valid YAML: expected ',' or '}', but got '<stream end>'",
+        ),
     ],
 )
 def test_errors_name_file_path_and_expectation(tmp_path, site, text, expected):
     assert expected in error_of(tmp_path, text, site)
+
+
+def test_a_yaml_syntax_error_is_file_line_col_as_every_other_error(tmp_path, site):
+    path = write_tree(tmp_path, "root:\n  type: Sequence\n   memory: true\n", "t.yaml")
+    with pytest.raises(TreeError) as info:
+        load_tree(path, site)
+    assert str(info.value).startswith(f"{path}:3:10: not valid YAML: ")
 
 
 def test_error_inside_an_included_file_names_that_file(tmp_path, site):
