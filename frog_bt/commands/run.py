@@ -145,7 +145,7 @@ class Settings:
 
 def resolve(args: argparse.Namespace, site: Site) -> Settings:
     """Check every option against the site config's defaults; UsageError on the first bad one."""
-    listen = parse_hostport(args.listen or site.links.listen, "--listen")
+    listen = parse_hostport(_given(args.listen, site.links.listen), "--listen")
     checkpoint = args.checkpoint
     if checkpoint is None:
         checkpoint = default_checkpoint(Path(args.config or DEFAULT_CONFIG), listen)
@@ -154,14 +154,20 @@ def resolve(args: argparse.Namespace, site: Site) -> Settings:
     elif checkpoint.is_dir():
         raise UsageError("--checkpoint", checkpoint, "is a directory; expected a file path")
     return Settings(
-        url=check_ws_url(args.rosbridge or site.links.rosbridge, "--rosbridge"),
-        frontend=parse_hostport(args.frontend or site.links.frontend, "--frontend"),
+        url=check_ws_url(_given(args.rosbridge, site.links.rosbridge), "--rosbridge"),
+        frontend=parse_hostport(_given(args.frontend, site.links.frontend), "--frontend"),
         listen=listen,
         checkpoint=checkpoint,
         record=None if args.record is None else record_target(args.record),
         rerun=rerun_spec(args.rerun),
         secret=read_secret(site),
     )
+
+
+def _given(value: str | None, default: str) -> str:
+    """An option's value, or the site config's when the option is not given at all (an
+    empty value is given, and refused like any bad one: not quietly the default)."""
+    return default if value is None else value
 
 
 def record_target(path: Path) -> Path:

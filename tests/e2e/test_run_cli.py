@@ -161,6 +161,11 @@ def _run(*argv: str, cwd=None) -> subprocess.CompletedProcess[str]:
             ["--rerun", "bogus"],
             "--rerun bogus: expected spawn, save:FILE.rrd, connect[:URL], serve or off",
         ),
+        (  # empty is a value given, not the site's default
+            ["--rosbridge", ""],
+            "--rosbridge: expected ws://HOST:PORT, e.g. ws://127.0.0.1:9090",
+        ),
+        (["--listen", ""], "--listen: expected HOST:PORT"),
         (
             ["--config", "/no/such/site.yaml"],
             "/no/such/site.yaml: cannot read: No such file or directory",
