@@ -284,8 +284,7 @@ async def _serve(args: argparse.Namespace, scenario: Scenario, pois: dict[str, P
     try:
         await sim.start()
     except OSError as exc:
-        print(f"frog-bt sim: cannot listen: {exc}", file=sys.stderr)
-        return 1
+        return _cannot_listen(args, exc)
     bridge = (
         f"robot via rosbridge {args.via}"
         if args.via is not None
@@ -325,6 +324,34 @@ def _stop_on_signals() -> asyncio.Task[bool]:
     return asyncio.create_task(stop.wait())
 
 
+def _cannot_listen(args: argparse.Namespace, exc: OSError) -> int:
+    """One line naming the address that could not be bound (found by trying each of
+    ``--rosbridge`` (TCP) and ``--frontend`` (UDP) again), exit 2 as any bad option."""
+    import socket
+
+    reason = exc.strerror or str(exc)
+    for flag, (host, port), kind in (
+        ("--rosbridge", args.rosbridge, socket.SOCK_STREAM),
+        ("--frontend", args.frontend, socket.SOCK_DGRAM),
+    ):
+        if not port:
+            continue
+        with socket.socket(socket.AF_INET, kind) as probe:
+            if kind == socket.SOCK_STREAM:
+                probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            try:
+                probe.bind((host, port))
+            except OSError as busy:
+                reason = busy.strerror or str(busy)
+                print(
+                    f"frog-bt sim: {flag} {host}:{port}: cannot listen there: {reason}",
+                    file=sys.stderr,
+                )
+                return 2
+    print(f"frog-bt sim: cannot listen: {reason}", file=sys.stderr)
+    return 2
+
+
 async def _relay(args: argparse.Namespace) -> int:
     from frog_bt.sim.rosbridge_server import RosbridgeServer
 
@@ -332,8 +359,7 @@ async def _relay(args: argparse.Namespace) -> int:
     try:
         await server.start()
     except OSError as exc:
-        print(f"frog-bt sim: cannot listen: {exc}", file=sys.stderr)
-        return 1
+        return _cannot_listen(args, exc)
     print(
         f"frog-bt sim: relaying rosbridge ws://{args.rosbridge[0]}:{server.port} "
         f"(no robot inside{'; clients authenticate' if args.secret else ''})",
@@ -376,8 +402,7 @@ async def _play(args: argparse.Namespace) -> int:
     try:
         await player.start()
     except OSError as exc:
-        print(f"frog-bt sim: cannot listen: {exc}", file=sys.stderr)
-        return 1
+        return _cannot_listen(args, exc)
     print(
         f"frog-bt sim: playing {', '.join(played.files)} ({len(played.inputs)} inputs, "
         f"{len(played.events)} front-end events, {played.end - played.start:.0f} s) at "

@@ -52,6 +52,22 @@ def test_a_bad_scenario_is_a_one_line_error(
     assert f"{bad}:1:45: visitors[0].faces: expected one of engaged" in err
 
 
+@pytest.mark.parametrize("flag", ["--rosbridge", "--frontend"])
+def test_an_address_in_use_is_one_line_naming_the_option_and_exit_2(
+    flag: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    kind = socket.SOCK_STREAM if flag == "--rosbridge" else socket.SOCK_DGRAM
+    with socket.socket(socket.AF_INET, kind) as taken:
+        taken.bind(("127.0.0.1", 0))
+        if kind == socket.SOCK_STREAM:
+            taken.listen()
+        busy = f"127.0.0.1:{taken.getsockname()[1]}"
+        other = "--frontend" if flag == "--rosbridge" else "--rosbridge"
+        assert main(["sim", flag, busy, other, "127.0.0.1:0"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == f"frog-bt sim: {flag} {busy}: cannot listen there: Address already in use"
+
+
 def read_line(proc: subprocess.Popen[str], timeout: float) -> str:
     assert proc.stdout is not None
     ready, _, _ = select.select([proc.stdout], [], [], timeout)
