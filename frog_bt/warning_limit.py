@@ -39,6 +39,15 @@ class WarningLimiter:
         self._last[kind] = now
         return self._held.pop(kind, 0)
 
+    def flush(self) -> int:
+        """Log, one line per kind, the warnings held back since their last line (at close:
+        a flood's last ones would otherwise never be told); how many lines were logged."""
+        held, self._held = self._held, {}
+        for kind, count in held.items():
+            if count:
+                self._log.warning("%d more %s suppressed before the end", count, kind)
+        return sum(1 for count in held.values() if count)
+
     def warn(self, kind: str, message: str) -> bool:
         """Log ``message`` unless ``kind`` was logged within the interval; True if logged."""
         held = self.allow(kind)

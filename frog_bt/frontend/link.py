@@ -224,6 +224,7 @@ class FrontendLink:
         if self._closing:
             return
         self._closing = True
+        self._warnings.flush()  # what a flood's last datagrams were, told once
         if self._resender is not None:
             self._resender.cancel()
         if self._transport is not None:

@@ -253,6 +253,7 @@ class RosbridgeClient:
     async def close(self) -> None:
         """Stop the connect loop and close the connection (code 1000); final."""
         self._closing = True
+        self._throttle.flush()  # the warnings held back since their last line, told once
         ws = self._ws
         if ws is not None:
             # A clean close handshake first: cancelling the loop inside ``connect``

@@ -418,8 +418,10 @@ def test_oversized_and_malformed_datagrams_are_counted(caplog: pytest.LogCapture
 
     with caplog.at_level(logging.WARNING, logger="frog_bt.frontend.link"):
         run(main)
-    malformed = [r for r in caplog.records if "malformed" in r.getMessage()]
-    assert len(malformed) == 1 and "oversized" in malformed[0].getMessage()
+    malformed = [r.getMessage() for r in caplog.records if "malformed" in r.getMessage()]
+    # one line for the first, the other two told in one line at close
+    assert len(malformed) == 2 and "oversized" in malformed[0], malformed
+    assert malformed[1] == "2 more malformed suppressed before the end"
 
 
 def test_handler_exception_does_not_break_the_link(caplog: pytest.LogCaptureFixture) -> None:
@@ -515,4 +517,25 @@ def test_warning_limiter(caplog: pytest.LogCaptureFixture) -> None:
         "stranger",
         "bad 4 (2 more malformed suppressed)",
         "bad 5",
+    ]
+
+
+def test_the_warnings_held_back_at_the_end_are_told_at_close(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """A flood's last bad datagrams are held back by the limiter; closing the link tells
+    how many, once, so that nothing is lost without a word."""
+    wall = [100.0]
+    limiter = WarningLimiter(5.0, wall=lambda: wall[0], logger=log)
+    with caplog.at_level(logging.WARNING, logger="frog_bt.frontend.link"):
+        limiter.warn("malformed", "bad 1")
+        limiter.warn("malformed", "bad 2")
+        limiter.warn("malformed", "bad 3")
+        limiter.warn("foreign", "stranger")
+        assert limiter.flush() == 1
+        assert limiter.flush() == 0  # told once
+    assert [r.getMessage() for r in caplog.records] == [
+        "bad 1",
+        "stranger",
+        "2 more malformed suppressed before the end",
     ]
