@@ -550,24 +550,13 @@ def _write_now(ws: Any, texts: Iterable[str]) -> int:
         if not written:
             return 0
     try:
-        data = ws.protocol.data_to_send()
-        if all(data):
-            ws.transport.writelines(data)
-        else:  # an end of stream among them (b""): as websockets' own send_data
-            _send_each(ws, data)
+        # text frames only, on an open connection not closing: no end of stream (b"")
+        # among them, which websockets' send_data would turn into write_eof
+        ws.transport.writelines(ws.protocol.data_to_send())
     except Exception as exc:  # written to the protocol: the link is broken, as send says
         ws.set_connection_exc(exc)
         ws.transport.abort()
     return written
-
-
-def _send_each(ws: Any, data: list[bytes]) -> None:
-    """websockets' ``send_data`` over chunks already taken from the protocol."""
-    for chunk in data:
-        if chunk:
-            ws.transport.write(chunk)
-        elif ws.transport.can_write_eof():
-            ws.transport.write_eof()
 
 
 def backoff_delays(initial: float, maximum: float) -> Iterator[float]:

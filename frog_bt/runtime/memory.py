@@ -1,8 +1,8 @@
 """Memory for a process that runs all day: glibc's malloc thresholds pinned, the
 start-up's objects frozen out of the cyclic collector's way (below).
 
-glibc raises its mmap threshold each time a large block (the recorder's 256 KiB
-chunks, rerun's and numpy's buffers) is freed, so later blocks of that size come
+glibc raises its mmap threshold each time a large block (asyncio's 256 KiB read
+buffers, the recorder's chunks) is freed, so later blocks of that size come
 from the heap instead, where the small objects allocated around them keep the
 heap from shrinking: RSS crept up by 30 to 70 KB per tour (docs/PERFORMANCE.md).
 Setting ``M_MMAP_THRESHOLD`` and ``M_TRIM_THRESHOLD`` explicitly turns that

@@ -100,6 +100,7 @@ import contextlib
 import json
 import logging
 import signal
+import socket
 import sys
 from datetime import datetime
 from pathlib import Path
@@ -327,8 +328,6 @@ def _stop_on_signals() -> asyncio.Task[bool]:
 def _cannot_listen(args: argparse.Namespace, exc: OSError) -> int:
     """One line naming the address that could not be bound (found by trying each of
     ``--rosbridge`` (TCP) and ``--frontend`` (UDP) again), exit 2 as any bad option."""
-    import socket
-
     reason = exc.strerror or str(exc)
     for flag, (host, port), kind in (
         ("--rosbridge", args.rosbridge, socket.SOCK_STREAM),
